@@ -1,1 +1,22 @@
-//! codegen
+//! The symbolic engine of rtest.
+//!
+//! spec → [`GainModel`] (exact first-order gains, canonical polynomials) → [`ir::Program`]
+//! (flat straight-line code after common-subexpression elimination) → Rust source
+//! ([`emit`]) or in-process evaluation ([`ir::Program::eval`]); and gain tables for people
+//! ([`table`]).
+
+#![warn(missing_docs)]
+
+pub mod atoms;
+pub mod derive;
+pub mod poly;
+pub mod rational;
+
+pub use derive::GainModel;
+pub mod emit;
+pub mod ir;
+pub mod lower;
+pub mod table;
+
+pub use ir::Program;
+pub use lower::compile;

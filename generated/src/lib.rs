@@ -1,1 +1,51 @@
+//! Error-gain functions of the built-in machines, generated at build time by `codegen` from
+//! `model-spec/machines/*.toml`.
+//!
+//! `#![no_std]`, no allocation, straight-line `+ − ×` bodies: the sines and cosines of the
+//! rotary commands are inputs, so the code runs on a controller without a maths library (CI
+//! builds it for `thumbv7em-none-eabihf`, a Cortex-M4F).
+//!
+//! Each machine is a module (`seed_ac`, `seed_3axis`, `head_table_bc`) with `Pose`, `Params`
+//! and one module per model (`full`, `reduced`, …) whose `gains(pose, params, out)` writes
+//! `[gx, gy, gz, gi, gj, gk]` per error: the error vector (tool minus workpiece) and the
+//! orientation error in the tool frame per unit of error (mm per mm for translational errors,
+//! mm per rad for angular errors).
+//!
+//! ```
+//! use generated::seed_ac::{Params, Pose, reduced};
+//! let (a, c) = (30f64.to_radians(), 45f64.to_radians());
+//! let pose = Pose { sin_a: a.sin(), cos_a: a.cos(), sin_c: c.sin(), cos_c: c.cos(), ..Pose::default() };
+//! let mut g = [[0.0; 6]; reduced::N];
+//! reduced::gains(&pose, &Params::default(), &mut g);
+//! assert_eq!(g[reduced::XOC][0], -1.0); // XOC moves the ball along x: tool minus ball is -1
+//! ```
+
 #![no_std]
+#![warn(missing_docs)]
+
+/// A compiled model, for callers that choose the machine and model at run time.
+#[derive(Clone, Copy, Debug)]
+pub struct CompiledModel {
+    /// Machine name (`seed-ac`).
+    pub machine: &'static str,
+    /// Model name (`full`, `reduced`, …).
+    pub model: &'static str,
+    /// Error names in output order.
+    pub errors: &'static [&'static str],
+    /// Names of the pose inputs in slice order (sines and cosines of rotary commands, then
+    /// linear commands in mm).
+    pub pose_inputs: &'static [&'static str],
+    /// Names of the kinematic parameters in slice order (mm).
+    pub parameters: &'static [&'static str],
+    /// Arithmetic operations of one evaluation.
+    pub operations: usize,
+    /// `gains(pose, params, out)`: `out` holds `6 * errors.len()` values, row-major.
+    pub gains: fn(&[f64], &[f64], &mut [f64]),
+}
+
+/// The compiled model `model` of the built-in machine `machine`.
+pub fn lookup(machine: &str, model: &str) -> Option<&'static CompiledModel> {
+    MODELS.iter().find(|m| m.machine == machine && m.model == model)
+}
+
+include!(concat!(env!("OUT_DIR"), "/machines.rs"));

@@ -1,0 +1,258 @@
+//! First-order error gains of a machine, derived symbolically.
+//!
+//! The tool point and the workpiece point are carried through their chains (the steps of
+//! [`model_spec::kinematics::chain_steps`], applied from the end towards the bed) as first-order
+//! vectors `v0 + Σ εi·vi`: truncation is structural, a product `εi·εj` is never formed. The
+//! same is done for the z direction of each end frame. Then, with `R0` the nominal rotation of
+//! the tool frame,
+//! - position gains: the first-order part of `R0ᵀ·(P_tool − P_work)`;
+//! - orientation gains: `R0ᵀ·(δz_tool − δz_work)`, the seed's eqs. (14)–(16).
+//!
+//! At a pose where the nominal tool point is on the nominal workpiece point (every R-test sample,
+//! every machining point) the position gains are the error in the actual tool frame; elsewhere
+//! they leave out the product of the tool frame's small rotation with the nominal gap.
+
+use crate::atoms::{AtomKind, AtomTable};
+use crate::poly::{Atom, Poly};
+use crate::rational::Rational;
+use model_spec::kinematics::{Step, chain_steps};
+use model_spec::{AxisKind, ErrorId, Machine, Side, Value};
+use std::collections::BTreeMap;
+
+/// A polynomial 3-vector.
+pub type Vec3 = [Poly; 3];
+
+fn zero3() -> Vec3 {
+    [Poly::zero(), Poly::zero(), Poly::zero()]
+}
+
+fn cross_unit(d: usize, v: &Vec3) -> Vec3 {
+    // e_d × v
+    match d {
+        0 => [Poly::zero(), v[2].neg(), v[1].clone()],
+        1 => [v[2].clone(), Poly::zero(), v[0].neg()],
+        _ => [v[1].neg(), v[0].clone(), Poly::zero()],
+    }
+}
+
+/// A nominal rotation about coordinate direction `d` by the angle whose sine is `s` and cosine
+/// `c` (as polynomials), as a row-major 3×3 matrix.
+fn rotation(d: usize, s: &Poly, c: &Poly) -> [[Poly; 3]; 3] {
+    let (o, z) = (Poly::constant(Rational::ONE), Poly::zero());
+    match d {
+        0 => [[o, z.clone(), z.clone()], [z.clone(), c.clone(), s.neg()], [z, s.clone(), c.clone()]],
+        1 => [[c.clone(), z.clone(), s.clone()], [z.clone(), o, z.clone()], [s.neg(), z, c.clone()]],
+        _ => [[c.clone(), s.neg(), z.clone()], [s.clone(), c.clone(), z.clone()], [z.clone(), z, o]],
+    }
+}
+
+fn mat_vec(r: &[[Poly; 3]; 3], v: &Vec3) -> Vec3 {
+    std::array::from_fn(|i| {
+        (0..3).fold(Poly::zero(), |acc, j| {
+            if r[i][j].is_zero() || v[j].is_zero() { acc } else { acc.add(&r[i][j].mul(&v[j])) }
+        })
+    })
+}
+
+fn mat_t_vec(r: &[[Poly; 3]; 3], v: &Vec3) -> Vec3 {
+    let t: [[Poly; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| r[j][i].clone()));
+    mat_vec(&t, v)
+}
+
+fn mat_mul(a: &[[Poly; 3]; 3], b: &[[Poly; 3]; 3]) -> [[Poly; 3]; 3] {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| (0..3).fold(Poly::zero(), |acc, k| acc.add(&a[i][k].mul(&b[k][j]))))
+    })
+}
+
+/// A first-order vector: nominal part plus one vector per tracked error.
+#[derive(Clone, Debug)]
+struct FirstOrder {
+    nominal: Vec3,
+    /// `true` for a point (translations act), `false` for a direction.
+    point: bool,
+    by_error: BTreeMap<usize, Vec3>,
+}
+
+impl FirstOrder {
+    fn add_to(&mut self, slot: usize, v: Vec3) {
+        let e = self.by_error.entry(slot).or_insert_with(zero3);
+        for k in 0..3 {
+            e[k] = e[k].add(&v[k]);
+        }
+    }
+}
+
+struct Deriver<'a> {
+    m: &'a Machine,
+    atoms: &'a AtomTable,
+    /// Catalogue id → slot in the requested error list.
+    slot: BTreeMap<ErrorId, usize>,
+}
+
+impl Deriver<'_> {
+    fn value(&self, v: Value) -> Poly {
+        match v {
+            Value::Number(x) => Poly::constant(Rational::from_decimal(x).expect("validated finite")),
+            Value::Symbol(s) => Poly::atom(self.atoms.find(AtomKind::Symbol(s))),
+        }
+    }
+
+    fn sin_cos(&self, axis: usize) -> (Poly, Poly) {
+        let sign = Rational::int(if self.m.axes[axis].direction.negative { -1 } else { 1 });
+        (
+            Poly::atom(self.atoms.find(AtomKind::Sin(axis))).scale(sign),
+            Poly::atom(self.atoms.find(AtomKind::Cos(axis))),
+        )
+    }
+
+    /// Applies one step: `v ← S·v`.
+    fn apply(&self, step: &Step, v: &mut FirstOrder) {
+        match step {
+            Step::Offset(o) => {
+                if v.point {
+                    for k in 0..3 {
+                        v.nominal[k] = v.nominal[k].add(&self.value(o[k]));
+                    }
+                }
+            }
+            Step::ErrorTranslation(ids) => {
+                if v.point {
+                    for (k, id) in ids.iter().enumerate() {
+                        if let Some(&slot) = id.as_ref().and_then(|id| self.slot.get(id)) {
+                            let mut t = zero3();
+                            t[k] = Poly::constant(Rational::ONE);
+                            v.add_to(slot, t);
+                        }
+                    }
+                }
+            }
+            Step::ErrorRotation(ids) => {
+                for (k, id) in ids.iter().enumerate() {
+                    if let Some(&slot) = id.as_ref().and_then(|id| self.slot.get(id)) {
+                        let d = cross_unit(k, &v.nominal);
+                        v.add_to(slot, d);
+                    }
+                }
+            }
+            Step::Motion { axis, positioning_error } => {
+                let a = &self.m.axes[*axis];
+                let d = a.direction.dir.index();
+                match a.kind {
+                    AxisKind::Linear => {
+                        if v.point {
+                            let q = Poly::atom(self.atoms.find(AtomKind::Command(*axis)));
+                            let sign = Rational::int(if a.direction.negative { -1 } else { 1 });
+                            v.nominal[d] = v.nominal[d].add(&q.scale(sign));
+                        }
+                    }
+                    AxisKind::Rotary => {
+                        if let Some(&slot) = positioning_error.as_ref().and_then(|id| self.slot.get(id)) {
+                            let dv = cross_unit(d, &v.nominal);
+                            v.add_to(slot, dv);
+                        }
+                        let (s, c) = self.sin_cos(*axis);
+                        let r = rotation(d, &s, &c);
+                        v.nominal = mat_vec(&r, &v.nominal);
+                        for e in v.by_error.values_mut() {
+                            *e = mat_vec(&r, e);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn end(&self, side: Side, point: bool) -> FirstOrder {
+        let mut v = FirstOrder {
+            nominal: if point { zero3() } else { [Poly::zero(), Poly::zero(), Poly::constant(Rational::ONE)] },
+            point,
+            by_error: BTreeMap::new(),
+        };
+        for step in chain_steps(self.m, side).iter().rev() {
+            self.apply(step, &mut v);
+        }
+        v
+    }
+
+    /// The nominal rotation of the tool frame.
+    fn tool_rotation(&self) -> [[Poly; 3]; 3] {
+        let one = Poly::constant(Rational::ONE);
+        let mut r: [[Poly; 3]; 3] =
+            std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one.clone() } else { Poly::zero() }));
+        for step in chain_steps(self.m, Side::Tool) {
+            if let Step::Motion { axis, .. } = step
+                && self.m.axes[axis].kind == AxisKind::Rotary
+            {
+                let (s, c) = self.sin_cos(axis);
+                r = mat_mul(&r, &rotation(self.m.axes[axis].direction.dir.index(), &s, &c));
+            }
+        }
+        r
+    }
+}
+
+/// The symbolic first-order gains of a set of errors of one machine.
+#[derive(Clone, Debug)]
+pub struct GainModel {
+    /// The machine's name.
+    pub machine: String,
+    /// The atoms the gains are written in.
+    pub atoms: AtomTable,
+    /// The errors, as catalogue ids of the machine.
+    pub errors: Vec<ErrorId>,
+    /// Their names (canonical).
+    pub error_names: Vec<String>,
+    /// `true` for angular errors (gains in mm/rad), `false` for translational ones (mm/mm).
+    pub angular: Vec<bool>,
+    /// For each error: `[gx, gy, gz, gi, gj, gk]`, position then orientation gains, in the tool
+    /// frame, canonical polynomials.
+    pub gains: Vec<[Poly; 6]>,
+}
+
+impl GainModel {
+    /// Derives the gains of `errors` (catalogue ids of `m`, any order; kept in the given order).
+    pub fn derive(m: &Machine, errors: &[ErrorId]) -> GainModel {
+        let atoms = AtomTable::new(m);
+        let slot = errors.iter().enumerate().map(|(i, &e)| (e, i)).collect();
+        let d = Deriver { m, atoms: &atoms, slot };
+        let (pt, pw) = (d.end(Side::Tool, true), d.end(Side::Work, true));
+        let (zt, zw) = (d.end(Side::Tool, false), d.end(Side::Work, false));
+        let r0 = d.tool_rotation();
+        let pairs = atoms.trig_pairs();
+        let diff = |a: &FirstOrder, b: &FirstOrder, i: usize| -> Vec3 {
+            let z = zero3();
+            let (va, vb) = (a.by_error.get(&i).unwrap_or(&z), b.by_error.get(&i).unwrap_or(&z));
+            let v: Vec3 = std::array::from_fn(|k| va[k].sub(&vb[k]));
+            mat_t_vec(&r0, &v).map(|p| p.reduce(&pairs))
+        };
+        let gains = (0..errors.len())
+            .map(|i| {
+                let [px, py, pz] = diff(&pt, &pw, i);
+                let [ox, oy, oz] = diff(&zt, &zw, i);
+                [px, py, pz, ox, oy, oz]
+            })
+            .collect();
+        GainModel {
+            machine: m.name.clone(),
+            error_names: errors.iter().map(|&e| m.catalogue[e].name.clone()).collect(),
+            angular: errors.iter().map(|&e| m.catalogue[e].is_angular()).collect(),
+            errors: errors.to_vec(),
+            atoms,
+            gains,
+        }
+    }
+
+    /// Numeric gains at a pose: `commands` per axis (linear mm, rotary rad), `params` per
+    /// kinematic symbol (mm). One `[gx, gy, gz, gi, gj, gk]` per error (mm/mm or mm/rad for
+    /// position rows, 1/mm or 1/rad for orientation rows).
+    pub fn evaluate(&self, commands: &[f64], params: &[f64]) -> Vec<[f64; 6]> {
+        let values = self.atoms.values(commands, params);
+        self.gains.iter().map(|g| std::array::from_fn(|k| g[k].eval(&values))).collect()
+    }
+
+    /// The atom used in the polynomials for `kind`.
+    pub fn atom(&self, kind: AtomKind) -> Atom {
+        self.atoms.find(kind)
+    }
+}

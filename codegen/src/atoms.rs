@@ -69,13 +69,24 @@ impl AtomTable {
                 AtomKind::Symbol(s) => latex_symbol(&m.symbols[s].name),
             })
             .collect();
-        debug_assert!(m.axes.iter().all(|a| a.kind == AxisKind::Linear || a.kind == AxisKind::Rotary));
-        AtomTable { kinds, names, latex }
+        debug_assert!(
+            m.axes
+                .iter()
+                .all(|a| a.kind == AxisKind::Linear || a.kind == AxisKind::Rotary)
+        );
+        AtomTable {
+            kinds,
+            names,
+            latex,
+        }
     }
 
     /// The atom of `kind`.
     pub fn find(&self, kind: AtomKind) -> Atom {
-        self.kinds.iter().position(|&k| k == kind).expect("every axis and symbol has its atoms") as Atom
+        self.kinds
+            .iter()
+            .position(|&k| k == kind)
+            .expect("every axis and symbol has its atoms") as Atom
     }
 
     /// `(sin, cos)` atom pairs of the rotary axes, for the canonical reduction.

@@ -40,16 +40,32 @@ fn cross_unit(d: usize, v: &Vec3) -> Vec3 {
 fn rotation(d: usize, s: &Poly, c: &Poly) -> [[Poly; 3]; 3] {
     let (o, z) = (Poly::constant(Rational::ONE), Poly::zero());
     match d {
-        0 => [[o, z.clone(), z.clone()], [z.clone(), c.clone(), s.neg()], [z, s.clone(), c.clone()]],
-        1 => [[c.clone(), z.clone(), s.clone()], [z.clone(), o, z.clone()], [s.neg(), z, c.clone()]],
-        _ => [[c.clone(), s.neg(), z.clone()], [s.clone(), c.clone(), z.clone()], [z.clone(), z, o]],
+        0 => [
+            [o, z.clone(), z.clone()],
+            [z.clone(), c.clone(), s.neg()],
+            [z, s.clone(), c.clone()],
+        ],
+        1 => [
+            [c.clone(), z.clone(), s.clone()],
+            [z.clone(), o, z.clone()],
+            [s.neg(), z, c.clone()],
+        ],
+        _ => [
+            [c.clone(), s.neg(), z.clone()],
+            [s.clone(), c.clone(), z.clone()],
+            [z.clone(), z, o],
+        ],
     }
 }
 
 fn mat_vec(r: &[[Poly; 3]; 3], v: &Vec3) -> Vec3 {
     std::array::from_fn(|i| {
         (0..3).fold(Poly::zero(), |acc, j| {
-            if r[i][j].is_zero() || v[j].is_zero() { acc } else { acc.add(&r[i][j].mul(&v[j])) }
+            if r[i][j].is_zero() || v[j].is_zero() {
+                acc
+            } else {
+                acc.add(&r[i][j].mul(&v[j]))
+            }
         })
     })
 }
@@ -93,13 +109,19 @@ struct Deriver<'a> {
 impl Deriver<'_> {
     fn value(&self, v: Value) -> Poly {
         match v {
-            Value::Number(x) => Poly::constant(Rational::from_decimal(x).expect("validated finite")),
+            Value::Number(x) => {
+                Poly::constant(Rational::from_decimal(x).expect("validated finite"))
+            }
             Value::Symbol(s) => Poly::atom(self.atoms.find(AtomKind::Symbol(s))),
         }
     }
 
     fn sin_cos(&self, axis: usize) -> (Poly, Poly) {
-        let sign = Rational::int(if self.m.axes[axis].direction.negative { -1 } else { 1 });
+        let sign = Rational::int(if self.m.axes[axis].direction.negative {
+            -1
+        } else {
+            1
+        });
         (
             Poly::atom(self.atoms.find(AtomKind::Sin(axis))).scale(sign),
             Poly::atom(self.atoms.find(AtomKind::Cos(axis))),
@@ -135,7 +157,10 @@ impl Deriver<'_> {
                     }
                 }
             }
-            Step::Motion { axis, positioning_error } => {
+            Step::Motion {
+                axis,
+                positioning_error,
+            } => {
                 let a = &self.m.axes[*axis];
                 let d = a.direction.dir.index();
                 match a.kind {
@@ -147,7 +172,9 @@ impl Deriver<'_> {
                         }
                     }
                     AxisKind::Rotary => {
-                        if let Some(&slot) = positioning_error.as_ref().and_then(|id| self.slot.get(id)) {
+                        if let Some(&slot) =
+                            positioning_error.as_ref().and_then(|id| self.slot.get(id))
+                        {
                             let dv = cross_unit(d, &v.nominal);
                             v.add_to(slot, dv);
                         }
@@ -165,7 +192,11 @@ impl Deriver<'_> {
 
     fn end(&self, side: Side, point: bool) -> FirstOrder {
         let mut v = FirstOrder {
-            nominal: if point { zero3() } else { [Poly::zero(), Poly::zero(), Poly::constant(Rational::ONE)] },
+            nominal: if point {
+                zero3()
+            } else {
+                [Poly::zero(), Poly::zero(), Poly::constant(Rational::ONE)]
+            },
             point,
             by_error: BTreeMap::new(),
         };
@@ -178,14 +209,18 @@ impl Deriver<'_> {
     /// The nominal rotation of the tool frame.
     fn tool_rotation(&self) -> [[Poly; 3]; 3] {
         let one = Poly::constant(Rational::ONE);
-        let mut r: [[Poly; 3]; 3] =
-            std::array::from_fn(|i| std::array::from_fn(|j| if i == j { one.clone() } else { Poly::zero() }));
+        let mut r: [[Poly; 3]; 3] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| if i == j { one.clone() } else { Poly::zero() })
+        });
         for step in chain_steps(self.m, Side::Tool) {
             if let Step::Motion { axis, .. } = step
                 && self.m.axes[axis].kind == AxisKind::Rotary
             {
                 let (s, c) = self.sin_cos(axis);
-                r = mat_mul(&r, &rotation(self.m.axes[axis].direction.dir.index(), &s, &c));
+                r = mat_mul(
+                    &r,
+                    &rotation(self.m.axes[axis].direction.dir.index(), &s, &c),
+                );
             }
         }
         r
@@ -215,14 +250,21 @@ impl GainModel {
     pub fn derive(m: &Machine, errors: &[ErrorId]) -> GainModel {
         let atoms = AtomTable::new(m);
         let slot = errors.iter().enumerate().map(|(i, &e)| (e, i)).collect();
-        let d = Deriver { m, atoms: &atoms, slot };
+        let d = Deriver {
+            m,
+            atoms: &atoms,
+            slot,
+        };
         let (pt, pw) = (d.end(Side::Tool, true), d.end(Side::Work, true));
         let (zt, zw) = (d.end(Side::Tool, false), d.end(Side::Work, false));
         let r0 = d.tool_rotation();
         let pairs = atoms.trig_pairs();
         let diff = |a: &FirstOrder, b: &FirstOrder, i: usize| -> Vec3 {
             let z = zero3();
-            let (va, vb) = (a.by_error.get(&i).unwrap_or(&z), b.by_error.get(&i).unwrap_or(&z));
+            let (va, vb) = (
+                a.by_error.get(&i).unwrap_or(&z),
+                b.by_error.get(&i).unwrap_or(&z),
+            );
             let v: Vec3 = std::array::from_fn(|k| va[k].sub(&vb[k]));
             mat_t_vec(&r0, &v).map(|p| p.reduce(&pairs))
         };
@@ -235,8 +277,14 @@ impl GainModel {
             .collect();
         GainModel {
             machine: m.name.clone(),
-            error_names: errors.iter().map(|&e| m.catalogue[e].name.clone()).collect(),
-            angular: errors.iter().map(|&e| m.catalogue[e].is_angular()).collect(),
+            error_names: errors
+                .iter()
+                .map(|&e| m.catalogue[e].name.clone())
+                .collect(),
+            angular: errors
+                .iter()
+                .map(|&e| m.catalogue[e].is_angular())
+                .collect(),
             errors: errors.to_vec(),
             atoms,
             gains,
@@ -248,7 +296,10 @@ impl GainModel {
     /// position rows, 1/mm or 1/rad for orientation rows).
     pub fn evaluate(&self, commands: &[f64], params: &[f64]) -> Vec<[f64; 6]> {
         let values = self.atoms.values(commands, params);
-        self.gains.iter().map(|g| std::array::from_fn(|k| g[k].eval(&values))).collect()
+        self.gains
+            .iter()
+            .map(|g| std::array::from_fn(|k| g[k].eval(&values)))
+            .collect()
     }
 
     /// The atom used in the polynomials for `kind`.

@@ -23,7 +23,11 @@ use quote::{format_ident, quote};
 /// unary minus.
 pub fn float_literal(x: f64) -> TokenStream {
     let lit = Literal::f64_suffixed(x.abs());
-    if x.is_sign_negative() && x != 0.0 { quote!(-#lit) } else { quote!(#lit) }
+    if x.is_sign_negative() && x != 0.0 {
+        quote!(-#lit)
+    } else {
+        quote!(#lit)
+    }
 }
 
 fn var(v: u32) -> Ident {
@@ -40,9 +44,17 @@ pub fn body(p: &Program, error_consts: &[Ident]) -> TokenStream {
         let dst = var(i as u32);
         let rhs = match *op {
             Op::Input(k) => {
-                let Input { field: f, parameter, .. } = &p.inputs[k as usize];
+                let Input {
+                    field: f,
+                    parameter,
+                    ..
+                } = &p.inputs[k as usize];
                 let f = field(f);
-                if *parameter { quote!(params.#f) } else { quote!(pose.#f) }
+                if *parameter {
+                    quote!(params.#f)
+                } else {
+                    quote!(pose.#f)
+                }
             }
             Op::Const(bits) => float_literal(f64::from_bits(bits)),
             Op::Add(a, b) => {
@@ -91,14 +103,24 @@ pub fn model_module(module: &str, model: &GainModel, p: &Program) -> TokenStream
     let consts: Vec<Ident> = names.iter().map(|e| field(e)).collect();
     let indices = (0..n_value).map(Literal::usize_unsuffixed);
     let const_docs = names.iter().zip(&model.angular).map(|(e, &ang)| {
-        format!(" Index of `{e}` in the outputs ({}).", if ang { "angular error, gains per rad" } else { "translational error, gains per mm" })
+        format!(
+            " Index of `{e}` in the outputs ({}).",
+            if ang {
+                "angular error, gains per rad"
+            } else {
+                "translational error, gains per mm"
+            }
+        )
     });
     let angular = &model.angular;
     let counts = p.op_counts();
     let ops_total = Literal::usize_unsuffixed(counts.total());
     let doc_gains = [
-        format!(" Gains of the {n_value} errors at `pose`: `out[i] = [gx, gy, gz, gi, gj, gk]`, the error"),
-        " vector (tool minus workpiece) and the orientation error in the tool frame per unit of".to_string(),
+        format!(
+            " Gains of the {n_value} errors at `pose`: `out[i] = [gx, gy, gz, gi, gj, gk]`, the error"
+        ),
+        " vector (tool minus workpiece) and the orientation error in the tool frame per unit of"
+            .to_string(),
         " error `i` (mm per mm for translational errors, mm per rad for angular ones).".to_string(),
         String::new(),
         format!(" Straight-line code, no allocation, no branches: {counts}."),
@@ -144,7 +166,11 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
     let params: Vec<&Input> = inputs.iter().filter(|i| i.parameter).collect();
     let pose_fields = pose.iter().map(|i| field(&i.field));
     let pose_docs = pose.iter().map(|i| {
-        let axis = i.field.trim_start_matches("sin_").trim_start_matches("cos_").to_ascii_uppercase();
+        let axis = i
+            .field
+            .trim_start_matches("sin_")
+            .trim_start_matches("cos_")
+            .to_ascii_uppercase();
         if i.field.starts_with("sin_") {
             format!(" Sine of the {axis} command.")
         } else if i.field.starts_with("cos_") {
@@ -157,16 +183,26 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
     let pose_fields2 = pose.iter().map(|i| field(&i.field));
     let pose_idx = (0..pose.len()).map(Literal::usize_unsuffixed);
     let param_idx = (0..params.len()).map(Literal::usize_unsuffixed);
-    let (n_pose, n_params) = (Literal::usize_unsuffixed(pose.len()), Literal::usize_unsuffixed(params.len()));
+    let (n_pose, n_params) = (
+        Literal::usize_unsuffixed(pose.len()),
+        Literal::usize_unsuffixed(params.len()),
+    );
     let pose_names = pose.iter().map(|i| i.name.as_str());
     let param_names = params.iter().map(|i| i.name.as_str());
     let defaults = params.iter().map(|i| {
-        let s = m.symbol_by_name(&i.field).expect("parameter inputs are symbols");
+        let s = m
+            .symbol_by_name(&i.field)
+            .expect("parameter inputs are symbols");
         float_literal(m.symbols[s].default)
     });
     let param_docs = params.iter().map(|i| {
-        let s = m.symbol_by_name(&i.field).expect("parameter inputs are symbols");
-        format!(" Kinematic parameter `{}`, mm (default {}).", i.field, m.symbols[s].default)
+        let s = m
+            .symbol_by_name(&i.field)
+            .expect("parameter inputs are symbols");
+        format!(
+            " Kinematic parameter `{}`, mm (default {}).",
+            i.field, m.symbols[s].default
+        )
     });
     quote! {
         /// Axis commands at one pose: sines and cosines of the rotary commands (so that the
@@ -211,7 +247,9 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
 pub fn machine_tokens(m: &Machine, models: &[(&str, &GainModel, &Program)]) -> TokenStream {
     let inputs = crate::lower::inputs(m, models.first().expect("at least one model").1);
     let structs = input_structs(m, &inputs);
-    let modules = models.iter().map(|(name, model, p)| model_module(name, model, p));
+    let modules = models
+        .iter()
+        .map(|(name, model, p)| model_module(name, model, p));
     quote!(#structs #(#modules)*)
 }
 
@@ -232,26 +270,34 @@ pub fn pretty(header: &str, tokens: TokenStream) -> Result<String, syn::Error> {
 /// Derives, compiles and emits the models `model_names` of `m` (every model when empty) as one
 /// Rust source file.
 pub fn generate_machine(m: &Machine, model_names: &[&str]) -> Result<String, String> {
-    let names: Vec<&str> = if model_names.is_empty() { m.model_names() } else { model_names.to_vec() };
+    let names: Vec<&str> = if model_names.is_empty() {
+        m.model_names()
+    } else {
+        model_names.to_vec()
+    };
     let mut built = Vec::new();
     for name in &names {
-        let errors = m.model_errors(name).ok_or_else(|| format!("machine {} has no model `{name}`", m.name))?;
+        let errors = m
+            .model_errors(name)
+            .ok_or_else(|| format!("machine {} has no model `{name}`", m.name))?;
         let model = GainModel::derive(m, errors);
         let program = compile(m, &model);
         built.push((name.replace('-', "_"), model, program));
     }
-    let refs: Vec<(&str, &GainModel, &Program)> = built.iter().map(|(n, g, p)| (n.as_str(), g, p)).collect();
+    let refs: Vec<(&str, &GainModel, &Program)> =
+        built.iter().map(|(n, g, p)| (n.as_str(), g, p)).collect();
     let header = format!(
         "Generated by rtest codegen from machine `{}` ({}). Do not edit.\n\
          Models: {}.\n\
          no_std-compatible: core arithmetic only, no allocation, sin/cos of rotary commands are inputs.",
         m.name,
-        m.description,
+        m.description.trim_end_matches('.'),
         built
             .iter()
             .map(|(n, g, p)| format!("{n} ({} errors, {})", g.errors.len(), p.op_counts()))
             .collect::<Vec<_>>()
             .join("; ")
     );
-    pretty(&header, machine_tokens(m, &refs)).map_err(|e| format!("emitted code does not parse: {e}"))
+    pretty(&header, machine_tokens(m, &refs))
+        .map_err(|e| format!("emitted code does not parse: {e}"))
 }

@@ -81,7 +81,14 @@ impl OpCounts {
 
 impl fmt::Display for OpCounts {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} operations: {} add/sub, {} mul, {} neg", self.total(), self.add, self.mul, self.neg)
+        write!(
+            f,
+            "{} operations: {} add/sub, {} mul, {} neg",
+            self.total(),
+            self.add,
+            self.mul,
+            self.neg
+        )
     }
 }
 
@@ -97,14 +104,22 @@ impl Program {
                 Op::Input(_) | Op::Const(_) => {}
             }
         }
-        c.neg += self.outputs.iter().filter(|o| matches!(o, Output::Neg(_))).count();
+        c.neg += self
+            .outputs
+            .iter()
+            .filter(|o| matches!(o, Output::Neg(_)))
+            .count();
         c
     }
 
     /// Evaluates the program: `inputs` in [`Program::inputs`] order, `out` of length
     /// `outputs.len()`. `scratch` is reused between calls (resized as needed).
     pub fn eval(&self, inputs: &[f64], scratch: &mut Vec<f64>, out: &mut [f64]) {
-        assert_eq!(inputs.len(), self.inputs.len(), "one value per program input");
+        assert_eq!(
+            inputs.len(),
+            self.inputs.len(),
+            "one value per program input"
+        );
         assert_eq!(out.len(), self.outputs.len(), "one slot per program output");
         scratch.clear();
         scratch.reserve(self.ops.len());

@@ -9,11 +9,11 @@
 //! and folded into `+`/`−`, so negations are rare. The result is deterministic: the same model
 //! always gives the same program.
 
+use crate::atoms::AtomKind;
 use crate::derive::GainModel;
 use crate::ir::{Input, Op, Output, Program, Var};
 use crate::poly::{Atom, Monomial, Poly};
 use crate::rational::Rational;
-use crate::atoms::AtomKind;
 use model_spec::Machine;
 use std::collections::HashMap;
 
@@ -150,12 +150,22 @@ pub fn inputs(m: &Machine, model: &GainModel) -> Vec<Input> {
         .zip(&model.atoms.names)
         .map(|(k, name)| {
             let (field, parameter) = match *k {
-                AtomKind::Sin(a) => (format!("sin_{}", m.axes[a].name.to_ascii_lowercase()), false),
-                AtomKind::Cos(a) => (format!("cos_{}", m.axes[a].name.to_ascii_lowercase()), false),
+                AtomKind::Sin(a) => (
+                    format!("sin_{}", m.axes[a].name.to_ascii_lowercase()),
+                    false,
+                ),
+                AtomKind::Cos(a) => (
+                    format!("cos_{}", m.axes[a].name.to_ascii_lowercase()),
+                    false,
+                ),
                 AtomKind::Command(a) => (m.axes[a].name.to_ascii_lowercase(), false),
                 AtomKind::Symbol(s) => (m.symbols[s].name.clone(), true),
             };
-            Input { name: name.clone(), field, parameter }
+            Input {
+                name: name.clone(),
+                field,
+                parameter,
+            }
         })
         .collect()
 }
@@ -164,8 +174,15 @@ pub fn inputs(m: &Machine, model: &GainModel) -> Vec<Input> {
 /// outputs per error.
 pub fn compile(m: &Machine, model: &GainModel) -> Program {
     let inputs = inputs(m, model);
-    let mut b = Builder { ops: Vec::new(), interned: HashMap::new(), memo: HashMap::new(), atom_vars: Vec::new() };
-    b.atom_vars = (0..inputs.len()).map(|i| b.push(Op::Input(i as u32))).collect();
+    let mut b = Builder {
+        ops: Vec::new(),
+        interned: HashMap::new(),
+        memo: HashMap::new(),
+        atom_vars: Vec::new(),
+    };
+    b.atom_vars = (0..inputs.len())
+        .map(|i| b.push(Op::Input(i as u32)))
+        .collect();
     let mut outputs = Vec::with_capacity(model.gains.len() * 6);
     for g in &model.gains {
         for p in g {
@@ -178,7 +195,11 @@ pub fn compile(m: &Machine, model: &GainModel) -> Program {
             });
         }
     }
-    prune(Program { inputs, ops: b.ops, outputs })
+    prune(Program {
+        inputs,
+        ops: b.ops,
+        outputs,
+    })
 }
 
 /// Drops the instructions no output depends on (unused inputs, say), renumbering the rest.
@@ -226,5 +247,9 @@ fn prune(p: Program) -> Program {
             c => c,
         })
         .collect();
-    Program { inputs: p.inputs, ops, outputs }
+    Program {
+        inputs: p.inputs,
+        ops,
+        outputs,
+    }
 }

@@ -90,7 +90,9 @@ impl PartialOrd for Monomial {
 impl Ord for Monomial {
     /// Lower degree first; then by the atom sequence.
     fn cmp(&self, o: &Self) -> std::cmp::Ordering {
-        self.degree().cmp(&o.degree()).then_with(|| self.0.cmp(&o.0))
+        self.degree()
+            .cmp(&o.degree())
+            .then_with(|| self.0.cmp(&o.0))
     }
 }
 
@@ -109,7 +111,10 @@ fn add_coeff(terms: &mut BTreeMap<Monomial, Rational>, m: Monomial, c: Rational)
             v.insert(c);
         }
         Entry::Occupied(mut o) => {
-            let sum = o.get().checked_add(c).expect("coefficients stay far below the i128 range");
+            let sum = o
+                .get()
+                .checked_add(c)
+                .expect("coefficients stay far below the i128 range");
             if sum.is_zero() {
                 o.remove();
             } else {
@@ -211,7 +216,11 @@ impl Poly {
         let mut out = BTreeMap::new();
         for (ma, ca) in &self.terms {
             for (mb, cb) in &o.terms {
-                add_coeff(&mut out, ma.mul(mb), ca.checked_mul(*cb).expect("bounded coefficients"));
+                add_coeff(
+                    &mut out,
+                    ma.mul(mb),
+                    ca.checked_mul(*cb).expect("bounded coefficients"),
+                );
             }
         }
         Poly { terms: out }
@@ -241,15 +250,20 @@ impl Poly {
         self.terms
             .iter()
             .map(|(m, c)| {
-                m.0.iter()
-                    .fold(c.to_f64(), |acc, &(a, e)| acc * atoms[a as usize].powi(e as i32))
+                m.0.iter().fold(c.to_f64(), |acc, &(a, e)| {
+                    acc * atoms[a as usize].powi(e as i32)
+                })
             })
             .sum()
     }
 
     /// The atoms that occur, ascending.
     pub fn atoms(&self) -> Vec<Atom> {
-        let mut v: Vec<Atom> = self.terms.keys().flat_map(|m| m.0.iter().map(|&(a, _)| a)).collect();
+        let mut v: Vec<Atom> = self
+            .terms
+            .keys()
+            .flat_map(|m| m.0.iter().map(|&(a, _)| a))
+            .collect();
         v.sort_unstable();
         v.dedup();
         v
@@ -270,7 +284,11 @@ impl Poly {
 
     /// The coefficient of the first term (canonical order), or zero.
     pub fn leading_coefficient(&self) -> Rational {
-        self.terms.values().next().copied().unwrap_or(Rational::ZERO)
+        self.terms
+            .values()
+            .next()
+            .copied()
+            .unwrap_or(Rational::ZERO)
     }
 }
 
@@ -281,12 +299,17 @@ mod tests {
     #[test]
     fn pythagoras_reduces_to_one() {
         let (s, c) = (0, 1);
-        let p = Poly::atom(s).mul(&Poly::atom(s)).add(&Poly::atom(c).mul(&Poly::atom(c)));
+        let p = Poly::atom(s)
+            .mul(&Poly::atom(s))
+            .add(&Poly::atom(c).mul(&Poly::atom(c)));
         assert_eq!(p.reduce(&[(s, c)]), Poly::constant(Rational::ONE));
         // x·c²·s + x·s³ = x·s
         let x = 2;
         let xs = Poly::atom(x).mul(&Poly::atom(s));
-        let q = xs.mul(&Poly::atom(c)).mul(&Poly::atom(c)).add(&xs.mul(&Poly::atom(s)).mul(&Poly::atom(s)));
+        let q = xs
+            .mul(&Poly::atom(c))
+            .mul(&Poly::atom(c))
+            .add(&xs.mul(&Poly::atom(s)).mul(&Poly::atom(s)));
         assert_eq!(q.reduce(&[(s, c)]), xs);
     }
 

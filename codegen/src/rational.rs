@@ -39,12 +39,18 @@ impl Rational {
         assert!(den != 0, "zero denominator");
         let g = gcd(num, den).max(1);
         let s = if den < 0 { -1 } else { 1 };
-        Rational { num: s * num / g, den: s * den / g }
+        Rational {
+            num: s * num / g,
+            den: s * den / g,
+        }
     }
 
     /// An integer.
     pub fn int(n: i64) -> Rational {
-        Rational { num: n as i128, den: 1 }
+        Rational {
+            num: n as i128,
+            den: 1,
+        }
     }
 
     /// The exact value of the shortest decimal that round-trips `x` (`None` if not finite or
@@ -100,7 +106,10 @@ impl Rational {
 
     /// The absolute value.
     pub fn abs(self) -> Rational {
-        Rational { num: self.num.abs(), den: self.den }
+        Rational {
+            num: self.num.abs(),
+            den: self.den,
+        }
     }
 
     /// The nearest `f64`.
@@ -132,7 +141,10 @@ impl Rational {
 impl std::ops::Neg for Rational {
     type Output = Rational;
     fn neg(self) -> Rational {
-        Rational { num: -self.num, den: self.den }
+        Rational {
+            num: -self.num,
+            den: self.den,
+        }
     }
 }
 
@@ -184,10 +196,19 @@ mod tests {
 
     #[test]
     fn decimals_are_exact() {
-        assert_eq!(Rational::from_decimal(211.537), Some(Rational::new(211537, 1000)));
-        assert_eq!(Rational::from_decimal(-0.279), Some(Rational::new(-279, 1000)));
+        assert_eq!(
+            Rational::from_decimal(211.537),
+            Some(Rational::new(211537, 1000))
+        );
+        assert_eq!(
+            Rational::from_decimal(-0.279),
+            Some(Rational::new(-279, 1000))
+        );
         assert_eq!(Rational::from_decimal(0.1), Some(Rational::new(1, 10)));
-        assert_eq!(Rational::from_decimal(1e20), Some(Rational::new(100_000_000_000_000_000_000, 1)));
+        assert_eq!(
+            Rational::from_decimal(1e20),
+            Some(Rational::new(100_000_000_000_000_000_000, 1))
+        );
         assert_eq!(Rational::from_decimal(f64::NAN), None);
         assert_eq!(Rational::new(211537, 1000).to_string(), "211.537");
         assert_eq!(Rational::new(-1, 3).to_string(), "-1/3");
@@ -201,6 +222,9 @@ mod tests {
         let b = Rational::new(1, 10);
         assert_eq!(a.checked_add(b), Ok(Rational::new(4, 15)));
         assert_eq!(a.checked_mul(b), Ok(Rational::new(1, 60)));
-        assert_eq!(Rational::new(i128::MAX, 1).checked_add(Rational::ONE), Err(Overflow));
+        assert_eq!(
+            Rational::new(i128::MAX, 1).checked_add(Rational::ONE),
+            Err(Overflow)
+        );
     }
 }

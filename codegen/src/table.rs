@@ -35,7 +35,11 @@ pub fn format_poly(p: &Poly, names: &[String], latex: bool) -> String {
         }
         let mut factors: Vec<String> = Vec::new();
         if !c.is_one() || m.0.is_empty() {
-            factors.push(if latex { latex_rational(c) } else { c.to_string() });
+            factors.push(if latex {
+                latex_rational(c)
+            } else {
+                c.to_string()
+            });
         }
         for &(a, e) in &m.0 {
             let n = &names[a as usize];
@@ -62,24 +66,43 @@ fn latex_rational(c: Rational) -> String {
 /// errors, `squareness` and `set-up` for the others.
 pub fn group(m: &Machine, error: usize) -> String {
     match m.catalogue[error].kind {
-        ErrorKind::Component { axis, .. } | ErrorKind::Location { axis, .. } => m.axes[axis].name.clone(),
+        ErrorKind::Component { axis, .. } | ErrorKind::Location { axis, .. } => {
+            m.axes[axis].name.clone()
+        }
         ErrorKind::Squareness { .. } => "squareness".into(),
         ErrorKind::Setup { .. } => "set-up".into(),
     }
 }
 
 const HEADERS: [&str; 6] = ["ΔX", "ΔY", "ΔZ", "ΔI", "ΔJ", "ΔK"];
-const LATEX_HEADERS: [&str; 6] = ["\\Delta X", "\\Delta Y", "\\Delta Z", "\\Delta I", "\\Delta J", "\\Delta K"];
+const LATEX_HEADERS: [&str; 6] = [
+    "\\Delta X",
+    "\\Delta Y",
+    "\\Delta Z",
+    "\\Delta I",
+    "\\Delta J",
+    "\\Delta K",
+];
 
 /// Renders the gain table of `model` (derived from `m`) under the title `title`.
 pub fn render(m: &Machine, model: &GainModel, title: &str, format: Format) -> String {
     let latex = format == Format::Latex;
-    let names = if latex { &model.atoms.latex } else { &model.atoms.names };
+    let names = if latex {
+        &model.atoms.latex
+    } else {
+        &model.atoms.names
+    };
     let rows: Vec<(String, String, Vec<String>)> = model
         .errors
         .iter()
         .zip(&model.gains)
-        .map(|(&e, g)| (group(m, e), m.catalogue[e].name.clone(), g.iter().map(|p| format_poly(p, names, latex)).collect()))
+        .map(|(&e, g)| {
+            (
+                group(m, e),
+                m.catalogue[e].name.clone(),
+                g.iter().map(|p| format_poly(p, names, latex)).collect(),
+            )
+        })
         .collect();
     let legend = legend(m, model);
     match format {
@@ -90,11 +113,17 @@ pub fn render(m: &Machine, model: &GainModel, title: &str, format: Format) -> St
 }
 
 fn legend(m: &Machine, model: &GainModel) -> String {
-    let rotary: Vec<String> = m.rotary_axes().map(|a| {
-        let l = m.axes[a].name.to_ascii_lowercase();
-        format!("S{l}, C{l} = sin, cos of the {} command", m.axes[a].name)
-    }).collect();
-    let linear: Vec<String> = m.linear_axes().map(|a| format!("{}m", m.axes[a].name)).collect();
+    let rotary: Vec<String> = m
+        .rotary_axes()
+        .map(|a| {
+            let l = m.axes[a].name.to_ascii_lowercase();
+            format!("S{l}, C{l} = sin, cos of the {} command", m.axes[a].name)
+        })
+        .collect();
+    let linear: Vec<String> = m
+        .linear_axes()
+        .map(|a| format!("{}m", m.axes[a].name))
+        .collect();
     let mut s = String::from(
         "Error vector = tool point minus workpiece point, in the tool frame (first order).\n\
          ΔX ΔY ΔZ: mm per mm of a translational error, mm per rad of an angular error.\n\
@@ -107,9 +136,12 @@ fn legend(m: &Machine, model: &GainModel) -> String {
     if !linear.is_empty() {
         s.push_str(&format!("{}: linear commands, mm. ", linear.join(", ")));
     }
-    let symbols: Vec<&str> = model.atoms.names.iter().skip_while(|_| false).filter(|n| m.symbol_by_name(n).is_some()).map(String::as_str).collect();
+    let symbols: Vec<&str> = m.symbols.iter().map(|s| s.name.as_str()).collect();
     if !symbols.is_empty() {
-        s.push_str(&format!("Kinematic parameters (mm): {}.", symbols.join(" ")));
+        s.push_str(&format!(
+            "Kinematic parameters (mm): {}.",
+            symbols.join(" ")
+        ));
     }
     s.push('\n');
     s
@@ -117,9 +149,18 @@ fn legend(m: &Machine, model: &GainModel) -> String {
 
 fn text(title: &str, rows: &[(String, String, Vec<String>)], legend: &str) -> String {
     let mut widths = [0usize; 8];
-    let header: Vec<String> = ["group", "error"].iter().map(|s| s.to_string()).chain(HEADERS.iter().map(|s| s.to_string())).collect();
+    let header: Vec<String> = ["group", "error"]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(HEADERS.iter().map(|s| s.to_string()))
+        .collect();
     let all: Vec<Vec<String>> = std::iter::once(header)
-        .chain(rows.iter().map(|(g, e, cells)| [g.clone(), e.clone()].into_iter().chain(cells.iter().cloned()).collect()))
+        .chain(rows.iter().map(|(g, e, cells)| {
+            [g.clone(), e.clone()]
+                .into_iter()
+                .chain(cells.iter().cloned())
+                .collect()
+        }))
         .collect();
     for r in &all {
         for (w, c) in widths.iter_mut().zip(r) {
@@ -128,11 +169,21 @@ fn text(title: &str, rows: &[(String, String, Vec<String>)], legend: &str) -> St
     }
     let mut out = format!("{title}\n{legend}\n");
     for (i, r) in all.iter().enumerate() {
-        let line: Vec<String> = r.iter().zip(&widths).map(|(c, w)| format!("{c:<w$}", w = *w)).collect();
+        let line: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .map(|(c, w)| format!("{c:<w$}", w = *w))
+            .collect();
         out.push_str(line.join("  ").trim_end());
         out.push('\n');
         if i == 0 {
-            out.push_str(&widths.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>().join("  "));
+            out.push_str(
+                &widths
+                    .iter()
+                    .map(|w| "-".repeat(*w))
+                    .collect::<Vec<_>>()
+                    .join("  "),
+            );
             out.push('\n');
         }
     }
@@ -140,32 +191,69 @@ fn text(title: &str, rows: &[(String, String, Vec<String>)], legend: &str) -> St
 }
 
 fn markdown(title: &str, rows: &[(String, String, Vec<String>)], legend: &str) -> String {
-    let mut out = format!("### {title}\n\n{}\n", legend.lines().map(|l| format!("{l}  \n")).collect::<String>());
+    let mut out = format!(
+        "### {title}\n\n{}\n",
+        legend
+            .lines()
+            .map(|l| format!("{l}  \n"))
+            .collect::<String>()
+    );
     out.push_str(&format!("| group | error | {} |\n", HEADERS.join(" | ")));
     out.push_str(&format!("|{}\n", "---|".repeat(8)));
     let mut last_group = String::new();
     for (g, e, cells) in rows {
-        let shown = if *g == last_group { String::new() } else { g.clone() };
+        let shown = if *g == last_group {
+            String::new()
+        } else {
+            g.clone()
+        };
         last_group = g.clone();
-        let cells: Vec<String> = cells.iter().map(|c| if c == "0" { "0".into() } else { format!("`{c}`") }).collect();
+        let cells: Vec<String> = cells
+            .iter()
+            .map(|c| {
+                if c == "0" {
+                    "0".into()
+                } else {
+                    format!("`{c}`")
+                }
+            })
+            .collect();
         out.push_str(&format!("| {shown} | {e} | {} |\n", cells.join(" | ")));
     }
     out
 }
 
 fn latex_table(title: &str, rows: &[(String, String, Vec<String>)]) -> String {
-    let mut out = String::from("% requires \\usepackage{longtable}\n\\begin{longtable}{llllllll}\n");
-    out.push_str(&format!("\\caption{{{}}}\\\\\n\\hline\n", title.replace('_', "\\_")));
-    out.push_str(&format!("group & error & {} \\\\\n\\hline\n\\endhead\n", LATEX_HEADERS.iter().map(|h| format!("${h}$")).collect::<Vec<_>>().join(" & ")));
+    let mut out =
+        String::from("% requires \\usepackage{longtable}\n\\begin{longtable}{llllllll}\n");
+    out.push_str(&format!(
+        "\\caption{{{}}}\\\\\n\\hline\n",
+        title.replace('_', "\\_")
+    ));
+    out.push_str(&format!(
+        "group & error & {} \\\\\n\\hline\n\\endhead\n",
+        LATEX_HEADERS
+            .iter()
+            .map(|h| format!("${h}$"))
+            .collect::<Vec<_>>()
+            .join(" & ")
+    ));
     let mut last_group = String::new();
     for (g, e, cells) in rows {
-        let shown = if *g == last_group { String::new() } else { g.clone() };
+        let shown = if *g == last_group {
+            String::new()
+        } else {
+            g.clone()
+        };
         if !last_group.is_empty() && *g != last_group {
             out.push_str("\\hline\n");
         }
         last_group = g.clone();
         let cells: Vec<String> = cells.iter().map(|c| format!("${c}$")).collect();
-        out.push_str(&format!("{shown} & ${e}$ & {} \\\\\n", cells.join(" & ")));
+        out.push_str(&format!(
+            "{shown} & $\\mathrm{{{e}}}$ & {} \\\\\n",
+            cells.join(" & ")
+        ));
     }
     out.push_str("\\hline\n\\end{longtable}\n");
     out

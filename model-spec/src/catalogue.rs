@@ -8,9 +8,10 @@
 //! - location errors of a rotary axis: two translations and two tilts perpendicular to it
 //!   (`XOC YOC AOC BOC` for C, `YOA ZOA BOA COA` for A, `XOB ZOB AOB COB` for B);
 //! - squareness of the linear axes, by the squareness order (reference first): the reference has
-//!   none, the second axis one (rotation about the direction perpendicular to both), every later
+//!   none, the second axis one (rotation about the direction perpendicular to both; two, about
+//!   the directions perpendicular to its own, if it is parallel to the reference), every later
 //!   axis two (rotations about the directions perpendicular to its own): `COX AOZ BOZ` for the
-//!   seed machine whose order is Y, X, Z;
+//!   seed machine whose order is Y, X, Z (see [`crate::default_squareness_order`]);
 //! - workpiece set-up errors `XOW YOW ZOW` (translations of the workpiece point in the last
 //!   frame of the work chain).
 //!
@@ -125,8 +126,8 @@ impl ErrorTerm {
     }
 }
 
-/// The canonical spelling of an error name: upper case, and the digit zero of `X0C` read as the
-/// letter O.
+/// The canonical spelling of an error name: surrounding white space removed, upper case, and
+/// the digit zero in the middle of a three-character name (`X0C`, `c0x`) read as the letter O.
 pub fn canonical_name(name: &str) -> String {
     let mut chars: Vec<char> = name.trim().to_ascii_uppercase().chars().collect();
     if chars.len() == 3 && chars[1] == '0' {

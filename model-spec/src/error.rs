@@ -35,7 +35,10 @@ pub(crate) struct Locator<'a> {
 impl Locator<'_> {
     /// The 1-based line and column of byte offset `at`.
     pub fn line_col(&self, at: usize) -> (usize, usize) {
-        let at = at.min(self.text.len());
+        let mut at = at.min(self.text.len());
+        while !self.text.is_char_boundary(at) {
+            at -= 1;
+        }
         let before = &self.text[..at];
         let line = before.matches('\n').count() + 1;
         let line_start = before.rfind('\n').map_or(0, |i| i + 1);

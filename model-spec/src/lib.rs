@@ -10,6 +10,46 @@
 //! Units: offsets and linear commands in mm, rotary commands in degrees at every boundary a
 //! person sees (radians inside), translational errors in mm inside (µm for people), angular
 //! errors in rad inside (µrad for people).
+//!
+//! ```
+//! let text = r#"
+//! name = "mill3"
+//!
+//! [[work]]
+//! end = "ball"
+//!
+//! [[tool]]
+//! axis = "X"
+//! type = "linear"
+//! direction = "+x"
+//! stroke = [-400, 400]
+//!
+//! [[tool]]
+//! axis = "Y"
+//! type = "linear"
+//! direction = "+y"
+//! stroke = [-300, 300]
+//!
+//! [[tool]]
+//! axis = "Z"
+//! type = "linear"
+//! direction = "+z"
+//! stroke = [-300, 300]
+//!
+//! [[tool]]
+//! end = "probe"
+//! "#;
+//! let m = model_spec::parse_machine("mill3.toml", text).unwrap();
+//! assert_eq!(m.catalogue.len(), 24); // 18 component errors, COY AOZ BOZ, XOW YOW ZOW
+//! assert_eq!(m.error_by_name("C0Y"), m.error_by_name("COY"));
+//!
+//! let bad = text.replace("[-300, 300]", "[300, -300]");
+//! let e = model_spec::parse_machine("mill3.toml", &bad).unwrap_err();
+//! assert_eq!(
+//!     e.to_string(),
+//!     "mill3.toml:17:10: axis Y: `stroke` minimum 300 is not below maximum -300 (mm)"
+//! );
+//! ```
 
 #![warn(missing_docs)]
 
@@ -30,4 +70,4 @@ pub use machine::{
     Axis, AxisId, AxisKind, Chain, FULL_MODEL, Link, Machine, Offset, Side, SubModel, Symbol,
     SymbolId, Value,
 };
-pub use validate::{build_catalogue, parse_machine, reserved_names};
+pub use validate::{build_catalogue, default_squareness_order, parse_machine, reserved_names};

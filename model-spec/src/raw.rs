@@ -2,12 +2,40 @@
 //! validation message may point at is `Spanned`, so errors name the line and column.
 
 use serde::Deserialize;
+use serde::de::{self, Deserializer, Visitor};
 use std::collections::BTreeMap;
+use std::fmt;
 use toml::Spanned;
 
+/// A number (integer or float) as written in the file; `nan` and `inf` are read and rejected
+/// by validation, so the message can say which number is wrong.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Num(pub f64);
+
+impl<'de> Deserialize<'de> for Num {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = Num;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("a number")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Num, E> {
+                Ok(Num(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Num, E> {
+                Ok(Num(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Num, E> {
+                Ok(Num(v as f64))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
 /// A number or a symbol name, as written in an offset.
-#[derive(Debug, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug)]
 pub enum RawValue {
     /// A number (mm).
     Number(f64),
@@ -15,15 +43,40 @@ pub enum RawValue {
     Name(String),
 }
 
+impl<'de> Deserialize<'de> for RawValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = RawValue;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("a number (mm) or the name of a symbol")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<RawValue, E> {
+                Ok(RawValue::Number(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<RawValue, E> {
+                Ok(RawValue::Number(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<RawValue, E> {
+                Ok(RawValue::Number(v as f64))
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<RawValue, E> {
+                Ok(RawValue::Name(v.to_string()))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
 /// A whole description file.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawMachine {
-    pub name: Spanned<String>,
+    pub name: Option<Spanned<String>>,
     #[serde(default)]
     pub description: String,
     #[serde(default)]
-    pub symbols: BTreeMap<Spanned<String>, Spanned<f64>>,
+    pub symbols: BTreeMap<Spanned<String>, Spanned<Num>>,
     #[serde(default)]
     pub work: Option<Spanned<Vec<Spanned<RawLink>>>>,
     #[serde(default)]
@@ -31,7 +84,7 @@ pub struct RawMachine {
     #[serde(default)]
     pub errors: RawErrors,
     #[serde(default)]
-    pub models: BTreeMap<Spanned<String>, RawModel>,
+    pub models: BTreeMap<Spanned<String>, Spanned<RawModel>>,
 }
 
 /// One `[[work]]` or `[[tool]]` entry: an axis, a fixed link or the end of the chain.
@@ -43,8 +96,8 @@ pub struct RawLink {
     pub kind: Option<Spanned<String>>,
     pub direction: Option<Spanned<String>>,
     pub offset: Option<Spanned<Vec<Spanned<RawValue>>>>,
-    pub stroke: Option<Spanned<Vec<Spanned<f64>>>>,
-    pub range: Option<Spanned<Vec<Spanned<f64>>>>,
+    pub stroke: Option<Spanned<Vec<Spanned<Num>>>>,
+    pub range: Option<Spanned<Vec<Spanned<Num>>>>,
     pub link: Option<Spanned<String>>,
     pub end: Option<Spanned<String>>,
 }
@@ -54,8 +107,7 @@ pub struct RawLink {
 #[serde(deny_unknown_fields)]
 pub struct RawErrors {
     pub include: Option<Spanned<Vec<Spanned<String>>>>,
-    #[serde(default)]
-    pub exclude: Vec<Spanned<String>>,
+    pub exclude: Option<Spanned<Vec<Spanned<String>>>>,
     pub squareness_order: Option<Spanned<Vec<Spanned<String>>>>,
 }
 
@@ -65,5 +117,5 @@ pub struct RawErrors {
 pub struct RawModel {
     #[serde(default)]
     pub description: String,
-    pub errors: Spanned<Vec<Spanned<String>>>,
+    pub errors: Option<Spanned<Vec<Spanned<String>>>>,
 }

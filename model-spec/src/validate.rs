@@ -1,19 +1,22 @@
 //! From the TOML text to a validated [`Machine`], with errors that name file, line and column.
 
 use crate::catalogue::{
-    ErrorKind, ErrorTerm, Motion, component_name, iso_rank, location_motions, location_name,
-    six_motions, squareness_rotations,
+    ErrorId, ErrorKind, ErrorTerm, Motion, component_name, iso_rank, location_motions,
+    location_name, six_motions, squareness_rotations,
 };
 use crate::error::{Locator, SpecError};
 use crate::geometry::{Dir, Direction};
 use crate::machine::{
     Axis, AxisId, AxisKind, Chain, FULL_MODEL, Link, Machine, Offset, Side, SubModel, Symbol, Value,
 };
-use crate::raw::{RawErrors, RawLink, RawMachine, RawValue};
-use std::collections::{BTreeMap, HashMap};
+use crate::raw::{Num, RawErrors, RawLink, RawMachine, RawValue};
+use std::collections::BTreeMap;
 use toml::Spanned;
 
 /// Reads and validates a machine description. `file` names the source in error messages.
+///
+/// Every problem is reported as a [`SpecError`] whose line and column point at the offending
+/// value or key (see `docs/model-spec.md` for the list of messages). No input panics.
 pub fn parse_machine(file: &str, text: &str) -> Result<Machine, SpecError> {
     let loc = Locator { file, text };
     let raw: RawMachine = toml::from_str(text).map_err(|e| {
@@ -24,7 +27,8 @@ pub fn parse_machine(file: &str, text: &str) -> Result<Machine, SpecError> {
 }
 
 /// The names a machine reserves for the commands of an axis in formulas: the linear command
-/// `Xm`, or the sine and cosine `Sa`, `Ca` of a rotary command.
+/// `Xm`, or the sine and cosine `Sa`, `Ca` of a rotary command. A kinematic symbol may not take
+/// one of these names.
 pub fn reserved_names(axis: &str, kind: AxisKind) -> Vec<String> {
     match kind {
         AxisKind::Linear => vec![format!("{axis}m")],
@@ -40,6 +44,7 @@ struct Validator<'a> {
 }
 
 type Res<T> = Result<T, SpecError>;
+type Span = std::ops::Range<usize>;
 
 fn is_identifier(s: &str) -> bool {
     let mut c = s.chars();
@@ -47,63 +52,128 @@ fn is_identifier(s: &str) -> bool {
         && c.all(|ch| ch.is_ascii_alphanumeric() || ch == '_')
 }
 
+/// Rust's strict and reserved keywords (2024 edition): generated code uses symbol names as
+/// field names and model names as module names, so neither may be one of these.
+const RUST_KEYWORDS: &[&str] = &[
+    "Self", "abstract", "as", "async", "await", "become", "box", "break", "const", "continue",
+    "crate", "do", "dyn", "else", "enum", "extern", "false", "final", "fn", "for", "gen", "if",
+    "impl", "in", "let", "loop", "macro", "match", "mod", "move", "mut", "override", "priv", "pub",
+    "ref", "return", "self", "static", "struct", "super", "trait", "true", "try", "type", "typeof",
+    "unsafe", "unsized", "use", "virtual", "where", "while", "yield",
+];
+
+fn is_rust_keyword(s: &str) -> bool {
+    RUST_KEYWORDS.contains(&s)
+}
+
+fn join<'a>(names: impl IntoIterator<Item = &'a str>) -> String {
+    names.into_iter().collect::<Vec<_>>().join(" ")
+}
+
+/// The unit people write a command limit in.
+fn limit_unit(field: &str) -> &'static str {
+    if field == "range" { "degrees" } else { "mm" }
+}
+
 impl Validator<'_> {
-    fn err<T>(&self, span: std::ops::Range<usize>, msg: impl Into<String>) -> Res<T> {
+    fn err<T>(&self, span: Span, msg: impl Into<String>) -> Res<T> {
         Err(self.loc.error(span, msg))
     }
 
+    fn line(&self, span: &Span) -> usize {
+        self.loc.line_col(span.start).0
+    }
+
     fn machine(&self, raw: RawMachine) -> Res<Machine> {
-        let name = raw.name.get_ref().trim().to_string();
+        let Some(raw_name) = &raw.name else {
+            return self.err(
+                0..0,
+                "no `name = \"...\"` at the top of the file: every machine needs a short name",
+            );
+        };
+        let name = raw_name.get_ref().trim().to_string();
         if name.is_empty()
             || !name
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
         {
             return self.err(
-                raw.name.span(),
+                raw_name.span(),
                 format!("machine name `{name}` must be letters, digits, `-` or `_`"),
             );
         }
 
+        // Checked and kept in the order of the file, not the order of the map.
+        let mut raw_symbols: Vec<(&Spanned<String>, &Spanned<Num>)> = raw.symbols.iter().collect();
+        raw_symbols.sort_by_key(|(k, _)| k.span().start);
         let mut symbols = Vec::new();
-        for (k, v) in &raw.symbols {
+        for &(k, v) in &raw_symbols {
             if !is_identifier(k.get_ref()) {
                 return self.err(
                     k.span(),
-                    format!("symbol name `{}` is not an identifier", k.get_ref()),
+                    format!(
+                        "symbol name `{}` is not an identifier (a letter, then letters, digits or `_`)",
+                        k.get_ref()
+                    ),
                 );
             }
-            if !v.get_ref().is_finite() {
+            if is_rust_keyword(k.get_ref()) {
+                return self.err(
+                    k.span(),
+                    format!(
+                        "symbol name `{}` is a Rust keyword (generated code uses symbol names as field names): rename it",
+                        k.get_ref()
+                    ),
+                );
+            }
+            let x = v.get_ref().0;
+            if !x.is_finite() {
                 return self.err(
                     v.span(),
-                    format!("symbol `{}` has a non-finite default", k.get_ref()),
+                    format!(
+                        "symbol `{}` has the non-finite default {x}: give a number (mm)",
+                        k.get_ref()
+                    ),
                 );
             }
             symbols.push(Symbol {
                 name: k.get_ref().clone(),
-                default: *v.get_ref(),
+                default: x,
             });
         }
-        // Keep the order of the file, not the order of the map.
-        symbols.sort_by_key(|s| {
-            raw.symbols
-                .keys()
-                .find(|k| k.get_ref() == &s.name)
-                .map(|k| k.span().start)
-        });
 
         let mut axes: Vec<Axis> = Vec::new();
-        let mut axis_spans: Vec<std::ops::Range<usize>> = Vec::new();
-        let work = self.chain(&raw.work, Side::Work, &symbols, &mut axes, &mut axis_spans)?;
-        let tool = self.chain(&raw.tool, Side::Tool, &symbols, &mut axes, &mut axis_spans)?;
+        let mut axis_spans: Vec<Span> = Vec::new();
+        let name_span = raw_name.span();
+        let work = self.chain(
+            &raw.work,
+            Side::Work,
+            (&name, &name_span),
+            &symbols,
+            &mut axes,
+            &mut axis_spans,
+        )?;
+        let tool = self.chain(
+            &raw.tool,
+            Side::Tool,
+            (&name, &name_span),
+            &symbols,
+            &mut axes,
+            &mut axis_spans,
+        )?;
 
-        for a in &axes {
-            for reserved in reserved_names(&a.name, a.kind) {
-                if let Some(k) = raw.symbols.keys().find(|k| *k.get_ref() == reserved) {
+        for &(k, _) in &raw_symbols {
+            for a in &axes {
+                if reserved_names(&a.name, a.kind).contains(k.get_ref()) {
+                    let what = match a.kind {
+                        AxisKind::Linear => "the command",
+                        AxisKind::Rotary => "the sine and cosine of the command",
+                    };
                     return self.err(
                         k.span(),
                         format!(
-                            "symbol `{reserved}` is reserved for the command of axis {}",
+                            "symbol `{}` is reserved for {what} of axis {} in formulas: rename the symbol",
+                            k.get_ref(),
                             a.name
                         ),
                     );
@@ -111,8 +181,19 @@ impl Validator<'_> {
             }
         }
 
-        let squareness_order = self.squareness_order(&raw.errors, &axes, &work, &tool)?;
+        let squareness_order = self.squareness_order(&raw.errors, &axes)?;
         let catalogue = build_catalogue(&axes, &squareness_order);
+        for &(k, _) in &raw_symbols {
+            if catalogue.iter().any(|e| e.name == *k.get_ref()) {
+                return self.err(
+                    k.span(),
+                    format!(
+                        "symbol `{}` has the name of an error of this machine: rename the symbol",
+                        k.get_ref()
+                    ),
+                );
+            }
+        }
         let mut machine = Machine {
             name,
             description: raw.description.trim().to_string(),
@@ -126,19 +207,45 @@ impl Validator<'_> {
             squareness_order,
         };
         machine.errors = self.model_errors(&raw.errors, &machine)?;
-        for (name, model) in &raw.models {
+        let mut raw_models: Vec<_> = raw.models.iter().collect();
+        raw_models.sort_by_key(|(name, _)| name.span().start);
+        for (name, model) in raw_models {
             let n = name.get_ref();
-            if n == FULL_MODEL || !is_identifier(n) {
+            if n == FULL_MODEL {
                 return self.err(
                     name.span(),
-                    format!("model name `{n}` is reserved or not an identifier"),
+                    format!(
+                        "model name `{FULL_MODEL}` is reserved for the machine's own error list ([errors]); choose another name"
+                    ),
                 );
             }
-            let errors = self.error_list(&model.errors, &machine, Some(&machine.errors))?;
+            if !is_identifier(n) {
+                return self.err(
+                    name.span(),
+                    format!(
+                        "model name `{n}` is not an identifier (a letter, then letters, digits or `_`)"
+                    ),
+                );
+            }
+            if is_rust_keyword(n) {
+                return self.err(
+                    name.span(),
+                    format!(
+                        "model name `{n}` is a Rust keyword (generated code uses model names as module names): choose another name"
+                    ),
+                );
+            }
+            let Some(list) = &model.get_ref().errors else {
+                return self.err(
+                    model.span(),
+                    format!("model `{n}` has no `errors = [...]` list"),
+                );
+            };
+            let errors = self.error_list(list, &machine, Some(n))?;
             machine.models.insert(
                 n.clone(),
                 SubModel {
-                    description: model.description.trim().to_string(),
+                    description: model.get_ref().description.trim().to_string(),
                     errors,
                 },
             );
@@ -150,44 +257,70 @@ impl Validator<'_> {
         &self,
         raw: &Option<Spanned<Vec<Spanned<RawLink>>>>,
         side: Side,
+        (machine_name, name_span): (&str, &Span),
         symbols: &[Symbol],
         axes: &mut Vec<Axis>,
-        axis_spans: &mut Vec<std::ops::Range<usize>>,
+        axis_spans: &mut Vec<Span>,
     ) -> Res<Chain> {
         let (table, end_word) = match side {
-            Side::Work => ("work", "workpiece"),
-            Side::Tool => ("tool", "tool"),
+            Side::Work => ("work", "workpiece point (the R-test ball)"),
+            Side::Tool => ("tool", "tool point (the R-test sensor nest)"),
         };
         let Some(entries) = raw else {
             return self.err(
-                0..0,
-                format!("no [[{table}]] chain: describe the {table} chain from the bed to its {end_word} end"),
+                name_span.clone(),
+                format!(
+                    "machine `{machine_name}` has no [[{table}]] chain: describe the chain from the bed to the {end_word} with [[{table}]] entries, the last one with `end = \"...\"`"
+                ),
             );
         };
         let mut links = Vec::new();
-        let mut end = None;
+        let mut end: Option<(String, Offset, Span)> = None;
         for entry in entries.get_ref() {
             let e = entry.get_ref();
-            if end.is_some() {
+            if let Some((_, _, end_span)) = &end {
                 return self.err(
                     entry.span(),
-                    format!("[[{table}]] entry after the {end_word} end: the `end` entry must be the last of the chain"),
+                    format!(
+                        "[[{table}]] entry after the `end` entry of line {}: the `end` entry must be the last of the chain",
+                        self.line(end_span)
+                    ),
                 );
             }
-            let roles = [e.axis.is_some(), e.link.is_some(), e.end.is_some()];
-            if roles.iter().filter(|&&r| r).count() != 1 {
-                return self.err(
-                    entry.span(),
-                    format!("each [[{table}]] entry needs exactly one of `axis`, `link` or `end`"),
-                );
+            let mut roles: Vec<(&str, Span)> =
+                [("axis", &e.axis), ("link", &e.link), ("end", &e.end)]
+                    .into_iter()
+                    .filter_map(|(k, v)| v.as_ref().map(|v| (k, v.span())))
+                    .collect();
+            // In the order they are written: the message points at the second one.
+            roles.sort_by_key(|(_, span)| span.start);
+            match roles.as_slice() {
+                [] => {
+                    return self.err(
+                        entry.span(),
+                        format!(
+                            "this [[{table}]] entry has none of `axis`, `link` or `end`: each entry is an axis, a fixed link or the end of the chain"
+                        ),
+                    );
+                }
+                [_] => {}
+                [(first, _), (second, span), ..] => {
+                    return self.err(
+                        span.clone(),
+                        format!(
+                            "this [[{table}]] entry has both `{first}` and `{second}`: each entry is one axis, one fixed link or the end of the chain; split it"
+                        ),
+                    );
+                }
             }
             let offset = self.offset(&e.offset, symbols)?;
             if let Some(name) = &e.axis {
-                let axis = self.axis(e, name, offset, side, axes)?;
+                let axis = self.axis(e, name, offset, side, axes, axis_spans)?;
                 axes.push(axis);
                 axis_spans.push(name.span());
                 links.push(Link::Axis(axes.len() - 1));
             } else {
+                let role = roles[0].0;
                 for (field, present) in [
                     ("type", e.kind.as_ref().map(Spanned::span)),
                     ("direction", e.direction.as_ref().map(Spanned::span)),
@@ -197,7 +330,7 @@ impl Validator<'_> {
                     if let Some(span) = present {
                         return self.err(
                             span,
-                            format!("`{field}` belongs to an axis, not to a `link` or `end` entry"),
+                            format!("`{field}` belongs to an axis, not to a `{role}` entry"),
                         );
                     }
                 }
@@ -207,14 +340,20 @@ impl Validator<'_> {
                         offset,
                     });
                 } else if let Some(n) = &e.end {
-                    end = Some((n.get_ref().clone(), offset));
+                    end = Some((n.get_ref().clone(), offset, entry.span()));
                 }
             }
         }
-        let Some((end_name, end_offset)) = end else {
+        let Some((end_name, end_offset, _)) = end else {
+            let at = entries
+                .get_ref()
+                .last()
+                .map_or_else(|| entries.span(), Spanned::span);
             return self.err(
-                entries.span(),
-                format!("the [[{table}]] chain has no {end_word} end: add a last entry with `end = \"...\"` and its offset"),
+                at,
+                format!(
+                    "the [[{table}]] chain has no `end` entry: add a last [[{table}]] entry with `end = \"...\"` and the offset of the {end_word}"
+                ),
             );
         };
         Ok(Chain {
@@ -231,29 +370,51 @@ impl Validator<'_> {
         offset: Offset,
         side: Side,
         axes: &[Axis],
+        axis_spans: &[Span],
     ) -> Res<Axis> {
         let n = name.get_ref().trim().to_string();
         let mut cs = n.chars();
-        let valid = match (cs.next(), cs.next()) {
-            (Some(c), None) => c.is_ascii_uppercase() && c != 'E' && c != 'O',
-            _ => false,
-        };
-        if !valid {
-            return self.err(
-                name.span(),
-                format!("axis name `{n}` must be one upper-case letter other than E and O"),
-            );
+        match (cs.next(), cs.next()) {
+            (Some('E' | 'O'), None) => {
+                return self.err(
+                    name.span(),
+                    format!(
+                        "axis name `{n}` is not allowed: E and O are the letters of the error names (EXX, XOC)"
+                    ),
+                );
+            }
+            (Some(c), None) if c.is_ascii_uppercase() => {}
+            (Some(c), None) if c.is_ascii_lowercase() && !matches!(c, 'e' | 'o') => {
+                return self.err(
+                    name.span(),
+                    format!(
+                        "axis name `{n}` must be upper case: write `{}`",
+                        c.to_ascii_uppercase()
+                    ),
+                );
+            }
+            _ => {
+                return self.err(
+                    name.span(),
+                    format!(
+                        "axis name `{n}` must be one upper-case letter other than E and O (X, Y, Z, A, B, C, …)"
+                    ),
+                );
+            }
         }
-        if axes.iter().any(|a| a.name == n) {
+        if let Some(first) = axes.iter().position(|a| a.name == n) {
             return self.err(
                 name.span(),
-                format!("duplicate axis `{n}`: every axis of the machine needs its own letter"),
+                format!(
+                    "axis letter `{n}` is used twice (first on line {}): every axis of the machine needs its own letter",
+                    self.line(&axis_spans[first])
+                ),
             );
         }
         let Some(kind_s) = &e.kind else {
             return self.err(
                 name.span(),
-                format!("axis {n} has no `type` (\"linear\" or \"rotary\")"),
+                format!("axis {n} has no `type`: add `type = \"linear\"` or `type = \"rotary\"`"),
             );
         };
         let kind = match kind_s.get_ref().as_str() {
@@ -269,7 +430,9 @@ impl Validator<'_> {
         let Some(dir_s) = &e.direction else {
             return self.err(
                 name.span(),
-                format!("axis {n} has no `direction` (\"+x\", \"-y\", \"z\", …)"),
+                format!(
+                    "axis {n} has no `direction`: add `direction = \"+x\"` (or -x, +y, -y, +z, -z)"
+                ),
             );
         };
         let Some(direction) = Direction::parse(dir_s.get_ref()) else {
@@ -292,7 +455,7 @@ impl Validator<'_> {
                 if let Some(r) = &e.range {
                     return self.err(
                         r.span(),
-                        format!("linear axis {n} takes `stroke` (mm), not `range`"),
+                        format!("linear axis {n} takes `stroke = [min, max]` (mm), not `range`"),
                     );
                 }
                 let Some(s) = &e.stroke else {
@@ -307,7 +470,9 @@ impl Validator<'_> {
                 if let Some(s) = &e.stroke {
                     return self.err(
                         s.span(),
-                        format!("rotary axis {n} takes `range` (degrees), not `stroke`"),
+                        format!(
+                            "rotary axis {n} takes `range = [min, max]` (degrees), not `stroke`"
+                        ),
                     );
                 }
                 match &e.range {
@@ -326,27 +491,32 @@ impl Validator<'_> {
         })
     }
 
-    fn limits(&self, s: &Spanned<Vec<Spanned<f64>>>, axis: &str, field: &str) -> Res<[f64; 2]> {
+    fn limits(&self, s: &Spanned<Vec<Spanned<Num>>>, axis: &str, field: &str) -> Res<[f64; 2]> {
         let v = s.get_ref();
+        let unit = limit_unit(field);
         if v.len() != 2 {
             return self.err(
                 s.span(),
-                format!("axis {axis}: `{field}` needs two numbers [min, max]"),
+                format!(
+                    "axis {axis}: `{field}` needs two numbers [min, max] ({unit}), found {}",
+                    v.len()
+                ),
             );
         }
         for x in v {
-            if !x.get_ref().is_finite() {
+            let value = x.get_ref().0;
+            if !value.is_finite() {
                 return self.err(
                     x.span(),
-                    format!("axis {axis}: `{field}` has a non-finite number"),
+                    format!("axis {axis}: `{field}` has the non-finite number {value}"),
                 );
             }
         }
-        let (lo, hi) = (*v[0].get_ref(), *v[1].get_ref());
+        let (lo, hi) = (v[0].get_ref().0, v[1].get_ref().0);
         if lo >= hi {
             return self.err(
                 s.span(),
-                format!("axis {axis}: `{field}` minimum {lo} is not below maximum {hi}"),
+                format!("axis {axis}: `{field}` minimum {lo} is not below maximum {hi} ({unit})"),
             );
         }
         Ok([lo, hi])
@@ -364,22 +534,30 @@ impl Validator<'_> {
         if v.len() != 3 {
             return self.err(
                 raw.span(),
-                "`offset` needs three entries [x, y, z] (numbers in mm or symbol names)",
+                format!(
+                    "`offset` needs three entries [x, y, z] (numbers in mm or symbol names), found {}",
+                    v.len()
+                ),
             );
         }
         let mut out = [Value::Number(0.0); 3];
         for (slot, item) in out.iter_mut().zip(v) {
             *slot = match item.get_ref() {
                 RawValue::Number(x) if x.is_finite() => Value::Number(*x),
-                RawValue::Number(_) => {
-                    return self.err(item.span(), "non-finite number in `offset`");
+                RawValue::Number(x) => {
+                    return self.err(
+                        item.span(),
+                        format!("`offset` has the non-finite number {x}"),
+                    );
                 }
                 RawValue::Name(s) => match symbols.iter().position(|sym| &sym.name == s) {
                     Some(i) => Value::Symbol(i),
                     None => {
                         return self.err(
                             item.span(),
-                            format!("unknown symbol `{s}`: declare it under [symbols] with its default (mm)"),
+                            format!(
+                                "unknown symbol `{s}`: declare it under [symbols] with its default (mm)"
+                            ),
                         );
                     }
                 },
@@ -388,13 +566,7 @@ impl Validator<'_> {
         Ok(out)
     }
 
-    fn squareness_order(
-        &self,
-        raw: &RawErrors,
-        axes: &[Axis],
-        work: &Chain,
-        tool: &Chain,
-    ) -> Res<Vec<AxisId>> {
+    fn squareness_order(&self, raw: &RawErrors, axes: &[Axis]) -> Res<Vec<AxisId>> {
         let linear: Vec<AxisId> = (0..axes.len())
             .filter(|&i| axes[i].kind == AxisKind::Linear)
             .collect();
@@ -404,11 +576,21 @@ impl Validator<'_> {
                 let Some(i) = axes.iter().position(|a| &a.name == item.get_ref()) else {
                     return self.err(
                         item.span(),
-                        format!("unknown axis `{}` in squareness_order", item.get_ref()),
+                        format!(
+                            "unknown axis `{}` in squareness_order (the linear axes are {})",
+                            item.get_ref(),
+                            join(linear.iter().map(|&i| axes[i].name.as_str()))
+                        ),
                     );
                 };
                 if axes[i].kind != AxisKind::Linear {
-                    return self.err(item.span(), format!("squareness_order lists rotary axis {}: only linear axes have squareness errors", axes[i].name));
+                    return self.err(
+                        item.span(),
+                        format!(
+                            "squareness_order lists rotary axis {}: only linear axes have squareness errors",
+                            axes[i].name
+                        ),
+                    );
                 }
                 if order.contains(&i) {
                     return self.err(
@@ -418,99 +600,164 @@ impl Validator<'_> {
                 }
                 order.push(i);
             }
-            if order.len() != linear.len() {
+            if let Some(&missing) = linear.iter().find(|i| !order.contains(i)) {
                 return self.err(
                     list.span(),
-                    "squareness_order must list every linear axis once",
+                    format!(
+                        "squareness_order misses linear axis {}: it must list every linear axis once",
+                        axes[missing].name
+                    ),
                 );
             }
             return Ok(order);
         }
-        // Default: by depth among the linear axes of its chain, the tool chain first on a tie.
-        let depth = |chain: &Chain, id: AxisId| {
-            chain
-                .links
-                .iter()
-                .filter_map(|l| match l {
-                    Link::Axis(a) if axes[*a].kind == AxisKind::Linear => Some(*a),
-                    _ => None,
-                })
-                .position(|a| a == id)
-        };
-        let mut order = linear;
-        order.sort_by_key(|&i| {
-            let (d, side_rank) = match depth(tool, i) {
-                Some(d) => (d, 0),
-                None => (depth(work, i).unwrap_or(usize::MAX), 1),
-            };
-            (d, side_rank, iso_rank(&axes[i].name))
-        });
-        Ok(order)
+        Ok(default_squareness_order(axes))
     }
 
+    /// The error ids of a list of names, in catalogue order. `model` names the sub-model the
+    /// list belongs to, whose errors must be in the machine's full model.
     fn error_list(
         &self,
         list: &Spanned<Vec<Spanned<String>>>,
         m: &Machine,
-        within: Option<&[usize]>,
-    ) -> Res<Vec<usize>> {
-        let mut ids = Vec::new();
+        model: Option<&str>,
+    ) -> Res<Vec<ErrorId>> {
+        let mut ids: Vec<(ErrorId, Span)> = Vec::new();
         for item in list.get_ref() {
             let id = self.error_id(item, m)?;
-            if ids.contains(&id) {
+            if let Some((_, first)) = ids.iter().find(|(i, _)| *i == id) {
                 return self.err(
                     item.span(),
-                    format!("error `{}` listed twice", item.get_ref()),
+                    format!(
+                        "error {} is listed twice (first on line {})",
+                        spelled(item.get_ref(), &m.catalogue[id].name),
+                        self.line(first)
+                    ),
                 );
             }
-            if let Some(allowed) = within
-                && !allowed.contains(&id)
+            if let Some(model) = model
+                && !m.errors.contains(&id)
             {
                 return self.err(
                     item.span(),
                     format!(
-                        "error `{}` is excluded from the machine's error list",
-                        item.get_ref()
+                        "model `{model}`: error {} is not in the machine's full model (it is left out by [errors] include/exclude)",
+                        spelled(item.get_ref(), &m.catalogue[id].name),
                     ),
                 );
             }
-            ids.push(id);
+            ids.push((id, item.span()));
         }
+        let mut ids: Vec<ErrorId> = ids.into_iter().map(|(i, _)| i).collect();
         ids.sort_unstable();
         Ok(ids)
     }
 
-    fn error_id(&self, item: &Spanned<String>, m: &Machine) -> Res<usize> {
-        m.error_by_name(item.get_ref()).ok_or_else(|| {
-            self.loc.error(
-                item.span(),
-                format!(
-                    "error `{}` does not exist for this topology (axes {}); see `rtest machines` for the catalogue",
-                    item.get_ref(),
-                    m.axes.iter().map(|a| a.name.as_str()).collect::<Vec<_>>().join(" ")
-                ),
-            )
-        })
+    fn error_id(&self, item: &Spanned<String>, m: &Machine) -> Res<ErrorId> {
+        let written = item.get_ref();
+        if let Some(id) = m.error_by_name(written) {
+            return Ok(id);
+        }
+        let canonical = crate::catalogue::canonical_name(written);
+        let axis_names = join(m.axes.iter().map(|a| a.name.as_str()));
+        let hint = match canonical.chars().count() {
+            3 => {
+                let last = canonical.chars().last().unwrap_or(' ').to_string();
+                let mut own: Vec<&str> = m
+                    .catalogue
+                    .iter()
+                    .filter(|e| e.axis().is_some_and(|a| m.axes[a].name == last))
+                    .map(|e| e.name.as_str())
+                    .collect();
+                let what = if last == "W" {
+                    own.extend(
+                        m.catalogue
+                            .iter()
+                            .filter(|e| matches!(e.kind, ErrorKind::Setup { .. }))
+                            .map(|e| e.name.as_str()),
+                    );
+                    if m.axis_by_name("W").is_some() {
+                        "axis W and the workpiece"
+                    } else {
+                        "the workpiece"
+                    }
+                } else {
+                    "axis"
+                };
+                if own.is_empty() {
+                    format!("the machine has no axis {last} (axes {axis_names})")
+                } else if what == "axis" {
+                    format!("the errors of axis {last} are {}", join(own))
+                } else {
+                    format!("the errors of {what} are {}", join(own))
+                }
+            }
+            _ => format!(
+                "ISO 230 names have three letters: E<motion><axis>, <motion>O<axis> or XOW YOW ZOW (axes {axis_names})"
+            ),
+        };
+        self.err(
+            item.span(),
+            format!("error `{written}` does not exist for this machine: {hint}"),
+        )
     }
 
-    fn model_errors(&self, raw: &RawErrors, m: &Machine) -> Res<Vec<usize>> {
-        let mut errors: Vec<usize> = match &raw.include {
+    fn model_errors(&self, raw: &RawErrors, m: &Machine) -> Res<Vec<ErrorId>> {
+        let mut errors: Vec<ErrorId> = match &raw.include {
             Some(list) => self.error_list(list, m, None)?,
             None => (0..m.catalogue.len()).collect(),
         };
-        let mut seen = HashMap::new();
-        for item in &raw.exclude {
-            let id = self.error_id(item, m)?;
-            if seen.insert(id, ()).is_some() {
-                return self.err(
-                    item.span(),
-                    format!("error `{}` excluded twice", item.get_ref()),
-                );
+        if let Some(exclude) = &raw.exclude {
+            let mut seen: Vec<(ErrorId, Span)> = Vec::new();
+            for item in exclude.get_ref() {
+                let id = self.error_id(item, m)?;
+                if let Some((_, first)) = seen.iter().find(|(i, _)| *i == id) {
+                    return self.err(
+                        item.span(),
+                        format!(
+                            "error {} is excluded twice (first on line {})",
+                            spelled(item.get_ref(), &m.catalogue[id].name),
+                            self.line(first)
+                        ),
+                    );
+                }
+                seen.push((id, item.span()));
+                errors.retain(|&e| e != id);
             }
-            errors.retain(|&e| e != id);
         }
         Ok(errors)
     }
+}
+
+/// An error name as written, with its canonical spelling when it differs (`X0C` (XOC)).
+fn spelled(written: &str, canonical: &str) -> String {
+    if written == canonical {
+        format!("`{written}`")
+    } else {
+        format!("`{written}` ({canonical})")
+    }
+}
+
+/// The default squareness order of the linear axes: by depth among the linear axes of their
+/// chain (the first linear axis from the bed has depth 0), the tool chain first on equal depth,
+/// then by ISO letter order. For the seed machine (work X; tool Y, Z) this is Y, X, Z.
+pub fn default_squareness_order(axes: &[Axis]) -> Vec<AxisId> {
+    let depth = |id: AxisId| {
+        (0..id)
+            .filter(|&j| axes[j].kind == AxisKind::Linear && axes[j].side == axes[id].side)
+            .count()
+    };
+    let mut order: Vec<AxisId> = (0..axes.len())
+        .filter(|&i| axes[i].kind == AxisKind::Linear)
+        .collect();
+    order.sort_by_key(|&i| {
+        let side_rank = match axes[i].side {
+            Side::Tool => 0,
+            Side::Work => 1,
+        };
+        (depth(i), side_rank, iso_rank(&axes[i].name))
+    });
+    order
 }
 
 /// Every ISO 230 error of the topology, in canonical order (see [`crate::catalogue`]).

@@ -11,8 +11,11 @@
 
 #![warn(missing_docs)]
 
+pub mod basis;
 pub mod exact;
 pub mod fd;
+pub mod model;
+pub mod record;
 
 pub use exact::{
     ErrorVector, ExactError, Transform, VirtualMachine, chain_transform, error_vector,

@@ -1,1 +1,95 @@
-fn main() {}
+//! `rtest`: geometric error models of machine tools from R-test measurements.
+//!
+//! A thin command line: every verb parses its flags and calls the libraries (`model-spec`,
+//! `codegen`, `solver`). Verbs live in [`cli`], one module each.
+
+mod cli;
+
+use clap::{Parser, Subcommand};
+use cli::{CliError, EXIT_CODES, EXIT_USAGE};
+use std::io::Write as _;
+use std::process::ExitCode;
+
+/// Geometric error models of five-axis (and three-axis) machine tools from R-test measurements.
+#[derive(Debug, Parser)]
+#[command(
+    name = "rtest",
+    version,
+    about = "Geometric error models of machine tools from R-test measurements",
+    long_about = "\
+Geometric error models of machine tools from R-test measurements: the ISO 230 error catalogue of \
+a machine topology, its error-gain functions, and no_std Rust code for controllers. Units at \
+every boundary: positions in mm, rotary positions in degrees, translational errors in µm, angular \
+errors in µrad; gains in mm/mm (translational errors) and mm/rad (angular errors). A machine is a \
+built-in name (see `rtest machines`) or the path of a TOML description (docs/model-spec.md).",
+    after_help = EXIT_CODES
+)]
+struct Cli {
+    #[command(subcommand)]
+    verb: Verb,
+}
+
+#[derive(Debug, Subcommand)]
+enum Verb {
+    Machines(cli::machines::MachinesArgs),
+    Gains(cli::gains::GainsArgs),
+    Generate(cli::generate::GenerateArgs),
+    Demo(cli::demo::DemoArgs),
+}
+
+/// A clap error as one line: its message and its hints, without the usage block.
+fn one_line(e: &clap::Error) -> String {
+    let rendered = e.render().to_string();
+    let parts: Vec<&str> = rendered
+        .lines()
+        .map(str::trim)
+        .filter(|l| {
+            !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information")
+        })
+        .collect();
+    let text = parts.join(" ");
+    text.strip_prefix("error: ").unwrap_or(&text).to_string()
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help, --version
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            let verb = std::env::args().nth(1).filter(|a| !a.starts_with('-'));
+            let help = match verb {
+                Some(v) if ["machines", "gains", "generate", "demo"].contains(&v.as_str()) => {
+                    format!("rtest {v} --help")
+                }
+                _ => "rtest --help".into(),
+            };
+            report(&CliError {
+                code: EXIT_USAGE,
+                message: format!("{} (see `{help}`)", one_line(&e)),
+            });
+            return ExitCode::from(EXIT_USAGE);
+        }
+    };
+    let result = match &cli.verb {
+        Verb::Machines(a) => cli::machines::run(a),
+        Verb::Gains(a) => cli::gains::run(a),
+        Verb::Generate(a) => cli::generate::run(a),
+        Verb::Demo(a) => cli::demo::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            report(&e);
+            ExitCode::from(e.code)
+        }
+    }
+}
+
+fn report(e: &CliError) {
+    let message = e.message.lines().collect::<Vec<_>>().join(" ");
+    let _ = writeln!(std::io::stderr(), "rtest: error: {message}");
+}

@@ -104,7 +104,7 @@ pub fn render(m: &Machine, model: &GainModel, title: &str, format: Format) -> St
             )
         })
         .collect();
-    let legend = legend(m, model);
+    let legend = legend(m);
     match format {
         Format::Text => text(title, &rows, &legend),
         Format::Markdown => markdown(title, &rows, &legend),
@@ -112,7 +112,7 @@ pub fn render(m: &Machine, model: &GainModel, title: &str, format: Format) -> St
     }
 }
 
-fn legend(m: &Machine, model: &GainModel) -> String {
+fn legend(m: &Machine) -> String {
     let rotary: Vec<String> = m
         .rotary_axes()
         .map(|a| {

@@ -59,6 +59,11 @@ fn main() -> ExitCode {
             let _ = e.print();
             return ExitCode::SUCCESS;
         }
+        Err(e) if e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            // `rtest` alone: the help, on stderr, as a usage error.
+            let _ = e.print();
+            return ExitCode::from(EXIT_USAGE);
+        }
         Err(e) => {
             let verb = std::env::args().nth(1).filter(|a| !a.starts_with('-'));
             let help = match verb {

@@ -16,7 +16,11 @@ use proptest::test_runner::{Config, TestRunner};
 /// A pose and parameters drawn from `unit` (numbers in [0, 1)).
 fn pose(m: &Machine, unit: &[f64]) -> (Vec<f64>, Vec<f64>) {
     let mut u = unit.iter().copied().cycle();
-    let params: Vec<f64> = m.symbols.iter().map(|s| s.default + 200.0 * (u.next().unwrap() - 0.5)).collect();
+    let params: Vec<f64> = m
+        .symbols
+        .iter()
+        .map(|s| s.default + 200.0 * (u.next().unwrap() - 0.5))
+        .collect();
     let mut commands: Vec<f64> = m
         .axes
         .iter()
@@ -24,12 +28,17 @@ fn pose(m: &Machine, unit: &[f64]) -> (Vec<f64>, Vec<f64>) {
             AxisKind::Linear => 0.0,
             AxisKind::Rotary => {
                 let [lo, hi] = a.limits;
-                let (lo, hi) = if lo.is_finite() { (lo, hi) } else { (-180.0, 180.0) };
+                let (lo, hi) = if lo.is_finite() {
+                    (lo, hi)
+                } else {
+                    (-180.0, 180.0)
+                };
                 (lo + (hi - lo) * u.next().unwrap()).to_radians()
             }
         })
         .collect();
-    solver::exact::tool_centre_point_ik(m, &mut commands, &params).expect("built-in machines have three independent linear axes");
+    solver::exact::tool_centre_point_ik(m, &mut commands, &params)
+        .expect("built-in machines have three independent linear axes");
     (commands, params)
 }
 
@@ -40,8 +49,14 @@ fn close(a: f64, b: f64, tol: f64) -> bool {
 #[test]
 fn symbolic_gains_equal_finite_differences_of_the_exact_chain() {
     let machines = all_builtin();
-    let models: Vec<GainModel> = machines.iter().map(|m| GainModel::derive(m, &(0..m.catalogue.len()).collect::<Vec<_>>())).collect();
-    let mut runner = TestRunner::new(Config { cases: 48, ..Config::default() });
+    let models: Vec<GainModel> = machines
+        .iter()
+        .map(|m| GainModel::derive(m, &(0..m.catalogue.len()).collect::<Vec<_>>()))
+        .collect();
+    let mut runner = TestRunner::new(Config {
+        cases: 48,
+        ..Config::default()
+    });
     runner
         .run(&proptest::collection::vec(0.0f64..1.0, 32), |unit| {
             for (m, model) in machines.iter().zip(&models) {
@@ -65,14 +80,18 @@ fn symbolic_gains_equal_finite_differences_of_the_exact_chain() {
 
 #[test]
 fn evaluator_and_compiled_code_equal_the_symbolic_gains_for_every_model() {
-    let mut runner = TestRunner::new(Config { cases: 64, ..Config::default() });
+    let mut runner = TestRunner::new(Config {
+        cases: 64,
+        ..Config::default()
+    });
     let machines = all_builtin();
     let mut checked = 0;
     for m in &machines {
         for name in m.model_names() {
             let model = GainModel::derive(m, m.model_errors(name).unwrap());
             let program = compile(m, &model);
-            let compiled = generated::lookup(&m.name, name).unwrap_or_else(|| panic!("{} {name} is compiled in", m.name));
+            let compiled = generated::lookup(&m.name, name)
+                .unwrap_or_else(|| panic!("{} {name} is compiled in", m.name));
             assert_eq!(compiled.errors, model.error_names.as_slice());
             assert_eq!(compiled.operations, program.op_counts().total());
             runner
@@ -86,10 +105,23 @@ fn evaluator_and_compiled_code_equal_the_symbolic_gains_for_every_model() {
                     let mut native = vec![0.0; program.outputs.len()];
                     (compiled.gains)(&inputs[..n_pose], &inputs[n_pose..], &mut native);
                     for (i, row) in symbolic.iter().enumerate() {
-                        for k in 0..6 {
+                        for (k, &s) in row.iter().enumerate() {
                             let j = 6 * i + k;
-                            prop_assert!(close(row[k], ir[j], 1e-12), "{} {name} {} row {k}: symbolic {} vs IR {}", m.name, model.error_names[i], row[k], ir[j]);
-                            prop_assert_eq!(ir[j].to_bits(), native[j].to_bits(), "{} {}: IR and compiled code differ", m.name, name);
+                            prop_assert!(
+                                close(s, ir[j], 1e-12),
+                                "{} {name} {} row {k}: symbolic {} vs IR {}",
+                                m.name,
+                                model.error_names[i],
+                                s,
+                                ir[j]
+                            );
+                            prop_assert_eq!(
+                                ir[j].to_bits(),
+                                native[j].to_bits(),
+                                "{} {}: IR and compiled code differ",
+                                m.name,
+                                name
+                            );
                         }
                     }
                     Ok(())
@@ -98,5 +130,9 @@ fn evaluator_and_compiled_code_equal_the_symbolic_gains_for_every_model() {
             checked += 1;
         }
     }
-    assert_eq!(checked, generated::MODELS.len(), "every compiled model was checked");
+    assert_eq!(
+        checked,
+        generated::MODELS.len(),
+        "every compiled model was checked"
+    );
 }

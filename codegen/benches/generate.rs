@@ -8,8 +8,13 @@ use std::hint::black_box;
 
 fn generate(c: &mut Criterion) {
     for m in model_spec::all_builtin() {
-        let full = m.model_errors("full").expect("every machine has a full model").to_vec();
-        c.bench_function(&format!("derive/{}", m.name), |b| b.iter(|| GainModel::derive(black_box(&m), black_box(&full))));
+        let full = m
+            .model_errors("full")
+            .expect("every machine has a full model")
+            .to_vec();
+        c.bench_function(&format!("derive/{}", m.name), |b| {
+            b.iter(|| GainModel::derive(black_box(&m), black_box(&full)))
+        });
         c.bench_function(&format!("derive+cse/{}", m.name), |b| {
             b.iter(|| {
                 let g = GainModel::derive(black_box(&m), black_box(&full));
@@ -17,7 +22,9 @@ fn generate(c: &mut Criterion) {
             })
         });
         c.bench_function(&format!("rust-source/{}", m.name), |b| {
-            b.iter(|| codegen::emit::generate_machine(black_box(&m), &[]).expect("built-ins generate"))
+            b.iter(|| {
+                codegen::emit::generate_machine(black_box(&m), &[]).expect("built-ins generate")
+            })
         });
     }
 }

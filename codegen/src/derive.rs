@@ -133,8 +133,8 @@ impl Deriver<'_> {
         match step {
             Step::Offset(o) => {
                 if v.point {
-                    for k in 0..3 {
-                        v.nominal[k] = v.nominal[k].add(&self.value(o[k]));
+                    for (n, &value) in v.nominal.iter_mut().zip(o) {
+                        *n = n.add(&self.value(value));
                     }
                 }
             }

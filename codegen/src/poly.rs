@@ -231,10 +231,7 @@ impl Poly {
     pub fn reduce(&self, trig_pairs: &[(Atom, Atom)]) -> Poly {
         let mut cur = self.clone();
         for &(s, c) in trig_pairs {
-            loop {
-                let Some(m) = cur.terms.keys().find(|m| m.exponent(c) >= 2).cloned() else {
-                    break;
-                };
+            while let Some(m) = cur.terms.keys().find(|m| m.exponent(c) >= 2).cloned() {
                 let coeff = cur.terms.remove(&m).expect("present");
                 let rest = m.divide(c, 2);
                 // rest · cos² = rest − rest · sin²

@@ -1,0 +1,57 @@
+//! `rtest generate`: standalone `no_std` Rust code for a machine's gains.
+
+use super::{CliError, CliResult, EXIT_CODES};
+use std::path::PathBuf;
+
+const LONG_ABOUT: &str = "\
+Generates a standalone Rust source file with the error-gain functions of a machine: \
+straight-line, allocation-free, no_std-compatible code (only + - *; the sines and cosines of the \
+rotary commands are inputs). It holds `Pose` (sin/cos of rotary commands, linear commands in mm), \
+`Params` (kinematic parameters in mm, defaulting to the machine description) and one module per \
+model whose `pub fn gains(pose, params, out)` writes [gx, gy, gz, gi, gj, gk] per error: tool \
+point minus workpiece point in the tool frame, mm per mm of a translational error and mm per rad \
+of an angular error. Errors themselves are in mm and rad inside the code (µm and µrad for \
+people). The file has no crate attributes, so it can be `include!`d or used as a module.";
+
+/// Flags of `rtest generate`.
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Generate no_std Rust code for a machine's error gains",
+    long_about = LONG_ABOUT,
+    after_help = EXIT_CODES
+)]
+pub struct GenerateArgs {
+    /// Built-in machine (see `rtest machines`) or path of a machine TOML file.
+    #[arg(long, value_name = "NAME|FILE")]
+    machine: String,
+    /// Model to generate (`full`, `reduced`, …); repeat for several. Default: every model of
+    /// the machine.
+    #[arg(long, value_name = "NAME")]
+    model: Vec<String>,
+    /// Write the code to FILE (atomically: through a temporary file in the same directory)
+    /// instead of standard output.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    output: Option<PathBuf>,
+}
+
+/// Runs `rtest generate`.
+pub fn run(args: &GenerateArgs) -> CliResult {
+    let m = super::load_machine(&args.machine)?;
+    for (i, name) in args.model.iter().enumerate() {
+        super::model_errors(&m, name)?;
+        if args.model[..i].contains(name) {
+            return Err(CliError::usage(format!("--model: `{name}` is given twice")));
+        }
+    }
+    let models: Vec<&str> = args.model.iter().map(String::as_str).collect();
+    let code = codegen::emit::generate_machine(&m, &models)
+        .map_err(|e| CliError::failure(format!("generate: machine {}: {e}", m.name)))?;
+    match &args.output {
+        Some(path) => {
+            super::write_atomic("-o", path, &code)?;
+            eprintln!("wrote {}", path.display());
+        }
+        None => print!("{code}"),
+    }
+    Ok(())
+}

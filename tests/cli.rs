@@ -1,0 +1,919 @@
+//! End-to-end tests of the `rtest` command line: every verb's happy path with real content,
+//! and every kind of bad input (message on one stderr line naming the flag and the item, exit
+//! code 2 for usage errors and 1 for other failures, no panic, no output file left behind).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Table 3 of the seed (mm).
+const XW: f64 = -217.504;
+const YW: f64 = -0.279;
+const ZW: f64 = 211.537;
+const ZC: f64 = 29.794;
+const TABLE_3: &str = "Xw=-217.504,Yw=-0.279,Zw=211.537,Zc=29.794";
+
+fn rtest_in(dir: Option<&Path>, args: &[&str]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_rtest"));
+    cmd.args(args);
+    if let Some(d) = dir {
+        cmd.current_dir(d);
+    }
+    cmd.output().expect("the rtest binary runs")
+}
+
+fn rtest(args: &[&str]) -> Output {
+    rtest_in(None, args)
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).expect("utf-8 stdout")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8(o.stderr.clone()).expect("utf-8 stderr")
+}
+
+/// Runs `args`, asserts success and returns stdout.
+fn ok(args: &[&str]) -> String {
+    let o = rtest(args);
+    assert!(
+        o.status.success(),
+        "rtest {args:?} failed ({:?}): {}",
+        o.status.code(),
+        stderr(&o)
+    );
+    stdout(&o)
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = ok(args);
+    serde_json::from_str(&out).unwrap_or_else(|e| panic!("rtest {args:?}: not JSON ({e}):\n{out}"))
+}
+
+/// Runs `args`, asserts the exit code, an empty stdout and one stderr line containing every
+/// string of `needles`; returns that line.
+fn fails(args: &[&str], code: i32, needles: &[&str]) -> String {
+    fails_in(None, args, code, needles)
+}
+
+fn fails_in(dir: Option<&Path>, args: &[&str], code: i32, needles: &[&str]) -> String {
+    let o = rtest_in(dir, args);
+    let err = stderr(&o);
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "rtest {args:?}: exit code; stderr: {err}"
+    );
+    assert!(!err.contains("panicked"), "rtest {args:?} panicked: {err}");
+    assert!(
+        o.stdout.is_empty(),
+        "rtest {args:?}: stdout not empty: {}",
+        stdout(&o)
+    );
+    assert_eq!(
+        err.lines().count(),
+        1,
+        "rtest {args:?}: not one line: {err}"
+    );
+    assert!(err.starts_with("rtest: error: "), "rtest {args:?}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "rtest {args:?}: `{n}` not in: {err}");
+    }
+    err
+}
+
+/// A fresh, empty temporary directory for one test, removed when dropped.
+struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn temp_dir(name: &str) -> TempDir {
+    let d = std::env::temp_dir().join(format!("rtest-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    TempDir(d)
+}
+
+/// The names of the entries of `dir`, sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .expect("dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// The built-in seed machine's TOML, copied into `dir`.
+fn seed_file(dir: &Path) -> PathBuf {
+    let text = model_spec::BUILTIN
+        .iter()
+        .find(|(n, _)| *n == "seed-ac")
+        .expect("seed-ac is built in")
+        .1;
+    let path = dir.join("my-seed.toml");
+    std::fs::write(&path, text).expect("write machine file");
+    path
+}
+
+fn triple(v: &serde_json::Value) -> [f64; 3] {
+    let a = v.as_array().expect("array");
+    assert_eq!(a.len(), 3, "{v}");
+    std::array::from_fn(|k| a[k].as_f64().expect("number"))
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * (1.0 + a.abs().max(b.abs()))
+}
+
+/// Keys of a JSON object in the order they appear in the text.
+fn key_order(text: &str, keys: &[&str]) -> Vec<usize> {
+    keys.iter()
+        .map(|k| {
+            text.find(&format!("\"{k}\""))
+                .unwrap_or_else(|| panic!("{k} missing"))
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------- machines
+
+#[test]
+fn machines_lists_every_builtin_with_axes_symbols_errors_and_models() {
+    let out = ok(&["machines"]);
+    for name in ["seed-ac:", "seed-3axis:", "head-table-bc:"] {
+        assert!(out.contains(name), "{name} missing:\n{out}");
+    }
+    assert!(
+        out.contains("work chain: bed -> X -> A -> C -> ball"),
+        "{out}"
+    );
+    assert!(
+        out.contains("tool chain: bed -> Y -> Z -> holder -> probe"),
+        "{out}"
+    );
+    let x = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("X   linear"))
+        .expect("X axis line");
+    assert!(
+        x.contains("+x") && x.contains("-500 .. 500 mm") && x.contains("work chain"),
+        "{x}"
+    );
+    let a = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("A   rotary"))
+        .expect("A axis line");
+    assert!(a.contains("-120 .. 120 deg"), "{a}");
+    assert!(
+        out.contains("Xw = -217.504") && out.contains("Zp = 184.67"),
+        "{out}"
+    );
+    assert!(
+        out.contains("errors (44 of the 44 of its topology"),
+        "{out}"
+    );
+    assert!(out.contains("COX AOZ BOZ XOW YOW ZOW"), "{out}");
+    assert!(out.contains("reduced (11 errors)"), "{out}");
+    assert!(
+        out.contains("XOW YOW ZOW YOA ZOA BOA COA XOC YOC AOC BOC"),
+        "{out}"
+    );
+}
+
+#[test]
+fn machines_describes_a_machine_file() {
+    let dir = temp_dir("machines-file");
+    let file = seed_file(&dir);
+    let from_file = ok(&["machines", "--machine", file.to_str().unwrap()]);
+    let builtin = ok(&["machines", "--machine", "seed-ac"]);
+    assert_eq!(from_file, builtin);
+    assert!(!builtin.contains("seed-3axis"));
+}
+
+// ---------------------------------------------------------------- gains, symbolic
+
+#[test]
+fn gains_symbolic_text_markdown_latex() {
+    let text = ok(&["gains", "--machine", "seed-ac", "--model", "reduced"]);
+    assert!(
+        text.starts_with("Error gains of seed-ac, model reduced (11 errors)"),
+        "{text}"
+    );
+    let boa = text.lines().find(|l| l.contains(" BOA ")).expect("BOA row");
+    assert!(boa.contains("Sa*Sc*Xw") && boa.contains("-Ca"), "{boa}");
+    let md = ok(&[
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--model",
+        "reduced",
+        "--format",
+        "markdown",
+    ]);
+    assert!(
+        md.lines().any(|l| l.starts_with('|') && l.contains("XOC")),
+        "{md}"
+    );
+    let tex = ok(&["gains", "--machine", "seed-ac", "--format", "latex"]);
+    assert!(
+        tex.contains("\\begin{longtable}") && tex.contains("EXX"),
+        "{tex}"
+    );
+    // The default model is `full`.
+    let full = ok(&["gains", "--machine", "seed-ac"]);
+    assert!(
+        full.starts_with("Error gains of seed-ac, model full (44 errors)"),
+        "{full}"
+    );
+}
+
+#[test]
+fn gains_symbolic_json() {
+    let args = [
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--model",
+        "reduced",
+        "--format",
+        "json",
+    ];
+    let v = json(&args);
+    assert_eq!(v["machine"], "seed-ac");
+    assert_eq!(v["model"], "reduced");
+    assert!(v["atoms"]["Sa"].as_str().unwrap().contains("A command"));
+    assert!(v["atoms"]["Xw"].as_str().unwrap().contains("-217.504"));
+    let gains = v["gains"].as_object().unwrap();
+    assert_eq!(gains.len(), 11);
+    assert_eq!(
+        v["gains"]["XOC"],
+        serde_json::json!(["-1", "0", "0", "0", "0", "0"])
+    );
+    let boa: Vec<&str> = v["gains"]["BOA"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_str().unwrap())
+        .collect();
+    assert_eq!(boa.len(), 6);
+    assert!(boa[0].contains("Sa*Sc*Xw") && boa[1] == "0", "{boa:?}");
+    // Errors keep the model's order.
+    let text = ok(&args);
+    let order = key_order(&text, &["XOW", "YOA", "BOA", "XOC", "BOC"]);
+    assert!(order.windows(2).all(|w| w[0] < w[1]), "{text}");
+}
+
+#[test]
+fn gains_errors_list_keeps_order_and_accepts_digit_zero() {
+    let args = [
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--errors",
+        "boa,X0C",
+        "--format",
+        "json",
+    ];
+    let v = json(&args);
+    assert_eq!(v["model"], serde_json::Value::Null);
+    let gains = v["gains"].as_object().unwrap();
+    assert_eq!(gains.len(), 2);
+    assert_eq!(v["gains"]["XOC"][0], "-1");
+    let text = ok(&args);
+    let order = key_order(&text, &["BOA", "XOC"]);
+    assert!(order[0] < order[1], "{text}");
+}
+
+// ---------------------------------------------------------------- gains, numeric
+
+/// The seed's Table 2 formulas of BOA (ΔX and ΔZ).
+fn boa_expected(a_deg: f64, c_deg: f64, xw: f64, yw: f64, zw: f64, zc: f64) -> [f64; 3] {
+    let (sa, ca) = a_deg.to_radians().sin_cos();
+    let (sc, cc) = c_deg.to_radians().sin_cos();
+    [
+        -ca * (zw + zc) - sa * sc * xw - sa * cc * yw,
+        0.0,
+        -sc * yw + cc * xw,
+    ]
+}
+
+#[test]
+fn gains_at_pose_match_the_seed_table_2() {
+    let param = format!("{TABLE_3},Zp=184.67");
+    let v = json(&[
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--at",
+        "X=0,Y=0,Z=0,A=30,C=45",
+        "--param",
+        &param,
+        "--format",
+        "json",
+    ]);
+    let map = v.as_object().unwrap();
+    assert_eq!(map.len(), 44, "every error of the full model");
+    assert_eq!(triple(&v["XOC"]), [-1.0, 0.0, 0.0]);
+    let boa = triple(&v["BOA"]);
+    let want = boa_expected(30.0, 45.0, XW, YW, ZW, ZC);
+    for k in 0..3 {
+        assert!(
+            close(boa[k], want[k]),
+            "BOA[{k}] = {} want {}",
+            boa[k],
+            want[k]
+        );
+    }
+}
+
+#[test]
+fn gains_param_overrides_defaults() {
+    let v = json(&[
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--model",
+        "reduced",
+        "--at",
+        "A=-60,C=200",
+        "--param",
+        "Xw=-100,Zc=10",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(v.as_object().unwrap().len(), 11);
+    let boa = triple(&v["BOA"]);
+    let want = boa_expected(-60.0, 200.0, -100.0, YW, ZW, 10.0);
+    for k in 0..3 {
+        assert!(
+            close(boa[k], want[k]),
+            "BOA[{k}] = {} want {}",
+            boa[k],
+            want[k]
+        );
+    }
+}
+
+#[test]
+fn gains_fill_missing_linear_axes_by_inverse_kinematics() {
+    let m = model_spec::builtin("seed-ac").unwrap().unwrap();
+    let params = m.default_parameters();
+    let mut commands = vec![0.0; m.axes.len()];
+    commands[m.axis_by_name("A").unwrap()] = 30f64.to_radians();
+    commands[m.axis_by_name("C").unwrap()] = 45f64.to_radians();
+    solver::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
+    let model = codegen::GainModel::derive(&m, &m.errors);
+    let want = model.evaluate(&commands, &params);
+
+    let v = json(&[
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--at",
+        "A=30,C=45",
+        "--format",
+        "json",
+    ]);
+    for (name, w) in model.error_names.iter().zip(&want) {
+        let got = triple(&v[name.as_str()]);
+        for k in 0..3 {
+            assert!(
+                (got[k] - w[k]).abs() <= 1e-9 * (1.0 + w[k].abs()),
+                "{name}[{k}]: {} vs {}",
+                got[k],
+                w[k]
+            );
+        }
+    }
+    // A given linear axis is kept, the others come from the inverse kinematics.
+    let text = ok(&[
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--model",
+        "reduced",
+        "--at",
+        "x=5,A=30,C=45",
+    ]);
+    assert!(text.contains("X = 5 mm,"), "{text}");
+    let y = format!("Y = {:.6}", commands[m.axis_by_name("Y").unwrap()]);
+    assert!(text.contains(&y) && text.contains("(IK)"), "{y} in {text}");
+    assert!(text.contains("mm/rad") && text.contains("mm/mm"), "{text}");
+    let boa = text
+        .lines()
+        .find(|l| l.starts_with("BOA"))
+        .expect("BOA row");
+    let want = boa_expected(30.0, 45.0, XW, YW, ZW, ZC);
+    assert!(boa.contains(&format!("{:.6}", want[0])), "{boa}");
+}
+
+#[test]
+fn gains_at_pose_other_formats() {
+    let md = ok(&[
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--errors",
+        "XOC",
+        "--at",
+        "A=0,C=0",
+        "--format",
+        "markdown",
+    ]);
+    assert!(
+        md.contains("| XOC | mm/mm | -1.000000 | 0.000000 | 0.000000 |"),
+        "{md}"
+    );
+    let tex = ok(&[
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--errors",
+        "BOA",
+        "--at",
+        "A=0,C=0",
+        "--format",
+        "latex",
+    ]);
+    assert!(tex.contains("$BOA$ & mm/rad"), "{tex}");
+}
+
+#[test]
+fn machine_file_gives_the_same_numbers_as_the_builtin() {
+    let dir = temp_dir("gains-file");
+    let file = seed_file(&dir);
+    let file = file.to_str().unwrap();
+    for (machine_args, at) in [
+        ("full", "X=1,Y=2,Z=3,A=30,C=45"),
+        ("reduced", "A=-45,C=120"),
+    ] {
+        let run = |machine: &str| {
+            ok(&[
+                "gains",
+                "--machine",
+                machine,
+                "--model",
+                machine_args,
+                "--at",
+                at,
+                "--format",
+                "json",
+            ])
+        };
+        assert_eq!(run(file), run("seed-ac"));
+    }
+    let sym = |machine: &str| ok(&["gains", "--machine", machine, "--model", "reduced"]);
+    assert_eq!(sym(file), sym("seed-ac"));
+}
+
+// ---------------------------------------------------------------- generate
+
+#[test]
+fn generate_writes_a_rust_file() {
+    let dir = temp_dir("generate");
+    let out = dir.join("seed.rs");
+    let o = rtest(&[
+        "generate",
+        "--machine",
+        "seed-ac",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(o.stdout.is_empty());
+    let code = std::fs::read_to_string(&out).unwrap();
+    assert!(code.contains("pub fn gains"), "{code}");
+    assert!(!code.contains("#!["), "no crate attributes");
+    assert!(code.contains("pub mod full") && code.contains("pub mod reduced"));
+    assert_eq!(entries(&dir), ["seed.rs"], "no temporary file left");
+    // Standard output gives the same code.
+    assert_eq!(ok(&["generate", "--machine", "seed-ac"]), code);
+    // One model only; a machine file works too.
+    let file = seed_file(&dir);
+    let only = ok(&[
+        "generate",
+        "--machine",
+        file.to_str().unwrap(),
+        "--model",
+        "reduced",
+    ]);
+    assert!(only.contains("pub mod reduced") && !only.contains("pub mod full"));
+    assert!(only.contains("pub fn gains"));
+    // An existing file is replaced.
+    std::fs::write(&out, "old").unwrap();
+    assert!(
+        rtest(&[
+            "generate",
+            "--machine",
+            "seed-ac",
+            "-o",
+            out.to_str().unwrap()
+        ])
+        .status
+        .success()
+    );
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), code);
+}
+
+// ---------------------------------------------------------------- demo
+
+#[test]
+fn demo_writes_its_three_files() {
+    let dir = temp_dir("demo");
+    let o = rtest_in(Some(&dir), &["demo"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("seed-ac"), "{out}");
+    assert!(out.contains("(the seed's Table 2)"), "{out}");
+    assert!(out.contains("K4 sample 60"), "{out}");
+    assert!(out.contains("full") && out.contains("operations"), "{out}");
+    for f in ["seed_ac.rs", "gains-reduced.md", "gains-k4.json"] {
+        assert!(
+            out.contains(&format!("rtest-demo/{f}")),
+            "{f} not reported:\n{out}"
+        );
+    }
+    let demo = dir.join("rtest-demo");
+    assert_eq!(
+        entries(&demo),
+        ["gains-k4.json", "gains-reduced.md", "seed_ac.rs"]
+    );
+    let code = std::fs::read_to_string(demo.join("seed_ac.rs")).unwrap();
+    assert!(code.contains("pub fn gains") && !code.contains("#!["));
+    let md = std::fs::read_to_string(demo.join("gains-reduced.md")).unwrap();
+    for e in ["XOC", "BOA"] {
+        assert!(
+            md.lines().any(|l| l.starts_with('|') && l.contains(e)),
+            "{md}"
+        );
+    }
+
+    let k4: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(demo.join("gains-k4.json")).unwrap())
+            .unwrap();
+    let samples = k4.as_array().unwrap();
+    assert_eq!(samples.len(), 241);
+    let m = model_spec::builtin("seed-ac").unwrap().unwrap();
+    let params = m.default_parameters();
+    for (i, s) in samples.iter().enumerate() {
+        assert_eq!(s["sample"], i);
+        let c = 1.5 * i as f64;
+        let a = -45.0 * (1.0 - c.to_radians().cos());
+        assert!(close(s["C_deg"].as_f64().unwrap(), c) && close(s["A_deg"].as_f64().unwrap(), a));
+        let gains = s["gains"].as_object().unwrap();
+        assert_eq!(gains.len(), 11);
+        assert_eq!(triple(&s["gains"]["XOC"]), [-1.0, 0.0, 0.0]);
+        let boa = triple(&s["gains"]["BOA"]);
+        let want = boa_expected(a, c, XW, YW, ZW, ZC);
+        for k in 0..3 {
+            assert!((boa[k] - want[k]).abs() < 1e-9, "sample {i} BOA[{k}]");
+        }
+        let mut commands = vec![0.0; m.axes.len()];
+        commands[m.axis_by_name("A").unwrap()] = a.to_radians();
+        commands[m.axis_by_name("C").unwrap()] = c.to_radians();
+        solver::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
+        for axis in ["X", "Y", "Z"] {
+            let got = s[format!("{axis}_mm")].as_f64().unwrap();
+            let want = commands[m.axis_by_name(axis).unwrap()];
+            assert!(
+                (got - want).abs() < 1e-9,
+                "sample {i} {axis}: {got} vs {want}"
+            );
+        }
+    }
+    assert_eq!(samples[120]["A_deg"], -90.0);
+    assert_eq!(samples[120]["C_deg"], 180.0);
+
+    // Running it again replaces the files and leaves no temporary file.
+    assert!(rtest_in(Some(&dir), &["demo"]).status.success());
+    assert_eq!(
+        entries(&demo),
+        ["gains-k4.json", "gains-reduced.md", "seed_ac.rs"]
+    );
+}
+
+// ---------------------------------------------------------------- help
+
+#[test]
+fn every_verb_documents_units_and_exit_codes() {
+    for verb in ["machines", "gains", "generate", "demo"] {
+        let help = ok(&[verb, "--help"]);
+        assert!(help.contains("Exit codes: 0 success; 2"), "{verb}: {help}");
+        assert!(help.contains("mm"), "{verb}: {help}");
+    }
+    let gains = ok(&["gains", "--help"]);
+    for s in [
+        "degrees",
+        "mm/rad",
+        "mm/mm",
+        "inverse kinematics",
+        "--param",
+    ] {
+        assert!(gains.contains(s), "`{s}` not in gains --help");
+    }
+    assert!(ok(&["--help"]).contains("µrad"));
+    assert!(ok(&["demo", "--help"]).contains("rtest-demo"));
+}
+
+// ---------------------------------------------------------------- bad input
+
+#[test]
+fn bad_machine() {
+    fails(
+        &["gains", "--machine", "nope"],
+        2,
+        &["--machine", "`nope`", "seed-ac"],
+    );
+    fails(
+        &["gains", "--machine", "missing.toml"],
+        2,
+        &["--machine", "`missing.toml`"],
+    );
+    fails(
+        &["machines", "--machine", "nope"],
+        2,
+        &["--machine", "`nope`"],
+    );
+    let dir = temp_dir("bad-machine");
+    let text = model_spec::BUILTIN[0]
+        .1
+        .replace("stroke = [-500.0, 500.0]", "stroke = [500.0, -500.0]");
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, text).unwrap();
+    let bad = bad.to_str().unwrap();
+    fails(
+        &["gains", "--machine", bad],
+        1,
+        &["--machine", bad, "stroke"],
+    );
+    std::fs::write(dir.join("junk.toml"), "this is [not toml").unwrap();
+    let junk = dir.join("junk.toml");
+    fails(
+        &["machines", "--machine", junk.to_str().unwrap()],
+        1,
+        &["--machine", "junk.toml:1:"],
+    );
+    fails(
+        &["gains", "--machine", dir.to_str().unwrap()],
+        1,
+        &["--machine", "cannot read"],
+    );
+}
+
+#[test]
+fn bad_model_and_errors() {
+    fails(
+        &["gains", "--machine", "seed-ac", "--model", "tiny"],
+        2,
+        &["--model", "`tiny`", "full, reduced"],
+    );
+    fails(
+        &["gains", "--machine", "seed-ac", "--errors", "XOC,FOO"],
+        2,
+        &["--errors", "`FOO`", "EXX", "BOC"],
+    );
+    fails(
+        &["gains", "--machine", "seed-ac", "--errors", "XOC,,BOA"],
+        2,
+        &["--errors", "empty item"],
+    );
+    fails(
+        &["gains", "--machine", "seed-ac", "--errors", ""],
+        2,
+        &["--errors", "empty list"],
+    );
+    fails(
+        &["gains", "--machine", "seed-ac", "--errors", "XOC,X0C"],
+        2,
+        &["--errors", "XOC given twice"],
+    );
+    fails(
+        &[
+            "gains",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "full",
+            "--errors",
+            "XOC",
+        ],
+        2,
+        &["--model", "--errors"],
+    );
+    // An error that exists in another machine only.
+    fails(
+        &["gains", "--machine", "seed-ac", "--errors", "XOB"],
+        2,
+        &["--errors", "`XOB`"],
+    );
+}
+
+#[test]
+fn bad_at() {
+    let base = ["gains", "--machine", "seed-ac", "--format", "json", "--at"];
+    let at = |s: &'static str| [&base[..], &[s]].concat();
+    fails(
+        &at("X=abc,A=0,C=0"),
+        2,
+        &["--at", "`X=abc`", "`abc` is not a number"],
+    );
+    fails(&at("X,A=0,C=0"), 2, &["--at", "`X` is not NAME=VALUE"]);
+    fails(&at("A=0,C=0,A=1"), 2, &["--at", "`A` is given twice"]);
+    fails(&at("A=0,C=0,c=1"), 2, &["--at", "`c` is given twice"]);
+    fails(
+        &at("A=0,C=0,Q=1"),
+        2,
+        &["--at", "no axis `Q`", "X, A, C, Y, Z"],
+    );
+    fails(&at("A=0,C=inf"), 2, &["--at", "`C=inf`", "finite"]);
+    fails(&at("A=NaN,C=0"), 2, &["--at", "`A=NaN`", "finite"]);
+    fails(&at("A=1e999,C=0"), 2, &["--at", "`A=1e999`", "finite"]);
+    fails(
+        &at("X=0,Y=0,Z=0,A=0"),
+        2,
+        &["--at", "rotary axis C is missing"],
+    );
+    fails(&at("A=0,C=0,"), 2, &["--at", "empty item"]);
+    fails(&at(""), 2, &["--at", "empty list"]);
+    fails(&at("=3,A=0,C=0"), 2, &["--at", "`=3` has no name"]);
+    fails(&at("X=,A=0,C=0"), 2, &["--at", "`X=`"]);
+}
+
+#[test]
+fn bad_param() {
+    let args = [
+        "gains",
+        "--machine",
+        "seed-ac",
+        "--at",
+        "A=0,C=0",
+        "--param",
+    ];
+    let with = |p: &'static str| [&args[..], &[p]].concat();
+    fails(&with("Foo=1"), 2, &["--param", "`Foo`", "Xw", "Zp"]);
+    fails(&with("Xw=abc"), 2, &["--param", "`Xw=abc`", "not a number"]);
+    fails(&with("Xw=1,Xw=2"), 2, &["--param", "`Xw` is given twice"]);
+    fails(&with("Xw=inf"), 2, &["--param", "finite"]);
+    fails(
+        &["gains", "--machine", "seed-ac", "--param", "Xw=1"],
+        2,
+        &["--at"],
+    );
+}
+
+#[test]
+fn bad_format_and_verb() {
+    fails(
+        &["gains", "--machine", "seed-ac", "--format", "yaml"],
+        2,
+        &["--format", "'yaml'", "json"],
+    );
+    fails(
+        &[
+            "gains",
+            "--machine",
+            "seed-ac",
+            "--at",
+            "A=0,C=0",
+            "--format",
+            "csv",
+        ],
+        2,
+        &["--format", "'csv'"],
+    );
+    fails(&["gains"], 2, &["--machine"]);
+    fails(&["frobnicate"], 2, &["frobnicate"]);
+    fails(
+        &["gains", "--machine", "seed-ac", "--bogus"],
+        2,
+        &["--bogus"],
+    );
+}
+
+#[test]
+fn inverse_kinematics_failure_is_not_a_usage_error() {
+    let dir = temp_dir("two-linear");
+    let file = dir.join("two.toml");
+    std::fs::write(
+        &file,
+        "name = \"two-linear\"\ndescription = \"C table, X and Y only\"\n\
+         [[work]]\naxis = \"C\"\ntype = \"rotary\"\ndirection = \"+z\"\n\
+         [[work]]\nend = \"ball\"\n\
+         [[tool]]\naxis = \"X\"\ntype = \"linear\"\ndirection = \"+x\"\nstroke = [-100, 100]\n\
+         [[tool]]\naxis = \"Y\"\ntype = \"linear\"\ndirection = \"+y\"\nstroke = [-100, 100]\n\
+         [[tool]]\nend = \"probe\"\n",
+    )
+    .unwrap();
+    let file = file.to_str().unwrap();
+    fails(
+        &["gains", "--machine", file, "--at", "C=10"],
+        1,
+        &["--at", "inverse kinematics", "three linear axes"],
+    );
+    // With every axis given, no inverse kinematics is needed.
+    let v = json(&[
+        "gains",
+        "--machine",
+        file,
+        "--at",
+        "C=10,X=0,Y=0",
+        "--errors",
+        "XOC",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(triple(&v["XOC"]), [-1.0, 0.0, 0.0]);
+}
+
+#[test]
+fn generate_failures_leave_no_file() {
+    let dir = temp_dir("generate-bad");
+    let out = dir.join("code.rs");
+    let o = out.to_str().unwrap();
+    fails(
+        &[
+            "generate",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "tiny",
+            "-o",
+            o,
+        ],
+        2,
+        &["--model", "`tiny`"],
+    );
+    fails(
+        &["generate", "--machine", "nope", "-o", o],
+        2,
+        &["--machine", "`nope`"],
+    );
+    fails(
+        &[
+            "generate",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--model",
+            "reduced",
+            "-o",
+            o,
+        ],
+        2,
+        &["--model", "twice"],
+    );
+    assert!(entries(&dir).is_empty(), "{:?}", entries(&dir));
+    // Unwritable destinations.
+    let missing = dir.join("no-such-dir").join("code.rs");
+    fails(
+        &[
+            "generate",
+            "--machine",
+            "seed-ac",
+            "-o",
+            missing.to_str().unwrap(),
+        ],
+        1,
+        &["-o", "cannot write", "no-such-dir"],
+    );
+    std::fs::create_dir(dir.join("sub")).unwrap();
+    fails(
+        &[
+            "generate",
+            "--machine",
+            "seed-ac",
+            "-o",
+            dir.join("sub").to_str().unwrap(),
+        ],
+        1,
+        &["-o", "directory"],
+    );
+    assert_eq!(entries(&dir), ["sub"]);
+    assert!(entries(&dir.join("sub")).is_empty());
+}
+
+#[test]
+fn demo_failure_leaves_no_partial_file() {
+    let dir = temp_dir("demo-bad");
+    // `rtest-demo` is a file, so the directory cannot be created.
+    std::fs::write(dir.join("rtest-demo"), "in the way").unwrap();
+    fails_in(Some(&dir), &["demo"], 1, &["demo", "rtest-demo"]);
+    assert_eq!(entries(&dir), ["rtest-demo"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("rtest-demo")).unwrap(),
+        "in the way"
+    );
+}

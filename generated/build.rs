@@ -21,12 +21,15 @@ fn main() {
     let mut table = String::new();
     for path in &paths {
         println!("cargo:rerun-if-changed={}", path.display());
-        let text = std::fs::read_to_string(path).unwrap_or_else(|e| fail(&format!("cannot read {}: {e}", path.display())));
-        let machine = model_spec::parse_machine(&path.display().to_string(), &text).unwrap_or_else(|e| fail(&e.to_string()));
+        let text = std::fs::read_to_string(path)
+            .unwrap_or_else(|e| fail(&format!("cannot read {}: {e}", path.display())));
+        let machine = model_spec::parse_machine(&path.display().to_string(), &text)
+            .unwrap_or_else(|e| fail(&e.to_string()));
         let code = codegen::emit::generate_machine(&machine, &[]).unwrap_or_else(|e| fail(&e));
         let module = machine.name.replace('-', "_");
         let file = format!("{module}.rs");
-        std::fs::write(out.join(&file), code).unwrap_or_else(|e| fail(&format!("cannot write {file}: {e}")));
+        std::fs::write(out.join(&file), code)
+            .unwrap_or_else(|e| fail(&format!("cannot write {file}: {e}")));
         let _ = writeln!(
             index,
             "/// Machine `{}`: {}\npub mod {module} {{\n    include!(concat!(env!(\"OUT_DIR\"), \"/{file}\"));\n}}",
@@ -40,8 +43,12 @@ fn main() {
             );
         }
     }
-    let _ = writeln!(index, "/// Every compiled model of every built-in machine.\npub const MODELS: &[CompiledModel] = &[\n{table}];");
-    std::fs::write(out.join("machines.rs"), index).unwrap_or_else(|e| fail(&format!("cannot write machines.rs: {e}")));
+    let _ = writeln!(
+        index,
+        "/// Every compiled model of every built-in machine.\npub const MODELS: &[CompiledModel] = &[\n{table}];"
+    );
+    std::fs::write(out.join("machines.rs"), index)
+        .unwrap_or_else(|e| fail(&format!("cannot write machines.rs: {e}")));
 }
 
 fn fail(message: &str) -> ! {

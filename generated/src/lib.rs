@@ -45,7 +45,9 @@ pub struct CompiledModel {
 
 /// The compiled model `model` of the built-in machine `machine`.
 pub fn lookup(machine: &str, model: &str) -> Option<&'static CompiledModel> {
-    MODELS.iter().find(|m| m.machine == machine && m.model == model)
+    MODELS
+        .iter()
+        .find(|m| m.machine == machine && m.model == model)
 }
 
 include!(concat!(env!("OUT_DIR"), "/machines.rs"));

@@ -12,10 +12,22 @@
 #![warn(missing_docs)]
 
 pub mod basis;
+pub mod csvio;
+pub mod distributions;
+pub mod estimate;
 pub mod exact;
 pub mod fd;
+pub mod hmatrix;
+pub mod identifiability;
 pub mod model;
+pub mod paths;
 pub mod record;
+pub mod report;
+pub mod rng;
+pub mod simulate;
+
+pub mod truth;
+pub mod validate;
 
 pub use exact::{
     ErrorVector, ExactError, Transform, VirtualMachine, chain_transform, error_vector,

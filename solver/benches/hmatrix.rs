@@ -1,0 +1,113 @@
+//! H-matrix filling on K4 of `seed-ac` (241 samples, 723 rows) for the reduced (11 errors) and
+//! full (44 errors) models, compiled code against the IR evaluator; the evaluator's set-up
+//! (derive + compile); and the estimation on K4 (least squares alone, and `identify` end to end).
+//!
+//! Needs `[[bench]] name = "hmatrix"`, `harness = false` in `solver/Cargo.toml`.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use model_spec::Machine;
+use nalgebra::DVector;
+use solver::estimate::{Constraint, IdentifyOptions, Tolerances, identify, least_squares};
+use solver::hmatrix::{GainSource, h_matrix, parameter_names};
+use solver::model::Model;
+use solver::record::{Record, Sample, motion_directions};
+use solver::tool_centre_point_ik;
+use std::hint::black_box;
+
+fn seed_ac() -> Machine {
+    model_spec::builtin("seed-ac")
+        .expect("built-in")
+        .expect("valid")
+}
+
+/// K4: C = 1.5·i°, A = −45·(1 − cos C)°, i = 0..=240, linear axes on the ball.
+fn k4(m: &Machine) -> Record {
+    let p = m.default_parameters();
+    let (a, c) = (m.axis_by_name("A").unwrap(), m.axis_by_name("C").unwrap());
+    let commands: Vec<Vec<f64>> = (0..=240)
+        .map(|i| {
+            let cc = (1.5 * i as f64).to_radians();
+            let mut q = vec![0.0; m.axes.len()];
+            q[c] = cc;
+            q[a] = (-45.0 * (1.0 - cc.cos())).to_radians();
+            tool_centre_point_ik(m, &mut q, &p).unwrap();
+            q
+        })
+        .collect();
+    let motion = motion_directions(&commands);
+    Record {
+        samples: commands
+            .into_iter()
+            .zip(motion)
+            .enumerate()
+            .map(|(i, (commands, motion))| Sample {
+                commands,
+                t: i as f64,
+                motion,
+            })
+            .collect(),
+        measured: vec![],
+    }
+}
+
+fn hmatrix(c: &mut Criterion) {
+    let m = seed_ac();
+    let p = m.default_parameters();
+    let rec = k4(&m);
+    let mut g = c.benchmark_group("hmatrix_k4");
+    for name in ["reduced", "full"] {
+        let model = Model::constant(m.model_errors(name).unwrap());
+        let mut compiled = GainSource::compiled(&m, &model.errors(), &p).unwrap();
+        let mut evaluator = GainSource::evaluator(&m, &model.errors(), &p).unwrap();
+        g.bench_function(format!("{name}/compiled"), |b| {
+            b.iter(|| h_matrix(&m, &model, black_box(&rec), &mut compiled).unwrap())
+        });
+        g.bench_function(format!("{name}/evaluator"), |b| {
+            b.iter(|| h_matrix(&m, &model, black_box(&rec), &mut evaluator).unwrap())
+        });
+        g.bench_function(format!("{name}/evaluator_setup"), |b| {
+            b.iter(|| GainSource::evaluator(&m, black_box(&model.errors()), &p).unwrap())
+        });
+    }
+    g.finish();
+}
+
+fn estimation(c: &mut Criterion) {
+    let m = seed_ac();
+    let p = m.default_parameters();
+    let model = Model::constant(m.model_errors("reduced").unwrap());
+    let mut rec = k4(&m);
+    let mut source = GainSource::new(&m, &model.errors(), &p).unwrap();
+    let h = h_matrix(&m, &model, &rec, &mut source).unwrap();
+    let x = DVector::from_column_slice(&[
+        0.012, -0.008, 0.015, 0.021, -0.011, 35e-6, -22e-6, 0.018, -0.014, 41e-6, -17e-6,
+    ]);
+    let y = &h * x;
+    rec.measured = (0..rec.samples.len())
+        .map(|i| [y[3 * i], y[3 * i + 1], y[3 * i + 2]])
+        .collect();
+    let names = parameter_names(&m, &model);
+    let tol = Tolerances::default();
+    let mut g = c.benchmark_group("estimate_k4");
+    g.bench_function("reduced/least_squares", |b| {
+        b.iter(|| least_squares(black_box(&h), &y, &names, &Constraint::None, &tol).unwrap())
+    });
+    g.bench_function("reduced/identify", |b| {
+        b.iter(|| identify(&m, &model, black_box(&rec), &IdentifyOptions::default()).unwrap())
+    });
+    let zeroed = IdentifyOptions {
+        zeroed: true,
+        ..Default::default()
+    };
+    g.bench_function("reduced/identify_zeroed", |b| {
+        b.iter(|| identify(&m, &model, black_box(&rec), &zeroed).unwrap())
+    });
+    let full = Model::constant(&m.errors);
+    g.bench_function("full/identify", |b| {
+        b.iter(|| identify(&m, &full, black_box(&rec), &IdentifyOptions::default()).unwrap())
+    });
+    g.finish();
+}
+
+criterion_group!(benches, hmatrix, estimation);
+criterion_main!(benches);

@@ -1,0 +1,154 @@
+//! Distribution functions for the significance tests: the regularized incomplete beta
+//! function and from it the upper tail of Fisher's F distribution and Student's t.
+//!
+//! `ln Γ` by the Lanczos approximation (g = 7, 9 coefficients; relative error below 1e-15 for
+//! positive arguments), the incomplete beta by its continued fraction (modified Lentz), as in
+//! Numerical Recipes §6.4. Checked against tabulated critical values in the tests.
+
+/// `ln Γ(x)` for `x > 0`.
+pub fn ln_gamma(x: f64) -> f64 {
+    const G: f64 = 7.0;
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        // Reflection: Γ(x)Γ(1−x) = π / sin(πx).
+        return (std::f64::consts::PI / (std::f64::consts::PI * x).sin()).ln() - ln_gamma(1.0 - x);
+    }
+    let x = x - 1.0;
+    let t = x + G + 0.5;
+    let series = C[1..]
+        .iter()
+        .enumerate()
+        .fold(C[0], |acc, (i, c)| acc + c / (x + i as f64 + 1.0));
+    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + series.ln()
+}
+
+/// The continued fraction of the incomplete beta function (modified Lentz).
+fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
+    const TINY: f64 = 1e-300;
+    let (qab, qap, qam) = (a + b, a + 1.0, a - 1.0);
+    let mut c = 1.0;
+    let mut d = 1.0 - qab * x / qap;
+    if d.abs() < TINY {
+        d = TINY;
+    }
+    d = 1.0 / d;
+    let mut h = d;
+    for m in 1..=10_000 {
+        let m = m as f64;
+        let m2 = 2.0 * m;
+        let aa = m * (b - m) * x / ((qam + m2) * (a + m2));
+        d = 1.0 + aa * d;
+        if d.abs() < TINY {
+            d = TINY;
+        }
+        c = 1.0 + aa / c;
+        if c.abs() < TINY {
+            c = TINY;
+        }
+        d = 1.0 / d;
+        h *= d * c;
+        let aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
+        d = 1.0 + aa * d;
+        if d.abs() < TINY {
+            d = TINY;
+        }
+        c = 1.0 + aa / c;
+        if c.abs() < TINY {
+            c = TINY;
+        }
+        d = 1.0 / d;
+        let del = d * c;
+        h *= del;
+        if (del - 1.0).abs() < 1e-15 {
+            break;
+        }
+    }
+    h
+}
+
+/// The regularized incomplete beta function `I_x(a, b)` for `a, b > 0`, `x ∈ [0, 1]`.
+pub fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let ln_front = ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln();
+    let front = ln_front.exp();
+    if x < (a + 1.0) / (a + b + 2.0) {
+        front * beta_cf(a, b, x) / a
+    } else {
+        1.0 - front * beta_cf(b, a, 1.0 - x) / b
+    }
+}
+
+/// The upper tail `P(F > f)` of Fisher's F distribution with `d1` and `d2` degrees of freedom
+/// (the p-value of an F statistic).
+pub fn f_upper_tail(f: f64, d1: f64, d2: f64) -> f64 {
+    if f.is_nan() || f <= 0.0 {
+        return 1.0;
+    }
+    incomplete_beta(d2 / 2.0, d1 / 2.0, d2 / (d2 + d1 * f))
+}
+
+/// The two-sided tail `P(|T| > t)` of Student's t distribution with `nu` degrees of freedom.
+pub fn t_two_sided(t: f64, nu: f64) -> f64 {
+    incomplete_beta(nu / 2.0, 0.5, nu / (nu + t * t))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gamma_values() {
+        assert!((ln_gamma(1.0)).abs() < 1e-14);
+        assert!((ln_gamma(5.0) - 24f64.ln()).abs() < 1e-13);
+        assert!((ln_gamma(0.5) - std::f64::consts::PI.sqrt().ln()).abs() < 1e-13);
+        assert!((ln_gamma(100.5) - 361.435_540_467_777_6).abs() < 1e-10);
+    }
+
+    #[test]
+    fn tabulated_f_critical_values() {
+        // (d1, d2, F at the 5 % point, F at the 1 % point), from scipy.stats.f.ppf.
+        for (d1, d2, f05, f01) in [
+            (1.0, 10.0, 4.964_602_743_730_711, 10.044_289_273_396_58),
+            (2.0, 100.0, 3.087_295_892_748_93, 4.823_909_807_159_251),
+            (5.0, 30.0, 2.533_554_547_559_27, 3.699_018_811_412_570_6),
+            (10.0, 700.0, 1.844_214_512_706_547_2, 2.346_256_417_986_641),
+        ] {
+            assert!(
+                (f_upper_tail(f05, d1, d2) - 0.05).abs() < 1e-10,
+                "{d1} {d2} {}",
+                f_upper_tail(f05, d1, d2)
+            );
+            assert!(
+                (f_upper_tail(f01, d1, d2) - 0.01).abs() < 1e-10,
+                "{d1} {d2} {}",
+                f_upper_tail(f01, d1, d2)
+            );
+        }
+        assert_eq!(f_upper_tail(0.0, 3.0, 10.0), 1.0);
+        assert!(f_upper_tail(1e6, 3.0, 10.0) < 1e-20);
+    }
+
+    #[test]
+    fn t_distribution_matches_f_with_one_numerator_degree() {
+        // t² with ν degrees of freedom is F(1, ν); t(0.975, 10) = 2.228138851986274 (scipy).
+        assert!((t_two_sided(2.228_138_851_986_274, 10.0) - 0.05).abs() < 1e-10);
+        for t in [0.5, 1.0, 3.0] {
+            assert!((t_two_sided(t, 20.0) - f_upper_tail(t * t, 1.0, 20.0)).abs() < 1e-14);
+        }
+    }
+}

@@ -1,0 +1,463 @@
+//! Least squares the way a calibration engineer needs it: column scaling, SVD with a stated
+//! numerical rank, residual-based standard uncertainties, covariance and correlation, condition
+//! number, and no number for a parameter the data cannot determine (see
+//! [`crate::identifiability`] and `docs/identification.md`).
+//!
+//! Model: `y = H·p + e`, `y` the stacked measured error vectors (mm, 3 rows per sample), `H`
+//! from [`crate::hmatrix`], `p` the parameters (mm for translational, rad for angular effects),
+//! `e` independent noise of one unknown standard deviation σ.
+//!
+//! 1. Scaling: `s_j = ‖h_j‖₂` (a zero column keeps `s_j = 1`), `A = H·S⁻¹`; unit-free, so mm
+//!    and rad columns compare.
+//! 2. SVD `A = U·Σ·Vᵀ` (singular values descending; more parameters than rows: `A` is padded
+//!    with zero rows so that `V` is complete).
+//! 3. Rank `r` = number of `σ_i > τ = σ_max · max(ρ, max(m, n)·ε)`, `ρ` =
+//!    [`RANK_RELATIVE_TOLERANCE`] = 1e-8, `ε` = 2.2e-16, `m = 3N` rows, `n` parameters.
+//! 4. Estimate (minimum norm in scaled coordinates, restricted to the identifiable subspace):
+//!    `p̂ = S⁻¹·V_r·Σ_r⁻¹·U_rᵀ·y`. Residual `ρ = y − H·p̂`, `RSS = ‖ρ‖²`,
+//!    `σ̂² = RSS / (3N − r)`.
+//! 5. Covariance `C = σ̂²·S⁻¹·V_r·Σ_r⁻²·V_rᵀ·S⁻¹`, std `√C_jj`, correlation
+//!    `C_jk / √(C_jj·C_kk)`; condition number `κ = σ_max / σ_r` of the scaled H.
+
+use crate::hmatrix::{Backend, GainSource, HMatrixError, h_matrix, parameter_names};
+use crate::identifiability::{
+    CORRELATION_LIMIT, DETERMINED_TOLERANCE, Identifiability, LINK_TOLERANCE, Swallowed,
+    near_confounded, null_space_groups, swallowed_by_offsets,
+};
+use crate::model::{Effect, Model, Term};
+use crate::record::Record;
+use model_spec::{Dir, Machine};
+use nalgebra::{DMatrix, DVector, SVD};
+
+/// Default `ρ`: singular values of the scaled H below `ρ·σ_max` count as zero (condition
+/// numbers above 1e8 are treated as rank deficiency; see `docs/identification.md`).
+pub const RANK_RELATIVE_TOLERANCE: f64 = 1e-8;
+
+/// How parameters the data cannot determine get a value.
+#[derive(Clone, Debug, PartialEq, Eq, Default)]
+pub enum Constraint {
+    /// They get none (`value: None`) and are named in the confounded groups.
+    #[default]
+    None,
+    /// Every parameter gets the minimum-norm value in scaled coordinates (`‖S·p‖` smallest
+    /// among all least-squares solutions): the undetermined part of each confounded group is
+    /// set to zero. Their standard uncertainties are those of that estimator, around the
+    /// projection of the truth, not around the truth.
+    MinimumNorm,
+    /// The named parameters ([`crate::hmatrix::parameter_name`]: `XOC`, `ECC@harmonic:1:cos`)
+    /// are fixed to zero before the fit (value 0, no uncertainty); the rest is fitted as with
+    /// [`Constraint::None`]. The digit-zero spelling of an error (`X0C`) is accepted.
+    Zero(Vec<String>),
+}
+
+/// The tolerances of the rank and identifiability decisions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerances {
+    /// `ρ` of the rank tolerance `σ_max · max(ρ, max(m, n)·ε)`.
+    pub rank_relative: f64,
+    /// τ_d: largest null-space weight `‖Nᵀ·e_j‖` of a determined parameter.
+    pub determined: f64,
+    /// τ_l: smallest `|(N·Nᵀ)_jk|` that links two undetermined parameters into a group.
+    pub link: f64,
+    /// `|correlation|` above which determined pairs are reported as nearly confounded.
+    pub correlation: f64,
+}
+
+impl Default for Tolerances {
+    /// 1e-8, 1e-6, 1e-6, 0.99.
+    fn default() -> Self {
+        Tolerances {
+            rank_relative: RANK_RELATIVE_TOLERANCE,
+            determined: DETERMINED_TOLERANCE,
+            link: LINK_TOLERANCE,
+            correlation: CORRELATION_LIMIT,
+        }
+    }
+}
+
+/// Why a fit could not be made.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum EstimateError {
+    /// The H matrix could not be built.
+    #[error(transparent)]
+    HMatrix(#[from] HMatrixError),
+    /// Sizes that do not fit together, or nothing to fit.
+    #[error("{0}")]
+    Shape(String),
+    /// A NaN or infinite input.
+    #[error("{0} is not finite")]
+    NotFinite(String),
+    /// A parameter named in [`Constraint::Zero`] is not in the model.
+    #[error("constraint: `{0}` is not a parameter of the model (parameters: {1})")]
+    UnknownParameter(String, String),
+    /// The SVD did not converge.
+    #[error("the singular value decomposition of the {0}×{1} scaled H matrix did not converge")]
+    Svd(usize, usize),
+}
+
+/// The result of a least-squares fit. Internal units: parameters in mm or rad, residuals mm.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fit {
+    /// Parameter names, one per H column.
+    pub names: Vec<String>,
+    /// Estimates (mm or rad); `None` for a parameter the data cannot determine (unless the
+    /// constraint gives it a value).
+    pub values: Vec<Option<f64>>,
+    /// Standard uncertainties (mm or rad); `None` where there is no value, for fixed
+    /// parameters, and when `3N = r` leaves no degree of freedom for σ̂.
+    pub std: Vec<Option<f64>>,
+    /// Fixed to zero by [`Constraint::Zero`].
+    pub fixed: Vec<bool>,
+    /// `s_j = ‖h_j‖₂` (mm per unit of the parameter × √rows), 1 for a zero column.
+    pub column_norms: Vec<f64>,
+    /// Singular values of the scaled H of the free parameters, descending.
+    pub singular_values: Vec<f64>,
+    /// Numerical rank r.
+    pub rank: usize,
+    /// The absolute tolerance τ the singular values were compared with.
+    pub rank_tolerance: f64,
+    /// `σ_max / σ_r` of the scaled H (over the identifiable part); `None` when r = 0.
+    pub condition: Option<f64>,
+    /// Covariance of the estimates (mm², mm·rad, rad²); NaN where a parameter has no value or
+    /// σ̂ is unknown; 0 in rows and columns of fixed parameters.
+    pub covariance: DMatrix<f64>,
+    /// Correlation of the estimates (independent of σ̂); NaN where undefined.
+    pub correlation: DMatrix<f64>,
+    /// `y − H·p̂`, mm, 3 rows per sample.
+    pub residual: DVector<f64>,
+    /// Residual sum of squares, mm².
+    pub rss: f64,
+    /// Degrees of freedom `3N − r`.
+    pub dof: usize,
+    /// σ̂ = √(RSS / dof), mm; `None` when dof = 0.
+    pub sigma: Option<f64>,
+    /// What the data determine (indices are parameter indices).
+    pub identifiability: Identifiability,
+    /// The constraint used.
+    pub constraint: Constraint,
+}
+
+impl Fit {
+    /// RMS of the residual over all rows, `√(RSS / 3N)`, mm.
+    pub fn residual_rms(&self) -> f64 {
+        let n = self.residual.len().max(1) as f64;
+        (self.rss / n).sqrt()
+    }
+}
+
+fn check_finite(what: &str, v: &[f64], cols: usize) -> Result<(), EstimateError> {
+    match v.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(i) if cols > 0 => Err(EstimateError::NotFinite(format!(
+            "{what}[{}, {}] ({})",
+            i % (v.len() / cols),
+            i / (v.len() / cols),
+            v[i]
+        ))),
+        Some(i) => Err(EstimateError::NotFinite(format!("{what}[{i}] ({})", v[i]))),
+    }
+}
+
+/// Fits `y ≈ H·p` (H: m × n, mm per unit; y: m, mm) with parameter `names` (one per column),
+/// under `constraint`, with `tol`. See the module documentation for the method.
+///
+/// # Errors
+/// Sizes that do not fit, no rows or no columns, NaN or infinite inputs, an unknown name in
+/// [`Constraint::Zero`], an SVD that does not converge.
+pub fn least_squares(
+    h: &DMatrix<f64>,
+    y: &DVector<f64>,
+    names: &[String],
+    constraint: &Constraint,
+    tol: &Tolerances,
+) -> Result<Fit, EstimateError> {
+    let (m, n) = h.shape();
+    if m == 0 || n == 0 {
+        return Err(EstimateError::Shape(format!(
+            "nothing to fit: H is {m}×{n} (samples × 3 by parameters)"
+        )));
+    }
+    if y.len() != m || names.len() != n {
+        return Err(EstimateError::Shape(format!(
+            "H is {m}×{n} but there are {} measured values and {} names",
+            y.len(),
+            names.len()
+        )));
+    }
+    check_finite("H", h.as_slice(), n)?;
+    check_finite("y", y.as_slice(), 0)?;
+    let mut fixed = vec![false; n];
+    if let Constraint::Zero(zero) = constraint {
+        for z in zero {
+            // The exact name, or the canonical spelling of its effect (`X0C` for `XOC`).
+            let canonical = match z.trim().split_once('@') {
+                Some((e, b)) => format!("{}@{b}", model_spec::canonical_name(e)),
+                None => model_spec::canonical_name(z),
+            };
+            let j = names
+                .iter()
+                .position(|x| x == z.trim() || *x == canonical)
+                .ok_or_else(|| EstimateError::UnknownParameter(z.clone(), names.join(", ")))?;
+            fixed[j] = true;
+        }
+    }
+    let free: Vec<usize> = (0..n).filter(|&j| !fixed[j]).collect();
+    let nf = free.len();
+    // Column scaling.
+    let mut norms = vec![1.0; n];
+    for &j in &free {
+        let s = h.column(j).norm();
+        if !s.is_finite() {
+            return Err(EstimateError::NotFinite(format!(
+                "the norm of column `{}` of H",
+                names[j]
+            )));
+        }
+        if s > 0.0 {
+            norms[j] = s;
+        }
+    }
+    let rows = m.max(nf);
+    let mut a = DMatrix::<f64>::zeros(rows, nf);
+    for (k, &j) in free.iter().enumerate() {
+        for i in 0..m {
+            a[(i, k)] = h[(i, j)] / norms[j];
+        }
+    }
+    let (sv, u, v) = if nf == 0 {
+        (Vec::new(), DMatrix::zeros(rows, 0), DMatrix::zeros(0, 0))
+    } else {
+        let svd = SVD::try_new(a, true, true, f64::EPSILON, 1000 + 200 * nf)
+            .ok_or(EstimateError::Svd(m, nf))?;
+        let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+            return Err(EstimateError::Svd(m, nf));
+        };
+        (svd.singular_values.as_slice().to_vec(), u, vt.transpose())
+    };
+    let smax = sv.first().copied().unwrap_or(0.0);
+    let tau = smax * tol.rank_relative.max(m.max(n) as f64 * f64::EPSILON);
+    let rank = sv.iter().take_while(|&&s| s > tau && s > 0.0).count();
+    // Minimum-norm solution in the identifiable subspace (scaled coordinates).
+    let mut ypad = DVector::<f64>::zeros(rows);
+    ypad.rows_mut(0, m).copy_from(y);
+    let mut z = DVector::<f64>::zeros(nf);
+    for (i, s) in sv.iter().enumerate().take(rank) {
+        let c = u.column(i).dot(&ypad) / s;
+        z.axpy(c, &v.column(i), 1.0);
+    }
+    let mut x = vec![0.0; n];
+    for (k, &j) in free.iter().enumerate() {
+        x[j] = z[k] / norms[j];
+    }
+    let residual = y - h * DVector::from_column_slice(&x);
+    let rss = residual.norm_squared();
+    let dof = m.saturating_sub(rank);
+    let sigma = (dof > 0).then(|| (rss / dof as f64).sqrt());
+    // Unit covariance V_r Σ_r⁻² V_rᵀ in scaled coordinates, then unscaled.
+    let mut unit = DMatrix::<f64>::zeros(n, n);
+    for (ka, &ja) in free.iter().enumerate() {
+        for (kb, &jb) in free.iter().enumerate() {
+            let c: f64 = (0..rank)
+                .map(|i| v[(ka, i)] * v[(kb, i)] / (sv[i] * sv[i]))
+                .sum();
+            unit[(ja, jb)] = c / (norms[ja] * norms[jb]);
+        }
+    }
+    // Null space (rows: all parameters; fixed rows zero).
+    let mut null = DMatrix::<f64>::zeros(n, nf - rank);
+    for (k, &j) in free.iter().enumerate() {
+        for c in rank..nf {
+            null[(j, c - rank)] = v[(k, c)];
+        }
+    }
+    let (null_weight, determined, confounded) = null_space_groups(&null, tol.determined, tol.link);
+    let has_value: Vec<bool> = (0..n)
+        .map(|j| fixed[j] || determined[j] || *constraint == Constraint::MinimumNorm)
+        .collect();
+    let values: Vec<Option<f64>> = (0..n).map(|j| has_value[j].then_some(x[j])).collect();
+    let std: Vec<Option<f64>> = (0..n)
+        .map(|j| match sigma {
+            Some(s) if has_value[j] && !fixed[j] => Some(s * unit[(j, j)].max(0.0).sqrt()),
+            _ => None,
+        })
+        .collect();
+    let mut covariance = DMatrix::<f64>::from_element(n, n, f64::NAN);
+    let mut correlation = DMatrix::<f64>::from_element(n, n, f64::NAN);
+    for a in 0..n {
+        for b in 0..n {
+            if fixed[a] || fixed[b] {
+                covariance[(a, b)] = 0.0;
+            } else if has_value[a] && has_value[b] {
+                if let Some(s) = sigma {
+                    covariance[(a, b)] = s * s * unit[(a, b)];
+                }
+                let d = (unit[(a, a)] * unit[(b, b)]).sqrt();
+                if d > 0.0 {
+                    correlation[(a, b)] = (unit[(a, b)] / d).clamp(-1.0, 1.0);
+                }
+            }
+        }
+    }
+    let eligible: Vec<bool> = (0..n).map(|j| determined[j] && !fixed[j]).collect();
+    let near = near_confounded(&correlation, &eligible, tol.correlation);
+    Ok(Fit {
+        names: names.to_vec(),
+        values,
+        std,
+        fixed,
+        column_norms: norms,
+        rank_tolerance: tau,
+        condition: (rank > 0).then(|| smax / sv[rank - 1]),
+        singular_values: sv,
+        rank,
+        covariance,
+        correlation,
+        residual,
+        rss,
+        dof,
+        sigma,
+        identifiability: Identifiability {
+            null_space: null,
+            null_weight,
+            determined,
+            confounded,
+            near_confounded: near,
+        },
+        constraint: constraint.clone(),
+    })
+}
+
+/// The stacked measured error vectors of `record` (mm): `[x₀, y₀, z₀, x₁, …]`.
+///
+/// # Errors
+/// No measurements, one row per sample missing, or a value that is not finite.
+pub fn measurement_vector(record: &Record) -> Result<DVector<f64>, EstimateError> {
+    if record.measured.len() != record.samples.len() {
+        return Err(EstimateError::Shape(format!(
+            "the record has {} samples but {} measured error vectors",
+            record.samples.len(),
+            record.measured.len()
+        )));
+    }
+    let y = DVector::from_iterator(
+        3 * record.measured.len(),
+        record.measured.iter().flat_map(|r| r.iter().copied()),
+    );
+    if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+        return Err(EstimateError::NotFinite(format!(
+            "the measured {} of sample {}",
+            ["dx", "dy", "dz"][i % 3],
+            i / 3
+        )));
+    }
+    Ok(y)
+}
+
+/// `model` with the constant sensor offsets `dx0 dy0 dz0` appended (those it lacks).
+pub fn with_offsets(model: &Model) -> Model {
+    let mut out = model.clone();
+    for d in Dir::ALL {
+        let t = Term {
+            effect: Effect::SensorOffset(d),
+            basis: crate::basis::Basis::Const,
+        };
+        if !out.terms.contains(&t) {
+            out.terms.push(t);
+        }
+    }
+    out
+}
+
+/// Options of [`identify`].
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct IdentifyOptions {
+    /// The readings were zeroed at the first sample: the constant offsets `dx0 dy0 dz0` join
+    /// the model (they absorb the unknown reading subtracted), and [`Identification::swallowed`]
+    /// says which errors they cannot be told from.
+    pub zeroed: bool,
+    /// What to do with undetermined parameters.
+    pub constraint: Constraint,
+    /// Rank and identifiability tolerances.
+    pub tolerances: Tolerances,
+    /// Kinematic parameters (mm, symbol order); `None`: the machine's defaults.
+    pub params: Option<Vec<f64>>,
+}
+
+/// An identification: the fitted model and its fit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Identification {
+    /// The machine's name.
+    pub machine: String,
+    /// The model fitted (with `dx0 dy0 dz0` when the readings were zeroed); its columns are the
+    /// fit's parameters.
+    pub model: Model,
+    /// The least-squares fit.
+    pub fit: Fit,
+    /// Number of samples used.
+    pub samples: usize,
+    /// Whether the readings were zeroed at the first sample.
+    pub zeroed: bool,
+    /// Per confounded group with a sensor offset: the errors it swallows.
+    pub swallowed: Vec<Swallowed>,
+    /// Which code computed the gains.
+    pub backend: Backend,
+}
+
+/// Identifies `model` of `m` from the measured `record`, with the best gain source (compiled
+/// code for built-in machines, the evaluator otherwise).
+///
+/// # Errors
+/// See [`identify_with`].
+pub fn identify(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    opts: &IdentifyOptions,
+) -> Result<Identification, EstimateError> {
+    let params = opts
+        .params
+        .clone()
+        .unwrap_or_else(|| m.default_parameters());
+    crate::hmatrix::check_model(m, model)?;
+    let mut source = GainSource::new(m, &model.errors(), &params)?;
+    identify_with(m, model, record, &mut source, opts)
+}
+
+/// As [`identify`], with gains from `source` (which must cover the model's errors; its
+/// parameters are used, `opts.params` is ignored).
+///
+/// # Errors
+/// A model or record that does not fit `m`, a record without (finite) measurements, no samples,
+/// a bad constraint, an SVD that does not converge.
+pub fn identify_with(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    source: &mut GainSource,
+    opts: &IdentifyOptions,
+) -> Result<Identification, EstimateError> {
+    let fitted = if opts.zeroed {
+        with_offsets(model)
+    } else {
+        model.clone()
+    };
+    let y = measurement_vector(record)?;
+    let h = h_matrix(m, &fitted, record, source)?;
+    let names = parameter_names(m, &fitted);
+    let fit = least_squares(&h, &y, &names, &opts.constraint, &opts.tolerances)?;
+    let is_offset: Vec<bool> = fitted
+        .columns()
+        .iter()
+        .map(|&(t, _)| matches!(fitted.terms[t].effect, Effect::SensorOffset(_)))
+        .collect();
+    let swallowed = swallowed_by_offsets(&names, &fit.identifiability.confounded, &is_offset);
+    Ok(Identification {
+        machine: m.name.clone(),
+        model: fitted,
+        fit,
+        samples: record.samples.len(),
+        zeroed: opts.zeroed,
+        swallowed,
+        backend: source.backend(),
+    })
+}

@@ -1,0 +1,172 @@
+//! Simulated R-test readings: the exact virtual machine run with a [`Truth`] along a path.
+//!
+//! At every sample `i` of the path, with commands `q` (mm, rad), directions of motion and
+//! normalised time `τ = record.tau(i)`:
+//! 1. the truth gives every catalogue error's value and the sensor zero offsets
+//!    ([`Truth::evaluate_into`]);
+//! 2. the exact chains (no linearisation) with the truth's kinematic parameters give the error
+//!    vector's position part `R_tool^T·(P_tool − P_work)` (mm, tool frame, tool minus
+//!    workpiece; [`crate::exact::ErrorVector::position`]); it includes any nominal mismatch the
+//!    path leaves, e.g. when the truth's kinematic parameters differ from the defaults the path
+//!    was planned with;
+//! 3. the offsets `dx0 dy0 dz0` are added, then Gaussian noise of standard deviation
+//!    `truth.noise_mm` per direction, drawn from [`Rng::new`]`(truth.seed)` in sample order,
+//!    x, y, z (no draws when the noise is zero);
+//! 4. when `truth.zeroed`, the first reading is subtracted from every reading (the first is
+//!    then exactly zero), as R-test software does.
+
+use crate::exact::VirtualMachine;
+use crate::model::Effect;
+use crate::record::Record;
+use crate::rng::Rng;
+use crate::truth::Truth;
+use model_spec::{Machine, Side};
+
+/// A record or truth that does not fit the machine (programming errors, reported, not panics).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SimulateError {
+    /// A sample's commands or directions are not one per axis.
+    #[error(
+        "machine {machine}: sample {sample} has {commands} commands and {motion} directions of motion, the machine has {axes} axes"
+    )]
+    Sample {
+        /// The machine.
+        machine: String,
+        /// The sample (0-based).
+        sample: usize,
+        /// Its number of commands.
+        commands: usize,
+        /// Its number of directions of motion.
+        motion: usize,
+        /// The machine's number of axes.
+        axes: usize,
+    },
+    /// The truth was made for another machine.
+    #[error("truth {source_name} does not fit machine {machine}: {why}")]
+    Truth {
+        /// The truth's source.
+        source_name: String,
+        /// The machine.
+        machine: String,
+        /// What does not fit.
+        why: String,
+    },
+}
+
+/// The readings an R-test would give on the virtual machine `m` with truth `truth` along
+/// `path` (see the module documentation). The result has the path's samples and one measured
+/// vector per sample (mm, tool frame, tool minus workpiece). Any measurements `path` carries
+/// are ignored.
+///
+/// # Errors
+/// [`SimulateError`] when a sample or the truth does not fit `m`.
+pub fn simulate(m: &Machine, truth: &Truth, path: &Record) -> Result<Record, SimulateError> {
+    check(m, truth, path)?;
+    let vm = VirtualMachine::new(m);
+    let params = &truth.params;
+    let mut errors = vec![0.0; m.catalogue.len()];
+    let mut offsets = [0.0; 3];
+    let mut rng = Rng::new(truth.seed);
+    let noise = truth.noise_mm;
+    let mut measured = Vec::with_capacity(path.samples.len());
+    for (i, s) in path.samples.iter().enumerate() {
+        let tau = path.tau(i);
+        truth.evaluate_into(m, &s.commands, &s.motion, tau, &mut errors, &mut offsets);
+        let value = |id: usize| errors[id];
+        let tool = vm.transform_with(Side::Tool, &s.commands, params, &value);
+        let work = vm.transform_with(Side::Work, &s.commands, params, &value);
+        let gap = tool.translation.vector - work.translation.vector;
+        let p = tool.rotation.inverse_transform_vector(&gap);
+        let mut r = [p.x + offsets[0], p.y + offsets[1], p.z + offsets[2]];
+        if noise > 0.0 {
+            for v in &mut r {
+                *v += noise * rng.normal();
+            }
+        }
+        measured.push(r);
+    }
+    if truth.zeroed
+        && let Some(&first) = measured.first()
+    {
+        for r in &mut measured {
+            for k in 0..3 {
+                r[k] -= first[k];
+            }
+        }
+    }
+    Ok(Record {
+        samples: path.samples.clone(),
+        measured,
+    })
+}
+
+fn check(m: &Machine, truth: &Truth, path: &Record) -> Result<(), SimulateError> {
+    let n = m.axes.len();
+    for (i, s) in path.samples.iter().enumerate() {
+        if s.commands.len() != n || s.motion.len() != n {
+            return Err(SimulateError::Sample {
+                machine: m.name.clone(),
+                sample: i,
+                commands: s.commands.len(),
+                motion: s.motion.len(),
+                axes: n,
+            });
+        }
+    }
+    let bad = |why: String| SimulateError::Truth {
+        source_name: truth.source.clone(),
+        machine: m.name.clone(),
+        why,
+    };
+    if truth.params.len() != m.symbols.len() {
+        return Err(bad(format!(
+            "it has {} kinematic parameters, the machine {}",
+            truth.params.len(),
+            m.symbols.len()
+        )));
+    }
+    if truth.coefficients.len() != truth.model.width() {
+        return Err(bad(format!(
+            "it has {} coefficients for {} model columns",
+            truth.coefficients.len(),
+            truth.model.width()
+        )));
+    }
+    for t in &truth.model.terms {
+        if let Effect::Error(e) = t.effect
+            && e >= m.catalogue.len()
+        {
+            return Err(bad(format!(
+                "it names error #{e}, the catalogue has {} errors",
+                m.catalogue.len()
+            )));
+        }
+        if let Err(e) = t.basis.check(m, t.effect.carrier(m)) {
+            return Err(bad(format!("term {}: {}", t.effect.name(m), e.0)));
+        }
+    }
+    Ok(())
+}
+
+/// Comment lines for the CSV of a simulation ([`crate::csvio::write_record`]): what produced
+/// it, the machine, the path, the truth and the units.
+pub fn provenance(m: &Machine, path_name: &str, truth: &Truth, samples: usize) -> Vec<String> {
+    vec![
+        format!(
+            "simulated by rtest {} (exact virtual machine, solver::simulate)",
+            env!("CARGO_PKG_VERSION")
+        ),
+        format!("machine: {}", m.name),
+        format!("path: {path_name} ({samples} samples)"),
+        truth.summary(m),
+        format!(
+            "readings {}",
+            if truth.zeroed {
+                "zeroed at the first sample"
+            } else {
+                "not zeroed (absolute)"
+            }
+        ),
+        "units: linear axes mm, rotary axes degrees, dx_um dy_um dz_um µm (tool minus workpiece, tool frame), t_s s".into(),
+    ]
+}

@@ -1,0 +1,721 @@
+//! The "truth" of a simulated machine: what the virtual machine's errors really are.
+//!
+//! A truth is read from a small TOML file (reference and examples: `docs/truth.md`):
+//!
+//! ```toml
+//! machine = "seed-ac"          # optional: the machine it is written for
+//! description = "example"      # optional text
+//! noise_um = 0.5               # standard deviation of the reading noise per direction, µm
+//! seed = 1                     # seed of the noise generator
+//! zeroed = false               # readings zeroed at the first sample
+//!
+//! [parameters]                 # the real machine's kinematic offsets, mm (default: nominal)
+//! Zp = 184.7
+//!
+//! [errors]                     # µm for translations and dx0 dy0 dz0, µrad for angles
+//! XOW = 12.0                   # a number: constant
+//! ECC = { const = 3.0, "harmonic:2" = [8.0, 6.0] }   # [cos, sin] pair of a harmonic
+//! dz0 = { const = 1.0, "time:1" = 0.5 }              # sensor zero offset and drift
+//! ```
+//!
+//! Inside, a [`Truth`] holds the terms as a [`Model`] and one coefficient per model column in
+//! mm (translations, sensor offsets) or rad (angles). The value of an effect at a sample is
+//! `Σ coefficient · basis value` over its terms ([`crate::basis::Basis::values`]). Every entry is
+//! validated against the machine, and every problem is a [`TruthError`] naming the file, the
+//! line and the column.
+//!
+//! Built-in truths for `seed-ac` ([`BUILTIN_TRUTHS`], files in `solver/truths/`): `seed-ac-demo`
+//! (the documented default of `rtest demo`) and `seed-ac-reduced` (the 11 errors of the reduced
+//! model only, constants, no noise).
+
+use crate::basis::{Basis, Carrier};
+use crate::csvio::{format_scaled, parse_scaled};
+use crate::model::{Effect, Model, Term};
+use crate::record::Sample;
+use model_spec::Machine;
+use std::ops::Range;
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
+
+/// Name and TOML text of every built-in truth.
+pub const BUILTIN_TRUTHS: &[(&str, &str)] = &[
+    ("seed-ac-demo", include_str!("../truths/seed-ac-demo.toml")),
+    (
+        "seed-ac-reduced",
+        include_str!("../truths/seed-ac-reduced.toml"),
+    ),
+];
+
+/// Decimal places between the unit people write and the unit inside: µm → mm is 3, µrad → rad
+/// is 6.
+fn places(m: &Machine, effect: Effect) -> i32 {
+    if effect.is_angular(m) { 6 } else { 3 }
+}
+
+/// A problem with a truth: its file cannot be read, or an entry is invalid.
+#[derive(Debug, thiserror::Error)]
+pub enum TruthError {
+    /// An invalid entry, located in the file (1-based line and column, in characters).
+    #[error("{file}:{line}:{column}: {message}")]
+    Invalid {
+        /// The file (or `<built-in NAME>`).
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column, in characters.
+        column: usize,
+        /// What is wrong and what would be right.
+        message: String,
+    },
+    /// The file could not be read.
+    #[error("cannot read truth file `{file}`: {source}")]
+    Io {
+        /// The file.
+        file: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// Neither a built-in truth nor an existing file.
+    #[error("no built-in truth and no file called `{0}` (built-in: {names})", names = BUILTIN_TRUTHS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "))]
+    NotFound(String),
+}
+
+/// The truth of a simulated machine. Built by [`Truth::parse`] (or [`Truth::nominal`]); the
+/// fields are public so that a caller can override the noise, the seed or zeroing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Truth {
+    /// Where it came from (file name or `<built-in NAME>`), for reports.
+    pub source: String,
+    /// What it is, for people (may be empty).
+    pub description: String,
+    /// The real machine's kinematic parameters, one per [`Machine::symbols`] entry (mm): the
+    /// defaults with the file's `[parameters]` overrides. Paths are planned with the defaults
+    /// (what the controller believes), the virtual machine runs with these.
+    pub params: Vec<f64>,
+    /// The terms (effect × basis), sorted, each at most once.
+    pub model: Model,
+    /// One coefficient per column of `model` (`Model::columns` order): mm for translational
+    /// errors and sensor offsets, rad for angular errors; `harmonic:K` has two (cos, sin).
+    pub coefficients: Vec<f64>,
+    /// Standard deviation of the Gaussian reading noise, per direction, mm.
+    pub noise_mm: f64,
+    /// Seed of the noise generator ([`crate::rng::Rng`]).
+    pub seed: u64,
+    /// `true`: the readings are zeroed at the first sample (subtracted from every sample).
+    pub zeroed: bool,
+}
+
+/// One term of a truth in the units people see, for reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TruthEntry {
+    /// The term.
+    pub term: Term,
+    /// Effect name (`XOC`, `dx0`).
+    pub name: String,
+    /// Its value(s): one, or `[cos, sin]` for `harmonic:K`; µm or µrad.
+    pub values: Vec<f64>,
+    /// `um` or `urad`.
+    pub unit: &'static str,
+}
+
+impl Truth {
+    /// The nominal machine: no errors, default kinematic parameters, no noise, seed 0, not
+    /// zeroed.
+    pub fn nominal(m: &Machine) -> Truth {
+        Truth {
+            source: "<nominal>".into(),
+            description: "no errors".into(),
+            params: m.default_parameters(),
+            model: Model::default(),
+            coefficients: Vec::new(),
+            noise_mm: 0.0,
+            seed: 0,
+            zeroed: false,
+        }
+    }
+
+    /// Reads and validates a truth for machine `m`; `file` names the source in error messages.
+    ///
+    /// # Errors
+    /// [`TruthError::Invalid`] for the first problem in the file (TOML syntax, unknown key,
+    /// unknown error or symbol, a basis that does not fit the error, an array of the wrong
+    /// length, a non-finite or negative number where it is not allowed, a term given twice).
+    pub fn parse(file: &str, text: &str, m: &Machine) -> Result<Truth, TruthError> {
+        let p = Parser { file, text, m };
+        let root =
+            DeTable::parse(text).map_err(|e| p.err(e.span().unwrap_or(0..0), e.message()))?;
+        p.truth(root.get_ref())
+    }
+
+    /// Reads the truth file `path` for machine `m`.
+    ///
+    /// # Errors
+    /// [`TruthError::Io`] when the file cannot be read; see [`Truth::parse`].
+    pub fn load(path: &std::path::Path, m: &Machine) -> Result<Truth, TruthError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| TruthError::Io {
+            file: file.clone(),
+            source,
+        })?;
+        Truth::parse(&file, &text, m)
+    }
+
+    /// The coefficient(s) of `term` (mm or rad; two for `harmonic:K`), if the truth has it.
+    pub fn coefficient(&self, term: &Term) -> Option<&[f64]> {
+        let mut at = 0;
+        for t in &self.model.terms {
+            let w = t.basis.width();
+            if t == term {
+                return self.coefficients.get(at..at + w);
+            }
+            at += w;
+        }
+        None
+    }
+
+    /// Evaluates every effect at a sample: `errors` (one per catalogue entry, mm or rad) and
+    /// `offsets` (`dx0 dy0 dz0`, mm) are overwritten. `commands` (mm, rad) and `motion` (+1/−1)
+    /// have one entry per axis; `tau` is the normalised time in [−1, 1] ([`crate::record::Record::tau`]).
+    ///
+    /// # Panics
+    /// When `errors` is not one per catalogue entry, or `commands`/`motion` not one per axis of
+    /// the machine the truth was parsed for.
+    pub fn evaluate_into(
+        &self,
+        m: &Machine,
+        commands: &[f64],
+        motion: &[i8],
+        tau: f64,
+        errors: &mut [f64],
+        offsets: &mut [f64; 3],
+    ) {
+        errors.fill(0.0);
+        *offsets = [0.0; 3];
+        let mut at = 0;
+        for t in &self.model.terms {
+            let b = t
+                .basis
+                .values(m, t.effect.carrier(m), commands, motion, tau);
+            let w = t.basis.width();
+            let c = &self.coefficients[at..at + w];
+            let v = c.iter().zip(b).map(|(c, b)| c * b).sum::<f64>();
+            match t.effect {
+                Effect::Error(e) => errors[e] += v,
+                Effect::SensorOffset(d) => offsets[d.index()] += v,
+            }
+            at += w;
+        }
+    }
+
+    /// Every catalogue error's value at `sample` (catalogue order; mm or rad), with normalised
+    /// time `tau` ∈ [−1, 1].
+    pub fn error_values(&self, m: &Machine, sample: &Sample, tau: f64) -> Vec<f64> {
+        let mut e = vec![0.0; m.catalogue.len()];
+        let mut o = [0.0; 3];
+        self.evaluate_into(m, &sample.commands, &sample.motion, tau, &mut e, &mut o);
+        e
+    }
+
+    /// The R-test zero offsets `dx0 dy0 dz0` at `sample` (mm, tool frame; added to the reading),
+    /// with normalised time `tau` ∈ [−1, 1].
+    pub fn sensor_offsets(&self, m: &Machine, sample: &Sample, tau: f64) -> [f64; 3] {
+        let mut e = vec![0.0; m.catalogue.len()];
+        let mut o = [0.0; 3];
+        self.evaluate_into(m, &sample.commands, &sample.motion, tau, &mut e, &mut o);
+        o
+    }
+
+    /// The terms in the units people see (µm, µrad), model order.
+    pub fn entries(&self, m: &Machine) -> Vec<TruthEntry> {
+        let mut at = 0;
+        let mut out = Vec::new();
+        for t in &self.model.terms {
+            let w = t.basis.width();
+            let p = places(m, t.effect);
+            out.push(TruthEntry {
+                term: *t,
+                name: t.effect.name(m),
+                // The decimal point moved in the shortest decimal: 0.012 mm is 12 µm exactly.
+                values: self.coefficients[at..at + w]
+                    .iter()
+                    .map(|&c| parse_scaled(&format_scaled(c, p), 0).unwrap_or(c * 10f64.powi(p)))
+                    .collect(),
+                unit: t.effect.unit(m),
+            });
+            at += w;
+        }
+        out
+    }
+
+    /// One line for people: source, number of terms, noise, seed, zeroing.
+    pub fn summary(&self, m: &Machine) -> String {
+        let names: Vec<String> = self
+            .model
+            .terms
+            .iter()
+            .map(|t| match t.basis {
+                Basis::Const => t.effect.name(m),
+                b => format!("{}@{b}", t.effect.name(m)),
+            })
+            .collect();
+        format!(
+            "truth {}: {} term(s) [{}], noise {} um, seed {}, {}",
+            self.source,
+            names.len(),
+            names.join(" "),
+            format_scaled(self.noise_mm, 3),
+            self.seed,
+            if self.zeroed {
+                "zeroed at the first sample"
+            } else {
+                "not zeroed"
+            }
+        )
+    }
+
+    /// The truth as a TOML file that [`Truth::parse`] reads back to the same truth, bit for bit
+    /// (numbers are written in µm / µrad with the decimal point moved, never rounded).
+    pub fn to_toml(&self, m: &Machine) -> String {
+        let mut s = format!("machine = \"{}\"\n", m.name);
+        if !self.description.is_empty() {
+            s += &format!("description = {}\n", toml_string(&self.description));
+        }
+        s += &format!(
+            "noise_um = {}\nseed = {}\nzeroed = {}\n",
+            format_scaled(self.noise_mm, 3),
+            self.seed,
+            self.zeroed
+        );
+        let defaults = m.default_parameters();
+        let changed: Vec<usize> = (0..m.symbols.len())
+            .filter(|&i| self.params[i].to_bits() != defaults[i].to_bits())
+            .collect();
+        if !changed.is_empty() {
+            s += "\n[parameters]\n";
+            for i in changed {
+                s += &format!("{} = {}\n", m.symbols[i].name, toml_float(self.params[i]));
+            }
+        }
+        s += "\n[errors]\n";
+        // Terms are sorted, so the terms of one effect are adjacent.
+        let mut at = 0;
+        let mut lines: Vec<(Effect, Vec<(Basis, String)>)> = Vec::new();
+        for t in &self.model.terms {
+            let w = t.basis.width();
+            let p = places(m, t.effect);
+            let v: Vec<String> = self.coefficients[at..at + w]
+                .iter()
+                .map(|&c| format_scaled(c, p))
+                .collect();
+            let value = if w == 2 {
+                format!("[{}]", v.join(", "))
+            } else {
+                v[0].clone()
+            };
+            let part = (t.basis, value);
+            match lines.last_mut() {
+                Some((e, parts)) if *e == t.effect => parts.push(part),
+                _ => lines.push((t.effect, vec![part])),
+            }
+            at += w;
+        }
+        for (effect, parts) in lines {
+            let value = match parts.as_slice() {
+                [(Basis::Const, v)] => v.clone(),
+                _ => {
+                    let p: Vec<String> = parts
+                        .iter()
+                        .map(|(b, v)| format!("\"{b}\" = {v}"))
+                        .collect();
+                    format!("{{ {} }}", p.join(", "))
+                }
+            };
+            s += &format!("{} = {value}\n", effect.name(m));
+        }
+        s
+    }
+}
+
+/// A TOML basic string.
+fn toml_string(s: &str) -> String {
+    serde_json::to_string(s).unwrap_or_else(|_| "\"\"".into())
+}
+
+/// An `f64` as a TOML float that reads back to the same bits.
+fn toml_float(x: f64) -> String {
+    let s = format!("{x:?}");
+    if s.contains(['.', 'e', 'E', 'i', 'n']) {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+/// The built-in truth called `name`, for machine `m`.
+pub fn builtin_truth(name: &str, m: &Machine) -> Option<Result<Truth, TruthError>> {
+    BUILTIN_TRUTHS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(n, text)| {
+            let mut t = Truth::parse(&format!("<built-in {n}>"), text, m)?;
+            t.source = n.to_string();
+            Ok(t)
+        })
+}
+
+/// A truth given by built-in name ([`BUILTIN_TRUTHS`]) or by the path of a TOML file.
+///
+/// # Errors
+/// [`TruthError::NotFound`] when it is neither; see [`Truth::load`].
+pub fn load_truth(name_or_path: &str, m: &Machine) -> Result<Truth, TruthError> {
+    if let Some(t) = builtin_truth(name_or_path, m) {
+        return t;
+    }
+    let path = std::path::Path::new(name_or_path);
+    if !path.is_file() {
+        return Err(TruthError::NotFound(name_or_path.to_string()));
+    }
+    Truth::load(path, m)
+}
+
+/// The default demo truth of `seed-ac` (`solver/truths/seed-ac-demo.toml`, documented in
+/// `docs/truth.md`): location errors of A and C and ball set-up errors of 10–30 µm and µrad,
+/// an angular positioning error of C twice per revolution (`ECC@harmonic:2`, amplitude
+/// 10 µrad) that the reduced model lacks, and 0.5 µm noise, seed 1, not zeroed. Parsed against
+/// the built-in `seed-ac`.
+pub fn seed_ac_demo_truth() -> Truth {
+    seed_ac_builtin("seed-ac-demo")
+}
+
+/// The reduced truth of `seed-ac` (`solver/truths/seed-ac-reduced.toml`): only the 11 errors of
+/// the reduced model, as constants of 10–40 µm and µrad, no noise, not zeroed.
+pub fn seed_ac_reduced_truth() -> Truth {
+    seed_ac_builtin("seed-ac-reduced")
+}
+
+fn seed_ac_builtin(name: &str) -> Truth {
+    let m = model_spec::builtin("seed-ac")
+        .expect("seed-ac is built in")
+        .expect("built-in machines are valid");
+    builtin_truth(name, &m)
+        .expect("listed")
+        .expect("built-in truths are valid (tested)")
+}
+
+/// The validator: the source, for locating errors, and the machine.
+struct Parser<'a> {
+    file: &'a str,
+    text: &'a str,
+    m: &'a Machine,
+}
+
+type Res<T> = Result<T, TruthError>;
+type Key<'i> = Spanned<std::borrow::Cow<'i, str>>;
+type Val<'i> = Spanned<DeValue<'i>>;
+
+const TOP_KEYS: &str = "machine, description, noise_um, seed, zeroed, [parameters], [errors]";
+
+impl Parser<'_> {
+    fn err(&self, span: Range<usize>, message: impl Into<String>) -> TruthError {
+        let (line, column) = line_col(self.text, span.start);
+        TruthError::Invalid {
+            file: self.file.to_string(),
+            line,
+            column,
+            message: message.into(),
+        }
+    }
+
+    fn line(&self, span: &Range<usize>) -> usize {
+        line_col(self.text, span.start).0
+    }
+
+    fn truth(&self, root: &DeTable<'_>) -> Res<Truth> {
+        let m = self.m;
+        let mut t = Truth::nominal(m);
+        t.source = self.file.to_string();
+        t.description = String::new();
+        let mut terms: Vec<(Term, Vec<f64>, Range<usize>)> = Vec::new();
+        for (k, v) in sorted(root) {
+            match k.get_ref().as_ref() {
+                "machine" => {
+                    let name = self.string(k, v)?;
+                    if name != m.name {
+                        return Err(self.err(
+                            v.span(),
+                            format!(
+                                "this truth is written for machine `{name}`, not `{}`",
+                                m.name
+                            ),
+                        ));
+                    }
+                }
+                "description" => t.description = self.string(k, v)?.trim().to_string(),
+                "noise_um" => {
+                    let what = "`noise_um` (standard deviation of the reading noise, µm)";
+                    let (x, text) = self.number(v, what)?;
+                    if x < 0.0 {
+                        return Err(self.err(v.span(), format!("{what} must not be negative")));
+                    }
+                    t.noise_mm = self.scaled(&text, 3, v, what)?;
+                }
+                "seed" => t.seed = self.seed(v)?,
+                "zeroed" => match v.get_ref() {
+                    DeValue::Boolean(b) => t.zeroed = *b,
+                    other => {
+                        return Err(self.err(
+                            v.span(),
+                            format!("`zeroed` must be true or false, not {}", other.type_str()),
+                        ));
+                    }
+                },
+                "parameters" => self.parameters(v, &mut t.params)?,
+                "errors" => self.errors(v, &mut terms)?,
+                other => {
+                    return Err(self.err(
+                        k.span(),
+                        format!("unknown key `{other}` (expected {TOP_KEYS})"),
+                    ));
+                }
+            }
+        }
+        terms.sort_by_key(|(term, _, _)| *term);
+        for (term, c, _) in terms {
+            t.model.terms.push(term);
+            t.coefficients.extend(c);
+        }
+        Ok(t)
+    }
+
+    fn table<'v, 'i>(&self, v: &'v Val<'i>, what: &str) -> Res<&'v DeTable<'i>> {
+        match v.get_ref() {
+            DeValue::Table(t) => Ok(t),
+            other => Err(self.err(
+                v.span(),
+                format!("{what} must be a table, not {}", other.type_str()),
+            )),
+        }
+    }
+
+    fn string(&self, k: &Key<'_>, v: &Val<'_>) -> Res<String> {
+        match v.get_ref() {
+            DeValue::String(s) => Ok(s.to_string()),
+            other => Err(self.err(
+                v.span(),
+                format!(
+                    "`{}` must be a string, not {}",
+                    k.get_ref(),
+                    other.type_str()
+                ),
+            )),
+        }
+    }
+
+    /// A finite number and the decimal text it was written as.
+    fn number(&self, v: &Val<'_>, what: &str) -> Res<(f64, String)> {
+        let text = match v.get_ref() {
+            DeValue::Float(f) => f.as_str().to_string(),
+            DeValue::Integer(i) => match i.radix() {
+                10 => i.as_str().to_string(),
+                r => i64::from_str_radix(i.as_str(), r)
+                    .map(|x| x.to_string())
+                    .map_err(|_| self.err(v.span(), format!("{what}: integer out of range")))?,
+            },
+            other => {
+                return Err(self.err(
+                    v.span(),
+                    format!("{what} must be a number, not {}", other.type_str()),
+                ));
+            }
+        };
+        match text.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok((x, text)),
+            _ => Err(self.err(
+                v.span(),
+                format!("{what} must be a finite number, not `{text}`"),
+            )),
+        }
+    }
+
+    /// The number `text` (already checked) with the decimal point moved `places` to the left.
+    fn scaled(&self, text: &str, places: i32, v: &Val<'_>, what: &str) -> Res<f64> {
+        match parse_scaled(text, -places) {
+            Some(x) if x.is_finite() => Ok(x),
+            _ => Err(self.err(v.span(), format!("{what}: `{text}` is out of range"))),
+        }
+    }
+
+    fn seed(&self, v: &Val<'_>) -> Res<u64> {
+        let msg = "`seed` must be a whole number from 0 to 9223372036854775807";
+        match v.get_ref() {
+            DeValue::Integer(i) => u64::from_str_radix(i.as_str(), i.radix())
+                .map_err(|_| self.err(v.span(), format!("{msg}, not `{i}`"))),
+            other => Err(self.err(v.span(), format!("{msg}, not {}", other.type_str()))),
+        }
+    }
+
+    fn parameters(&self, v: &Val<'_>, params: &mut [f64]) -> Res<()> {
+        let m = self.m;
+        for (k, v) in sorted(self.table(v, "`[parameters]`")?) {
+            let name = k.get_ref().as_ref();
+            let Some(i) = m.symbol_by_name(name) else {
+                let known: Vec<&str> = m.symbols.iter().map(|s| s.name.as_str()).collect();
+                return Err(self.err(
+                    k.span(),
+                    format!(
+                        "machine {} has no kinematic parameter `{name}` (it has: {})",
+                        m.name,
+                        if known.is_empty() {
+                            "none".to_string()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                ));
+            };
+            params[i] = self.number(v, &format!("parameter `{name}` (mm)"))?.0;
+        }
+        Ok(())
+    }
+
+    fn errors(&self, v: &Val<'_>, terms: &mut Vec<(Term, Vec<f64>, Range<usize>)>) -> Res<()> {
+        let m = self.m;
+        for (k, v) in sorted(self.table(v, "`[errors]`")?) {
+            let name = k.get_ref().as_ref();
+            let Some(effect) = Effect::parse(m, name) else {
+                return Err(self.err(
+                    k.span(),
+                    format!(
+                        "`{name}` is neither an error of machine {} nor a sensor offset dx0 dy0 dz0 (errors: {})",
+                        m.name,
+                        m.catalogue.iter().map(|e| e.name.as_str()).collect::<Vec<_>>().join(" ")
+                    ),
+                ));
+            };
+            let unit = effect.unit(m).replace('u', "µ");
+            match v.get_ref() {
+                DeValue::Table(table) => {
+                    if table.is_empty() {
+                        return Err(self.err(
+                            v.span(),
+                            format!("`{name}` has no terms: give e.g. {{ const = 1.0 }} ({unit})"),
+                        ));
+                    }
+                    for (bk, bv) in sorted(table) {
+                        let basis = Basis::parse(bk.get_ref())
+                            .map_err(|e| self.err(bk.span(), format!("{name}: {}", e.0)))?;
+                        self.term(effect, basis, &bk.span(), bv, terms)?;
+                    }
+                }
+                DeValue::Integer(_) | DeValue::Float(_) => {
+                    self.term(effect, Basis::Const, &k.span(), v, terms)?;
+                }
+                other => {
+                    return Err(self.err(
+                        v.span(),
+                        format!(
+                            "`{name}` must be a number (a constant, {unit}) or a table of basis = value, e.g. {{ const = 1.0, \"harmonic:2\" = [0.5, 0.0] }}, not {}",
+                            other.type_str()
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// One term `effect × basis` whose value `v` is written at `v`; `at` locates the basis key
+    /// (or the error name for a constant given as a plain number).
+    fn term(
+        &self,
+        effect: Effect,
+        basis: Basis,
+        at: &Range<usize>,
+        v: &Val<'_>,
+        terms: &mut Vec<(Term, Vec<f64>, Range<usize>)>,
+    ) -> Res<()> {
+        let m = self.m;
+        let name = effect.name(m);
+        let term = Term::new(m, effect, basis).map_err(|e| {
+            let what = match effect.carrier(m) {
+                Carrier::Axis(a) => format!("{name} is an error of axis {}", m.axes[a].name),
+                Carrier::None => format!("{name} belongs to no axis"),
+            };
+            self.err(
+                at.clone(),
+                format!("{name}: basis does not fit: {} ({what})", e.0),
+            )
+        })?;
+        if let Some((_, _, first)) = terms.iter().find(|(t, _, _)| *t == term) {
+            return Err(self.err(
+                at.clone(),
+                format!(
+                    "{name} with basis `{basis}` is given twice (first at line {})",
+                    self.line(first)
+                ),
+            ));
+        }
+        let unit = effect.unit(m).replace('u', "µ");
+        let what = format!("{name} `{basis}` ({unit})");
+        let p = places(m, effect);
+        let values = if basis.width() == 2 {
+            let arr = match v.get_ref() {
+                DeValue::Array(a) if a.len() == 2 => a,
+                DeValue::Array(a) => {
+                    return Err(self.err(
+                        v.span(),
+                        format!(
+                            "{what} needs two numbers [cos, sin], got an array of {}",
+                            a.len()
+                        ),
+                    ));
+                }
+                other => {
+                    return Err(self.err(
+                        v.span(),
+                        format!(
+                            "{what} needs two numbers [cos, sin], not {}",
+                            other.type_str()
+                        ),
+                    ));
+                }
+            };
+            let mut out = Vec::with_capacity(2);
+            for x in arr.iter() {
+                let (_, text) = self.number(x, &what)?;
+                out.push(self.scaled(&text, p, x, &what)?);
+            }
+            out
+        } else {
+            if let DeValue::Array(_) = v.get_ref() {
+                return Err(self.err(
+                    v.span(),
+                    format!("{what} takes one number; only `harmonic:K` takes a pair [cos, sin]"),
+                ));
+            }
+            let (_, text) = self.number(v, &what)?;
+            vec![self.scaled(&text, p, v, &what)?]
+        };
+        terms.push((term, values, at.clone()));
+        Ok(())
+    }
+}
+
+/// The entries of a table in the order of the file.
+fn sorted<'t, 'i>(t: &'t DeTable<'i>) -> Vec<(&'t Key<'i>, &'t Val<'i>)> {
+    let mut v: Vec<_> = t.iter().collect();
+    v.sort_by_key(|(k, _)| k.span().start);
+    v
+}
+
+/// The 1-based line and column (in characters) of byte offset `at` of `text`.
+pub fn line_col(text: &str, at: usize) -> (usize, usize) {
+    let mut at = at.min(text.len());
+    while !text.is_char_boundary(at) {
+        at -= 1;
+    }
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, text[start..at].chars().count() + 1)
+}

@@ -22,6 +22,7 @@ pub mod identifiability;
 pub mod model;
 pub mod paths;
 pub mod record;
+pub mod refine;
 pub mod report;
 pub mod rng;
 pub mod simulate;

@@ -44,6 +44,10 @@ pub const BUILTIN_TRUTHS: &[(&str, &str)] = &[
         "seed-ac-reduced",
         include_str!("../truths/seed-ac-reduced.toml"),
     ),
+    (
+        "seed-ac-budget",
+        include_str!("../truths/seed-ac-budget.toml"),
+    ),
 ];
 
 /// Decimal places between the unit people write and the unit inside: µm → mm is 3, µrad → rad

@@ -230,7 +230,7 @@ fn load_truth_by_name_or_file() {
     let e = load_truth("no-such-truth.toml", &m).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "no built-in truth and no file called `no-such-truth.toml` (built-in: seed-ac-demo, seed-ac-reduced)"
+        "no built-in truth and no file called `no-such-truth.toml` (built-in: seed-ac-demo, seed-ac-reduced, seed-ac-budget)"
     );
     let dir = std::env::temp_dir().join(format!("rtest-truth-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

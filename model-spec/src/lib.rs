@@ -53,6 +53,7 @@
 
 #![warn(missing_docs)]
 
+pub mod basis;
 pub mod builtin;
 pub mod catalogue;
 mod error;
@@ -60,6 +61,7 @@ pub mod geometry;
 pub mod kinematics;
 pub mod machine;
 mod raw;
+pub mod terms;
 mod validate;
 
 pub use builtin::{BUILTIN, LoadError, all_builtin, builtin, load_machine};

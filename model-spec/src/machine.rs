@@ -100,13 +100,17 @@ pub struct Chain {
     pub end_offset: Offset,
 }
 
-/// A named subset of the machine's error terms.
+/// A named sub-model: terms over a subset of the machine's errors (and the R-test's sensor
+/// offsets).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SubModel {
     /// What it is for, for people.
     pub description: String,
-    /// Its errors, in catalogue order.
+    /// The machine errors its terms use, in catalogue order, each once.
     pub errors: Vec<ErrorId>,
+    /// Its terms in the order written: `NAME` is the constant term of an error, `NAME@BASIS` a
+    /// position-, direction- or time-dependent one ([`crate::terms`]).
+    pub terms: Vec<crate::terms::Term>,
 }
 
 /// A validated machine description.

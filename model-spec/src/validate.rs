@@ -1,5 +1,6 @@
 //! From the TOML text to a validated [`Machine`], with errors that name file, line and column.
 
+use crate::basis::Basis;
 use crate::catalogue::{
     ErrorId, ErrorKind, ErrorTerm, Motion, component_name, iso_rank, location_motions,
     location_name, six_motions, squareness_rotations,
@@ -10,6 +11,7 @@ use crate::machine::{
     Axis, AxisId, AxisKind, Chain, FULL_MODEL, Link, Machine, Offset, Side, SubModel, Symbol, Value,
 };
 use crate::raw::{Num, RawErrors, RawLink, RawMachine, RawValue};
+use crate::terms::{Effect, Term};
 use std::collections::BTreeMap;
 use toml::Spanned;
 
@@ -241,12 +243,13 @@ impl Validator<'_> {
                     format!("model `{n}` has no `errors = [...]` list"),
                 );
             };
-            let errors = self.error_list(list, &machine, Some(n))?;
+            let (errors, terms) = self.term_list(list, &machine, n)?;
             machine.models.insert(
                 n.clone(),
                 SubModel {
                     description: model.get_ref().description.trim().to_string(),
                     errors,
+                    terms,
                 },
             );
         }
@@ -614,14 +617,8 @@ impl Validator<'_> {
         Ok(default_squareness_order(axes))
     }
 
-    /// The error ids of a list of names, in catalogue order. `model` names the sub-model the
-    /// list belongs to, whose errors must be in the machine's full model.
-    fn error_list(
-        &self,
-        list: &Spanned<Vec<Spanned<String>>>,
-        m: &Machine,
-        model: Option<&str>,
-    ) -> Res<Vec<ErrorId>> {
+    /// The error ids of a list of names (the `[errors] include` list), in catalogue order.
+    fn error_list(&self, list: &Spanned<Vec<Spanned<String>>>, m: &Machine) -> Res<Vec<ErrorId>> {
         let mut ids: Vec<(ErrorId, Span)> = Vec::new();
         for item in list.get_ref() {
             let id = self.error_id(item, m)?;
@@ -635,17 +632,6 @@ impl Validator<'_> {
                     ),
                 );
             }
-            if let Some(model) = model
-                && !m.errors.contains(&id)
-            {
-                return self.err(
-                    item.span(),
-                    format!(
-                        "model `{model}`: error {} is not in the machine's full model (it is left out by [errors] include/exclude)",
-                        spelled(item.get_ref(), &m.catalogue[id].name),
-                    ),
-                );
-            }
             ids.push((id, item.span()));
         }
         let mut ids: Vec<ErrorId> = ids.into_iter().map(|(i, _)| i).collect();
@@ -654,7 +640,11 @@ impl Validator<'_> {
     }
 
     fn error_id(&self, item: &Spanned<String>, m: &Machine) -> Res<ErrorId> {
-        let written = item.get_ref();
+        self.error_id_at(item.get_ref(), item.span(), m)
+    }
+
+    /// The error called `written` (located at `span` for the message).
+    fn error_id_at(&self, written: &str, span: Span, m: &Machine) -> Res<ErrorId> {
         if let Some(id) = m.error_by_name(written) {
             return Ok(id);
         }
@@ -697,14 +687,87 @@ impl Validator<'_> {
             ),
         };
         self.err(
-            item.span(),
+            span,
             format!("error `{written}` does not exist for this machine: {hint}"),
         )
     }
 
+    /// The terms of a sub-model's list: `NAME` (constant) or `NAME@BASIS`, `NAME` an error of
+    /// the machine's full model or `dx0 dy0 dz0`. Returns the errors used (catalogue order, each
+    /// once) and the terms in the order written.
+    fn term_list(
+        &self,
+        list: &Spanned<Vec<Spanned<String>>>,
+        m: &Machine,
+        model: &str,
+    ) -> Res<(Vec<ErrorId>, Vec<Term>)> {
+        let mut terms: Vec<(Term, Span)> = Vec::new();
+        for item in list.get_ref() {
+            let written = item.get_ref().trim();
+            let (name, basis) = match written.split_once('@') {
+                Some((n, b)) => (n.trim(), Some(b.trim())),
+                None => (written, None),
+            };
+            let effect = match Effect::parse_offset(name) {
+                Some(e) => e,
+                None => {
+                    let id = self.error_id_at(name, item.span(), m)?;
+                    if !m.errors.contains(&id) {
+                        return self.err(
+                            item.span(),
+                            format!(
+                                "model `{model}`: error {} is not in the machine's full model (it is left out by [errors] include/exclude)",
+                                spelled(name, &m.catalogue[id].name),
+                            ),
+                        );
+                    }
+                    Effect::Error(id)
+                }
+            };
+            let basis = match basis {
+                None => Basis::Const,
+                Some(b) => Basis::parse(b)
+                    .or_else(|e| self.err(item.span(), format!("model `{model}`: {}", e.0)))?,
+            };
+            let term = Term::new(m, effect, basis).or_else(|e| {
+                self.err(
+                    item.span(),
+                    format!("model `{model}`: {}: {}", effect.name(m), e.0),
+                )
+            })?;
+            if let Some((_, first)) = terms.iter().find(|(t, _)| *t == term) {
+                let what = match (effect, basis) {
+                    (Effect::Error(id), Basis::Const) if !written.contains('@') => {
+                        format!("error {}", spelled(name, &m.catalogue[id].name))
+                    }
+                    _ => format!("model `{model}`: term `{written}`"),
+                };
+                return self.err(
+                    item.span(),
+                    format!(
+                        "{what} is listed twice (first on line {})",
+                        self.line(first)
+                    ),
+                );
+            }
+            terms.push((term, item.span()));
+        }
+        let terms: Vec<Term> = terms.into_iter().map(|(t, _)| t).collect();
+        let mut errors: Vec<ErrorId> = terms
+            .iter()
+            .filter_map(|t| match t.effect {
+                Effect::Error(e) => Some(e),
+                Effect::SensorOffset(_) => None,
+            })
+            .collect();
+        errors.sort_unstable();
+        errors.dedup();
+        Ok((errors, terms))
+    }
+
     fn model_errors(&self, raw: &RawErrors, m: &Machine) -> Res<Vec<ErrorId>> {
         let mut errors: Vec<ErrorId> = match &raw.include {
-            Some(list) => self.error_list(list, m, None)?,
+            Some(list) => self.error_list(list, m)?,
             None => (0..m.catalogue.len()).collect(),
         };
         if let Some(exclude) = &raw.exclude {

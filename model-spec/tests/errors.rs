@@ -868,3 +868,86 @@ fn squareness_order_rotary_twice_and_missing() {
         "m.toml:50:20: squareness_order misses linear axis X: it must list every linear axis once",
     );
 }
+
+// Sub-models with basis terms (`NAME@BASIS`).
+
+#[test]
+fn submodel_terms_with_bases() {
+    let text = edit(
+        r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+        r#"errors = ["XOC", "ECC@harmonic:2", "dx0@time:1", "EYY@poly:1", "EXY@reversal", "ECC@harmonic:1"]"#,
+    );
+    let m = parse_machine("m.toml", &text).unwrap();
+    let sub = &m.models["reduced"];
+    let names: Vec<String> = sub
+        .terms
+        .iter()
+        .map(|t| format!("{}@{}", t.effect.name(&m), t.basis))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "XOC@const",
+            "ECC@harmonic:2",
+            "dx0@time:1",
+            "EYY@poly:1",
+            "EXY@reversal",
+            "ECC@harmonic:1"
+        ]
+    );
+    let errors: Vec<&str> = sub
+        .errors
+        .iter()
+        .map(|&e| m.catalogue[e].name.as_str())
+        .collect();
+    assert_eq!(
+        errors,
+        ["EXY", "EYY", "ECC", "XOC"],
+        "distinct errors, catalogue order"
+    );
+}
+
+#[test]
+fn submodel_term_errors_are_located() {
+    let line = BASE
+        .lines()
+        .position(|l| l.contains(r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#))
+        .unwrap()
+        + 1;
+    check(
+        &edit(
+            r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+            r#"errors = ["XOC@harmonic:2"]"#,
+        ),
+        &format!(
+            "m.toml:{line}:11: model `reduced`: XOC: `harmonic:2` needs an error of a rotary axis"
+        ),
+    );
+    check(
+        &edit(
+            r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+            r#"errors = ["XOC", "ECC@cubic:2"]"#,
+        ),
+        &format!(
+            "m.toml:{line}:18: model `reduced`: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal or time:K)"
+        ),
+    );
+    check(
+        &edit(
+            r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+            r#"errors = ["ECC@harmonic:2", "ECC@harmonic:2"]"#,
+        ),
+        &format!(
+            "m.toml:{line}:29: model `reduced`: term `ECC@harmonic:2` is listed twice (first on line {line})"
+        ),
+    );
+    check(
+        &edit(
+            r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+            r#"errors = ["dx0@poly:1"]"#,
+        ),
+        &format!(
+            "m.toml:{line}:11: model `reduced`: dx0: `poly:1` needs an error of a linear axis"
+        ),
+    );
+}

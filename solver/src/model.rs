@@ -1,106 +1,9 @@
-//! What a model fits: terms, each an effect (an ISO 230 error of the machine, or an R-test
-//! sensor zero offset `dx0 dy0 dz0`) times a basis of the vocabulary. A term gives one H-matrix
-//! column, two for `harmonic:K`.
+//! What a model fits: its terms in order ([`Effect`] × basis, see `model_spec::terms`); its
+//! H-matrix columns are the terms' columns in order.
 
-use crate::basis::{Basis, BasisError, Carrier};
-use model_spec::{Dir, ErrorId, Machine};
-use std::fmt;
-
-/// Something that moves the measured error vector.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Effect {
-    /// An error of the machine's catalogue.
-    Error(ErrorId),
-    /// The R-test's zero offset along a tool-frame axis (`dx0 dy0 dz0`): adds to the reading,
-    /// gain +1 in that direction.
-    SensorOffset(Dir),
-}
-
-impl Effect {
-    /// The effect called `name` on `m`: an error name (digit-zero alias accepted) or
-    /// `dx0 dy0 dz0`.
-    pub fn parse(m: &Machine, name: &str) -> Option<Effect> {
-        match name.trim() {
-            "dx0" => Some(Effect::SensorOffset(Dir::X)),
-            "dy0" => Some(Effect::SensorOffset(Dir::Y)),
-            "dz0" => Some(Effect::SensorOffset(Dir::Z)),
-            n => m.error_by_name(n).map(Effect::Error),
-        }
-    }
-
-    /// Its name (`XOC`, `dx0`).
-    pub fn name(self, m: &Machine) -> String {
-        match self {
-            Effect::Error(e) => m.catalogue[e].name.clone(),
-            Effect::SensorOffset(d) => format!("d{d}0"),
-        }
-    }
-
-    /// `true` for angular errors (rad inside, µrad for people).
-    pub fn is_angular(self, m: &Machine) -> bool {
-        matches!(self, Effect::Error(e) if m.catalogue[e].is_angular())
-    }
-
-    /// The unit people see: `um` or `urad`.
-    pub fn unit(self, m: &Machine) -> &'static str {
-        if self.is_angular(m) { "urad" } else { "um" }
-    }
-
-    /// What its basis depends on.
-    pub fn carrier(self, m: &Machine) -> Carrier {
-        match self {
-            Effect::Error(e) => match m.catalogue[e].kind {
-                model_spec::ErrorKind::Component { axis, .. } => Carrier::Axis(axis),
-                _ => Carrier::None,
-            },
-            Effect::SensorOffset(_) => Carrier::None,
-        }
-    }
-}
-
-/// One term of a model: an effect times a basis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Term {
-    /// The effect.
-    pub effect: Effect,
-    /// Its basis.
-    pub basis: Basis,
-}
-
-impl Term {
-    /// A term, checked against the machine (the basis must fit the effect: harmonics of rotary
-    /// axes' component errors, polynomials and reversal of component errors of axes).
-    pub fn new(m: &Machine, effect: Effect, basis: Basis) -> Result<Term, BasisError> {
-        basis.check(m, effect.carrier(m))?;
-        Ok(Term { effect, basis })
-    }
-
-    /// Parses `NAME` (constant) or `NAME@BASIS` (`ECC@harmonic:2`, `dx0@time:1`).
-    pub fn parse(m: &Machine, s: &str) -> Result<Term, BasisError> {
-        let (name, basis) = match s.split_once('@') {
-            Some((n, b)) => (n, Basis::parse(b)?),
-            None => (s, Basis::Const),
-        };
-        let effect = Effect::parse(m, name).ok_or_else(|| {
-            BasisError(format!(
-                "`{}` is neither an error of machine {} nor dx0/dy0/dz0",
-                name.trim(),
-                m.name
-            ))
-        })?;
-        Term::new(m, effect, basis).map_err(|e| BasisError(format!("{}: {}", name.trim(), e.0)))
-    }
-
-    /// Its H-matrix column names: `XOC const`, `ECC harmonic:2:cos`, ….
-    pub fn column_names(&self, m: &Machine) -> Vec<String> {
-        let n = self.effect.name(m);
-        self.basis
-            .column_names()
-            .into_iter()
-            .map(|b| format!("{n} {b}"))
-            .collect()
-    }
-}
+use model_spec::basis::Basis;
+pub use model_spec::terms::{Effect, Term};
+use model_spec::{ErrorId, Machine};
 
 /// A model: terms in order; its columns are the terms' columns in order.
 #[derive(Clone, Debug, PartialEq, Eq, Default)]
@@ -110,7 +13,18 @@ pub struct Model {
 }
 
 impl Model {
-    /// Every error of the named model of `m` with a constant basis.
+    /// The model called `name` of machine `m` (`full`: every error of the machine, constant;
+    /// a sub-model: its terms), or `None`.
+    pub fn of(m: &Machine, name: &str) -> Option<Model> {
+        if name == model_spec::FULL_MODEL {
+            return Some(Model::constant(&m.errors));
+        }
+        m.models.get(name).map(|s| Model {
+            terms: s.terms.clone(),
+        })
+    }
+
+    /// Every error of `errors` with a constant basis.
     pub fn constant(errors: &[ErrorId]) -> Model {
         Model {
             terms: errors
@@ -150,11 +64,5 @@ impl Model {
         v.sort_unstable();
         v.dedup();
         v
-    }
-}
-
-impl fmt::Display for Term {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{:?}@{}", self.effect, self.basis)
     }
 }

@@ -106,3 +106,98 @@ impl Term {
             .collect()
     }
 }
+
+/// What an effect is, in a machine-tool engineer's words (`angular positioning error of C`,
+/// `straightness of X in y`, `squareness of X to the reference`, `ball set-up error in x`).
+pub fn describe_effect(m: &Machine, effect: Effect) -> String {
+    use crate::{AxisKind, ErrorKind, Motion};
+    let e = match effect {
+        Effect::SensorOffset(d) => return format!("R-test zero offset in {d}"),
+        Effect::Error(e) => &m.catalogue[e],
+    };
+    match e.kind {
+        ErrorKind::Component { axis, motion } => {
+            let a = &m.axes[axis];
+            let own = a.direction.dir;
+            match (a.kind, motion) {
+                (AxisKind::Linear, Motion::Translation(d)) if d == own => {
+                    format!("positioning error of {}", a.name)
+                }
+                (AxisKind::Linear, Motion::Translation(d)) => {
+                    format!("straightness of {} in {d}", a.name)
+                }
+                (AxisKind::Linear, Motion::Rotation(d)) if d == own => {
+                    format!("roll of {} (about {d})", a.name)
+                }
+                (AxisKind::Linear, Motion::Rotation(d)) => {
+                    format!("angular error of {} about {d}", a.name)
+                }
+                (AxisKind::Rotary, Motion::Rotation(d)) if d == own => {
+                    format!("angular positioning error of {}", a.name)
+                }
+                (AxisKind::Rotary, Motion::Rotation(d)) => {
+                    format!("tilt (wobble) of {} about {d}", a.name)
+                }
+                (AxisKind::Rotary, Motion::Translation(d)) if d == own => {
+                    format!("axial motion error of {}", a.name)
+                }
+                (AxisKind::Rotary, Motion::Translation(d)) => {
+                    format!("radial motion error of {} in {d}", a.name)
+                }
+            }
+        }
+        ErrorKind::Location { axis, motion } => match motion {
+            Motion::Translation(d) => {
+                format!("position of the {} axis line in {d}", m.axes[axis].name)
+            }
+            Motion::Rotation(d) => format!(
+                "orientation of the {} axis line about {d}",
+                m.axes[axis].name
+            ),
+        },
+        ErrorKind::Squareness { axis, about } => {
+            format!(
+                "squareness of {} (rotation about {about})",
+                m.axes[axis].name
+            )
+        }
+        ErrorKind::Setup { along } => format!("workpiece (ball) set-up error in {along}"),
+    }
+}
+
+/// What a basis means for people: `constant`, `twice per revolution`, `linear over the stroke`.
+pub fn describe_basis(basis: Basis) -> String {
+    match basis {
+        Basis::Const => "constant".into(),
+        Basis::Harmonic(1) => "once per revolution".into(),
+        Basis::Harmonic(2) => "twice per revolution".into(),
+        Basis::Harmonic(k) => format!("{k} times per revolution"),
+        Basis::Poly(1) => "linear over the stroke".into(),
+        Basis::Poly(2) => "quadratic over the stroke".into(),
+        Basis::Poly(k) => format!("order-{k} polynomial over the stroke"),
+        Basis::Reversal => "with the direction of motion (reversal)".into(),
+        Basis::Time(1) => "drifting linearly in time".into(),
+        Basis::Time(k) => format!("order-{k} polynomial in time"),
+    }
+}
+
+impl Term {
+    /// `ECC harmonic:2: angular positioning error of C, twice per revolution`.
+    pub fn describe(&self, m: &Machine) -> String {
+        format!(
+            "{} {}: {}, {}",
+            self.effect.name(m),
+            self.basis,
+            describe_effect(m, self.effect),
+            describe_basis(self.basis)
+        )
+    }
+
+    /// `ECC@harmonic:2` (`XOC` for a constant term): the spelling of sub-model lists.
+    pub fn spelling(&self, m: &Machine) -> String {
+        match self.basis {
+            Basis::Const => self.effect.name(m),
+            b => format!("{}@{b}", self.effect.name(m)),
+        }
+    }
+}

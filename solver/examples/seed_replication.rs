@@ -17,10 +17,15 @@ use solver::simulate::simulate;
 use solver::truth::{Truth, builtin_truth};
 use solver::validate::{ValidateOptions, validate};
 
+/// Per path: name, max |measured| per direction, max |residual| per direction, RMS before and
+/// after (µm).
+type PathStats = (&'static str, [f64; 3], [f64; 3], f64, f64);
+/// A group of the budget: its label and which effects it holds.
+type Group<'a> = (&'a str, Box<dyn Fn(Effect) -> bool + 'a>);
+
 struct Run {
     ident: Identification,
-    /// Per path: (max |measured| per direction, max |residual| per direction, RMS after), µm.
-    paths: Vec<(&'static str, [f64; 3], [f64; 3], f64, f64)>,
+    paths: Vec<PathStats>,
 }
 
 fn run(m: &Machine, truth: &Truth) -> Run {
@@ -152,7 +157,7 @@ fn main() {
         },
         _ => false,
     };
-    let groups: Vec<(&str, Box<dyn Fn(Effect) -> bool>)> = vec![
+    let groups: Vec<Group> = vec![
         ("none (reduced errors only)", Box::new(|_| false)),
         (
             "linear-axis component errors (18)",

@@ -13,6 +13,7 @@
 
 pub mod basis;
 pub mod csvio;
+pub mod diagnose;
 pub mod distributions;
 pub mod estimate;
 pub mod exact;

@@ -1,0 +1,2 @@
+//! Placeholder replaced by the diagnosis benchmark.
+fn main() {}

@@ -171,6 +171,37 @@ pub fn least_squares(
     constraint: &Constraint,
     tol: &Tolerances,
 ) -> Result<Fit, EstimateError> {
+    solve(h, y, names, constraint, tol, h.nrows(), 0.0)
+}
+
+/// [`least_squares`] on a reduced system: `r` (p × p or (p+1) × p) and `z` with `rᵀr = HᵀH`
+/// and `rᵀz = Hᵀy` for the real `H` (`rows` rows) and `y`, and `rss_outside` the part of
+/// `‖y‖²` no combination of H's columns reaches (the triangular factor of a streaming QR,
+/// [`crate::streaming`]). Estimates, rank, uncertainties, covariance and identifiability are
+/// those of the full system; [`Fit::residual`] is the reduced system's (length of `z`).
+pub fn least_squares_reduced(
+    r: &DMatrix<f64>,
+    z: &DVector<f64>,
+    names: &[String],
+    constraint: &Constraint,
+    tol: &Tolerances,
+    rows: usize,
+    rss_outside: f64,
+) -> Result<Fit, EstimateError> {
+    solve(r, z, names, constraint, tol, rows, rss_outside)
+}
+
+/// The solver behind both: `rows` is the real number of rows (for the rank tolerance and the
+/// degrees of freedom), `rss_outside` adds to the residual sum of squares.
+fn solve(
+    h: &DMatrix<f64>,
+    y: &DVector<f64>,
+    names: &[String],
+    constraint: &Constraint,
+    tol: &Tolerances,
+    rows_total: usize,
+    rss_outside: f64,
+) -> Result<Fit, EstimateError> {
     let (m, n) = h.shape();
     if m == 0 || n == 0 {
         return Err(EstimateError::Shape(format!(
@@ -235,7 +266,10 @@ pub fn least_squares(
         (svd.singular_values.as_slice().to_vec(), u, vt.transpose())
     };
     let smax = sv.first().copied().unwrap_or(0.0);
-    let tau = smax * tol.rank_relative.max(m.max(n) as f64 * f64::EPSILON);
+    let tau = smax
+        * tol
+            .rank_relative
+            .max(rows_total.max(n) as f64 * f64::EPSILON);
     let rank = sv.iter().take_while(|&&s| s > tau && s > 0.0).count();
     // Minimum-norm solution in the identifiable subspace (scaled coordinates).
     let mut ypad = DVector::<f64>::zeros(rows);
@@ -250,8 +284,8 @@ pub fn least_squares(
         x[j] = z[k] / norms[j];
     }
     let residual = y - h * DVector::from_column_slice(&x);
-    let rss = residual.norm_squared();
-    let dof = m.saturating_sub(rank);
+    let rss = residual.norm_squared() + rss_outside;
+    let dof = rows_total.saturating_sub(rank);
     let sigma = (dof > 0).then(|| (rss / dof as f64).sqrt());
     // Unit covariance V_r Σ_r⁻² V_rᵀ in scaled coordinates, then unscaled.
     let mut unit = DMatrix::<f64>::zeros(n, n);

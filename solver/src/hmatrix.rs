@@ -492,6 +492,18 @@ pub fn h_matrix(
     record: &Record,
     source: &mut GainSource,
 ) -> Result<DMatrix<f64>, HMatrixError> {
+    h_matrix_spanned(m, model, record, source, None)
+}
+
+/// [`h_matrix`] of a block of a longer record: `time_span` `(t0, t1)` (s) is the whole
+/// record's, so that `time:K` terms are normalised over the record, not the block.
+pub fn h_matrix_spanned(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    source: &mut GainSource,
+    time_span: Option<(f64, f64)>,
+) -> Result<DMatrix<f64>, HMatrixError> {
     check_model(m, model)?;
     // Per column: where its gain comes from, carrier, basis, component.
     let mut cols = Vec::with_capacity(model.width());
@@ -523,7 +535,11 @@ pub fn h_matrix(
                 HMatrixError::Sample { message, .. } => HMatrixError::Sample { sample: i, message },
                 other => other,
             })?;
-        let tau = record.tau(i);
+        let tau = match time_span {
+            Some((t0, t1)) if t1 > t0 => 2.0 * (s.t - t0) / (t1 - t0) - 1.0,
+            Some(_) => 0.0,
+            None => record.tau(i),
+        };
         for (c, &(gain, carrier, basis, k)) in cols.iter().enumerate() {
             let b = basis.values(m, carrier, &s.commands, &s.motion, tau)[k];
             let v = match gain {

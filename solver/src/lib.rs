@@ -27,6 +27,7 @@ pub mod refine;
 pub mod report;
 pub mod rng;
 pub mod simulate;
+pub mod streaming;
 
 pub mod truth;
 pub mod validate;

@@ -1,0 +1,144 @@
+//! Identification from long records without holding the H matrix.
+//!
+//! Blocks of rows of `[H | y]` are folded into the upper-triangular factor `R` ((p+1) × (p+1))
+//! of a QR decomposition: `R ← triangular factor of [R; H_b y_b]` (Householder). At every
+//! step `RᵀR` equals the Gram matrix of all rows seen, so at the end
+//! - `R₁₁` (p × p) and `z = R₁₂` (p) satisfy `R₁₁ᵀR₁₁ = HᵀH` and `R₁₁ᵀz = Hᵀy`;
+//! - `R₂₂²` is the part of `‖y‖²` that no combination of the columns reaches,
+//!
+//! and [`crate::estimate::least_squares_reduced`] gives exactly the in-memory solver's estimate,
+//! rank, uncertainties, covariance and identifiability. Memory: `(p+1)²` numbers plus one block,
+//! whatever the number of samples. Time: `O(rows · p²)`, like one QR of the whole H.
+
+use crate::estimate::{
+    Constraint, EstimateError, Fit, Tolerances, least_squares_reduced, measurement_vector,
+};
+use crate::hmatrix::{GainSource, HMatrixError, h_matrix_spanned, parameter_names};
+use crate::model::Model;
+use crate::record::Record;
+use model_spec::Machine;
+use nalgebra::{DMatrix, DVector};
+
+/// The running triangular factor of `[H | y]`.
+#[derive(Clone, Debug)]
+pub struct StreamingQr {
+    r: DMatrix<f64>,
+    p: usize,
+    rows: usize,
+}
+
+impl StreamingQr {
+    /// For `p` parameters.
+    pub fn new(p: usize) -> StreamingQr {
+        StreamingQr {
+            r: DMatrix::zeros(p + 1, p + 1),
+            p,
+            rows: 0,
+        }
+    }
+
+    /// Folds in a block of rows `h` (b × p) with measurements `y` (b).
+    pub fn add(&mut self, h: &DMatrix<f64>, y: &DVector<f64>) {
+        let (b, p) = (h.nrows(), self.p);
+        assert_eq!(h.ncols(), p, "block has {} columns, the fit {p}", h.ncols());
+        assert_eq!(
+            y.len(),
+            b,
+            "block has {b} rows and {} measurements",
+            y.len()
+        );
+        if b == 0 {
+            return;
+        }
+        let mut a = DMatrix::zeros(p + 1 + b, p + 1);
+        a.view_mut((0, 0), (p + 1, p + 1)).copy_from(&self.r);
+        a.view_mut((p + 1, 0), (b, p)).copy_from(h);
+        a.view_mut((p + 1, p), (b, 1)).copy_from(y);
+        self.r = a.qr().r();
+        self.rows += b;
+    }
+
+    /// Rows folded in so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Bytes held between blocks (the factor).
+    pub fn state_bytes(&self) -> usize {
+        self.r.len() * std::mem::size_of::<f64>()
+    }
+
+    /// The least-squares fit of all rows seen (see [`crate::estimate::least_squares`]).
+    pub fn solve(
+        &self,
+        names: &[String],
+        constraint: &Constraint,
+        tol: &Tolerances,
+    ) -> Result<Fit, EstimateError> {
+        let p = self.p;
+        let r11 = self.r.view((0, 0), (p, p)).into_owned();
+        let z = self.r.view((0, p), (p, 1)).column(0).into_owned();
+        let outside = self.r[(p, p)] * self.r[(p, p)];
+        least_squares_reduced(&r11, &z, names, constraint, tol, self.rows, outside)
+    }
+}
+
+/// Why a streaming identification failed.
+#[derive(Debug, thiserror::Error)]
+pub enum StreamingError<E: std::error::Error + 'static> {
+    /// A block could not be read.
+    #[error(transparent)]
+    Read(E),
+    /// A block's H matrix could not be built.
+    #[error(transparent)]
+    HMatrix(#[from] HMatrixError),
+    /// A block's measurements, or the final solve, failed.
+    #[error(transparent)]
+    Estimate(#[from] EstimateError),
+}
+
+/// A streaming identification.
+#[derive(Clone, Debug)]
+pub struct StreamingIdentification {
+    /// The fit (its `residual` is the reduced system's, not per sample).
+    pub fit: Fit,
+    /// Samples used.
+    pub samples: usize,
+    /// Blocks folded in.
+    pub blocks: usize,
+    /// Largest block, samples.
+    pub largest_block: usize,
+}
+
+/// Identifies `model` from `blocks` of one record (each a [`Record`] with measurements;
+/// `time_span` `(t0, t1)` is the whole record's, s, for `time:K` terms), with gains from
+/// `source`. First-order least squares, as [`crate::estimate::identify_with`] without the
+/// refinement (which needs the whole record).
+pub fn identify_streaming<E: std::error::Error + 'static>(
+    m: &Machine,
+    model: &Model,
+    blocks: impl IntoIterator<Item = Result<Record, E>>,
+    time_span: Option<(f64, f64)>,
+    source: &mut GainSource,
+    constraint: &Constraint,
+    tol: &Tolerances,
+) -> Result<StreamingIdentification, StreamingError<E>> {
+    let mut qr = StreamingQr::new(model.width());
+    let (mut samples, mut count, mut largest) = (0, 0, 0);
+    for block in blocks {
+        let block = block.map_err(StreamingError::Read)?;
+        let h = h_matrix_spanned(m, model, &block, source, time_span)?;
+        let y = measurement_vector(&block)?;
+        qr.add(&h, &y);
+        samples += block.samples.len();
+        largest = largest.max(block.samples.len());
+        count += 1;
+    }
+    let fit = qr.solve(&parameter_names(m, model), constraint, tol)?;
+    Ok(StreamingIdentification {
+        fit,
+        samples,
+        blocks: count,
+        largest_block: largest,
+    })
+}

@@ -55,22 +55,21 @@ fn compare(model: &Model, block: usize) {
         s.fit.rss,
         full.rss
     );
-    for j in 0..names.len() {
+    for (j, name) in names.iter().enumerate() {
         match (s.fit.values[j], full.values[j]) {
             (Some(a), Some(b)) => assert!(
                 (a - b).abs() <= 1e-9 * b.abs().max(1e-6),
-                "{}: {a} vs {b}",
-                names[j]
+                "{name}: {a} vs {b}"
             ),
             (None, None) => {}
-            other => panic!("{}: determined differently {other:?}", names[j]),
+            other => panic!("{name}: determined differently {other:?}"),
         }
         match (s.fit.std[j], full.std[j]) {
             (Some(a), Some(b)) => {
-                assert!((a / b - 1.0).abs() < 1e-9, "{} std: {a} vs {b}", names[j])
+                assert!((a / b - 1.0).abs() < 1e-9, "{name} std: {a} vs {b}")
             }
             (None, None) => {}
-            other => panic!("{} std: {other:?}", names[j]),
+            other => panic!("{name} std: {other:?}"),
         }
     }
     assert_eq!(

@@ -18,6 +18,7 @@ pub mod distributions;
 pub mod estimate;
 pub mod exact;
 pub mod fd;
+pub mod first_order;
 pub mod hmatrix;
 pub mod identifiability;
 pub mod model;

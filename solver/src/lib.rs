@@ -23,6 +23,7 @@ pub mod hmatrix;
 pub mod identifiability;
 pub mod model;
 pub mod paths;
+pub mod perf;
 pub mod record;
 pub mod refine;
 pub mod report;

@@ -1,0 +1,376 @@
+//! In-process performance comparisons (`rtest bench`): medians of repeated runs on this
+//! computer, reported as ratios. The criterion benchmarks (`cargo bench`) and callgrind
+//! instruction counts in BENCHMARKS.md are the careful versions; these take seconds.
+//!
+//! 1. Gains of the whole `seed-ac` model (44 errors × 6) at one pose by (a) the generated code,
+//!    (b) the IR evaluator, (c) the exact HTM chain with central finite differences (what an
+//!    engineer writes without a generator), (d) a runtime first-order product of the chain.
+//!    Every method includes the sines and cosines of the pose.
+//! 2. The H matrix of the full model (3 rows × 44 columns per pose) filled for many poses in
+//!    blocks into a reused buffer, against a plain write of the same bytes into that buffer.
+//! 3. Streaming identification of a long record (the reduced model), with the peak memory.
+//! 4. Code generation of every built-in machine.
+
+use crate::estimate::{Constraint, Tolerances};
+use crate::exact::{VirtualMachine, tool_centre_point_ik};
+use crate::fd::{FdSteps, fd_gains_with};
+use crate::first_order::FirstOrderChain;
+use crate::hmatrix::GainSource;
+use crate::model::Model;
+use crate::record::{Record, Sample};
+use crate::rng::Rng;
+use crate::streaming::identify_streaming;
+use codegen::{GainModel, compile};
+use generated::seed_ac::{Params, Pose, full};
+use model_spec::{AxisKind, Machine};
+use std::hint::black_box;
+use std::time::Instant;
+
+/// The median of `runs` timings of `f`, in seconds.
+pub fn median_seconds(runs: usize, mut f: impl FnMut()) -> f64 {
+    let mut t: Vec<f64> = (0..runs.max(1))
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64()
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[t.len() / 2]
+}
+
+/// One method of computing the gains.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MethodTime {
+    /// What it is.
+    pub method: &'static str,
+    /// Median time per pose, ns.
+    pub ns_per_pose: f64,
+    /// Its time over the generated code's.
+    pub ratio_to_generated: f64,
+}
+
+fn machine() -> Machine {
+    model_spec::builtin("seed-ac")
+        .expect("built in")
+        .expect("valid")
+}
+
+/// Random on-ball poses of seed-ac: `(commands, params)`.
+fn poses(m: &Machine, n: usize) -> Vec<Vec<f64>> {
+    let mut rng = Rng::new(17);
+    let params = m.default_parameters();
+    (0..n)
+        .map(|_| {
+            let mut c: Vec<f64> = m
+                .axes
+                .iter()
+                .map(|a| match a.kind {
+                    AxisKind::Rotary => rng.uniform_in(-1.5, 1.5),
+                    AxisKind::Linear => 0.0,
+                })
+                .collect();
+            tool_centre_point_ik(m, &mut c, &params).expect("seed-ac has three linear axes");
+            c
+        })
+        .collect()
+}
+
+/// Gains of the full seed-ac model by the four methods (`quick`: fewer repetitions).
+pub fn gain_methods(quick: bool) -> Vec<MethodTime> {
+    let m = machine();
+    let errors = m.model_errors("full").expect("full").to_vec();
+    let params = m.default_parameters();
+    let ps = poses(&m, if quick { 64 } else { 256 });
+    let runs = if quick { 5 } else { 15 };
+    let model = GainModel::derive(&m, &errors);
+    let program = compile(&m, &model);
+    let chain = FirstOrderChain::new(&m, &errors);
+    let vm = VirtualMachine::new(&m);
+    let typed_params = Params::default();
+    let (ia, ic) = (
+        m.axis_by_name("A").expect("A"),
+        m.axis_by_name("C").expect("C"),
+    );
+    let (ix, iy, iz) = (
+        m.axis_by_name("X").expect("X"),
+        m.axis_by_name("Y").expect("Y"),
+        m.axis_by_name("Z").expect("Z"),
+    );
+    let per = |s: f64, reps: usize| s * 1e9 / (ps.len() * reps) as f64;
+
+    let mut out = [[0.0; 6]; full::N];
+    let generated = per(
+        median_seconds(runs, || {
+            for _ in 0..10 {
+                for c in &ps {
+                    let (sa, ca) = c[ia].sin_cos();
+                    let (sc, cc) = c[ic].sin_cos();
+                    let pose = Pose {
+                        sin_a: sa,
+                        cos_a: ca,
+                        sin_c: sc,
+                        cos_c: cc,
+                        x: c[ix],
+                        y: c[iy],
+                        z: c[iz],
+                    };
+                    full::gains(black_box(&pose), black_box(&typed_params), &mut out);
+                    black_box(&out);
+                }
+            }
+        }),
+        10,
+    );
+    let (mut scratch, mut flat) = (Vec::new(), vec![0.0; 6 * errors.len()]);
+    let evaluator = per(
+        median_seconds(runs, || {
+            for c in &ps {
+                let inputs = model.atoms.values(c, &params);
+                program.eval(black_box(&inputs), &mut scratch, &mut flat);
+                black_box(&flat);
+            }
+        }),
+        1,
+    );
+    let steps = FdSteps {
+        richardson: false,
+        ..FdSteps::default()
+    };
+    let fd_runs = if quick { 2 } else { 5 };
+    let fd_poses = &ps[..ps.len().min(16)];
+    let fd = median_seconds(fd_runs, || {
+        for c in fd_poses {
+            black_box(fd_gains_with(&vm, black_box(c), &params, &errors, steps));
+        }
+    }) * 1e9
+        / fd_poses.len() as f64;
+    let mut d = vec![[0.0; 6]; errors.len()];
+    let first_order = per(
+        median_seconds(runs, || {
+            for c in &ps {
+                chain.gains(black_box(c), &params, &mut d);
+                black_box(&d);
+            }
+        }),
+        1,
+    );
+    [
+        ("(a) generated code", generated),
+        ("(b) IR evaluator", evaluator),
+        ("(c) exact HTMs + finite differences", fd),
+        ("(d) runtime first-order product", first_order),
+    ]
+    .into_iter()
+    .map(|(method, ns)| MethodTime {
+        method,
+        ns_per_pose: ns,
+        ratio_to_generated: ns / generated,
+    })
+    .collect()
+}
+
+/// The H-matrix fill against a plain write.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FillBandwidth {
+    /// Poses filled.
+    pub poses: usize,
+    /// Poses per block (the reused buffer).
+    pub block: usize,
+    /// Bytes of H written: poses × 3 rows × 44 columns × 8.
+    pub bytes: f64,
+    /// Fill time, s (median).
+    pub fill_seconds: f64,
+    /// Plain write of the same bytes into the same buffer, s (median).
+    pub write_seconds: f64,
+}
+
+impl FillBandwidth {
+    /// The fill's bandwidth as a fraction of the plain write's.
+    pub fn fraction(&self) -> f64 {
+        self.write_seconds / self.fill_seconds
+    }
+}
+
+/// Fills the full seed-ac H matrix (position rows) for `poses` poses of a K4-like sweep, in
+/// blocks of `block` poses.
+pub fn fill_bandwidth(poses: usize, block: usize, runs: usize) -> FillBandwidth {
+    let params = Params::default();
+    let cols = full::N;
+    let mut buffer = vec![0.0f64; block * 3 * cols];
+    let mut g = [[0.0; 6]; full::N];
+    let fill = median_seconds(runs, || {
+        let mut done = 0;
+        while done < poses {
+            let b = block.min(poses - done);
+            for i in 0..b {
+                let theta = (done + i) as f64 * 1e-4;
+                let (sc, cc) = theta.sin_cos();
+                let a = -std::f64::consts::FRAC_PI_4 * (1.0 - cc);
+                let (sa, ca) = a.sin_cos();
+                let pose = Pose {
+                    sin_a: sa,
+                    cos_a: ca,
+                    sin_c: sc,
+                    cos_c: cc,
+                    x: 200.0 * cc,
+                    y: 200.0 * sc,
+                    z: 50.0 * ca,
+                };
+                full::gains(&pose, &params, &mut g);
+                let row = &mut buffer[i * 3 * cols..(i + 1) * 3 * cols];
+                for (e, gain) in g.iter().enumerate() {
+                    row[e] = gain[0];
+                    row[cols + e] = gain[1];
+                    row[2 * cols + e] = gain[2];
+                }
+            }
+            black_box(&buffer);
+            done += b;
+        }
+    });
+    let write = median_seconds(runs, || {
+        let mut done = 0;
+        while done < poses {
+            let b = block.min(poses - done);
+            buffer[..b * 3 * cols].fill(black_box(done as f64));
+            black_box(&buffer);
+            done += b;
+        }
+    });
+    FillBandwidth {
+        poses,
+        block,
+        bytes: (poses * 3 * cols * 8) as f64,
+        fill_seconds: fill,
+        write_seconds: write,
+    }
+}
+
+/// A streaming identification run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StreamingRun {
+    /// Samples.
+    pub samples: usize,
+    /// Generating the record's blocks alone (poses, first-order readings, noise), s.
+    pub generate_seconds: f64,
+    /// Generating and identifying, s.
+    pub total_seconds: f64,
+    /// Peak resident memory of the process afterwards (VmHWM), bytes, if known.
+    pub peak_rss_bytes: Option<u64>,
+    /// Largest estimate error against the values used to generate, in units of its standard
+    /// uncertainty.
+    pub worst_z: f64,
+}
+
+/// Blocks of a long dynamic record of seed-ac: C turning continuously, A swinging, readings from
+/// the first-order reduced model at `truth` (mm, rad) plus 0.5 µm noise.
+fn synthetic_blocks(
+    m: &Machine,
+    samples: usize,
+    block: usize,
+    truth: Vec<f64>,
+) -> impl Iterator<Item = Result<Record, std::convert::Infallible>> + '_ {
+    let model = Model::of(m, "reduced").expect("seed-ac has a reduced model");
+    let params = m.default_parameters();
+    let mut source = GainSource::new(m, &model.errors(), &params).expect("compiled");
+    let mut rng = Rng::new(99);
+    let (ia, ic) = (
+        m.axis_by_name("A").expect("A"),
+        m.axis_by_name("C").expect("C"),
+    );
+    let mut done = 0;
+    std::iter::from_fn(move || {
+        if done >= samples {
+            return None;
+        }
+        let b = block.min(samples - done);
+        let mut rec = Record::default();
+        let mut g = vec![[0.0; 3]; model.errors().len()];
+        for i in done..done + b {
+            let t = i as f64 * 1e-3;
+            let mut c = vec![0.0; m.axes.len()];
+            c[ic] = 0.7 * t;
+            c[ia] = -0.6 * (1.0 - (0.05 * t).cos());
+            source.position_gains(&c, &mut g).expect("valid pose");
+            let mut y = [0.0; 3];
+            for (j, v) in truth.iter().enumerate() {
+                for d in 0..3 {
+                    y[d] += g[j][d] * v;
+                }
+            }
+            rec.measured.push(y.map(|v| v + 0.5e-3 * rng.normal()));
+            rec.samples.push(Sample {
+                commands: c,
+                t,
+                motion: vec![1; m.axes.len()],
+            });
+        }
+        done += b;
+        Some(Ok(rec))
+    })
+}
+
+/// The process's peak resident memory (Linux `VmHWM`), bytes.
+pub fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Identifies the reduced model of seed-ac from `samples` synthetic samples in blocks.
+pub fn streaming_identify(samples: usize) -> StreamingRun {
+    let m = machine();
+    let model = Model::of(&m, "reduced").expect("reduced");
+    // The same values as the `seed-ac-reduced` truth, mm and rad.
+    let truth = vec![
+        12e-3, -18e-3, 15e-3, 20e-3, -15e-3, 25e-6, -18e-6, 10e-3, -22e-3, 30e-6, -12e-6,
+    ];
+    let block = 4096;
+    let start = Instant::now();
+    for b in synthetic_blocks(&m, samples, block, truth.clone()) {
+        black_box(b.expect("infallible"));
+    }
+    let generate_seconds = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let mut source =
+        GainSource::new(&m, &model.errors(), &m.default_parameters()).expect("compiled");
+    let run = identify_streaming(
+        &m,
+        &model,
+        synthetic_blocks(&m, samples, block, truth.clone()),
+        None,
+        &mut source,
+        &Constraint::None,
+        &Tolerances::default(),
+    )
+    .expect("a well-posed synthetic record");
+    let total_seconds = start.elapsed().as_secs_f64();
+    let worst_z = (0..truth.len())
+        .map(|j| match (run.fit.values[j], run.fit.std[j]) {
+            (Some(v), Some(s)) => ((v - truth[j]) / s).abs(),
+            _ => f64::INFINITY,
+        })
+        .fold(0.0, f64::max);
+    StreamingRun {
+        samples,
+        generate_seconds,
+        total_seconds,
+        peak_rss_bytes: peak_rss_bytes(),
+        worst_z,
+    }
+}
+
+/// Time to generate the Rust source of every model of every built-in machine, s (median).
+pub fn codegen_times(runs: usize) -> Vec<(String, f64)> {
+    model_spec::all_builtin()
+        .into_iter()
+        .map(|m| {
+            let s = median_seconds(runs, || {
+                black_box(codegen::emit::generate_machine(&m, &[]).expect("built-ins generate"));
+            });
+            (m.name.clone(), s)
+        })
+        .collect()
+}

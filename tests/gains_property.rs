@@ -104,6 +104,21 @@ fn evaluator_and_compiled_code_equal_the_symbolic_gains_for_every_model() {
                     let n_pose = compiled.pose_inputs.len();
                     let mut native = vec![0.0; program.outputs.len()];
                     (compiled.gains)(&inputs[..n_pose], &inputs[n_pose..], &mut native);
+                    let n = model.errors.len();
+                    let mut position = vec![0.0; 3 * n];
+                    (compiled.position_gains)(&inputs[..n_pose], &inputs[n_pose..], &mut position);
+                    for i in 0..n {
+                        for d in 0..3 {
+                            prop_assert!(
+                                close(position[d * n + i], native[6 * i + d], 1e-13),
+                                "{} {}: position gains {} vs gains {}",
+                                m.name,
+                                model.error_names[i],
+                                position[d * n + i],
+                                native[6 * i + d]
+                            );
+                        }
+                    }
                     for (i, row) in symbolic.iter().enumerate() {
                         for (k, &s) in row.iter().enumerate() {
                             let j = 6 * i + k;

@@ -14,7 +14,7 @@
 //!   angular ones; orientation rows per mm and per rad).
 
 use crate::ir::{Input, Op, Output, Program};
-use crate::{GainModel, compile};
+use crate::{GainModel, compile, compile_position};
 use model_spec::Machine;
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
@@ -38,8 +38,46 @@ fn field(name: &str) -> Ident {
     Ident::new(name, Span::call_site())
 }
 
-/// The statements of a program's body: one `let` per instruction, then the stores to `out`.
+/// One output cell: a value, a negated value or a literal.
+fn cell(o: &Output) -> TokenStream {
+    match *o {
+        Output::Var(v) => {
+            let v = var(v);
+            quote!(#v)
+        }
+        Output::Neg(v) => {
+            let v = var(v);
+            quote!(-#v)
+        }
+        Output::Const(c) => float_literal(c),
+    }
+}
+
+/// The statements of a six-row program's body: one `let` per instruction, then one store of
+/// `[gx, gy, gz, gi, gj, gk]` per error.
 pub fn body(p: &Program, error_consts: &[Ident]) -> TokenStream {
+    let lets = lets(p);
+    let stores = p.outputs.chunks(6).zip(error_consts).map(|(row, name)| {
+        let cells = row.iter().map(cell);
+        quote!(out[#name] = [#(#cells),*];)
+    });
+    quote!(#lets #(#stores)*)
+}
+
+/// The statements of a position program's body ([`crate::compile_position`]): one `let` per
+/// instruction, then one store per direction of the gains of all `n` errors.
+pub fn position_body(p: &Program, n: usize) -> TokenStream {
+    let lets = lets(p);
+    let stores = p.outputs.chunks(n.max(1)).enumerate().map(|(d, row)| {
+        let d = Literal::usize_unsuffixed(d);
+        let cells = row.iter().map(cell);
+        quote!(out[#d] = [#(#cells),*];)
+    });
+    quote!(#lets #(#stores)*)
+}
+
+/// One `let` per instruction.
+fn lets(p: &Program) -> TokenStream {
     let lets = p.ops.iter().enumerate().map(|(i, op)| {
         let dst = var(i as u32);
         let rhs = match *op {
@@ -76,25 +114,11 @@ pub fn body(p: &Program, error_consts: &[Ident]) -> TokenStream {
         };
         quote!(let #dst = #rhs;)
     });
-    let stores = p.outputs.chunks(6).zip(error_consts).map(|(row, name)| {
-        let cells = row.iter().map(|o| match *o {
-            Output::Var(v) => {
-                let v = var(v);
-                quote!(#v)
-            }
-            Output::Neg(v) => {
-                let v = var(v);
-                quote!(-#v)
-            }
-            Output::Const(c) => float_literal(c),
-        });
-        quote!(out[#name] = [#(#cells),*];)
-    });
-    quote!(#(#lets)* #(#stores)*)
+    quote!(#(#lets)*)
 }
 
 /// One model's module (`pub mod reduced { … }`).
-pub fn model_module(module: &str, model: &GainModel, p: &Program) -> TokenStream {
+pub fn model_module(module: &str, model: &GainModel, p: &Program, pos: &Program) -> TokenStream {
     let module_doc = format!(" Model `{module}` of machine `{}`.", model.machine);
     let module = field(module);
     let n_value = model.errors.len();
@@ -126,6 +150,19 @@ pub fn model_module(module: &str, model: &GainModel, p: &Program) -> TokenStream
         format!(" Straight-line code, no allocation, no branches: {counts}."),
     ];
     let body = body(p, &consts);
+    let pos_body = position_body(pos, n_value);
+    let pos_counts = pos.op_counts();
+    let pos_total = Literal::usize_unsuffixed(pos_counts.total());
+    let doc_position = [
+        format!(
+            " Position gains only, in the layout of three rows of an H matrix: `out[d][i]` is the"
+        ),
+        " gain of error `i` in direction `d` (x, y, z of the tool frame; mm per mm or mm per rad)."
+            .to_string(),
+        " The orientation rows are not computed.".to_string(),
+        String::new(),
+        format!(" Straight-line code, no allocation, no branches: {pos_counts}."),
+    ];
     quote! {
         #[doc = #module_doc]
         pub mod #module {
@@ -146,6 +183,21 @@ pub fn model_module(module: &str, model: &GainModel, p: &Program) -> TokenStream
             #[allow(clippy::all, unused_variables)]
             pub fn gains(pose: &Pose, params: &Params, out: &mut [[f64; 6]; #n]) {
                 #body
+            }
+            /// Arithmetic operations in [`position_gains`].
+            pub const POSITION_OPERATIONS: usize = #pos_total;
+            #(#[doc = #doc_position])*
+            #[allow(clippy::all, unused_variables)]
+            pub fn position_gains(pose: &Pose, params: &Params, out: &mut [[f64; #n]; 3]) {
+                #pos_body
+            }
+            /// [`position_gains`] on slices: `out` of length `3 * N`, direction after direction.
+            pub fn position_gains_slice(pose: &[f64], params: &[f64], out: &mut [f64]) {
+                let mut g = [[0.0f64; N]; 3];
+                position_gains(&Pose::from_slice(pose), &Params::from_slice(params), &mut g);
+                for (dst, src) in out.chunks_exact_mut(N).zip(g.iter()) {
+                    dst.copy_from_slice(src);
+                }
             }
             /// [`gains`] on slices: `pose` and `params` in the order of [`super::POSE_INPUTS`]
             /// and [`super::PARAMETERS`], `out` of length `6 * N`, row-major.
@@ -244,12 +296,15 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
 
 /// The code of one machine: its `Pose`, `Params` and one module per model, as a token stream
 /// (the content of a module; no crate attributes, so it can be `include!`d).
-pub fn machine_tokens(m: &Machine, models: &[(&str, &GainModel, &Program)]) -> TokenStream {
+pub fn machine_tokens(
+    m: &Machine,
+    models: &[(&str, &GainModel, &Program, &Program)],
+) -> TokenStream {
     let inputs = crate::lower::inputs(m, models.first().expect("at least one model").1);
     let structs = input_structs(m, &inputs);
     let modules = models
         .iter()
-        .map(|(name, model, p)| model_module(name, model, p));
+        .map(|(name, model, p, pos)| model_module(name, model, p, pos));
     quote!(#structs #(#modules)*)
 }
 
@@ -282,10 +337,13 @@ pub fn generate_machine(m: &Machine, model_names: &[&str]) -> Result<String, Str
             .ok_or_else(|| format!("machine {} has no model `{name}`", m.name))?;
         let model = GainModel::derive(m, errors);
         let program = compile(m, &model);
-        built.push((name.replace('-', "_"), model, program));
+        let position = compile_position(m, &model);
+        built.push((name.replace('-', "_"), model, program, position));
     }
-    let refs: Vec<(&str, &GainModel, &Program)> =
-        built.iter().map(|(n, g, p)| (n.as_str(), g, p)).collect();
+    let refs: Vec<(&str, &GainModel, &Program, &Program)> = built
+        .iter()
+        .map(|(n, g, p, q)| (n.as_str(), g, p, q))
+        .collect();
     let header = format!(
         "Generated by rtest codegen from machine `{}` ({}). Do not edit.\n\
          Models: {}.\n\
@@ -294,7 +352,12 @@ pub fn generate_machine(m: &Machine, model_names: &[&str]) -> Result<String, Str
         m.description.trim_end_matches('.'),
         built
             .iter()
-            .map(|(n, g, p)| format!("{n} ({} errors, {})", g.errors.len(), p.op_counts()))
+            .map(|(n, g, p, q)| format!(
+                "{n} ({} errors; gains {}; position gains {})",
+                g.errors.len(),
+                p.op_counts(),
+                q.op_counts()
+            ))
             .collect::<Vec<_>>()
             .join("; ")
     );

@@ -19,4 +19,4 @@ pub mod lower;
 pub mod table;
 
 pub use ir::Program;
-pub use lower::compile;
+pub use lower::{compile, compile_position};

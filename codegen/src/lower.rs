@@ -171,8 +171,24 @@ pub fn inputs(m: &Machine, model: &GainModel) -> Vec<Input> {
 }
 
 /// Compiles the gains of `model` (derived from `m`) into a straight-line program with six
-/// outputs per error.
+/// outputs per error (`gx gy gz gi gj gk`, error after error).
 pub fn compile(m: &Machine, model: &GainModel) -> Program {
+    let polys: Vec<&Poly> = model.gains.iter().flat_map(|g| g.iter()).collect();
+    compile_polys(m, model, &polys)
+}
+
+/// Compiles the position gains only, direction-major: outputs `d·N + e` is the gain of error `e`
+/// in direction `d` (x, y, z), the layout of three rows of an H matrix. The orientation rows
+/// are not computed.
+pub fn compile_position(m: &Machine, model: &GainModel) -> Program {
+    let polys: Vec<&Poly> = (0..3)
+        .flat_map(|d| model.gains.iter().map(move |g| &g[d]))
+        .collect();
+    compile_polys(m, model, &polys)
+}
+
+/// One program with one output per polynomial, in order, sharing common subexpressions.
+fn compile_polys(m: &Machine, model: &GainModel, polys: &[&Poly]) -> Program {
     let inputs = inputs(m, model);
     let mut b = Builder {
         ops: Vec::new(),
@@ -183,18 +199,16 @@ pub fn compile(m: &Machine, model: &GainModel) -> Program {
     b.atom_vars = (0..inputs.len())
         .map(|i| b.push(Op::Input(i as u32)))
         .collect();
-    let mut outputs = Vec::with_capacity(model.gains.len() * 6);
-    for g in &model.gains {
-        for p in g {
-            outputs.push(match p.as_constant() {
-                Some(c) => Output::Const(c.to_f64()),
-                None => match b.poly(p) {
-                    (v, false) => Output::Var(v),
-                    (v, true) => Output::Neg(v),
-                },
-            });
-        }
-    }
+    let outputs = polys
+        .iter()
+        .map(|p| match p.as_constant() {
+            Some(c) => Output::Const(c.to_f64()),
+            None => match b.poly(p) {
+                (v, false) => Output::Var(v),
+                (v, true) => Output::Neg(v),
+            },
+        })
+        .collect();
     prune(Program {
         inputs,
         ops: b.ops,

@@ -41,6 +41,11 @@ pub struct CompiledModel {
     pub operations: usize,
     /// `gains(pose, params, out)`: `out` holds `6 * errors.len()` values, row-major.
     pub gains: fn(&[f64], &[f64], &mut [f64]),
+    /// `position_gains(pose, params, out)`: `out` holds `3 * errors.len()` values, direction
+    /// after direction (three rows of an H matrix); orientation rows are not computed.
+    pub position_gains: fn(&[f64], &[f64], &mut [f64]),
+    /// Arithmetic operations of one position-gain evaluation.
+    pub position_operations: usize,
 }
 
 /// The compiled model `model` of the built-in machine `machine`.

@@ -7,17 +7,21 @@ fn main() {
             r.method, r.ns_per_pose, r.ratio_to_generated
         );
     }
-    let f = solver::perf::fill_bandwidth(if quick { 100_000 } else { 1_000_000 }, 4096, 3);
-    println!(
-        "fill {} poses: {:.3} s ({:.2} GB/s), plain write {:.3} s ({:.2} GB/s): {:.0} %",
-        f.poses,
-        f.fill_seconds,
-        f.bytes / f.fill_seconds / 1e9,
-        f.write_seconds,
-        f.bytes / f.write_seconds / 1e9,
-        100.0 * f.fraction()
-    );
-    let s = solver::perf::streaming_identify(if quick { 100_000 } else { 1_000_000 });
+    let poses = if quick { 100_000 } else { 1_000_000 };
+    for block in [4096, 65536] {
+        let f = solver::perf::fill_bandwidth(poses, block, 3);
+        println!(
+            "fill {} poses, block {block} ({:.1} MB): {:.3} s ({:.2} GB/s), plain write {:.3} s ({:.2} GB/s): {:.0} %",
+            f.poses,
+            (block * 3 * 44 * 8) as f64 / 1e6,
+            f.fill_seconds,
+            f.bytes / f.fill_seconds / 1e9,
+            f.write_seconds,
+            f.bytes / f.write_seconds / 1e9,
+            100.0 * f.fraction()
+        );
+    }
+    let s = solver::perf::streaming_identify(poses);
     println!(
         "streaming {} samples: generate {:.3} s, generate+identify {:.3} s, peak RSS {:.1} MB, worst z {:.2}",
         s.samples,

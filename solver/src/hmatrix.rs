@@ -269,7 +269,7 @@ impl GainSource {
             s.compiled = Some(CompiledPart {
                 model: c,
                 picks,
-                out: vec![0.0; 6 * c.errors.len()],
+                out: vec![0.0; 3 * c.errors.len()],
             });
         }
         s.attach_evaluator(m, &rest);
@@ -373,9 +373,10 @@ impl GainSource {
         }
         if let Some(c) = &mut self.compiled {
             let (pose, params) = self.values.split_at(self.n_pose);
-            (c.model.gains)(pose, params, &mut c.out);
+            (c.model.position_gains)(pose, params, &mut c.out);
+            let n = c.model.errors.len();
             for &(k, s) in &c.picks {
-                out[s].copy_from_slice(&c.out[6 * k..6 * k + 3]);
+                out[s] = [c.out[k], c.out[n + k], c.out[2 * n + k]];
             }
         }
         if let Some(e) = &mut self.evaluator {

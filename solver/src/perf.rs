@@ -6,8 +6,9 @@
 //!    (b) the IR evaluator, (c) the exact HTM chain with central finite differences (what an
 //!    engineer writes without a generator), (d) a runtime first-order product of the chain.
 //!    Every method includes the sines and cosines of the pose.
-//! 2. The H matrix of the full model (3 rows × 44 columns per pose) filled for many poses in
-//!    blocks into a reused buffer, against a plain write of the same bytes into that buffer.
+//! 2. The H matrix of the full model (3 rows × 44 columns per pose, the generated
+//!    `position_gains` writing straight into the rows) filled for many poses in blocks into a
+//!    reused buffer, against a plain write of the same bytes into that buffer.
 //! 3. Streaming identification of a long record (the reduced model), with the peak memory.
 //! 4. Code generation of every built-in machine.
 
@@ -198,12 +199,12 @@ pub fn fill_bandwidth(poses: usize, block: usize, runs: usize) -> FillBandwidth 
     let params = Params::default();
     let cols = full::N;
     let mut buffer = vec![0.0f64; block * 3 * cols];
-    let mut g = [[0.0; 6]; full::N];
     let fill = median_seconds(runs, || {
         let mut done = 0;
         while done < poses {
             let b = block.min(poses - done);
-            for i in 0..b {
+            let (rows, _) = buffer[..b * 3 * cols].as_chunks_mut::<{ full::N }>();
+            for (i, pose_rows) in rows.chunks_exact_mut(3).enumerate() {
                 let theta = (done + i) as f64 * 1e-4;
                 let (sc, cc) = theta.sin_cos();
                 let a = -std::f64::consts::FRAC_PI_4 * (1.0 - cc);
@@ -217,13 +218,8 @@ pub fn fill_bandwidth(poses: usize, block: usize, runs: usize) -> FillBandwidth 
                     y: 200.0 * sc,
                     z: 50.0 * ca,
                 };
-                full::gains(&pose, &params, &mut g);
-                let row = &mut buffer[i * 3 * cols..(i + 1) * 3 * cols];
-                for (e, gain) in g.iter().enumerate() {
-                    row[e] = gain[0];
-                    row[cols + e] = gain[1];
-                    row[2 * cols + e] = gain[2];
-                }
+                let out: &mut [[f64; full::N]; 3] = pose_rows.try_into().expect("three rows");
+                full::position_gains(&pose, &params, out);
             }
             black_box(&buffer);
             done += b;

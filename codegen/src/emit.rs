@@ -154,9 +154,8 @@ pub fn model_module(module: &str, model: &GainModel, p: &Program, pos: &Program)
     let pos_counts = pos.op_counts();
     let pos_total = Literal::usize_unsuffixed(pos_counts.total());
     let doc_position = [
-        format!(
-            " Position gains only, in the layout of three rows of an H matrix: `out[d][i]` is the"
-        ),
+        " Position gains only, in the layout of three rows of an H matrix: `out[d][i]` is the"
+            .to_string(),
         " gain of error `i` in direction `d` (x, y, z of the tool frame; mm per mm or mm per rad)."
             .to_string(),
         " The orientation rows are not computed.".to_string(),

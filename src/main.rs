@@ -18,7 +18,9 @@ use std::process::ExitCode;
     about = "Geometric error models of machine tools from R-test measurements",
     long_about = "\
 Geometric error models of machine tools from R-test measurements: the ISO 230 error catalogue of \
-a machine topology, its error-gain functions, and no_std Rust code for controllers. Units at \
+a machine topology, its error-gain functions, no_std Rust code for controllers, simulated R-test \
+measurements on the exact virtual machine, identification of the errors with uncertainties and \
+what the data cannot separate, and validation on other test paths. Units at \
 every boundary: positions in mm, rotary positions in degrees, translational errors in µm, angular \
 errors in µrad; gains in mm/mm (translational errors) and mm/rad (angular errors). A machine is a \
 built-in name (see `rtest machines`) or the path of a TOML description (docs/model-spec.md).",
@@ -34,8 +36,16 @@ enum Verb {
     Machines(cli::machines::MachinesArgs),
     Gains(cli::gains::GainsArgs),
     Generate(cli::generate::GenerateArgs),
+    Simulate(cli::simulate::SimulateArgs),
+    Identify(cli::identify::IdentifyArgs),
+    Validate(cli::validate::ValidateArgs),
     Demo(cli::demo::DemoArgs),
 }
+
+/// The verbs, for the hint of a usage error.
+const VERBS: [&str; 7] = [
+    "machines", "gains", "generate", "simulate", "identify", "validate", "demo",
+];
 
 /// A clap error as one line: its message and its hints, without the usage block.
 fn one_line(e: &clap::Error) -> String {
@@ -67,7 +77,7 @@ fn main() -> ExitCode {
         Err(e) => {
             let verb = std::env::args().nth(1).filter(|a| !a.starts_with('-'));
             let help = match verb {
-                Some(v) if ["machines", "gains", "generate", "demo"].contains(&v.as_str()) => {
+                Some(v) if VERBS.contains(&v.as_str()) => {
                     format!("rtest {v} --help")
                 }
                 _ => "rtest --help".into(),
@@ -83,6 +93,9 @@ fn main() -> ExitCode {
         Verb::Machines(a) => cli::machines::run(a),
         Verb::Gains(a) => cli::gains::run(a),
         Verb::Generate(a) => cli::generate::run(a),
+        Verb::Simulate(a) => cli::simulate::run(a),
+        Verb::Identify(a) => cli::identify::run(a),
+        Verb::Validate(a) => cli::validate::run(a),
         Verb::Demo(a) => cli::demo::run(a),
     };
     match result {

@@ -103,6 +103,10 @@ pub struct Fit {
     /// Estimates (mm or rad); `None` for a parameter the data cannot determine (unless the
     /// constraint gives it a value).
     pub values: Vec<Option<f64>>,
+    /// The minimum-norm solution in the identifiable subspace for every parameter, determined
+    /// or not (mm or rad; fixed parameters 0): what `H·p̂` is made of. Undetermined entries are
+    /// one representative of their confounded group, not values to report.
+    pub solution: Vec<f64>,
     /// Standard uncertainties (mm or rad); `None` where there is no value, for fixed
     /// parameters, and when `3N = r` leaves no degree of freedom for σ̂.
     pub std: Vec<Option<f64>>,
@@ -337,6 +341,7 @@ fn solve(
     Ok(Fit {
         names: names.to_vec(),
         values,
+        solution: x,
         std,
         fixed,
         column_norms: norms,

@@ -12,7 +12,8 @@
 //! ```
 //!
 //! where `exact(v)` is the virtual machine ([`crate::simulate`]) with the model's terms at the
-//! values `v` (parameters without a value at 0). The iteration contracts by the ratio of the
+//! values `v`. `v` is the whole minimum-norm solution, undetermined parameters included (one
+//! representative of each confounded group, as in `H·v`); they get no reported value. The iteration contracts by the ratio of the
 //! second-order to the first-order terms (about 1e-4), so two or three steps reach rounding.
 //! With zeroed readings the sensor offsets are terms of the model like any other, so the
 //! prediction is `exact(v) + d0` exactly as the linear model has it.
@@ -115,23 +116,24 @@ pub fn refine(
     let linear_rms = (ident.fit.rss / rows).sqrt();
     let params = source.params().to_vec();
     let influence: Vec<f64> = (0..h.ncols()).map(|j| h.column(j).amax()).collect();
-    let mut values = ident.fit.values.clone();
+    // Iterate on the whole minimum-norm solution, undetermined parameters included: it is what
+    // the linear model's prediction is made of. Which values are reported is decided at the end.
+    let mut x = ident.fit.solution.clone();
     let mut steps = Vec::new();
     let mut converged = false;
-    let residual = |values: &[Option<f64>]| -> Result<DVector<f64>, RefineError> {
-        let p = exact_prediction(m, &ident.model, values, record, &params)?;
+    let residual = |x: &[f64]| -> Result<DVector<f64>, RefineError> {
+        let values: Vec<Option<f64>> = x.iter().map(|&v| Some(v)).collect();
+        let p = exact_prediction(m, &ident.model, &values, record, &params)?;
         Ok(&y - DVector::from_iterator(y.len(), p.iter().flat_map(|r| r.iter().copied())))
     };
     for _ in 0..opts.max_iterations {
-        let r = residual(&values)?;
+        let r = residual(&x)?;
         let correction =
             least_squares(&h, &r, &ident.fit.names, &ident.fit.constraint, tolerances)?;
         let mut step = 0.0f64;
-        for (j, v) in values.iter_mut().enumerate() {
-            if let (Some(v), Some(d)) = (v.as_mut(), correction.values[j]) {
-                *v += d;
-                step = step.max(d.abs() * influence[j]);
-            }
+        for (j, (v, d)) in x.iter_mut().zip(&correction.solution).enumerate() {
+            *v += d;
+            step = step.max(d.abs() * influence[j]);
         }
         steps.push(step);
         if step <= opts.tolerance_mm {
@@ -139,13 +141,19 @@ pub fn refine(
             break;
         }
     }
-    // The fit of the exact residual at the refined values: the same H, so the same rank,
+    // The fit of the exact residual at the refined solution: the same H, so the same rank,
     // identifiability and unit covariance; σ̂, uncertainties and residual now those of the
     // exact model. Its own correction is below the tolerance and is not added.
-    let r = residual(&values)?;
+    let r = residual(&x)?;
     let refined_rms = (r.norm_squared() / rows).sqrt();
     let mut fit = least_squares(&h, &r, &ident.fit.names, &ident.fit.constraint, tolerances)?;
-    fit.values = values;
+    fit.values = fit
+        .values
+        .iter()
+        .zip(&x)
+        .map(|(has, &v)| has.map(|_| v))
+        .collect();
+    fit.solution = x;
     ident.fit = fit;
     Ok(Refinement {
         iterations: steps.len(),

@@ -261,7 +261,22 @@ fn a_path_that_cannot_separate_the_model_is_reported_not_solved_into_nonsense() 
             );
         }
     }
-    // What K1 does determine (AOC: the tilt of C about x, seen as a once-per-turn wobble) is right.
+    // What K1 does determine (AOC: the tilt of C about x, seen as a once-per-turn wobble) is
+    // right, and exactly so after the refinement against the exact machine, which iterates on
+    // the whole minimum-norm solution (the undetermined groups included).
+    let refined = identify_refined(&m, &reduced(&m), &k1, false);
+    let j = refined.fit.names.iter().position(|n| n == "AOC").unwrap();
+    let aoc_refined = refined.fit.values[j].expect("AOC is determined on K1");
+    assert!(
+        (aoc_refined * 1e6 - 30.0).abs() < 1e-4,
+        "refined AOC {} µrad",
+        aoc_refined * 1e6
+    );
+    assert!(
+        refined.fit.residual_rms() * 1e3 < 1e-6,
+        "the exact residual vanishes: {}",
+        refined.fit.residual_rms()
+    );
     let j = ident.fit.names.iter().position(|n| n == "AOC").unwrap();
     let aoc = ident.fit.values[j].expect("AOC is determined on K1");
     assert!((aoc * 1e6 - 30.0).abs() < 0.01, "AOC {} µrad", aoc * 1e6);

@@ -259,15 +259,16 @@ pub fn numeric_table(
     }
 }
 
-/// An aligned text table: first two columns left-aligned, the rest right-aligned.
-pub fn text_table<const N: usize>(header: &[String; N], rows: &[[String; N]]) -> String {
-    let mut widths = [0usize; N];
-    for r in std::iter::once(header).chain(rows) {
+/// An aligned text table: first two columns left-aligned, the rest right-aligned. Every row
+/// has the header's number of cells.
+pub fn text_table<R: AsRef<[String]>>(header: &[String], rows: &[R]) -> String {
+    let mut widths = vec![0usize; header.len()];
+    for r in std::iter::once(header).chain(rows.iter().map(AsRef::as_ref)) {
         for (w, c) in widths.iter_mut().zip(r) {
             *w = (*w).max(c.chars().count());
         }
     }
-    let line = |r: &[String; N]| {
+    let line = |r: &[String]| {
         let cells: Vec<String> = r
             .iter()
             .zip(&widths)
@@ -292,7 +293,7 @@ pub fn text_table<const N: usize>(header: &[String; N], rows: &[[String; N]]) ->
             .join("  ")
     ));
     for r in rows {
-        out.push_str(&line(r));
+        out.push_str(&line(r.as_ref()));
     }
     out
 }

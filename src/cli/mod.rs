@@ -2,12 +2,16 @@
 //! codes, loading a machine and choosing a model from flags, writing files atomically, and a
 //! small ordered JSON writer.
 
+pub mod data;
 pub mod demo;
 pub mod gains;
 pub mod generate;
+pub mod identify;
 pub mod json;
 pub mod machines;
 pub mod pose;
+pub mod simulate;
+pub mod validate;
 
 use codegen::{GainModel, Program};
 use model_spec::{ErrorId, LoadError, Machine};
@@ -21,12 +25,13 @@ pub const EXIT_FAILURE: u8 = 1;
 
 /// The exit-code rule, shown after every verb's help.
 pub const EXIT_CODES: &str = "\
-Exit codes: 0 success; 2 the command line is wrong (unknown flag, machine name, model, axis, \
-symbol or error name, malformed --at/--param/--errors, non-finite number, unknown --format); \
-1 the command was understood but failed (a machine file that cannot be read or does not \
-validate, inverse kinematics without a solution, an output file that cannot be written). \
-Errors are one line on stderr, starting with the flag at fault; no partial output file is \
-ever left behind.";
+Exit codes: 0 success; 2 the command line is wrong (missing or unknown flag; unknown machine, \
+model, path, truth, axis, symbol, error or term name; malformed --at/--param/--errors/--terms/\
+--constraint/--noise-um; non-finite number; unknown --format); 1 the command was understood but \
+failed (a machine, truth, measurement CSV or JSON file that cannot be read, is malformed or \
+belongs to another machine; inverse kinematics without a solution; an output file that cannot be \
+written). Errors are one line on stderr, starting with the flag at fault (a malformed file is \
+named with its line and column); no partial output file is ever left behind.";
 
 /// A failure of a verb: a one-line message and its exit code.
 #[derive(Debug)]

@@ -40,11 +40,12 @@ enum Verb {
     Identify(cli::identify::IdentifyArgs),
     Validate(cli::validate::ValidateArgs),
     Demo(cli::demo::DemoArgs),
+    Bench(cli::bench::BenchArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 7] = [
-    "machines", "gains", "generate", "simulate", "identify", "validate", "demo",
+const VERBS: [&str; 8] = [
+    "machines", "gains", "generate", "simulate", "identify", "validate", "demo", "bench",
 ];
 
 /// A clap error as one line: its message and its hints, without the usage block.
@@ -97,6 +98,7 @@ fn main() -> ExitCode {
         Verb::Identify(a) => cli::identify::run(a),
         Verb::Validate(a) => cli::validate::run(a),
         Verb::Demo(a) => cli::demo::run(a),
+        Verb::Bench(a) => cli::bench::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

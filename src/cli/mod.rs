@@ -2,6 +2,7 @@
 //! codes, loading a machine and choosing a model from flags, writing files atomically, and a
 //! small ordered JSON writer.
 
+pub mod bench;
 pub mod data;
 pub mod demo;
 pub mod gains;

@@ -24,7 +24,7 @@
 //!
 //! Files are written atomically: to a temporary file in the same directory, then renamed.
 
-use crate::paths::{fill_linear_ik, record_from_commands};
+pub use crate::csvread::{MeasurementBlocks, parse_csv, time_span};
 use crate::record::Record;
 use model_spec::catalogue::iso_rank;
 use model_spec::{AxisKind, Machine};
@@ -73,13 +73,13 @@ fn format_located(
 
 /// What a column holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Col {
+pub(crate) enum Col {
     Axis(usize),
     Time,
     Measured(usize),
 }
 
-const MEASURED: [&str; 3] = ["dx_um", "dy_um", "dz_um"];
+pub(crate) const MEASURED: [&str; 3] = ["dx_um", "dy_um", "dz_um"];
 
 /// Whether the `dx_um,dy_um,dz_um` columns must be there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,12 +90,17 @@ pub enum Need {
     Path,
 }
 
-struct Ctx<'a> {
-    file: &'a str,
+pub(crate) struct Ctx<'a> {
+    pub(crate) file: &'a str,
 }
 
 impl Ctx<'_> {
-    fn err(&self, line: usize, column: Option<(usize, &str)>, msg: impl Into<String>) -> CsvError {
+    pub(crate) fn err(
+        &self,
+        line: usize,
+        column: Option<(usize, &str)>,
+        msg: impl Into<String>,
+    ) -> CsvError {
         CsvError::Format {
             file: self.file.to_string(),
             line,
@@ -126,208 +131,7 @@ pub fn read_measurement(path: &Path, m: &Machine) -> Result<Record, CsvError> {
     parse_measurement(&file, &text, m)
 }
 
-/// Reads a CSV of machine `m`; `need` says whether the measured columns are required.
-pub fn parse_csv(file: &str, text: &str, m: &Machine, need: Need) -> Result<Record, CsvError> {
-    let cx = Ctx { file };
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut lines = text
-        .split('\n')
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
-        .filter(|(_, l)| {
-            let t = l.trim();
-            !t.is_empty() && !t.starts_with('#')
-        });
-    let expected = expected_columns(m);
-    let Some((header_line, header)) = lines.next() else {
-        let last = text.split('\n').count().max(1);
-        return Err(cx.err(
-            last,
-            None,
-            format!("empty file: expected a header line naming the columns ({expected})"),
-        ));
-    };
-    let names: Vec<&str> = header.split(',').map(clean_name).collect();
-    let mut cols: Vec<Col> = Vec::with_capacity(names.len());
-    for (i, &name) in names.iter().enumerate() {
-        let col = classify(m, name).ok_or_else(|| {
-            let what = if name.is_empty() {
-                "empty column name".to_string()
-            } else {
-                format!("unknown column `{name}`")
-            };
-            cx.err(
-                header_line,
-                Some((i, name)),
-                format!("{what} (expected {expected})"),
-            )
-        })?;
-        if let Some(j) = cols.iter().position(|&c| c == col) {
-            return Err(cx.err(
-                header_line,
-                Some((i, name)),
-                format!("column `{name}` appears twice (also column {})", j + 1),
-            ));
-        }
-        cols.push(col);
-    }
-    let has = |c: Col| cols.contains(&c);
-    let missing = |ids: &mut dyn Iterator<Item = usize>| -> Vec<String> {
-        ids.filter(|&a| !has(Col::Axis(a)))
-            .map(|a| m.axes[a].name.clone())
-            .collect()
-    };
-    let rotary_missing = missing(&mut m.rotary_axes());
-    if !rotary_missing.is_empty() {
-        return Err(cx.err(
-            header_line,
-            None,
-            format!(
-                "missing column(s) {} (rotary axes, degrees): every rotary axis needs a column",
-                rotary_missing.join(", ")
-            ),
-        ));
-    }
-    let linear_missing = missing(&mut m.linear_axes());
-    let n_linear = m.linear_axes().count();
-    if !linear_missing.is_empty() && linear_missing.len() < n_linear {
-        return Err(cx.err(
-            header_line,
-            None,
-            format!(
-                "missing column(s) {} (linear axes, mm): give every linear axis or none (then they are filled by the nominal inverse kinematics)",
-                linear_missing.join(", ")
-            ),
-        ));
-    }
-    let fill_ik = n_linear > 0 && !linear_missing.is_empty();
-    let n_measured = (0..3).filter(|&k| has(Col::Measured(k))).count();
-    let required = need == Need::Measured || n_measured > 0;
-    if required && n_measured < 3 {
-        let absent: Vec<&str> = (0..3)
-            .filter(|&k| !has(Col::Measured(k)))
-            .map(|k| MEASURED[k])
-            .collect();
-        return Err(cx.err(
-            header_line,
-            None,
-            format!(
-                "missing column(s) {} (measured error vector, µm): a measurement file needs dx_um, dy_um and dz_um",
-                absent.join(", ")
-            ),
-        ));
-    }
-
-    let mut commands: Vec<Vec<f64>> = Vec::new();
-    let mut times: Vec<f64> = Vec::new();
-    let mut measured: Vec<[f64; 3]> = Vec::new();
-    let mut row_lines: Vec<usize> = Vec::new();
-    let mut last_t: Option<(f64, usize)> = None;
-    for (line, row) in lines {
-        let fields: Vec<&str> = row.split(',').collect();
-        if fields.len() != cols.len() {
-            return Err(cx.err(
-                line,
-                None,
-                format!(
-                    "ragged row: {} field(s), the header (line {header_line}) has {} columns",
-                    fields.len(),
-                    cols.len()
-                ),
-            ));
-        }
-        let mut c = vec![0.0; m.axes.len()];
-        let mut t = commands.len() as f64;
-        let mut d = [0.0; 3];
-        for (i, (field, &col)) in fields.iter().zip(&cols).enumerate() {
-            let at = Some((i, names[i]));
-            let f = field.trim();
-            let unit = match col {
-                Col::Axis(a) if m.axes[a].kind == AxisKind::Rotary => "degrees",
-                Col::Axis(_) => "mm",
-                Col::Time => "s",
-                Col::Measured(_) => "µm",
-            };
-            let x = match f.parse::<f64>() {
-                _ if f.is_empty() => {
-                    return Err(cx.err(
-                        line,
-                        at,
-                        format!("empty field: expected a number ({unit})"),
-                    ));
-                }
-                Ok(x) if x.is_finite() => x,
-                Ok(_) => {
-                    return Err(cx.err(line, at, format!("`{f}` is not a finite number ({unit})")));
-                }
-                Err(_) => {
-                    return Err(cx.err(line, at, format!("`{f}` is not a number ({unit})")));
-                }
-            };
-            match col {
-                Col::Axis(a) => {
-                    c[a] = match m.axes[a].kind {
-                        AxisKind::Rotary => x.to_radians(),
-                        AxisKind::Linear => x,
-                    }
-                }
-                Col::Time => {
-                    if let Some((prev, prev_line)) = last_t
-                        && x < prev
-                    {
-                        return Err(cx.err(
-                            line,
-                            at,
-                            format!(
-                                "time {f} s is before the time of the previous sample ({prev} s, line {prev_line}): times must not decrease"
-                            ),
-                        ));
-                    }
-                    last_t = Some((x, line));
-                    t = x;
-                }
-                Col::Measured(k) => {
-                    d[k] = match parse_scaled(f, -3) {
-                        Some(v) if v.is_finite() => v,
-                        _ => {
-                            return Err(cx.err(line, at, format!("`{f}` is out of range (µm)")));
-                        }
-                    }
-                }
-            }
-        }
-        commands.push(c);
-        times.push(t);
-        measured.push(d);
-        row_lines.push(line);
-    }
-    if commands.is_empty() {
-        return Err(cx.err(
-            header_line,
-            None,
-            "header only: the file has no samples (one row per sample expected after the header)",
-        ));
-    }
-    if fill_ik {
-        fill_linear_ik(m, &m.default_parameters(), &mut commands).map_err(|(i, e)| {
-            cx.err(
-                row_lines[i],
-                None,
-                format!(
-                    "the linear axes are not given and the nominal inverse kinematics cannot fill them: {e}"
-                ),
-            )
-        })?;
-    }
-    let mut record = record_from_commands(commands, times);
-    if n_measured == 3 {
-        record.measured = measured;
-    }
-    Ok(record)
-}
-
-/// The header name without spaces and double quotes around it.
-fn clean_name(s: &str) -> &str {
+pub(crate) fn clean_name(s: &str) -> &str {
     let s = s.trim();
     s.strip_prefix('"')
         .and_then(|s| s.strip_suffix('"'))
@@ -335,7 +139,7 @@ fn clean_name(s: &str) -> &str {
         .trim()
 }
 
-fn classify(m: &Machine, name: &str) -> Option<Col> {
+pub(crate) fn classify(m: &Machine, name: &str) -> Option<Col> {
     if let Some(a) = m
         .axes
         .iter()
@@ -365,7 +169,7 @@ pub fn column_order(m: &Machine) -> Vec<usize> {
     axes
 }
 
-fn expected_columns(m: &Machine) -> String {
+pub(crate) fn expected_columns(m: &Machine) -> String {
     let mut v: Vec<String> = column_order(m)
         .into_iter()
         .map(|a| {

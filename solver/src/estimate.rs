@@ -144,8 +144,13 @@ pub struct Fit {
 impl Fit {
     /// RMS of the residual over all rows, `√(RSS / 3N)`, mm.
     pub fn residual_rms(&self) -> f64 {
-        let n = self.residual.len().max(1) as f64;
-        (self.rss / n).sqrt()
+        (self.rss / self.rows().max(1) as f64).sqrt()
+    }
+
+    /// Rows of the system fitted (3 per sample): `dof + rank`, also for a reduced (streaming)
+    /// system whose [`Fit::residual`] is shorter.
+    pub fn rows(&self) -> usize {
+        self.dof + self.rank
     }
 }
 

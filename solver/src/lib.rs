@@ -13,6 +13,7 @@
 
 pub mod basis;
 pub mod csvio;
+pub mod csvread;
 pub mod diagnose;
 pub mod distributions;
 pub mod estimate;

@@ -142,3 +142,71 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
         largest_block: largest,
     })
 }
+
+/// Identifies `model` of `m` from the measurement CSV at `path`, read in blocks of `block`
+/// samples (never the whole record, never the whole H): first-order least squares, with the
+/// options of [`crate::estimate::identify`] (zeroed readings add `dx0 dy0 dz0`). A model with
+/// `time:K` terms costs one more pass over the file for the record's time span.
+pub fn identify_file(
+    m: &Machine,
+    model: &Model,
+    path: &std::path::Path,
+    opts: &crate::estimate::IdentifyOptions,
+    block: usize,
+) -> Result<
+    (crate::estimate::Identification, StreamingIdentification),
+    StreamingError<crate::csvio::CsvError>,
+> {
+    use crate::csvio::{MeasurementBlocks, time_span};
+    use crate::model::Effect;
+    let fitted = if opts.zeroed {
+        crate::estimate::with_offsets(model)
+    } else {
+        model.clone()
+    };
+    let params = opts
+        .params
+        .clone()
+        .unwrap_or_else(|| m.default_parameters());
+    let mut source = GainSource::new(m, &fitted.errors(), &params)?;
+    let has_time = fitted
+        .terms
+        .iter()
+        .any(|t| matches!(t.basis, model_spec::basis::Basis::Time(_)));
+    let span = if has_time {
+        Some(time_span(path, m).map_err(StreamingError::Read)?)
+    } else {
+        None
+    };
+    let blocks = MeasurementBlocks::open(path, m, block).map_err(StreamingError::Read)?;
+    let run = identify_streaming(
+        m,
+        &fitted,
+        blocks,
+        span,
+        &mut source,
+        &opts.constraint,
+        &opts.tolerances,
+    )?;
+    let names = parameter_names(m, &fitted);
+    let is_offset: Vec<bool> = fitted
+        .columns()
+        .iter()
+        .map(|&(t, _)| matches!(fitted.terms[t].effect, Effect::SensorOffset(_)))
+        .collect();
+    let swallowed = crate::identifiability::swallowed_by_offsets(
+        &names,
+        &run.fit.identifiability.confounded,
+        &is_offset,
+    );
+    let ident = crate::estimate::Identification {
+        machine: m.name.clone(),
+        model: fitted,
+        fit: run.fit.clone(),
+        samples: run.samples,
+        zeroed: opts.zeroed,
+        swallowed,
+        backend: source.backend(),
+    };
+    Ok((ident, run))
+}

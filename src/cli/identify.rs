@@ -74,6 +74,14 @@ pub struct IdentifyArgs {
     /// Also write the result as JSON to FILE (atomically).
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// Read the measurement in blocks and fold them into an incremental QR: for long records
+    /// (10^6 samples and more), memory bounded by the number of parameters. First order (the
+    /// refinement needs the whole record).
+    #[arg(long)]
+    stream: bool,
+    /// Samples per block with --stream.
+    #[arg(long, value_name = "N", default_value_t = 4096, requires = "stream")]
+    block: usize,
 }
 
 /// Runs `rtest identify`.
@@ -81,16 +89,51 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     let (label, model) = data::model(&m, args.model.as_deref(), args.terms.as_deref())?;
     let constraint = data::constraint(args.constraint.as_deref())?;
-    let record = data::measurement("--data", &m, &args.data)?;
     let opts = IdentifyOptions {
         zeroed: args.zeroed,
         constraint,
         ..Default::default()
     };
-    let result = data::identify(&m, &model, &record, &opts, !args.first_order)?;
     let data_name = args.data.display().to_string();
+    let (result, first_reading_zero) = if args.stream {
+        if args.block == 0 {
+            return Err(CliError::usage("--block: must be at least 1 sample"));
+        }
+        let (ident, run) = solver::streaming::identify_file(
+            &m, &model, &args.data, &opts, args.block,
+        )
+        .map_err(|e| match e {
+            solver::streaming::StreamingError::Estimate(
+                solver::estimate::EstimateError::UnknownParameter(name, names),
+            ) => CliError::usage(format!(
+                "--constraint: `{name}` is not a parameter of the model (parameters: {names})"
+            )),
+            other => CliError::failure(format!("--data: {other}")),
+        })?;
+        let note = format!(
+            "Read in {} block(s) of at most {} samples folded into an incremental QR (first order; state {} numbers).\n",
+            run.blocks,
+            run.largest_block,
+            (model.width() + 4) * (model.width() + 4)
+        );
+        print!("{note}");
+        (
+            data::Identified {
+                ident,
+                refinement: None,
+            },
+            false,
+        )
+    } else {
+        let record = data::measurement("--data", &m, &args.data)?;
+        let zero = data::looks_zeroed(&record);
+        (
+            data::identify(&m, &model, &record, &opts, !args.first_order)?,
+            zero,
+        )
+    };
     let mut text = report(&m, &label, &data_name, &result);
-    if data::looks_zeroed(&record) && !args.zeroed {
+    if first_reading_zero && !args.zeroed {
         text.push_str(
             "Note: the first reading is exactly 0: if the readings were zeroed at the first sample, give --zeroed.\n",
         );
@@ -240,7 +283,7 @@ pub fn report(m: &Machine, label: &str, data_name: &str, r: &Identified) -> Stri
     out.push_str(&format!(
         "residual RMS {} µm over {} readings; σ̂ = {} ({} degrees of freedom)\n",
         data::um(fit.residual_rms()),
-        fit.residual.len(),
+        fit.rows(),
         fit.sigma
             .map_or("undefined".into(), |s| format!("{} µm", data::um(s))),
         fit.dof

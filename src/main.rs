@@ -41,11 +41,13 @@ enum Verb {
     Validate(cli::validate::ValidateArgs),
     Demo(cli::demo::DemoArgs),
     Bench(cli::bench::BenchArgs),
+    Diagnose(cli::diagnose::DiagnoseArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 8] = [
-    "machines", "gains", "generate", "simulate", "identify", "validate", "demo", "bench",
+const VERBS: [&str; 9] = [
+    "machines", "gains", "generate", "simulate", "identify", "validate", "diagnose", "demo",
+    "bench",
 ];
 
 /// A clap error as one line: its message and its hints, without the usage block.
@@ -99,6 +101,7 @@ fn main() -> ExitCode {
         Verb::Validate(a) => cli::validate::run(a),
         Verb::Demo(a) => cli::demo::run(a),
         Verb::Bench(a) => cli::bench::run(a),
+        Verb::Diagnose(a) => cli::diagnose::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

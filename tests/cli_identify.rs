@@ -936,11 +936,19 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
     let out = ok(&dir, &["demo"]);
     let elapsed = start.elapsed();
     let files = [
+        "diagnose.json",
         "gains-reduced.md",
         "identify.json",
+        "k1-path.svg",
+        "k1-spectrum.svg",
         "k1.csv",
+        "k2-path.svg",
+        "k2-spectrum.svg",
         "k2.csv",
+        "k4-path.svg",
+        "k4-spectrum.svg",
         "k4.csv",
+        "seed-ac-extended.toml",
         "seed_ac.rs",
         "validate-k1.json",
         "validate-k2.json",

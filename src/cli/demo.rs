@@ -1,13 +1,16 @@
 //! `rtest demo`: the seed's experiment on the virtual seed machine (`seed-ac`) with the
 //! documented demo truth: simulate K4, K1 and K2, identify the reduced model on K4, validate on
-//! K1 and K2, say what is left unexplained and why, and write everything to `./rtest-demo/`.
+//! K1 and K2, say what is left unexplained and why, diagnose what the reduced model lacks (with
+//! K1 and K2 held out), and write everything to `./rtest-demo/`.
 
 use super::data;
+use super::diagnose as diag;
 use super::validate::{defaulted_note, residual_table};
 use super::{CliError, CliResult, Compiled, EXIT_CODES};
 use codegen::table::{self, render};
 use model_spec::{FULL_MODEL, Machine};
 use solver::csvio::format_record;
+use solver::diagnose::{DiagnoseOptions, Diagnosis, diagnose};
 use solver::estimate::IdentifyOptions;
 use solver::model::Model;
 use solver::record::Record;
@@ -27,6 +30,8 @@ const REDUCED: &str = "reduced";
 const OUT_DIR: &str = "rtest-demo";
 /// The paths simulated, and the offset of each one's noise seed from the truth's.
 const PATHS: [(&str, u64); 3] = [("K4", 0), ("K1", 1), ("K2", 2)];
+/// The extended machine description the demo writes.
+const EXTENDED_FILE: &str = "seed-ac-extended.toml";
 /// The seed's deviations (measured minus predicted) on K4, and on K1 and K2, µm.
 const SEED_DEVIATION_UM: (f64, f64) = (12.0, 15.0);
 
@@ -49,14 +54,22 @@ standard uncertainties (µm, µrad), like the seed's Table 4.
 (nominal machine) and after (identified model, exact prediction), compared with the seed's \
 ±12 µm (K4) and ±15 µm (K1, K2).
 4. Says what is left unexplained and why: the truth's terms the reduced model lacks, how much \
-they move the readings, and the fit with them added.
+they move the readings and how they bias the 11 values.
+5. Diagnoses the reduced model on K4 with K1 and K2 held out (rtest diagnose): the missing term \
+found from the data alone, named as an ISO 230 error with its value ± std (µm, µrad), its \
+significance, and the residual RMS before and after on K4, K1 and K2; then checks it against the \
+truth (known here, not used by the diagnosis).
 
 Writes, in ./rtest-demo/ (created if needed; every file computed first, then replaced \
 atomically): k4.csv, k1.csv, k2.csv (the measurements: axes in mm and degrees, readings in µm), \
 identify.json (rtest identify --json), validate-k1.json and validate-k2.json (rtest validate \
---json), seed_ac.rs (generated no_std Rust gains of the full and reduced models) and \
-gains-reduced.md (the Markdown gain table of the reduced model, mm/mm and mm/rad). The same \
-steps one by one: rtest simulate / identify / validate.",
+--json), seed_ac.rs (generated no_std Rust gains of the full and reduced models), \
+gains-reduced.md (the Markdown gain table of the reduced model, mm/mm and mm/rad), \
+diagnose.json (rtest diagnose --json), seed-ac-extended.toml (the machine with the extended \
+model, rtest diagnose --model-out) and the figures of rtest diagnose --plot: k4-path.svg, \
+k1-path.svg, k2-path.svg (measured against predicted error, base and extended model) and \
+k4-spectrum.svg, k1-spectrum.svg, k2-spectrum.svg (residual components before and after). The \
+same steps one by one: rtest simulate / identify / validate / diagnose.",
     after_help = EXIT_CODES
 )]
 pub struct DemoArgs {}
@@ -159,19 +172,45 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         let b = data::identify(&m, &model, &alone, &IdentifyOptions::default(), false)?;
         Some(b.ident.fit.values)
     };
-    let extended = if hidden.terms.is_empty() {
-        None
-    } else {
-        let mut ext = model.clone();
-        ext.terms.extend(hidden.terms.iter().copied());
-        let r = data::identify(&m, &ext, &k4.record, &IdentifyOptions::default(), true)?;
-        let v: Vec<Validation> = runs
+    // 5. The diagnosis of the reduced model on K4, K1 and K2 held out: what it lacks, found
+    //    from the data alone (the truth is used only for the check printed after it).
+    let dir = Path::new(OUT_DIR);
+    let path_of = |f: &str| dir.join(f).display().to_string();
+    let opts = DiagnoseOptions::default();
+    let held: Vec<(String, Record)> = runs[1..]
+        .iter()
+        .map(|r| (path_of(&r.file), r.record.clone()))
+        .collect();
+    let diagnosis = diagnose(&m, &model, &k4.record, &held, &opts).map_err(fail)?;
+    let extended = diag::extended_terms(&model, &diagnosis);
+    let machine_text = diag::machine_text(MACHINE)?;
+    let (ext_name, ext_text) = diag::extended_machine(
+        &m,
+        &machine_text,
+        &extended,
+        &format!(
+            "{} (rtest demo: the diagnosis of the reduced model on K4)",
+            diag::extended_label(&m, REDUCED, &diagnosis)
+        ),
+    )
+    .map_err(fail)?;
+    let k4_path = path_of(&k4.file);
+    let diag_run = diag::Run {
+        machine: MACHINE,
+        label: REDUCED,
+        data: &k4_path,
+        samples: k4.record.samples.len(),
+        held: held
             .iter()
-            .map(|run| validate(&m, &r.ident.model, &r.ident.fit.values, &run.record, &exact))
-            .collect::<Result<_, _>>()
-            .map_err(fail)?;
-        Some((r, v))
+            .map(|(n, r)| (n.clone(), r.samples.len()))
+            .collect(),
+        opts: &opts,
+        model_out: Some((ext_name, path_of(EXTENDED_FILE))),
     };
+    let diag_json = diag::diagnosis_json(&m, &diag_run, &diagnosis, &extended);
+    let mut figure_records = vec![(k4_path.clone(), &k4.record, true)];
+    figure_records.extend(held.iter().map(|(n, r)| (n.clone(), r, false)));
+    let figures = diag::plots(&m, &diag_run, &diagnosis, &figure_records).map_err(fail)?;
 
     // Files people take away.
     let code = codegen::emit::generate_machine(&m, &[]).map_err(fail)?;
@@ -183,8 +222,6 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         &super::gains::title(&m, Some(REDUCED), reduced.model.errors.len()),
         table::Format::Markdown,
     );
-    let dir = Path::new(OUT_DIR);
-    let path_of = |f: &str| dir.join(f).display().to_string();
     let mut files: Vec<(String, String, String)> = Vec::new();
     for r in &runs {
         files.push((
@@ -226,6 +263,24 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         markdown,
         "gain table of the reduced model, the seed's Table 2, Markdown".into(),
     ));
+    files.push((
+        "diagnose.json".into(),
+        diag_json.render(),
+        "the diagnosis of the reduced model on K4, as rtest diagnose --json writes it".into(),
+    ));
+    files.push((
+        EXTENDED_FILE.into(),
+        ext_text,
+        "seed-ac with the extended model appended ([models.extended]), as rtest diagnose --model-out writes it".into(),
+    ));
+    for (name, svg) in figures {
+        let what = if name.ends_with("-path.svg") {
+            "measured and predicted error along the path (base and extended model), x, y, z"
+        } else {
+            "residual components before and after the extension"
+        };
+        files.push((name, svg, format!("figure: {what}")));
+    }
 
     // The summary.
     let mut out = String::from(
@@ -312,19 +367,19 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         max_after(2),
         solver::csvio::format_scaled(truth.noise_mm, 3)
     ));
-    if let Some((ext, ext_v)) = &extended {
-        out.push_str(&unexplained(
-            &m,
-            &hidden,
-            &hidden_values,
-            &hidden_rms,
-            &ext.ident,
-            ext_v,
-            truth.noise_mm,
-        ));
-    } else {
+    if hidden.terms.is_empty() {
         out.push_str("The truth has nothing the reduced model lacks: what is left is the noise.\n");
+    } else {
+        out.push_str(&unexplained(&m, &hidden, &hidden_values, &hidden_rms));
     }
+    out.push_str(&diagnosis_text(
+        &m,
+        &diag_run,
+        &diagnosis,
+        &truth,
+        &hidden,
+        truth.noise_mm,
+    ));
     out.push_str("\nCompiled straight-line code (per evaluation of all gains):\n");
     for (name, c) in [(FULL_MODEL, &full), (REDUCED, &reduced)] {
         out.push_str(&format!(
@@ -344,7 +399,7 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         out.push_str(&format!("  {}  ({what})\n", path_of(name)));
     }
     out.push_str(&format!(
-        "\nDone in {:.2} s. The same steps one by one: rtest simulate, rtest identify, rtest validate (see --help).\n",
+        "\nDone in {:.2} s. The same steps one by one: rtest simulate, rtest identify, rtest validate, rtest diagnose (see --help).\n",
         start.elapsed().as_secs_f64()
     ));
     print!("{out}");
@@ -428,80 +483,129 @@ fn truth_table(
     super::gains::text_table(&header, &rows)
 }
 
-/// Two lines: what the reduced model lacks, how much it moves the readings, and the fit with it.
-fn unexplained(
-    m: &Machine,
-    hidden: &Model,
-    values: &[Option<f64>],
-    hidden_rms: &[f64],
-    ext: &solver::estimate::Identification,
-    ext_v: &[Validation],
-    noise_mm: f64,
-) -> String {
+/// What the reduced model lacks according to the truth (known in the demo), how much it moves
+/// the readings, and the bias it puts into the fit.
+fn unexplained(m: &Machine, hidden: &Model, values: &[Option<f64>], hidden_rms: &[f64]) -> String {
     let mut at = 0;
     let mut names = Vec::new();
-    let mut found = Vec::new();
     for t in &hidden.terms {
-        let name = solver::hmatrix::parameter_name(m, t, 0);
-        let name = name.strip_suffix(":cos").unwrap_or(&name).to_string();
         let f = display_factor(m, t.effect);
         let w = t.basis.width();
         let unit = data::unit(t.effect.unit(m));
-        let show = |v: &[Option<f64>]| -> String {
-            let parts: Vec<String> = v
-                .iter()
-                .map(|x| x.map_or("?".into(), |x| super::short(x * f)))
-                .collect();
-            if w == 2 {
-                format!("[{}]", parts.join(", "))
-            } else {
-                parts.join(", ")
-            }
-        };
-        names.push(format!("{name} = {} {unit}", show(&values[at..at + w])));
-        // The same term in the extended fit.
-        let cols = ext.model.columns();
-        if let Some(j) = cols
+        let parts: Vec<String> = values[at..at + w]
             .iter()
-            .position(|&(ti, k)| ext.model.terms[ti] == *t && k == 0)
-        {
-            let parts: Vec<String> = (j..j + w)
-                .map(|c| match (ext.fit.values[c], ext.fit.std[c]) {
-                    (Some(v), Some(s)) => format!("{:.2} ± {:.2}", v * f, s * f),
-                    (Some(v), None) => format!("{:.2}", v * f),
-                    _ => "not determined".into(),
-                })
-                .collect();
-            found.push(format!("{name} = {} {unit}", parts.join(", ")));
-        }
+            .map(|x| x.map_or("?".into(), |x| super::short(x * f)))
+            .collect();
+        let shown = if w == 2 {
+            format!("[{}]", parts.join(", "))
+        } else {
+            parts.join(", ")
+        };
+        names.push(format!("{} = {shown} {unit}", t.spelling(m)));
         at += w;
     }
-    let rms = |v: &[f64]| {
-        v.iter()
-            .map(|x| format!("{:.2}", x * 1e3))
-            .collect::<Vec<_>>()
-            .join("/")
-    };
-    let after: Vec<f64> = ext_v.iter().map(|v| v.overall.residual_rms).collect();
-    let terms: Vec<String> = hidden
-        .terms
+    let rms: Vec<String> = hidden_rms
         .iter()
-        .map(|t| {
-            let n = t.effect.name(m);
-            match t.basis {
-                solver::basis::Basis::Const => n,
-                b => format!("{n}@{b}"),
-            }
-        })
+        .map(|x| format!("{:.2}", x * 1e3))
         .collect();
     format!(
-        "Left unexplained: the truth's {}, which the reduced model lacks; alone it moves the readings by {} µm RMS on K4/K1/K2, and the fit on K4 bends the 11 values to absorb what it can of it: the hidden-term bias column, larger than the std, which covers the noise only.\n\
-         Added to the model (rtest identify --model reduced --terms {}), it comes out as {} and the residual RMS falls to {} µm on K4/K1/K2, the noise ({} µm).\n",
+        "Left unexplained: the truth's {}, which the reduced model lacks; alone it moves the readings by {} µm RMS on K4/K1/K2, and the fit on K4 bends the 11 values to absorb what it can of it: the hidden-term bias column, larger than the std, which covers the noise only.\n",
         names.join(", "),
-        rms(hidden_rms),
-        terms.join(","),
-        found.join(", "),
-        rms(&after),
-        solver::csvio::format_scaled(noise_mm, 3)
+        rms.join("/"),
     )
+}
+
+/// The diagnosis's own result (what it found, its gain, the command that uses it), then the
+/// check against the truth, which the diagnosis did not use.
+fn diagnosis_text(
+    m: &Machine,
+    run: &diag::Run,
+    d: &Diagnosis,
+    truth: &Truth,
+    hidden: &Model,
+    noise_mm: f64,
+) -> String {
+    let held: Vec<&str> = run.held.iter().map(|(n, _)| n.as_str()).collect();
+    let mut out = format!(
+        "\nDiagnosis (rtest diagnose --machine {} --model {} --data {} --validate {}): {} candidate terms the reduced model lacks, tried one at a time at α = {} (corrected for the candidates tried); the truth is not used.\n",
+        run.machine,
+        run.label,
+        run.data,
+        held.join(","),
+        d.dictionary_size,
+        run.opts.alpha
+    );
+    if d.findings.is_empty() {
+        out.push_str("  no finding\n");
+    } else {
+        out.push_str("Found:\n");
+        out.push_str(&diag::findings_text(m, d, run.opts.draws));
+    }
+    out.push_str(&diag::stop_text(m, d));
+    out.push_str(&format!(
+        "Gain: residual RMS, reduced → {}:\n",
+        diag::extended_label(m, run.label, d)
+    ));
+    out.push_str(&diag::gain_text(run, d));
+    out.push_str(&diag::worse_text(d));
+    out.push_str(&diag::use_text(m, run, d));
+
+    // The check against the truth.
+    let mut checks = Vec::new();
+    for t in &hidden.terms {
+        let f = display_factor(m, t.effect);
+        let unit = data::unit(t.effect.unit(m));
+        let want: Vec<f64> = truth
+            .coefficient(t)
+            .unwrap_or(&[])
+            .iter()
+            .map(|v| v * f)
+            .collect();
+        let shown: Vec<String> = want.iter().map(|&v| super::short(v)).collect();
+        match d.findings.iter().find(|x| x.term == *t) {
+            Some(x) => {
+                let z: Vec<String> = x
+                    .values
+                    .iter()
+                    .zip(&x.stds)
+                    .zip(&want)
+                    .map(|((v, s), w)| match s {
+                        Some(s) if *s > 0.0 => format!("{:+.2}", (v * f - w) / (s * f)),
+                        _ => "-".into(),
+                    })
+                    .collect();
+                checks.push(format!(
+                    "{} found: {} against the truth {} {unit}, (found - truth)/std = {}",
+                    t.spelling(m),
+                    diag::values_text(m, x),
+                    shown.join(", "),
+                    z.join(", ")
+                ));
+            }
+            None => checks.push(format!(
+                "{} (truth {} {unit}) NOT found",
+                t.spelling(m),
+                shown.join(", ")
+            )),
+        }
+    }
+    for x in &d.findings {
+        if !hidden.terms.contains(&x.term) {
+            checks.push(format!(
+                "{} found but not in the truth (a false finding)",
+                x.term.spelling(m)
+            ));
+        }
+    }
+    let after: Vec<String> = std::iter::once(d.fit_rms.1)
+        .chain(d.validation.iter().map(|v| v.2))
+        .map(|x| format!("{:.2}", x * 1e3))
+        .collect();
+    out.push_str(&format!(
+        "Check against the truth (known here only): {}; residual RMS after {} µm on K4/K1/K2, against {} µm of noise.\n",
+        checks.join("; "),
+        after.join("/"),
+        solver::csvio::format_scaled(noise_mm, 3)
+    ));
+    out
 }

@@ -7,6 +7,10 @@
 pub enum Json {
     /// `null`.
     Null,
+    /// `true` or `false`.
+    Bool(bool),
+    /// An integer (a count).
+    Int(i64),
     /// A number (non-finite numbers are written as `null`).
     Num(f64),
     /// A string.
@@ -44,6 +48,8 @@ impl Json {
         let pad = |out: &mut String, n: usize| out.extend(std::iter::repeat_n("  ", n));
         match self {
             Json::Null => out.push_str("null"),
+            Json::Bool(b) => out.push_str(if *b { "true" } else { "false" }),
+            Json::Int(i) => out.push_str(&i.to_string()),
             Json::Num(x) => out.push_str(&serde_json::to_string(&(x + 0.0)).expect("f64")),
             Json::Str(s) => out.push_str(&serde_json::to_string(s).expect("string")),
             Json::Arr(items) if items.is_empty() => out.push_str("[]"),

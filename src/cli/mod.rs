@@ -5,6 +5,7 @@
 pub mod bench;
 pub mod data;
 pub mod demo;
+pub mod diagnose;
 pub mod gains;
 pub mod generate;
 pub mod identify;

@@ -302,6 +302,18 @@ impl GainModel {
             .collect()
     }
 
+    /// The sub-model of the errors at positions `rows` of this one (same atoms).
+    pub fn select(&self, rows: &[usize]) -> GainModel {
+        GainModel {
+            machine: self.machine.clone(),
+            atoms: self.atoms.clone(),
+            errors: rows.iter().map(|&i| self.errors[i]).collect(),
+            error_names: rows.iter().map(|&i| self.error_names[i].clone()).collect(),
+            angular: rows.iter().map(|&i| self.angular[i]).collect(),
+            gains: rows.iter().map(|&i| self.gains[i].clone()).collect(),
+        }
+    }
+
     /// The atom used in the polynomials for `kind`.
     pub fn atom(&self, kind: AtomKind) -> Atom {
         self.atoms.find(kind)

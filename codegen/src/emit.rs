@@ -13,8 +13,9 @@
 //!   (tool minus workpiece, tool frame; mm per mm for translational errors, mm per rad for
 //!   angular ones; orientation rows per mm and per rad).
 
+use crate::GainModel;
 use crate::ir::{Input, Op, Output, Program};
-use crate::{GainModel, compile, compile_position};
+use crate::lower::{MAX_INSTRUCTIONS, Part, compile_parts};
 use model_spec::Machine;
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
@@ -76,6 +77,82 @@ pub fn position_body(p: &Program, n: usize) -> TokenStream {
     quote!(#lets #(#stores)*)
 }
 
+/// The body of one part of a split position program: its `let`s, then one store per cell
+/// `out[d][ERROR] = …` (the part's errors only).
+fn position_part_body(p: &Program, error_consts: &[Ident]) -> TokenStream {
+    let lets = lets(p);
+    let n = error_consts.len().max(1);
+    let stores = p.outputs.chunks(n).enumerate().flat_map(|(d, row)| {
+        let d = Literal::usize_unsuffixed(d);
+        row.iter().zip(error_consts).map(move |(o, name)| {
+            let c = cell(o);
+            quote!(out[#d][#name] = #c;)
+        })
+    });
+    quote!(#lets #(#stores)*)
+}
+
+/// The bodies of `gains` and `position_gains` and the part functions they call (none when the
+/// model is one part).
+fn model_bodies(
+    parts: &[Part],
+    consts: &[Ident],
+    n: &Literal,
+    n_value: usize,
+) -> (TokenStream, TokenStream, TokenStream) {
+    if let [one] = parts {
+        return (
+            body(&one.gains, consts),
+            position_body(&one.position, n_value),
+            quote!(),
+        );
+    }
+    let mut fns = Vec::new();
+    let (mut calls, mut pos_calls) = (Vec::new(), Vec::new());
+    for (k, part) in parts.iter().enumerate() {
+        let part_consts: Vec<Ident> = part.rows.iter().map(|&i| consts[i].clone()).collect();
+        let (g, q) = (
+            format_ident!("gains_part{}", k),
+            format_ident!("position_gains_part{}", k),
+        );
+        let doc = format!(
+            " Part {k} of [`gains`] ({} errors, {}).",
+            part.rows.len(),
+            part.gains.op_counts()
+        );
+        let pos_doc = format!(
+            " Part {k} of [`position_gains`] ({} errors, {}).",
+            part.rows.len(),
+            part.position.op_counts()
+        );
+        let gb = body(&part.gains, &part_consts);
+        let pb = position_part_body(&part.position, &part_consts);
+        fns.push(quote! {
+            #[doc = #doc]
+            #[allow(clippy::all, unused_variables)]
+            fn #g(pose: &Pose, params: &Params, out: &mut [[f64; 6]; #n]) { #gb }
+            #[doc = #pos_doc]
+            #[allow(clippy::all, unused_variables)]
+            fn #q(pose: &Pose, params: &Params, out: &mut [[f64; #n]; 3]) { #pb }
+        });
+        calls.push(quote!(#g(pose, params, out);));
+        pos_calls.push(quote!(#q(pose, params, out);));
+    }
+    (quote!(#(#calls)*), quote!(#(#pos_calls)*), quote!(#(#fns)*))
+}
+
+/// Operation counts of a program list, added up.
+fn sum_counts<'a>(programs: impl Iterator<Item = &'a Program>) -> crate::ir::OpCounts {
+    programs.fold(crate::ir::OpCounts::default(), |a, p| {
+        let c = p.op_counts();
+        crate::ir::OpCounts {
+            add: a.add + c.add,
+            mul: a.mul + c.mul,
+            neg: a.neg + c.neg,
+        }
+    })
+}
+
 /// One `let` per instruction.
 fn lets(p: &Program) -> TokenStream {
     let lets = p.ops.iter().enumerate().map(|(i, op)| {
@@ -118,7 +195,7 @@ fn lets(p: &Program) -> TokenStream {
 }
 
 /// One model's module (`pub mod reduced { … }`).
-pub fn model_module(module: &str, model: &GainModel, p: &Program, pos: &Program) -> TokenStream {
+pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStream {
     let module_doc = format!(" Model `{module}` of machine `{}`.", model.machine);
     let module = field(module);
     let n_value = model.errors.len();
@@ -137,7 +214,7 @@ pub fn model_module(module: &str, model: &GainModel, p: &Program, pos: &Program)
         )
     });
     let angular = &model.angular;
-    let counts = p.op_counts();
+    let counts = sum_counts(parts.iter().map(|p| &p.gains));
     let ops_total = Literal::usize_unsuffixed(counts.total());
     let doc_gains = [
         format!(
@@ -149,9 +226,8 @@ pub fn model_module(module: &str, model: &GainModel, p: &Program, pos: &Program)
         String::new(),
         format!(" Straight-line code, no allocation, no branches: {counts}."),
     ];
-    let body = body(p, &consts);
-    let pos_body = position_body(pos, n_value);
-    let pos_counts = pos.op_counts();
+    let (body, pos_body, part_fns) = model_bodies(parts, &consts, &n, n_value);
+    let pos_counts = sum_counts(parts.iter().map(|p| &p.position));
     let pos_total = Literal::usize_unsuffixed(pos_counts.total());
     let doc_position = [
         " Position gains only, in the layout of three rows of an H matrix: `out[d][i]` is the"
@@ -178,6 +254,7 @@ pub fn model_module(module: &str, model: &GainModel, p: &Program, pos: &Program)
                 #[doc = #const_docs]
                 pub const #consts: usize = #indices;
             )*
+            #part_fns
             #(#[doc = #doc_gains])*
             #[allow(clippy::all, unused_variables)]
             pub fn gains(pose: &Pose, params: &Params, out: &mut [[f64; 6]; #n]) {
@@ -295,15 +372,12 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
 
 /// The code of one machine: its `Pose`, `Params` and one module per model, as a token stream
 /// (the content of a module; no crate attributes, so it can be `include!`d).
-pub fn machine_tokens(
-    m: &Machine,
-    models: &[(&str, &GainModel, &Program, &Program)],
-) -> TokenStream {
+pub fn machine_tokens(m: &Machine, models: &[(&str, &GainModel, Vec<Part>)]) -> TokenStream {
     let inputs = crate::lower::inputs(m, models.first().expect("at least one model").1);
     let structs = input_structs(m, &inputs);
     let modules = models
         .iter()
-        .map(|(name, model, p, pos)| model_module(name, model, p, pos));
+        .map(|(name, model, parts)| model_module(name, model, parts));
     quote!(#structs #(#modules)*)
 }
 
@@ -322,8 +396,17 @@ pub fn pretty(header: &str, tokens: TokenStream) -> Result<String, syn::Error> {
 }
 
 /// Derives, compiles and emits the models `model_names` of `m` (every model when empty) as one
-/// Rust source file.
+/// Rust source file; models larger than [`MAX_INSTRUCTIONS`] are split into parts.
 pub fn generate_machine(m: &Machine, model_names: &[&str]) -> Result<String, String> {
+    generate_machine_with(m, model_names, MAX_INSTRUCTIONS)
+}
+
+/// [`generate_machine`] with a bound on the instructions of one generated function.
+pub fn generate_machine_with(
+    m: &Machine,
+    model_names: &[&str],
+    max_instructions: usize,
+) -> Result<String, String> {
     let names: Vec<&str> = if model_names.is_empty() {
         m.model_names()
     } else {
@@ -335,14 +418,9 @@ pub fn generate_machine(m: &Machine, model_names: &[&str]) -> Result<String, Str
             .model_errors(name)
             .ok_or_else(|| format!("machine {} has no model `{name}`", m.name))?;
         let model = GainModel::derive(m, errors);
-        let program = compile(m, &model);
-        let position = compile_position(m, &model);
-        built.push((name.replace('-', "_"), model, program, position));
+        let parts = compile_parts(m, &model, max_instructions);
+        built.push((name.replace('-', "_"), model, parts));
     }
-    let refs: Vec<(&str, &GainModel, &Program, &Program)> = built
-        .iter()
-        .map(|(n, g, p, q)| (n.as_str(), g, p, q))
-        .collect();
     let header = format!(
         "Generated by rtest codegen from machine `{}` ({}). Do not edit.\n\
          Models: {}.\n\
@@ -351,15 +429,26 @@ pub fn generate_machine(m: &Machine, model_names: &[&str]) -> Result<String, Str
         m.description.trim_end_matches('.'),
         built
             .iter()
-            .map(|(n, g, p, q)| format!(
-                "{n} ({} errors; gains {}; position gains {})",
-                g.errors.len(),
-                p.op_counts(),
-                q.op_counts()
-            ))
+            .map(|(n, g, parts)| {
+                let split = if parts.len() > 1 {
+                    format!(" in {} parts", parts.len())
+                } else {
+                    String::new()
+                };
+                format!(
+                    "{n} ({} errors{split}; gains {}; position gains {})",
+                    g.errors.len(),
+                    sum_counts(parts.iter().map(|p| &p.gains)),
+                    sum_counts(parts.iter().map(|p| &p.position))
+                )
+            })
             .collect::<Vec<_>>()
             .join("; ")
     );
+    let refs: Vec<(&str, &GainModel, Vec<Part>)> = built
+        .iter()
+        .map(|(n, g, p)| (n.as_str(), g, p.clone()))
+        .collect();
     pretty(&header, machine_tokens(m, &refs))
         .map_err(|e| format!("emitted code does not parse: {e}"))
 }

@@ -19,4 +19,4 @@ pub mod lower;
 pub mod table;
 
 pub use ir::Program;
-pub use lower::{compile, compile_position};
+pub use lower::{MAX_INSTRUCTIONS, Part, compile, compile_parts, compile_position};

@@ -187,6 +187,83 @@ pub fn compile_position(m: &Machine, model: &GainModel) -> Program {
     compile_polys(m, model, &polys)
 }
 
+/// A part of a model compiled on its own: some of its errors, with their gains and position
+/// gains programs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Part {
+    /// Positions of its errors in the model's error list, ascending.
+    pub rows: Vec<usize>,
+    /// Six outputs per error of the part ([`compile`] of the part).
+    pub gains: Program,
+    /// Position gains, direction-major over the part's errors ([`compile_position`]).
+    pub position: Program,
+}
+
+/// The default bound on the instructions of one generated function.
+pub const MAX_INSTRUCTIONS: usize = 4000;
+
+/// Compiles a model into parts of at most `max_instructions` instructions each (one part when
+/// the whole model fits): the errors are grouped by the axis they belong to (squareness,
+/// set-up and sensor-offset errors by their kind), groups are added to a part while it stays
+/// within the bound, and a group that alone exceeds it is split error by error. Each part has
+/// its own common-subexpression elimination, so sharing across parts is lost: the bound trades
+/// a little arithmetic for a bounded function size and compile time.
+pub fn compile_parts(m: &Machine, model: &GainModel, max_instructions: usize) -> Vec<Part> {
+    let build = |rows: Vec<usize>| {
+        let sub = model.select(&rows);
+        Part {
+            gains: compile(m, &sub),
+            position: compile_position(m, &sub),
+            rows,
+        }
+    };
+    let whole = build((0..model.errors.len()).collect());
+    let size = |p: &Part| p.gains.ops.len().max(p.position.ops.len());
+    if size(&whole) <= max_instructions {
+        return vec![whole];
+    }
+    // Groups of consecutive errors with the same key (catalogue order keeps an axis together).
+    let key = |i: usize| {
+        let e = &m.catalogue[model.errors[i]];
+        (e.axis(), std::mem::discriminant(&e.kind))
+    };
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for i in 0..model.errors.len() {
+        match groups.last_mut() {
+            Some(g) if key(g[0]) == key(i) => g.push(i),
+            _ => groups.push(vec![i]),
+        }
+    }
+    let mut parts: Vec<Part> = Vec::new();
+    let mut current: Vec<usize> = Vec::new();
+    for g in groups {
+        let mut trial = current.clone();
+        trial.extend(&g);
+        let candidate = build(trial.clone());
+        if size(&candidate) <= max_instructions || current.is_empty() && g.len() == 1 {
+            current = trial;
+            continue;
+        }
+        if !current.is_empty() {
+            parts.push(build(std::mem::take(&mut current)));
+        }
+        // The group alone, error by error if it does not fit either.
+        for &i in &g {
+            let mut t = current.clone();
+            t.push(i);
+            if current.is_empty() || size(&build(t.clone())) <= max_instructions {
+                current = t;
+            } else {
+                parts.push(build(std::mem::replace(&mut current, vec![i])));
+            }
+        }
+    }
+    if !current.is_empty() {
+        parts.push(build(current));
+    }
+    parts
+}
+
 /// One program with one output per polynomial, in order, sharing common subexpressions.
 fn compile_polys(m: &Machine, model: &GainModel, polys: &[&Poly]) -> Program {
     let inputs = inputs(m, model);

@@ -569,8 +569,8 @@ fn component_rows(before: &[Component], after: &[Component], n: usize) -> Vec<(S
             let a = after
                 .iter()
                 .find(|x| x.source == c.source && x.shape == c.shape && x.direction == c.direction)
-                .map_or(0.0, |x| x.amplitude_um);
-            (component_label(c), c.amplitude_um, a)
+                .map_or(0.0, |x| x.explained_rms_um);
+            (component_label(c), c.explained_rms_um, a)
         })
         .collect()
 }
@@ -621,7 +621,7 @@ pub fn report(m: &Machine, run: &Run, d: &Diagnosis) -> String {
     ));
 
     out.push_str(
-        "\nResidual structure of the base fit: the largest shapes, each fitted alone per direction (amplitude, µm; shapes of axes that move together overlap, so these are indications: the selection decides):\n",
+        "\nResidual structure of the base fit: the largest shapes, each fitted alone per direction (RMS of what it explains, µm; shapes of axes that move together overlap, so these are indications: the selection decides):\n",
     );
     let rows = component_rows(&d.structure_before, &d.structure_after, 8);
     if rows.is_empty() {
@@ -761,7 +761,7 @@ fn components_json(c: &[Component], n: usize) -> Json {
                     ("source".into(), Json::str(&c.source)),
                     ("shape".into(), Json::str(&c.shape)),
                     ("direction".into(), Json::str(["x", "y", "z"][c.direction])),
-                    ("amplitude_um".into(), Json::Num(c.amplitude_um)),
+                    ("explained_rms_um".into(), Json::Num(c.explained_rms_um)),
                 ])
             })
             .collect(),

@@ -1,19 +1,19 @@
 //! The structure of a residual: what is left after a fit, per direction (x, y, z), against
 //! every axis position, time and direction of motion, so that a person can see it.
 //!
-//! For each direction of the residual and each source it fits, by least squares with an
-//! intercept, one shape at a time and reports its amplitude (µm):
-//! - a rotary axis that moves: `harmonic:k` (k = 1..K), amplitude `√(a² + b²)` of
-//!   `a·cos kθ + b·sin kθ`;
-//! - a linear axis that moves: `poly:k` (Legendre of the position normalised over the stroke),
-//!   amplitude the largest |value| of the fitted shape over the samples' range of positions;
-//! - time: `time:k`, likewise over the record;
-//! - the direction of motion of an axis that moves both ways: `reversal`, half the difference of
-//!   the mean residual moving forward and backward.
+//! For each direction of the residual and each source, one shape at a time is fitted by least
+//! squares with an intercept, and reported as the RMS of what it explains: the RMS over the
+//! samples of the fitted shape minus its mean (µm). That measure is comparable between shapes
+//! and does not blow up when a shape is nearly constant on the path (a harmonic of an axis that
+//! covers a quarter turn, where the coefficients alone would be huge and cancel). The shapes:
+//! - a rotary axis that moves: `harmonic:k` (k = 1..K), `a·cos kθ + b·sin kθ`;
+//! - a linear axis that moves: `poly:k` (Legendre of the position normalised over the stroke);
+//! - time: `time:k`, Legendre over the record;
+//! - the direction of motion of an axis that moves both ways: `reversal` (±1).
 //!
 //! Shapes of different sources are not independent on a given path (on K4 every axis moves
-//! with C), so amplitudes are indications, not a decomposition; the selection
-//! ([`super::select`]) is what decides.
+//! with C), so these are indications, not a decomposition; the selection ([`super::select`])
+//! is what decides.
 
 use crate::record::Record;
 use model_spec::basis::legendre;
@@ -29,13 +29,13 @@ pub struct Component {
     pub shape: String,
     /// The residual's direction: 0, 1, 2 for x, y, z.
     pub direction: usize,
-    /// Amplitude, µm.
-    pub amplitude_um: f64,
+    /// RMS of what the shape alone explains of the residual in that direction, µm.
+    pub explained_rms_um: f64,
 }
 
-/// Least-squares amplitude of the columns `shape` (plus an intercept) in `y`: the fitted values'
-/// largest |value| without the intercept, or the harmonic amplitude for two columns.
-fn fit_amplitude(shape: &[Vec<f64>], y: &[f64], harmonic: bool) -> Option<f64> {
+/// The RMS of what the columns `shape` (plus an intercept) explain of `y`: the fitted shape
+/// minus its mean, over the samples. `None` when the shape does not vary on the samples.
+fn explained_rms(shape: &[Vec<f64>], y: &[f64]) -> Option<f64> {
     let n = y.len();
     let k = shape.len();
     if n <= k + 1 {
@@ -45,19 +45,16 @@ fn fit_amplitude(shape: &[Vec<f64>], y: &[f64], harmonic: bool) -> Option<f64> {
     let b = DVector::from_column_slice(y);
     let svd = a.svd(true, true);
     let smax = svd.singular_values.max();
-    if svd.singular_values.min() <= smax * 1e-9 {
-        return None; // the shape does not vary on this record
+    let tol = smax * 1e-9;
+    if svd.singular_values.iter().filter(|&&s| s > tol).count() < 2 {
+        return None; // the shape is constant on this record
     }
-    let x = svd.solve(&b, smax * 1e-12).ok()?;
-    if harmonic {
-        Some((x[1] * x[1] + x[2] * x[2]).sqrt())
-    } else {
-        (0..n)
-            .map(|i| (1..=k).map(|j| x[j] * shape[j - 1][i]).sum::<f64>().abs())
-            .fold(None, |acc: Option<f64>, v| {
-                Some(acc.map_or(v, |a| a.max(v)))
-            })
-    }
+    let x = svd.solve(&b, tol).ok()?;
+    let fitted: Vec<f64> = (0..n)
+        .map(|i| (1..=k).map(|j| x[j] * shape[j - 1][i]).sum())
+        .collect();
+    let mean = fitted.iter().sum::<f64>() / n as f64;
+    Some((fitted.iter().map(|f| (f - mean).powi(2)).sum::<f64>() / n as f64).sqrt())
 }
 
 /// The components of `residual` (mm, one `[x, y, z]` per sample of `record`), largest first.
@@ -71,19 +68,15 @@ pub fn analyse(
 ) -> Vec<Component> {
     let n = record.samples.len();
     let mut out = Vec::new();
-    let push = |source: &str,
-                shape: String,
-                cols: Vec<Vec<f64>>,
-                harmonic: bool,
-                out: &mut Vec<Component>| {
+    let push = |source: &str, shape: String, cols: Vec<Vec<f64>>, out: &mut Vec<Component>| {
         for d in 0..3 {
             let y: Vec<f64> = residual.iter().map(|r| r[d] * 1e3).collect();
-            if let Some(a) = fit_amplitude(&cols, &y, harmonic) {
+            if let Some(a) = explained_rms(&cols, &y) {
                 out.push(Component {
                     source: source.into(),
                     shape: shape.clone(),
                     direction: d,
-                    amplitude_um: a,
+                    explained_rms_um: a,
                 });
             }
         }
@@ -103,13 +96,7 @@ pub fn analyse(
                 for k in 1..=harmonics {
                     let c = q.iter().map(|t| (k as f64 * t).cos()).collect();
                     let s = q.iter().map(|t| (k as f64 * t).sin()).collect();
-                    push(
-                        &axis.name,
-                        format!("harmonic:{k}"),
-                        vec![c, s],
-                        true,
-                        &mut out,
-                    );
+                    push(&axis.name, format!("harmonic:{k}"), vec![c, s], &mut out);
                 }
             }
             AxisKind::Linear => {
@@ -119,7 +106,7 @@ pub fn analyse(
                         .iter()
                         .map(|x| legendre(k, 2.0 * (x - slo) / (shi - slo) - 1.0))
                         .collect();
-                    push(&axis.name, format!("poly:{k}"), vec![p], false, &mut out);
+                    push(&axis.name, format!("poly:{k}"), vec![p], &mut out);
                 }
             }
         }
@@ -129,15 +116,15 @@ pub fn analyse(
             dirs.iter().filter(|&&v| v < 0.0).count(),
         );
         if fwd > 1 && bwd > 1 {
-            push(&axis.name, "reversal".into(), vec![dirs], false, &mut out);
+            push(&axis.name, "reversal".into(), vec![dirs], &mut out);
         }
     }
     if n > 2 {
         for k in 1..=time {
             let t = (0..n).map(|i| legendre(k, record.tau(i))).collect();
-            push("time", format!("time:{k}"), vec![t], false, &mut out);
+            push("time", format!("time:{k}"), vec![t], &mut out);
         }
     }
-    out.sort_by(|a, b| b.amplitude_um.total_cmp(&a.amplitude_um));
+    out.sort_by(|a, b| b.explained_rms_um.total_cmp(&a.explained_rms_um));
     out
 }

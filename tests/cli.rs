@@ -3,7 +3,26 @@
 //! code 2 for usage errors and 1 for other failures, no panic, no output file left behind).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
+
+mod common;
+use common::{TempDir, entries, stderr, stdout};
+
+fn rtest_in(dir: Option<&Path>, args: &[&str]) -> Output {
+    common::run(dir, args)
+}
+
+fn fails(args: &[&str], code: i32, needles: &[&str]) -> String {
+    fails_in(None, args, code, needles)
+}
+
+fn fails_in(dir: Option<&Path>, args: &[&str], code: i32, needles: &[&str]) -> String {
+    common::check_fails(&rtest_in(dir, args), args, code, needles)
+}
+
+fn temp_dir(name: &str) -> TempDir {
+    common::temp_dir_tagged("cli", name)
+}
 
 /// Table 3 of the seed (mm).
 const XW: f64 = -217.504;
@@ -12,25 +31,8 @@ const ZW: f64 = 211.537;
 const ZC: f64 = 29.794;
 const TABLE_3: &str = "Xw=-217.504,Yw=-0.279,Zw=211.537,Zc=29.794";
 
-fn rtest_in(dir: Option<&Path>, args: &[&str]) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_rtest"));
-    cmd.args(args);
-    if let Some(d) = dir {
-        cmd.current_dir(d);
-    }
-    cmd.output().expect("the rtest binary runs")
-}
-
 fn rtest(args: &[&str]) -> Output {
     rtest_in(None, args)
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8(o.stdout.clone()).expect("utf-8 stdout")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8(o.stderr.clone()).expect("utf-8 stderr")
 }
 
 /// Runs `args`, asserts success and returns stdout.
@@ -48,71 +50,6 @@ fn ok(args: &[&str]) -> String {
 fn json(args: &[&str]) -> serde_json::Value {
     let out = ok(args);
     serde_json::from_str(&out).unwrap_or_else(|e| panic!("rtest {args:?}: not JSON ({e}):\n{out}"))
-}
-
-/// Runs `args`, asserts the exit code, an empty stdout and one stderr line containing every
-/// string of `needles`; returns that line.
-fn fails(args: &[&str], code: i32, needles: &[&str]) -> String {
-    fails_in(None, args, code, needles)
-}
-
-fn fails_in(dir: Option<&Path>, args: &[&str], code: i32, needles: &[&str]) -> String {
-    let o = rtest_in(dir, args);
-    let err = stderr(&o);
-    assert_eq!(
-        o.status.code(),
-        Some(code),
-        "rtest {args:?}: exit code; stderr: {err}"
-    );
-    assert!(!err.contains("panicked"), "rtest {args:?} panicked: {err}");
-    assert!(
-        o.stdout.is_empty(),
-        "rtest {args:?}: stdout not empty: {}",
-        stdout(&o)
-    );
-    assert_eq!(
-        err.lines().count(),
-        1,
-        "rtest {args:?}: not one line: {err}"
-    );
-    assert!(err.starts_with("rtest: error: "), "rtest {args:?}: {err}");
-    for n in needles {
-        assert!(err.contains(n), "rtest {args:?}: `{n}` not in: {err}");
-    }
-    err
-}
-
-/// A fresh, empty temporary directory for one test, removed when dropped.
-struct TempDir(PathBuf);
-
-impl std::ops::Deref for TempDir {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn temp_dir(name: &str) -> TempDir {
-    let d = std::env::temp_dir().join(format!("rtest-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    TempDir(d)
-}
-
-/// The names of the entries of `dir`, sorted.
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .expect("dir")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// The built-in seed machine's TOML, copied into `dir`.

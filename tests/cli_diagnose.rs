@@ -7,25 +7,16 @@
 //! code and no output file.
 
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
 // ---------------------------------------------------------------- helpers
 
+mod common;
+use common::{TempDir, entries, read_json, stderr, stdout};
+
 fn rtest_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rtest"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the rtest binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8(o.stdout.clone()).expect("utf-8 stdout")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8(o.stderr.clone()).expect("utf-8 stderr")
+    common::run(Some(dir), args)
 }
 
 /// Runs `args` in `dir`, asserts success, returns stdout.
@@ -40,70 +31,13 @@ fn ok(dir: &Path, args: &[&str]) -> String {
     stdout(&o)
 }
 
-/// Runs `args` in `dir`, asserts the exit code, an empty stdout and one stderr line starting
-/// with `rtest: error: ` that contains every string of `needles`; returns that line.
+/// Runs `args` in `dir` and checks the failure (see `common::check_fails`).
 fn fails(dir: &Path, args: &[&str], code: i32, needles: &[&str]) -> String {
-    let o = rtest_in(dir, args);
-    let err = stderr(&o);
-    assert_eq!(
-        o.status.code(),
-        Some(code),
-        "rtest {args:?}: exit code; stderr: {err}"
-    );
-    assert!(!err.contains("panicked"), "rtest {args:?} panicked: {err}");
-    assert!(
-        o.stdout.is_empty(),
-        "rtest {args:?}: stdout not empty: {}",
-        stdout(&o)
-    );
-    assert_eq!(
-        err.lines().count(),
-        1,
-        "rtest {args:?}: not one line: {err}"
-    );
-    assert!(err.starts_with("rtest: error: "), "rtest {args:?}: {err}");
-    for n in needles {
-        assert!(err.contains(n), "rtest {args:?}: `{n}` not in: {err}");
-    }
-    err
-}
-
-/// A fresh, empty temporary directory for one test, removed when dropped.
-struct TempDir(PathBuf);
-
-impl std::ops::Deref for TempDir {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
+    common::check_fails(&rtest_in(dir, args), args, code, needles)
 }
 
 fn temp_dir(name: &str) -> TempDir {
-    let d = std::env::temp_dir().join(format!("rtest-cli-diag-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    TempDir(d)
-}
-
-/// The names of the entries of `dir`, sorted.
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .expect("dir")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
-
-fn read_json(path: &Path) -> Value {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: not JSON: {e}", path.display()))
+    common::temp_dir_tagged("cli-diag", name)
 }
 
 fn num(v: &Value) -> f64 {

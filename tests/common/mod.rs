@@ -1,0 +1,96 @@
+//! What the end-to-end tests of the `rtest` binary share: running it, reading its output,
+//! checking a failure (exit code, one stderr line naming the flag, nothing on stdout, no panic),
+//! temporary directories and their contents.
+
+#![allow(dead_code)]
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs the binary with `args`, in `dir` when given.
+pub fn run(dir: Option<&Path>, args: &[&str]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_rtest"));
+    c.args(args);
+    if let Some(d) = dir {
+        c.current_dir(d);
+    }
+    c.output().expect("the rtest binary runs")
+}
+
+/// Standard output as text.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).expect("utf-8 stdout")
+}
+
+/// Standard error as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8(o.stderr.clone()).expect("utf-8 stderr")
+}
+
+/// Asserts that `o` (the run of `args`) failed with `code`, an empty stdout and one stderr line
+/// starting with `rtest: error: ` that contains every string of `needles`; returns that line.
+pub fn check_fails(o: &Output, args: &[&str], code: i32, needles: &[&str]) -> String {
+    let err = stderr(o);
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "rtest {args:?}: exit code; stderr: {err}"
+    );
+    assert!(!err.contains("panicked"), "rtest {args:?} panicked: {err}");
+    assert!(
+        o.stdout.is_empty(),
+        "rtest {args:?}: stdout not empty: {}",
+        stdout(o)
+    );
+    assert_eq!(
+        err.lines().count(),
+        1,
+        "rtest {args:?}: not one line: {err}"
+    );
+    assert!(err.starts_with("rtest: error: "), "rtest {args:?}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "rtest {args:?}: `{n}` not in: {err}");
+    }
+    err
+}
+
+/// A fresh, empty temporary directory for one test, removed when dropped.
+pub struct TempDir(pub PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A fresh temporary directory named after the test file (`tag`) and the test (`name`).
+pub fn temp_dir_tagged(tag: &str, name: &str) -> TempDir {
+    let d = std::env::temp_dir().join(format!("rtest-{tag}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    TempDir(d)
+}
+
+/// The names of the entries of `dir`, sorted.
+pub fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .expect("dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// A JSON file, parsed.
+pub fn read_json(path: &Path) -> Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: not JSON: {e}", path.display()))
+}

@@ -10,44 +10,13 @@ use nalgebra::DVector;
 use solver::estimate::{Constraint, IdentifyOptions, Tolerances, identify, least_squares};
 use solver::hmatrix::{GainSource, h_matrix, parameter_names};
 use solver::model::Model;
-use solver::record::{Record, Sample, motion_directions};
-use solver::tool_centre_point_ik;
+use solver::record::Record;
 use std::hint::black_box;
 
 fn seed_ac() -> Machine {
     model_spec::builtin("seed-ac")
         .expect("built-in")
         .expect("valid")
-}
-
-/// K4: C = 1.5·i°, A = −45·(1 − cos C)°, i = 0..=240, linear axes on the ball.
-fn k4(m: &Machine) -> Record {
-    let p = m.default_parameters();
-    let (a, c) = (m.axis_by_name("A").unwrap(), m.axis_by_name("C").unwrap());
-    let commands: Vec<Vec<f64>> = (0..=240)
-        .map(|i| {
-            let cc = (1.5 * i as f64).to_radians();
-            let mut q = vec![0.0; m.axes.len()];
-            q[c] = cc;
-            q[a] = (-45.0 * (1.0 - cc.cos())).to_radians();
-            tool_centre_point_ik(m, &mut q, &p).unwrap();
-            q
-        })
-        .collect();
-    let motion = motion_directions(&commands);
-    Record {
-        samples: commands
-            .into_iter()
-            .zip(motion)
-            .enumerate()
-            .map(|(i, (commands, motion))| Sample {
-                commands,
-                t: i as f64,
-                motion,
-            })
-            .collect(),
-        measured: vec![],
-    }
 }
 
 fn hmatrix(c: &mut Criterion) {
@@ -111,3 +80,8 @@ fn estimation(c: &mut Criterion) {
 
 criterion_group!(benches, hmatrix, estimation);
 criterion_main!(benches);
+
+/// The built-in test path K4 of DESIGN.md.
+fn k4(m: &Machine) -> Record {
+    solver::paths::builtin_path(m, "K4").unwrap().unwrap()
+}

@@ -7,13 +7,13 @@ mod common;
 use common::{Rng, builtin, id};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
+use solver::error_vector;
 use solver::estimate::{
     Constraint, EstimateError, IdentifyOptions, Tolerances, identify, least_squares,
 };
 use solver::hmatrix::{h_matrix_auto, parameter_names};
 use solver::model::Model;
-use solver::record::{Record, Sample, motion_directions};
-use solver::{error_vector, tool_centre_point_ik};
+use solver::record::Record;
 
 /// Standard normal draws (Box–Muller) from the tests' uniform generator.
 struct Normal(Rng);
@@ -29,50 +29,6 @@ impl Normal {
         let u2 = self.0.unit();
         (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
     }
-}
-
-fn path(m: &Machine, poses: impl Iterator<Item = (f64, f64)>) -> Record {
-    let p = m.default_parameters();
-    let (a, c) = (m.axis_by_name("A").unwrap(), m.axis_by_name("C").unwrap());
-    let commands: Vec<Vec<f64>> = poses
-        .map(|(aa, cc)| {
-            let mut q = vec![0.0; m.axes.len()];
-            q[a] = aa;
-            q[c] = cc;
-            tool_centre_point_ik(m, &mut q, &p).unwrap();
-            q
-        })
-        .collect();
-    let motion = motion_directions(&commands);
-    Record {
-        samples: commands
-            .into_iter()
-            .zip(motion)
-            .enumerate()
-            .map(|(i, (commands, motion))| Sample {
-                commands,
-                t: i as f64,
-                motion,
-            })
-            .collect(),
-        measured: vec![],
-    }
-}
-
-/// K4: C = 1.5·i°, A = −45·(1 − cos C)°, i = 0..=240.
-fn k4(m: &Machine) -> Record {
-    path(
-        m,
-        (0..=240).map(|i| {
-            let c = (1.5 * i as f64).to_radians();
-            ((-45.0 * (1.0 - c.cos())).to_radians(), c)
-        }),
-    )
-}
-
-/// K1: C = 0..=360° in 1° steps, A = 0.
-fn k1(m: &Machine) -> Record {
-    path(m, (0..=360).map(|i| (0.0, (i as f64).to_radians())))
 }
 
 fn reduced(m: &Machine) -> Model {
@@ -455,4 +411,14 @@ fn exact_machine_data_are_recovered_to_second_order() {
     );
     assert!(worst_um < 1e-2, "{worst_um}");
     let _ = id(&m, "XOC");
+}
+
+/// The built-in test path K4 of DESIGN.md.
+fn k4(m: &Machine) -> Record {
+    solver::paths::builtin_path(m, "K4").unwrap().unwrap()
+}
+
+/// The built-in test path K1 of DESIGN.md.
+fn k1(m: &Machine) -> Record {
+    solver::paths::builtin_path(m, "K1").unwrap().unwrap()
 }

@@ -12,50 +12,7 @@ use solver::hmatrix::{
     Backend, GainSource, HMatrixError, h_matrix, h_matrix_auto, parameter_names,
 };
 use solver::model::{Effect, Model, Term};
-use solver::record::{Record, Sample, motion_directions};
-use solver::tool_centre_point_ik;
-
-/// A record on the poses of `rotary` (per sample: (axis name, rad)), linear axes by the
-/// nominal tool-centre-point inverse kinematics, 1 s between samples, no measurements.
-fn path(m: &Machine, rotary: &[Vec<(&str, f64)>]) -> Record {
-    let p = m.default_parameters();
-    let commands: Vec<Vec<f64>> = rotary
-        .iter()
-        .map(|pose| {
-            let mut c = vec![0.0; m.axes.len()];
-            for (name, v) in pose {
-                c[m.axis_by_name(name).unwrap()] = *v;
-            }
-            tool_centre_point_ik(m, &mut c, &p).unwrap();
-            c
-        })
-        .collect();
-    let motion = motion_directions(&commands);
-    Record {
-        samples: commands
-            .into_iter()
-            .zip(motion)
-            .enumerate()
-            .map(|(i, (commands, motion))| Sample {
-                commands,
-                t: i as f64,
-                motion,
-            })
-            .collect(),
-        measured: vec![],
-    }
-}
-
-/// K4 of seed-ac: C = 1.5·i°, A = −45·(1 − cos C)°, i = 0..=240.
-fn k4(m: &Machine) -> Record {
-    let poses: Vec<Vec<(&str, f64)>> = (0..=240)
-        .map(|i| {
-            let c = (1.5 * i as f64).to_radians();
-            vec![("C", c), ("A", (-45.0 * (1.0 - c.cos())).to_radians())]
-        })
-        .collect();
-    path(m, &poses)
-}
+use solver::record::Record;
 
 fn term(m: &Machine, s: &str) -> Term {
     Term::parse(m, s).unwrap()
@@ -271,4 +228,9 @@ fn bad_input_is_an_error_not_a_panic() {
     };
     let h = h_matrix_auto(&m, &offsets, &Record::default(), &p).unwrap();
     assert_eq!(h.shape(), (0, 1));
+}
+
+/// The built-in test path K4 of DESIGN.md.
+fn k4(m: &Machine) -> Record {
+    solver::paths::builtin_path(m, "K4").unwrap().unwrap()
 }

@@ -49,20 +49,6 @@ fn path(m: &Machine, poses: impl Iterator<Item = (f64, f64)>) -> Record {
     }
 }
 
-fn k4(m: &Machine) -> Record {
-    path(
-        m,
-        (0..=240).map(|i| {
-            let c = (1.5 * i as f64).to_radians();
-            ((-45.0 * (1.0 - c.cos())).to_radians(), c)
-        }),
-    )
-}
-
-fn k1(m: &Machine) -> Record {
-    path(m, (0..=360).map(|i| (0.0, (i as f64).to_radians())))
-}
-
 fn k2(m: &Machine) -> Record {
     path(m, (0..=120).map(|i| ((-90.0 + i as f64).to_radians(), 0.0)))
 }
@@ -365,4 +351,14 @@ fn bad_identify_json_names_the_file_and_the_field() {
             .starts_with("/nonexistent/id.json: cannot read: "),
         "{e}"
     );
+}
+
+/// The built-in test path K4 of DESIGN.md.
+fn k4(m: &Machine) -> Record {
+    solver::paths::builtin_path(m, "K4").unwrap().unwrap()
+}
+
+/// The built-in test path K1 of DESIGN.md.
+fn k1(m: &Machine) -> Record {
+    solver::paths::builtin_path(m, "K1").unwrap().unwrap()
 }

@@ -11,9 +11,10 @@
 //! F_g    = (ΔRSS_g / q_g) / ((RSS − ΔRSS_g) / (n − rank − q_g))
 //! ```
 //!
-//! The step takes the candidate with the largest ΔRSS. Its significance is corrected for the
+//! The step takes the candidate with the largest ΔRSS (the name it is given among candidates the
+//! data cannot tell apart is decided in [`super::diagnose`]). Its significance is corrected for the
 //! number of candidates tried: first by Bonferroni (`p·N`, conservative); when that is not
-//! decisive, by the null distribution of the selection rule itself — the F of the
+//! decisive, by the null distribution of the selection rule itself — the raw p-value of the
 //! largest-ΔRSS candidate on pure Gaussian noise, projected like the data — estimated by Monte
 //! Carlo (a seeded generator, so results are reproducible). Under Gaussian noise this test has
 //! level α exactly, whatever the correlation between candidates.
@@ -130,11 +131,19 @@ pub fn f_statistic(delta_rss: f64, rss: f64, q: usize, n: usize, rank: usize) ->
 
 /// The p-value of the chosen candidate under the null of the selection rule, by Monte Carlo:
 /// the share of `draws` pure-noise vectors (projected out of `model`) whose largest-ΔRSS
-/// candidate (among `scored`) has an F at least `f_observed`. Returns `(count + 1) / (draws + 1)`.
+/// candidate (among `scored`) has a raw p-value ([`f_p_value`] of its F with its own number of
+/// directions) at most `p_observed`, the raw p-value of the chosen candidate. Returns
+/// `(count + 1) / (draws + 1)`.
+///
+/// The statistic is the raw p-value rather than F so that the Bonferroni bound is a bound of
+/// this p-value whatever the widths of the candidates: `P(p_sel ≤ t) ≤ P(min_g p_g ≤ t) ≤ N·t`.
+/// Bonferroni decisive (`N·p_observed < α`) then implies this p-value below α, and the two
+/// corrections together keep level α. (With F as the statistic, a two-column candidate's F
+/// and a one-column candidate's F are on different scales, and the bound does not hold.)
 pub fn monte_carlo_p(
     model: &Basis,
     scored: &[Scored],
-    f_observed: f64,
+    p_observed: f64,
     draws: usize,
     seed: u64,
 ) -> f64 {
@@ -174,7 +183,7 @@ pub fn monte_carlo_p(
                 off += w;
             }
             if let Some(f) = f_statistic(best, rss, best_q, n, rank)
-                && f >= f_observed
+                && f_p_value(f, best_q, n, rank) <= p_observed
             {
                 exceed += 1;
             }
@@ -227,7 +236,7 @@ mod tests {
         }];
         for f in [1.0, 4.0, 7.0] {
             let exact = f_p_value(f, 1, n, 0);
-            let mc = monte_carlo_p(&model, &scored, f, 20_000, 3);
+            let mc = monte_carlo_p(&model, &scored, exact, 20_000, 3);
             assert!(
                 (mc - exact).abs() < 4.0 * (exact * (1.0 - exact) / 20_000.0).sqrt() + 1e-3,
                 "F {f}: {mc} vs {exact}"

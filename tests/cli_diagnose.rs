@@ -8,33 +8,11 @@
 
 use serde_json::Value;
 use std::path::Path;
-use std::process::Output;
 
 // ---------------------------------------------------------------- helpers
 
 mod common;
-use common::{TempDir, entries, read_json, stderr, stdout};
-
-fn rtest_in(dir: &Path, args: &[&str]) -> Output {
-    common::run(Some(dir), args)
-}
-
-/// Runs `args` in `dir`, asserts success, returns stdout.
-fn ok(dir: &Path, args: &[&str]) -> String {
-    let o = rtest_in(dir, args);
-    assert!(
-        o.status.success(),
-        "rtest {args:?} failed ({:?}): {}",
-        o.status.code(),
-        stderr(&o)
-    );
-    stdout(&o)
-}
-
-/// Runs `args` in `dir` and checks the failure (see `common::check_fails`).
-fn fails(dir: &Path, args: &[&str], code: i32, needles: &[&str]) -> String {
-    common::check_fails(&rtest_in(dir, args), args, code, needles)
-}
+use common::{TempDir, entries, fails, ok, read_json};
 
 fn temp_dir(name: &str) -> TempDir {
     common::temp_dir_tagged("cli-diag", name)

@@ -94,3 +94,20 @@ pub fn read_json(path: &Path) -> Value {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: not JSON: {e}", path.display()))
 }
+
+/// Runs `args` in `dir`, asserts success, returns stdout.
+pub fn ok(dir: &Path, args: &[&str]) -> String {
+    let o = run(Some(dir), args);
+    assert!(
+        o.status.success(),
+        "rtest {args:?} failed ({:?}): {}",
+        o.status.code(),
+        stderr(&o)
+    );
+    stdout(&o)
+}
+
+/// Runs `args` in `dir` and checks the failure (see [`check_fails`]).
+pub fn fails(dir: &Path, args: &[&str], code: i32, needles: &[&str]) -> String {
+    check_fails(&run(Some(dir), args), args, code, needles)
+}

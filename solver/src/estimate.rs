@@ -489,19 +489,42 @@ pub fn identify_with(
     let h = h_matrix(m, &fitted, record, source)?;
     let names = parameter_names(m, &fitted);
     let fit = least_squares(&h, &y, &names, &opts.constraint, &opts.tolerances)?;
-    let is_offset: Vec<bool> = fitted
-        .columns()
-        .iter()
-        .map(|&(t, _)| matches!(fitted.terms[t].effect, Effect::SensorOffset(_)))
-        .collect();
-    let swallowed = swallowed_by_offsets(&names, &fit.identifiability.confounded, &is_offset);
-    Ok(Identification {
-        machine: m.name.clone(),
-        model: fitted,
+    Ok(Identification::new(
+        m,
+        fitted,
         fit,
-        samples: record.samples.len(),
-        zeroed: opts.zeroed,
-        swallowed,
-        backend: source.backend(),
-    })
+        record.samples.len(),
+        opts.zeroed,
+        source.backend(),
+    ))
+}
+
+impl Identification {
+    /// An identification of `model` (the model fitted, offsets included) by `fit`, with what
+    /// the sensor offsets swallow derived from the fit's confounded groups.
+    pub fn new(
+        m: &Machine,
+        model: Model,
+        fit: Fit,
+        samples: usize,
+        zeroed: bool,
+        backend: Backend,
+    ) -> Identification {
+        let is_offset: Vec<bool> = model
+            .columns()
+            .iter()
+            .map(|&(t, _)| matches!(model.terms[t].effect, Effect::SensorOffset(_)))
+            .collect();
+        let swallowed =
+            swallowed_by_offsets(&fit.names, &fit.identifiability.confounded, &is_offset);
+        Identification {
+            machine: m.name.clone(),
+            model,
+            fit,
+            samples,
+            zeroed,
+            swallowed,
+            backend,
+        }
+    }
 }

@@ -158,7 +158,6 @@ pub fn identify_file(
     StreamingError<crate::csvio::CsvError>,
 > {
     use crate::csvio::{MeasurementBlocks, time_span};
-    use crate::model::Effect;
     let fitted = if opts.zeroed {
         crate::estimate::with_offsets(model)
     } else {
@@ -188,25 +187,13 @@ pub fn identify_file(
         &opts.constraint,
         &opts.tolerances,
     )?;
-    let names = parameter_names(m, &fitted);
-    let is_offset: Vec<bool> = fitted
-        .columns()
-        .iter()
-        .map(|&(t, _)| matches!(fitted.terms[t].effect, Effect::SensorOffset(_)))
-        .collect();
-    let swallowed = crate::identifiability::swallowed_by_offsets(
-        &names,
-        &run.fit.identifiability.confounded,
-        &is_offset,
+    let ident = crate::estimate::Identification::new(
+        m,
+        fitted,
+        run.fit.clone(),
+        run.samples,
+        opts.zeroed,
+        source.backend(),
     );
-    let ident = crate::estimate::Identification {
-        machine: m.name.clone(),
-        model: fitted,
-        fit: run.fit.clone(),
-        samples: run.samples,
-        zeroed: opts.zeroed,
-        swallowed,
-        backend: source.backend(),
-    };
     Ok((ident, run))
 }

@@ -22,7 +22,8 @@
 //! residual; the identifiability analysis is unchanged (it depends on H only).
 
 use crate::estimate::{
-    EstimateError, Identification, Tolerances, least_squares, measurement_vector,
+    EstimateError, Identification, IdentifyOptions, Tolerances, identify_with, least_squares,
+    measurement_vector,
 };
 use crate::hmatrix::{GainSource, HMatrixError, h_matrix};
 use crate::model::Model;
@@ -161,4 +162,20 @@ pub fn refine(
         converged,
         rms_mm: (linear_rms, refined_rms),
     })
+}
+
+/// Identifies `model` on `record` with gains from `source`
+/// ([`crate::estimate::identify_with`]) and refines the result against the exact machine
+/// ([`refine`], with the identification's tolerances).
+pub fn identify_refined(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    source: &mut GainSource,
+    opts: &IdentifyOptions,
+    refine_opts: &RefineOptions,
+) -> Result<(Identification, Refinement), RefineError> {
+    let mut ident = identify_with(m, model, record, source, opts)?;
+    let r = refine(m, record, &mut ident, source, &opts.tolerances, refine_opts)?;
+    Ok((ident, r))
 }

@@ -3,13 +3,13 @@
 //! and the validation on K1 and K2.
 
 use model_spec::{Machine, builtin};
-use solver::estimate::{Constraint, Identification, IdentifyOptions, Tolerances, identify};
+use solver::estimate::{Constraint, Identification, IdentifyOptions, identify};
 use solver::hmatrix::GainSource;
 use solver::hmatrix::h_matrix;
 use solver::model::{Effect, Model};
 use solver::paths::builtin_path;
 use solver::record::Record;
-use solver::refine::{RefineOptions, refine};
+use solver::refine::{self, RefineOptions};
 use solver::report::display_factor;
 use solver::simulate::simulate;
 use solver::truth::{Truth, builtin_truth};
@@ -37,14 +37,13 @@ fn identify_refined(m: &Machine, model: &Model, record: &Record, zeroed: bool) -
         zeroed,
         ..Default::default()
     };
-    let mut ident = identify(m, model, record, &opts).unwrap();
-    let mut source = GainSource::new(m, &ident.model.errors(), &m.default_parameters()).unwrap();
-    let r = refine(
+    let mut source = GainSource::new(m, &model.errors(), &m.default_parameters()).unwrap();
+    let (ident, r) = refine::identify_refined(
         m,
+        model,
         record,
-        &mut ident,
         &mut source,
-        &Tolerances::default(),
+        &opts,
         &RefineOptions::default(),
     )
     .unwrap();

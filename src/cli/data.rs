@@ -7,14 +7,13 @@ use super::{CliError, CliResult};
 use model_spec::Machine;
 use solver::csvio::CsvError;
 use solver::estimate::{
-    Constraint, EstimateError, Identification, IdentifyOptions, Tolerances, identify_with,
-    with_offsets,
+    Constraint, EstimateError, Identification, IdentifyOptions, identify_with, with_offsets,
 };
 use solver::hmatrix::{GainSource, parameter_names};
 use solver::model::{Effect, Model, Term};
 use solver::paths::PathError;
 use solver::record::Record;
-use solver::refine::{RefineOptions, Refinement, refine};
+use solver::refine::{RefineError, RefineOptions, Refinement, identify_refined};
 use solver::truth::{Truth, TruthError};
 use std::path::Path;
 
@@ -209,32 +208,27 @@ pub fn identify(
     };
     let mut source = GainSource::new(m, &fitted.errors(), &params)
         .map_err(|e| CliError::failure(format!("--machine: {e}")))?;
-    let mut ident = identify_with(m, model, record, &mut source, opts).map_err(|e| match e {
+    let cannot_identify = |e: EstimateError| match e {
         EstimateError::UnknownParameter(name, _) => CliError::usage(format!(
             "--constraint: `{name}` is not a parameter of the model (parameters: {})",
             parameter_names(m, &fitted).join(", ")
         )),
         other => CliError::failure(format!("--data: cannot identify: {other}")),
-    })?;
-    let refinement = if exact {
-        let tolerances: Tolerances = opts.tolerances;
-        Some(
-            refine(
-                m,
-                record,
-                &mut ident,
-                &mut source,
-                &tolerances,
-                &RefineOptions::default(),
-            )
-            .map_err(|e| {
-                CliError::failure(format!(
-                    "--data: the refinement against the exact machine failed: {e} (--first-order skips it)"
-                ))
-            })?,
-        )
+    };
+    let (ident, refinement) = if exact {
+        let (ident, r) = identify_refined(m, model, record, &mut source, opts, &RefineOptions::default())
+            .map_err(|e| match e {
+                RefineError::Estimate(e) => cannot_identify(e),
+                other => CliError::failure(format!(
+                    "--data: the refinement against the exact machine failed: {other} (--first-order skips it)"
+                )),
+            })?;
+        (ident, Some(r))
     } else {
-        None
+        (
+            identify_with(m, model, record, &mut source, opts).map_err(cannot_identify)?,
+            None,
+        )
     };
     Ok(Identified { ident, refinement })
 }

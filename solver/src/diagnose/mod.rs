@@ -23,13 +23,12 @@ pub mod structure;
 
 use crate::distributions::f_upper_tail;
 use crate::estimate::{
-    EstimateError, Identification, IdentifyOptions, Tolerances, identify_with, measurement_vector,
-    with_offsets,
+    EstimateError, Identification, IdentifyOptions, Tolerances, measurement_vector, with_offsets,
 };
 use crate::hmatrix::{GainSource, HMatrixError, h_matrix};
 use crate::model::Model;
 use crate::record::Record;
-use crate::refine::{RefineError, RefineOptions, refine};
+use crate::refine::{RefineError, RefineOptions, identify_refined};
 use crate::validate::{ValidateError, ValidateOptions, validate_with};
 use dictionary::{DictionaryOptions, dictionary};
 use model_spec::Machine;
@@ -204,16 +203,9 @@ fn fit(
         tolerances: o.tolerances,
         params: None,
     };
-    let mut ident = identify_with(m, model, record, source, &opts)?;
+    let (mut ident, _) =
+        identify_refined(m, model, record, source, &opts, &RefineOptions::default())?;
     ident.zeroed = o.zeroed;
-    refine(
-        m,
-        record,
-        &mut ident,
-        source,
-        &o.tolerances,
-        &RefineOptions::default(),
-    )?;
     Ok(ident)
 }
 

@@ -5,7 +5,7 @@
 //! For instruction counts: run under `valgrind --tool=callgrind` with two N and divide the
 //! difference (BENCHMARKS.md).
 
-use generated::seed_ac::{Params, Pose, full};
+use generated::seed_ac::{Params, full};
 use std::hint::black_box;
 
 fn main() {
@@ -26,28 +26,15 @@ fn main() {
     let (mut scratch, mut flat) = (Vec::new(), vec![0.0; 6 * full::N]);
     let mut d = vec![[0.0; 6]; full::N];
     for i in 0..n {
-        let theta = i as f64 * 1e-3;
-        let (sc, cc) = theta.sin_cos();
-        let a = -std::f64::consts::FRAC_PI_4 * (1.0 - cc);
-        let (sa, ca) = a.sin_cos();
-        let pose = Pose {
-            sin_a: sa,
-            cos_a: ca,
-            sin_c: sc,
-            cos_c: cc,
-            x: 200.0 * cc,
-            y: 200.0 * sc,
-            z: 50.0 * ca,
-        };
+        let (pose, commands) = solver::perf::sweep_pose(i as f64 * 1e-3);
         match method.as_str() {
             "position" => full::position_gains(black_box(&pose), &params, &mut rows),
             "gains" => full::gains(black_box(&pose), &params, &mut six),
             "evaluator" => {
-                let commands = [pose.x, a, theta, pose.y, pose.z];
                 let inputs = model.atoms.values(&commands, &defaults);
                 program.eval(&inputs, &mut scratch, &mut flat);
             }
-            "first-order" => chain.gains(&[pose.x, a, theta, pose.y, pose.z], &defaults, &mut d),
+            "first-order" => chain.gains(&commands, &defaults, &mut d),
             other => panic!("unknown method {other}"),
         }
         black_box((&rows, &six, &flat, &d));

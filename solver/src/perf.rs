@@ -171,6 +171,26 @@ pub fn gain_methods(quick: bool) -> Vec<MethodTime> {
     .collect()
 }
 
+/// A pose of the K4-like sweep the fill benchmarks use, at C = `theta` (rad): A = −45°·(1 − cos C)
+/// and the linear axes on a circle. Returns the generated code's `Pose` (sines and cosines
+/// computed here) and the commands in seed-ac's axis order X, A, C, Y, Z (mm, rad).
+#[inline]
+pub fn sweep_pose(theta: f64) -> (Pose, [f64; 5]) {
+    let (sc, cc) = theta.sin_cos();
+    let a = -std::f64::consts::FRAC_PI_4 * (1.0 - cc);
+    let (sa, ca) = a.sin_cos();
+    let pose = Pose {
+        sin_a: sa,
+        cos_a: ca,
+        sin_c: sc,
+        cos_c: cc,
+        x: 200.0 * cc,
+        y: 200.0 * sc,
+        z: 50.0 * ca,
+    };
+    (pose, [pose.x, a, theta, pose.y, pose.z])
+}
+
 /// The H-matrix fill against a plain write.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FillBandwidth {
@@ -208,19 +228,7 @@ pub fn fill_bandwidth(poses: usize, block: usize, runs: usize) -> FillBandwidth 
             let b = block.min(poses - done);
             let (rows, _) = buffer[..b * 3 * cols].as_chunks_mut::<{ full::N }>();
             for (i, pose_rows) in rows.chunks_exact_mut(3).enumerate() {
-                let theta = (done + i) as f64 * 1e-4;
-                let (sc, cc) = theta.sin_cos();
-                let a = -std::f64::consts::FRAC_PI_4 * (1.0 - cc);
-                let (sa, ca) = a.sin_cos();
-                let pose = Pose {
-                    sin_a: sa,
-                    cos_a: ca,
-                    sin_c: sc,
-                    cos_c: cc,
-                    x: 200.0 * cc,
-                    y: 200.0 * sc,
-                    z: 50.0 * ca,
-                };
+                let (pose, _) = sweep_pose((done + i) as f64 * 1e-4);
                 let out: &mut [[f64; full::N]; 3] = pose_rows.try_into().expect("three rows");
                 full::position_gains(&pose, &params, out);
             }

@@ -62,6 +62,7 @@ pub mod kinematics;
 pub mod machine;
 mod raw;
 pub mod terms;
+pub mod units;
 mod validate;
 
 pub use builtin::{BUILTIN, LoadError, all_builtin, builtin, load_machine};

@@ -51,6 +51,15 @@ impl Effect {
         if self.is_angular(m) { "urad" } else { "um" }
     }
 
+    /// The factor from the unit inside (mm, rad) to the unit people see (µm, µrad).
+    pub fn display_factor(self, m: &Machine) -> f64 {
+        if self.is_angular(m) {
+            crate::units::URAD_PER_RAD
+        } else {
+            crate::units::UM_PER_MM
+        }
+    }
+
     /// What its basis depends on.
     pub fn carrier(self, m: &Machine) -> Carrier {
         match self {

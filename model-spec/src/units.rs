@@ -1,0 +1,111 @@
+//! Units at the boundaries people see, and the one way numbers are written for them.
+//!
+//! Inside rtest, lengths and translational errors are in mm and angles in rad. People read
+//! translational errors in µm, angular errors in µrad, positions in mm and rotary positions in
+//! degrees. The conversion factors live here, and so do the formatters every text report,
+//! table and description uses:
+//!
+//! - [`fixed`]: a fixed number of decimals (`12.3400`), for aligned table columns;
+//! - [`readable`]: [`fixed`], or two significant digits in scientific notation when the value
+//!   would print as zero (`3.2e-7`), so that a noise-free fit does not claim an exact 0;
+//! - [`short`]: at most six decimals with trailing zeros removed (`-217.504`, `45`), for
+//!   values given by people (offsets, strokes, poses);
+//! - [`p_value`]: a probability (`0.034`, `2.1e-15`, `< 1e-300`).
+//!
+//! None of them prints a negative zero. Non-finite numbers are written as Rust writes them
+//! (`NaN`, `inf`); the reports check for them before they format anything.
+//!
+//! Numbers written to files that are read back (CSV readings, JSON values, Rust literals) do
+//! not use these: they use the shortest decimal that reads back to the same `f64`.
+
+/// µm per mm.
+pub const UM_PER_MM: f64 = 1e3;
+/// µrad per rad.
+pub const URAD_PER_RAD: f64 = 1e6;
+
+/// The unit symbol people read for an ASCII unit name: `um` → `µm`, `urad` → `µrad`; any
+/// other name unchanged.
+pub fn symbol(unit: &str) -> &str {
+    match unit {
+        "um" => "µm",
+        "urad" => "µrad",
+        other => other,
+    }
+}
+
+/// Removes the sign of a formatted zero (`-0.000` → `0.000`).
+fn unsigned_zero(s: String) -> String {
+    match s.strip_prefix('-') {
+        Some(rest) if rest.chars().all(|c| c == '0' || c == '.') => rest.to_string(),
+        _ => s,
+    }
+}
+
+/// `x` with exactly `decimals` decimals, no negative zero (`fixed(-0.00001, 3)` is `0.000`).
+pub fn fixed(x: f64, decimals: usize) -> String {
+    unsigned_zero(format!("{x:.decimals$}"))
+}
+
+/// [`fixed`], except that a non-zero value that would print as zero is written with two
+/// significant digits in scientific notation (`readable(3.2e-7, 4)` is `3.2e-7`).
+pub fn readable(x: f64, decimals: usize) -> String {
+    let limit = 0.5 * 10f64.powi(-(decimals as i32));
+    if x != 0.0 && x.abs() < limit {
+        return format!("{x:.1e}");
+    }
+    fixed(x, decimals)
+}
+
+/// At most six decimals, trailing zeros and a trailing point removed, no negative zero
+/// (`-217.504`, `0`, `45`, `153.601271`).
+pub fn short(x: f64) -> String {
+    let s = fixed(x, 6);
+    if !x.is_finite() {
+        return s;
+    }
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    match s {
+        "" | "-" => "0".to_string(),
+        s => s.to_string(),
+    }
+}
+
+/// A probability for people: three decimals from 0.001 up, two significant digits in
+/// scientific notation below, `< 1e-300` for an underflow to zero.
+pub fn p_value(p: f64) -> String {
+    if p == 0.0 {
+        "< 1e-300".into()
+    } else if p < 1e-3 {
+        format!("{p:.1e}")
+    } else {
+        format!("{p:.3}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formatters() {
+        assert_eq!(fixed(-0.0000001, 6), "0.000000");
+        assert_eq!(fixed(1.25, 1), "1.2");
+        assert_eq!(fixed(-3.5, 2), "-3.50");
+        assert_eq!(readable(3.2e-7, 4), "3.2e-7");
+        assert_eq!(readable(-3.2e-7, 4), "-3.2e-7");
+        assert_eq!(readable(0.0, 4), "0.0000");
+        assert_eq!(readable(12.34567, 4), "12.3457");
+        assert_eq!(readable(0.0004, 3), "4.0e-4");
+        assert_eq!(short(-217.504), "-217.504");
+        assert_eq!(short(45.0), "45");
+        assert_eq!(short(-0.0), "0");
+        assert_eq!(short(153.6012714), "153.601271");
+        assert_eq!(short(1e-9), "0");
+        assert_eq!(p_value(0.0), "< 1e-300");
+        assert_eq!(p_value(2.1e-15), "2.1e-15");
+        assert_eq!(p_value(0.0341), "0.034");
+        assert_eq!(symbol("um"), "µm");
+        assert_eq!(symbol("urad"), "µrad");
+        assert_eq!(symbol("mm"), "mm");
+    }
+}

@@ -7,11 +7,11 @@
 
 use model_spec::Machine;
 use serde_json::Value;
-use solver::estimate::IdentifyOptions;
+use solver::fitting::estimate::IdentifyOptions;
+use solver::io::json::display_factor;
 use solver::model::Model;
 use solver::record::Record;
-use solver::report::display_factor;
-use solver::truth::{Truth, builtin_truth};
+use solver::simulation::truth::{Truth, builtin_truth};
 use std::path::Path;
 
 // ---------------------------------------------------------------- helpers
@@ -59,7 +59,7 @@ fn truth(m: &Machine, name: &str) -> Truth {
 fn truth_values(m: &Machine, t: &Truth) -> Vec<(String, f64)> {
     t.entries(m)
         .into_iter()
-        .filter(|e| e.values.len() == 1 && e.term.basis == solver::basis::Basis::Const)
+        .filter(|e| e.values.len() == 1 && e.term.basis == solver::model::Basis::Const)
         .map(|e| (e.name, e.values[0]))
         .collect()
 }
@@ -825,13 +825,13 @@ fn hidden_bias(m: &Machine, t: &Truth, k4: &Record) -> Vec<f64> {
         .flat_map(|x| t.coefficient(x).unwrap().to_vec())
         .map(Some)
         .collect();
-    let measured =
-        solver::refine::exact_prediction(m, &hidden, &values, k4, &t.params).expect("prediction");
+    let measured = solver::fitting::refine::exact_prediction(m, &hidden, &values, k4, &t.params)
+        .expect("prediction");
     let alone = Record {
         samples: k4.samples.clone(),
         measured,
     };
-    let fit = solver::estimate::identify(m, &reduced, &alone, &IdentifyOptions::default())
+    let fit = solver::fitting::estimate::identify(m, &reduced, &alone, &IdentifyOptions::default())
         .expect("identify");
     reduced
         .terms
@@ -889,7 +889,7 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
 
     let m = machine();
     let t = truth(&m, "seed-ac-demo");
-    let k4 = solver::csvio::read_measurement(&demo.join("k4.csv"), &m).unwrap();
+    let k4 = solver::io::csv::read_measurement(&demo.join("k4.csv"), &m).unwrap();
     assert_eq!(k4.samples.len(), 241);
     let json = read_json(&demo.join("identify.json"));
     assert_eq!(json["machine"], "seed-ac");

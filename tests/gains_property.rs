@@ -37,7 +37,7 @@ fn pose(m: &Machine, unit: &[f64]) -> (Vec<f64>, Vec<f64>) {
             }
         })
         .collect();
-    solver::exact::tool_centre_point_ik(m, &mut commands, &params)
+    solver::simulation::exact::tool_centre_point_ik(m, &mut commands, &params)
         .expect("built-in machines have three independent linear axes");
     (commands, params)
 }
@@ -62,7 +62,7 @@ fn symbolic_gains_equal_finite_differences_of_the_exact_chain() {
             for (m, model) in machines.iter().zip(&models) {
                 let (commands, params) = pose(m, &unit);
                 let symbolic = model.evaluate(&commands, &params);
-                let numeric = solver::fd::fd_gains(m, &commands, &params, &model.errors);
+                let numeric = solver::simulation::fd::fd_gains(m, &commands, &params, &model.errors);
                 for (i, (s, n)) in symbolic.iter().zip(&numeric).enumerate() {
                     for k in 0..6 {
                         prop_assert!(

@@ -15,13 +15,13 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use model_spec::Machine;
-use solver::diagnose::dictionary::{DictionaryOptions, dictionary};
-use solver::diagnose::{DiagnoseOptions, diagnose};
+use solver::diagnosis::dictionary::{DictionaryOptions, dictionary};
+use solver::diagnosis::{DiagnoseOptions, diagnose};
 use solver::model::Model;
-use solver::paths::builtin_path;
 use solver::record::Record;
-use solver::simulate::simulate;
-use solver::truth::builtin_truth;
+use solver::simulation::paths::builtin_path;
+use solver::simulation::readings::simulate;
+use solver::simulation::truth::builtin_truth;
 use std::hint::black_box;
 
 fn seed_ac() -> Machine {

@@ -7,8 +7,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use model_spec::Machine;
 use nalgebra::DVector;
-use solver::estimate::{Constraint, IdentifyOptions, Tolerances, identify, least_squares};
-use solver::hmatrix::{GainSource, h_matrix, parameter_names};
+use solver::fitting::estimate::{Constraint, IdentifyOptions, Tolerances, identify, least_squares};
+use solver::fitting::hmatrix::{GainSource, h_matrix, parameter_names};
 use solver::model::Model;
 use solver::record::Record;
 use std::hint::black_box;
@@ -83,5 +83,7 @@ criterion_main!(benches);
 
 /// The built-in test path K4 of DESIGN.md.
 fn k4(m: &Machine) -> Record {
-    solver::paths::builtin_path(m, "K4").unwrap().unwrap()
+    solver::simulation::paths::builtin_path(m, "K4")
+        .unwrap()
+        .unwrap()
 }

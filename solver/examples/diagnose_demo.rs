@@ -12,22 +12,24 @@
 //! and two figures: the K1 residual along C before and after, and its spectrum against C.
 
 use model_spec::Machine;
-use solver::diagnose::{DiagnoseOptions, Diagnosis, diagnose};
+use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose};
+use solver::fitting::validate::{ValidateOptions, validate};
 use solver::model::Model;
 use solver::record::Record;
-use solver::validate::{ValidateOptions, validate};
 
 fn main() {
     let m = model_spec::builtin("seed-ac").unwrap().unwrap();
     let name = std::env::args().nth(1).unwrap_or("seed-ac-demo".into());
-    let mut truth = solver::truth::load_truth(&name, &m).unwrap();
+    let mut truth = solver::simulation::truth::load_truth(&name, &m).unwrap();
     println!("{}", truth.summary(&m));
     let mut rec = vec![];
     for p in ["K4", "K1", "K2"] {
-        let path = solver::paths::builtin_path(&m, p).unwrap().unwrap();
+        let path = solver::simulation::paths::builtin_path(&m, p)
+            .unwrap()
+            .unwrap();
         rec.push((
             p.to_string(),
-            solver::simulate::simulate(&m, &truth, &path).unwrap(),
+            solver::simulation::readings::simulate(&m, &truth, &path).unwrap(),
         ));
         truth.seed += 1;
     }
@@ -36,7 +38,7 @@ fn main() {
     let t = std::time::Instant::now();
     let d = diagnose(&m, &base, &rec[0].1, &rec[1..], &o).unwrap();
     let elapsed = t.elapsed();
-    let columns: usize = solver::diagnose::dictionary::dictionary(&m, &base.terms, &o.dictionary)
+    let columns: usize = solver::diagnosis::dictionary::dictionary(&m, &base.terms, &o.dictionary)
         .iter()
         .map(|t| t.basis.width())
         .sum();
@@ -163,7 +165,7 @@ fn main() {
 }
 
 /// The top components of a residual structure.
-fn structure(s: &[solver::diagnose::structure::Component]) {
+fn structure(s: &[solver::diagnosis::structure::Component]) {
     for c in s.iter().take(6) {
         println!(
             "   {:>5} {:10} in {}: {:.2}",

@@ -6,16 +6,16 @@
 //! Run: `cargo run --release -p solver --example seed_replication`. Prints Markdown tables.
 
 use model_spec::{ErrorKind, Machine, builtin};
-use solver::estimate::{Identification, IdentifyOptions, Tolerances, identify};
-use solver::hmatrix::GainSource;
+use solver::fitting::estimate::{Identification, IdentifyOptions, Tolerances, identify};
+use solver::fitting::hmatrix::GainSource;
+use solver::fitting::refine::{RefineOptions, refine};
+use solver::fitting::validate::{ValidateOptions, validate};
+use solver::io::json::display_factor;
 use solver::model::{Effect, Model};
-use solver::paths::builtin_path;
 use solver::record::Record;
-use solver::refine::{RefineOptions, refine};
-use solver::report::display_factor;
-use solver::simulate::simulate;
-use solver::truth::{Truth, builtin_truth};
-use solver::validate::{ValidateOptions, validate};
+use solver::simulation::paths::builtin_path;
+use solver::simulation::readings::simulate;
+use solver::simulation::truth::{Truth, builtin_truth};
 
 /// Per path: name, max |measured| per direction, max |residual| per direction, RMS before and
 /// after (µm).

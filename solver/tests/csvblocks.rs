@@ -1,11 +1,11 @@
 //! Reading a measurement file in blocks gives exactly the slices of the whole-file record.
 
 use model_spec::builtin;
-use solver::csvio::{MeasurementBlocks, format_record, parse_measurement};
-use solver::paths::{builtin_path, fill_linear_ik, record_from_commands};
+use solver::io::csv::{MeasurementBlocks, format_record, parse_measurement};
 use solver::record::Record;
-use solver::simulate::simulate;
-use solver::truth::builtin_truth;
+use solver::simulation::paths::{builtin_path, fill_linear_ik, record_from_commands};
+use solver::simulation::readings::simulate;
+use solver::simulation::truth::builtin_truth;
 use std::io::Cursor;
 
 fn concatenated(text: &str, m: &model_spec::Machine, block: usize) -> Record {

@@ -7,11 +7,11 @@ mod common;
 
 use common::builtin;
 use model_spec::Machine;
-use solver::csvio::{CsvError, format_record, parse_measurement, read_measurement, write_record};
-use solver::paths::builtin_path;
+use solver::io::csv::{CsvError, format_record, parse_measurement, read_measurement, write_record};
 use solver::record::Record;
-use solver::simulate::{provenance, simulate};
-use solver::truth::seed_ac_demo_truth;
+use solver::simulation::paths::builtin_path;
+use solver::simulation::readings::{provenance, simulate};
+use solver::simulation::truth::seed_ac_demo_truth;
 use std::path::PathBuf;
 
 fn seed_ac() -> Machine {
@@ -203,8 +203,8 @@ fn missing_linear_columns_are_filled_by_inverse_kinematics() {
     for s in &k4.samples {
         text += &format!(
             "{},{},1,2,3,{}\n",
-            solver::csvio::degrees_for(s.commands[a]),
-            solver::csvio::degrees_for(s.commands[c]),
+            solver::io::csv::degrees_for(s.commands[a]),
+            solver::io::csv::degrees_for(s.commands[c]),
             s.t
         );
     }
@@ -278,7 +278,7 @@ fn a_bare_path_is_written_without_measured_columns() {
     assert_eq!(lines.next(), Some("X,Y,Z,A,C,t_s"));
     assert!(lines.next().unwrap().ends_with(",0,0,0"), "{text}");
     assert_eq!(lines.nth(89).unwrap().split(',').nth(4), Some("90"));
-    let back = solver::paths::parse_path("k1.csv", &text, &m).unwrap();
+    let back = solver::simulation::paths::parse_path("k1.csv", &text, &m).unwrap();
     assert_eq!(back, k1);
 }
 

@@ -3,7 +3,7 @@
 //! Set-up of every scenario (helpers in `tests/diagnose/helpers.rs`):
 //! - machine `seed-ac`; base truth: the 11 errors of the reduced model as in `seed-ac-reduced`
 //!   (10–30 µm and µrad), plus the hidden effect(s), simulated on the exact virtual machine
-//!   (`solver::simulate`, exact HTMs, not the first-order model), 0.5 µm Gaussian noise, a
+//!   (`solver::simulation::readings`, exact HTMs, not the first-order model), 0.5 µm Gaussian noise, a
 //!   different noise seed on every path;
 //! - base model: the seed's `reduced` model (or it minus the error that is hidden);
 //! - fitted on K4, held out K1 and K2 (for backlash of C: fitted on `K4R`, K4 out to C = 360°
@@ -29,7 +29,7 @@
 mod helpers;
 
 use helpers::*;
-use solver::diagnose::{DiagnoseOptions, Diagnosis};
+use solver::diagnosis::{DiagnoseOptions, Diagnosis};
 use solver::model::Term;
 
 /// One hidden-effect scenario.
@@ -524,12 +524,12 @@ fn visibility() {
 #[ignore]
 fn budget_on_more_paths() {
     let m = machine();
-    let mut truth = solver::truth::builtin_truth("seed-ac-budget", &m)
+    let mut truth = solver::simulation::truth::builtin_truth("seed-ac-budget", &m)
         .expect("built in")
         .expect("valid");
     let mut recs = vec![];
     for p in ["K4", "K1", "K2", "K1R", "K4R"] {
-        let r = solver::simulate::simulate(&m, &truth, &path(&m, p)).expect("simulate");
+        let r = solver::simulation::readings::simulate(&m, &truth, &path(&m, p)).expect("simulate");
         recs.push((p.to_string(), r));
         truth.seed += 1;
     }
@@ -558,9 +558,9 @@ fn budget_on_more_paths() {
 #[test]
 #[ignore]
 fn nestings() {
-    use solver::diagnose::dictionary::dictionary;
-    use solver::diagnose::select::Basis;
-    use solver::hmatrix::{GainSource, h_matrix};
+    use solver::diagnosis::dictionary::dictionary;
+    use solver::diagnosis::select::Basis;
+    use solver::fitting::hmatrix::{GainSource, h_matrix};
     let m = machine();
     let base = base_model(&m, &[]);
     let candidates = dictionary(&m, &base.terms, &options().dictionary);

@@ -7,13 +7,13 @@ mod common;
 use common::{Rng, builtin, id};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
-use solver::error_vector;
-use solver::estimate::{
+use solver::fitting::estimate::{
     Constraint, EstimateError, IdentifyOptions, Tolerances, identify, least_squares,
 };
-use solver::hmatrix::{h_matrix_auto, parameter_names};
+use solver::fitting::hmatrix::{h_matrix_auto, parameter_names};
 use solver::model::Model;
 use solver::record::Record;
+use solver::simulation::error_vector;
 
 /// Standard normal draws (Box–Muller) from the tests' uniform generator.
 struct Normal(Rng);
@@ -415,10 +415,14 @@ fn exact_machine_data_are_recovered_to_second_order() {
 
 /// The built-in test path K4 of DESIGN.md.
 fn k4(m: &Machine) -> Record {
-    solver::paths::builtin_path(m, "K4").unwrap().unwrap()
+    solver::simulation::paths::builtin_path(m, "K4")
+        .unwrap()
+        .unwrap()
 }
 
 /// The built-in test path K1 of DESIGN.md.
 fn k1(m: &Machine) -> Record {
-    solver::paths::builtin_path(m, "K1").unwrap().unwrap()
+    solver::simulation::paths::builtin_path(m, "K1")
+        .unwrap()
+        .unwrap()
 }

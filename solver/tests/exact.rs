@@ -5,9 +5,11 @@ mod common;
 use common::{Rng, builtin, commands, id, random_rotary, sym};
 use model_spec::{Machine, Side, all_builtin, parse_machine};
 use nalgebra::{Vector3, Vector4};
-use solver::exact::{ExactError, VirtualMachine};
-use solver::fd::fd_gains;
-use solver::{chain_transform, error_vector, nominal_error_vector, tool_centre_point_ik};
+use solver::simulation::exact::{ExactError, VirtualMachine};
+use solver::simulation::fd::fd_gains;
+use solver::simulation::{
+    chain_transform, error_vector, nominal_error_vector, tool_centre_point_ik,
+};
 
 fn close(a: &Vector3<f64>, b: &Vector3<f64>, tol: f64) -> bool {
     (a - b).amax() <= tol

@@ -5,8 +5,8 @@ mod common;
 
 use common::{Rng, builtin, commands, id, random_rotary, sym};
 use model_spec::Machine;
-use solver::exact::VirtualMachine;
-use solver::fd::{FdSteps, fd_gains, fd_gains_with};
+use solver::simulation::exact::VirtualMachine;
+use solver::simulation::fd::{FdSteps, fd_gains, fd_gains_with};
 
 /// The reduced model of the seed's Table 2 (position rows, tool minus workpiece, tool frame) at
 /// `A`, `C` (rad), for `Xa = Ya = Za = 0` as in Table 3. Every entry re-derived by hand from the
@@ -106,7 +106,7 @@ fn seed_table2_boa_x_and_aoc_y_at_a_nontrivial_pose() {
     let p = m.default_parameters();
     let (a, c) = ((-37.0f64).to_radians(), 123.0f64.to_radians());
     let mut q = commands(&m, &[("A", a), ("C", c)]);
-    solver::tool_centre_point_ik(&m, &mut q, &p).unwrap();
+    solver::simulation::tool_centre_point_ik(&m, &mut q, &p).unwrap();
     let (xw, yw, zw, zc) = (
         sym(&m, &p, "Xw"),
         sym(&m, &p, "Yw"),

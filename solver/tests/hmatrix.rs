@@ -6,13 +6,13 @@ mod common;
 use common::{builtin, id};
 use model_spec::{Dir, Machine};
 use nalgebra::DMatrix;
-use solver::basis::Basis;
-use solver::fd::fd_gains;
-use solver::hmatrix::{
+use solver::fitting::hmatrix::{
     Backend, GainSource, HMatrixError, h_matrix, h_matrix_auto, parameter_names,
 };
+use solver::model::Basis;
 use solver::model::{Effect, Model, Term};
 use solver::record::Record;
+use solver::simulation::fd::fd_gains;
 
 fn term(m: &Machine, s: &str) -> Term {
     Term::parse(m, s).unwrap()
@@ -114,7 +114,7 @@ fn columns_are_finite_differences_of_the_exact_machine() {
             assert_eq!(h[(row, n + 3)], if d == 1 { 1.0 } else { 0.0 });
         }
     }
-    // FD accuracy: ~1e-10 mm/rad for lever arms of a few hundred mm (see solver::fd).
+    // FD accuracy: ~1e-10 mm/rad for lever arms of a few hundred mm (see solver::simulation::fd).
     eprintln!("largest deviation from finite differences: {worst:e} mm/mm or mm/rad");
     assert!(
         worst < 1e-8,
@@ -232,5 +232,7 @@ fn bad_input_is_an_error_not_a_panic() {
 
 /// The built-in test path K4 of DESIGN.md.
 fn k4(m: &Machine) -> Record {
-    solver::paths::builtin_path(m, "K4").unwrap().unwrap()
+    solver::simulation::paths::builtin_path(m, "K4")
+        .unwrap()
+        .unwrap()
 }

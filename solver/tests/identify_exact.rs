@@ -3,17 +3,17 @@
 //! and the validation on K1 and K2.
 
 use model_spec::{Machine, builtin};
-use solver::estimate::{Constraint, Identification, IdentifyOptions, identify};
-use solver::hmatrix::GainSource;
-use solver::hmatrix::h_matrix;
+use solver::fitting::estimate::{Constraint, Identification, IdentifyOptions, identify};
+use solver::fitting::hmatrix::GainSource;
+use solver::fitting::hmatrix::h_matrix;
+use solver::fitting::refine::{self, RefineOptions};
+use solver::fitting::validate::{ValidateOptions, validate};
+use solver::io::json::display_factor;
 use solver::model::{Effect, Model};
-use solver::paths::builtin_path;
 use solver::record::Record;
-use solver::refine::{self, RefineOptions};
-use solver::report::display_factor;
-use solver::simulate::simulate;
-use solver::truth::{Truth, builtin_truth};
-use solver::validate::{ValidateOptions, validate};
+use solver::simulation::paths::builtin_path;
+use solver::simulation::readings::simulate;
+use solver::simulation::truth::{Truth, builtin_truth};
 
 fn machine() -> Machine {
     builtin("seed-ac").unwrap().unwrap()

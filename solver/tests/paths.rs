@@ -6,11 +6,11 @@ mod common;
 
 use common::builtin;
 use model_spec::Machine;
-use solver::VirtualMachine;
-use solver::paths::{
+use solver::record::Record;
+use solver::simulation::VirtualMachine;
+use solver::simulation::paths::{
     BUILTIN_PATHS, PathError, SAMPLE_PERIOD_S, builtin_path, fill_linear_ik, load_path, parse_path,
 };
-use solver::record::Record;
 
 fn seed_ac() -> Machine {
     builtin("seed-ac")
@@ -127,8 +127,8 @@ fn a_path_file_without_linear_columns_is_filled_by_inverse_kinematics() {
         let c = s.commands[m.axis_by_name("C").unwrap()];
         text += &format!(
             "{},{}\n",
-            solver::csvio::degrees_for(c),
-            solver::csvio::degrees_for(a)
+            solver::io::csv::degrees_for(c),
+            solver::io::csv::degrees_for(a)
         );
     }
     let dir = std::env::temp_dir().join(format!("rtest-paths-{}", std::process::id()));

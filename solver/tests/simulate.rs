@@ -8,11 +8,11 @@ mod common;
 
 use common::builtin;
 use model_spec::Machine;
-use solver::VirtualMachine;
-use solver::paths::{builtin_path, record_from_commands};
 use solver::record::Record;
-use solver::simulate::{SimulateError, simulate};
-use solver::truth::{Truth, seed_ac_demo_truth, seed_ac_reduced_truth};
+use solver::simulation::VirtualMachine;
+use solver::simulation::paths::{builtin_path, record_from_commands};
+use solver::simulation::readings::{SimulateError, simulate};
+use solver::simulation::truth::{Truth, seed_ac_demo_truth, seed_ac_reduced_truth};
 
 fn seed_ac() -> Machine {
     builtin("seed-ac")
@@ -28,7 +28,7 @@ fn pose(m: &Machine, a: f64, c: f64) -> Record {
     q[m.axis_by_name("A").unwrap()] = a.to_radians();
     q[m.axis_by_name("C").unwrap()] = c.to_radians();
     let mut cmds = vec![q];
-    solver::paths::fill_linear_ik(m, &m.default_parameters(), &mut cmds).unwrap();
+    solver::simulation::paths::fill_linear_ik(m, &m.default_parameters(), &mut cmds).unwrap();
     record_from_commands(cmds, vec![0.0])
 }
 
@@ -124,7 +124,7 @@ fn the_reduced_truth_reads_the_first_order_gains_to_second_order() {
         let r = simulate(&m, &t, &k4).unwrap();
         let mut worst = 0.0f64;
         for (i, s) in k4.samples.iter().enumerate().step_by(10) {
-            let g = solver::fd_gains(&m, &s.commands, &t.params, errors);
+            let g = solver::simulation::fd_gains(&m, &s.commands, &t.params, errors);
             let e = t.error_values(&m, s, 0.0);
             for k in 0..3 {
                 let lin: f64 = errors

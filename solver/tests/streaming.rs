@@ -2,14 +2,16 @@
 
 use model_spec::builtin;
 use model_spec::terms::Term;
-use solver::estimate::{Constraint, Tolerances, least_squares, measurement_vector, with_offsets};
-use solver::hmatrix::{GainSource, h_matrix, parameter_names};
+use solver::fitting::estimate::{
+    Constraint, Tolerances, least_squares, measurement_vector, with_offsets,
+};
+use solver::fitting::hmatrix::{GainSource, h_matrix, parameter_names};
+use solver::fitting::streaming::identify_streaming;
 use solver::model::Model;
-use solver::paths::builtin_path;
 use solver::record::Record;
-use solver::simulate::simulate;
-use solver::streaming::identify_streaming;
-use solver::truth::builtin_truth;
+use solver::simulation::paths::builtin_path;
+use solver::simulation::readings::simulate;
+use solver::simulation::truth::builtin_truth;
 
 fn blocks(r: &Record, size: usize) -> Vec<Result<Record, std::io::Error>> {
     (0..r.samples.len())

@@ -5,10 +5,10 @@ mod common;
 
 use common::{builtin, commands, id};
 use model_spec::{Dir, Machine};
-use solver::basis::Basis;
+use solver::model::Basis;
 use solver::model::{Effect, Term};
 use solver::record::Sample;
-use solver::truth::{
+use solver::simulation::truth::{
     BUILTIN_TRUTHS, Truth, TruthError, builtin_truth, load_truth, seed_ac_demo_truth,
     seed_ac_reduced_truth,
 };

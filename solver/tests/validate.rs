@@ -6,15 +6,17 @@ mod common;
 use common::{Rng, builtin};
 use model_spec::Machine;
 use nalgebra::DVector;
-use solver::estimate::{IdentifyOptions, identify};
-use solver::hmatrix::h_matrix_auto;
-use solver::model::{Model, Term};
-use solver::record::{Record, Sample, motion_directions};
-use solver::report::{
+use solver::fitting::estimate::{IdentifyOptions, identify};
+use solver::fitting::hmatrix::h_matrix_auto;
+use solver::fitting::validate::{
+    Unidentified, ValidateError, ValidateOptions, statistics, validate,
+};
+use solver::io::json::{
     ReportError, identify_json, parse_identify_json, read_identify_json, validate_json,
 };
-use solver::tool_centre_point_ik;
-use solver::validate::{Unidentified, ValidateError, ValidateOptions, statistics, validate};
+use solver::model::{Model, Term};
+use solver::record::{Record, Sample, motion_directions};
+use solver::simulation::tool_centre_point_ik;
 
 fn normal(rng: &mut Rng) -> f64 {
     let u1 = 1.0 - rng.unit();
@@ -355,10 +357,14 @@ fn bad_identify_json_names_the_file_and_the_field() {
 
 /// The built-in test path K4 of DESIGN.md.
 fn k4(m: &Machine) -> Record {
-    solver::paths::builtin_path(m, "K4").unwrap().unwrap()
+    solver::simulation::paths::builtin_path(m, "K4")
+        .unwrap()
+        .unwrap()
 }
 
 /// The built-in test path K1 of DESIGN.md.
 fn k1(m: &Machine) -> Record {
-    solver::paths::builtin_path(m, "K1").unwrap().unwrap()
+    solver::simulation::paths::builtin_path(m, "K1")
+        .unwrap()
+        .unwrap()
 }

@@ -2,7 +2,7 @@
 
 use super::json::Json;
 use super::{CliResult, EXIT_CODES};
-use solver::perf;
+use perf;
 
 const LONG_ABOUT: &str = "\
 Measures, on this computer and in this process, what the generated code buys (medians of \

@@ -1,20 +1,20 @@
 //! The inputs of `simulate`, `identify`, `validate` and `demo`, read from their flags: truths,
 //! test paths, measurement files, models (`--model`, `--terms`), constraints, and the
-//! identification itself (solver::estimate, refined by solver::refine). Every error names its
+//! identification itself (solver::fitting::estimate, refined by solver::fitting::refine). Every error names its
 //! flag; exit code 2 for a wrong command line, 1 for a file that cannot be read or does not fit.
 
 use super::{CliError, CliResult};
 use model_spec::Machine;
-use solver::csvio::CsvError;
-use solver::estimate::{
+use solver::fitting::estimate::{
     Constraint, EstimateError, Identification, IdentifyOptions, identify_with, with_offsets,
 };
-use solver::hmatrix::{GainSource, parameter_names};
+use solver::fitting::hmatrix::{GainSource, parameter_names};
+use solver::fitting::refine::{RefineError, RefineOptions, Refinement, identify_refined};
+use solver::io::csv::CsvError;
 use solver::model::{Effect, Model, Term};
-use solver::paths::PathError;
 use solver::record::Record;
-use solver::refine::{RefineError, RefineOptions, Refinement, identify_refined};
-use solver::truth::{Truth, TruthError};
+use solver::simulation::paths::PathError;
+use solver::simulation::truth::{Truth, TruthError};
 use std::path::Path;
 
 /// The truth of `--truth` (a built-in name or a TOML file), or, without it, the machine's
@@ -25,7 +25,7 @@ pub fn truth(m: &Machine, name: Option<&str>) -> CliResult<Truth> {
     let Some(name) = name else {
         return default_truth(m);
     };
-    solver::truth::load_truth(name, m).map_err(|e| match e {
+    solver::simulation::truth::load_truth(name, m).map_err(|e| match e {
         TruthError::NotFound(_) => CliError::usage(format!("--truth: {e}")),
         TruthError::Invalid { .. } | TruthError::Io { .. } => {
             CliError::failure(format!("--truth: {e}"))
@@ -41,7 +41,7 @@ pub fn demo_truth_name(m: &Machine) -> String {
 /// The machine's built-in demo truth (`<machine>-demo`), else the nominal machine.
 pub fn default_truth(m: &Machine) -> CliResult<Truth> {
     let name = demo_truth_name(m);
-    match solver::truth::builtin_truth(&name, m) {
+    match solver::simulation::truth::builtin_truth(&name, m) {
         Some(Ok(t)) => Ok(t),
         Some(Err(e)) => Err(CliError::failure(format!(
             "--truth: the default truth {name} of machine {} does not fit this description of it: {e} (give --truth)",
@@ -53,7 +53,7 @@ pub fn default_truth(m: &Machine) -> CliResult<Truth> {
 
 /// The path of `--path`: `K1`, `K2`, `K4` (any case) or a path CSV file.
 pub fn path(m: &Machine, name: &str) -> CliResult<Record> {
-    solver::paths::load_path(m, name).map_err(|e| match e {
+    solver::simulation::paths::load_path(m, name).map_err(|e| match e {
         PathError::NotFound(_) | PathError::NotAC { .. } => CliError::usage(format!("--path: {e}")),
         PathError::Ik { .. } => CliError::failure(format!("--path: {e}")),
         PathError::Csv(c) => CliError::failure(format!("--path: {}", csv_message(&c))),
@@ -70,7 +70,7 @@ fn csv_message(e: &CsvError) -> String {
 
 /// The measurement CSV of `flag` (`--data`): commands, readings (mm inside), times.
 pub fn measurement(flag: &str, m: &Machine, file: &Path) -> CliResult<Record> {
-    solver::csvio::read_measurement(file, m)
+    solver::io::csv::read_measurement(file, m)
         .map_err(|e| CliError::failure(format!("{flag}: {}", csv_message(&e))))
 }
 
@@ -187,8 +187,8 @@ pub struct Identified {
     pub refinement: Option<Refinement>,
 }
 
-/// Identifies `model` of `m` on `record` (solver::estimate::identify_with), then, when
-/// `exact`, refines it against the exact machine (solver::refine::refine) with the same gain
+/// Identifies `model` of `m` on `record` (solver::fitting::estimate::identify_with), then, when
+/// `exact`, refines it against the exact machine (solver::fitting::refine::refine) with the same gain
 /// source. `data` names the measurement flag in error messages.
 pub fn identify(
     m: &Machine,

@@ -9,16 +9,16 @@ use super::validate::{defaulted_note, residual_table};
 use super::{CliError, CliResult, Compiled, EXIT_CODES};
 use codegen::table::{self, render};
 use model_spec::{FULL_MODEL, Machine};
-use solver::csvio::format_record;
-use solver::diagnose::{DiagnoseOptions, Diagnosis, diagnose};
-use solver::estimate::IdentifyOptions;
+use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose};
+use solver::fitting::estimate::IdentifyOptions;
+use solver::fitting::refine::exact_prediction;
+use solver::fitting::validate::{ValidateOptions, Validation, statistics, validate};
+use solver::io::csv::format_record;
+use solver::io::json::{display_factor, identify_json, validate_json};
 use solver::model::Model;
 use solver::record::Record;
-use solver::refine::exact_prediction;
-use solver::report::{display_factor, identify_json, validate_json};
-use solver::simulate::{provenance, simulate};
-use solver::truth::Truth;
-use solver::validate::{ValidateOptions, Validation, statistics, validate};
+use solver::simulation::readings::{provenance, simulate};
+use solver::simulation::truth::Truth;
 use std::path::Path;
 use std::time::Instant;
 
@@ -98,7 +98,7 @@ pub fn run(_args: &DemoArgs) -> CliResult {
     // 1. Simulations.
     let mut runs = Vec::new();
     for (name, offset) in PATHS {
-        let path = solver::paths::builtin_path(&m, name)
+        let path = solver::simulation::paths::builtin_path(&m, name)
             .ok_or_else(|| fail(format!("no built-in path {name}")))?
             .map_err(fail)?;
         let mut t = truth.clone();
@@ -156,7 +156,7 @@ pub fn run(_args: &DemoArgs) -> CliResult {
             let zeros = vec![[0.0; 3]; p.len()];
             Ok(statistics(&p, &zeros).1.measured_rms)
         })
-        .collect::<Result<_, solver::simulate::SimulateError>>()
+        .collect::<Result<_, solver::simulation::readings::SimulateError>>()
         .map_err(fail)?;
     // The bias the hidden terms put into the reduced model's values: the first-order fit of
     // their readings alone on K4 (noise-free).
@@ -365,7 +365,7 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         max_after(0),
         max_after(1),
         max_after(2),
-        solver::csvio::format_scaled(truth.noise_mm, 3)
+        solver::io::csv::format_scaled(truth.noise_mm, 3)
     ));
     if hidden.terms.is_empty() {
         out.push_str("The truth has nothing the reduced model lacks: what is left is the noise.\n");
@@ -428,7 +428,7 @@ fn machine_line(m: &Machine) -> String {
 fn truth_table(
     m: &Machine,
     truth: &Truth,
-    ident: &solver::estimate::Identification,
+    ident: &solver::fitting::estimate::Identification,
     bias: Option<&[Option<f64>]>,
 ) -> String {
     let fit = &ident.fit;
@@ -605,7 +605,7 @@ fn diagnosis_text(
         "Check against the truth (known here only): {}; residual RMS after {} µm on K4/K1/K2, against {} µm of noise.\n",
         checks.join("; "),
         after.join("/"),
-        solver::csvio::format_scaled(noise_mm, 3)
+        solver::io::csv::format_scaled(noise_mm, 3)
     ));
     out
 }

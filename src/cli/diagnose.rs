@@ -1,19 +1,19 @@
 //! `rtest diagnose`: where the model and the measurement disagree, the missing effect named as
 //! an engineer reads it, the extended model (as a machine description `identify` and
-//! `generate` accept) and its gain on the fitted and the held-out data (solver::diagnose).
+//! `generate` accept) and its gain on the fitted and the held-out data (solver::diagnosis).
 
 use super::data;
 use super::json::Json;
 use super::{CliError, CliResult, EXIT_CODES};
 use model_spec::Machine;
 use model_spec::basis::Basis;
-use solver::diagnose::dictionary::DictionaryOptions;
-use solver::diagnose::structure::{self, Component};
-use solver::diagnose::{Correction, DiagnoseOptions, Diagnosis, Finding, diagnose};
+use solver::diagnosis::dictionary::DictionaryOptions;
+use solver::diagnosis::structure::{self, Component};
+use solver::diagnosis::{Correction, DiagnoseOptions, Diagnosis, Finding, diagnose};
+use solver::fitting::validate::{ValidateOptions, validate};
+use solver::io::json::display_factor;
 use solver::model::{Model, Term};
 use solver::record::Record;
-use solver::report::display_factor;
-use solver::validate::{ValidateOptions, validate};
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
@@ -1076,7 +1076,7 @@ pub fn plots(
         // The fitted record: the fits' own prediction (the minimum-norm solution, so that
         // confounded groups keep their combined effect), not zeroed: the offsets of --zeroed are
         // in the models. Held out: the values, zeroed like the readings (as the gain).
-        let predict = |fit: &solver::estimate::Identification| {
+        let predict = |fit: &solver::fitting::estimate::Identification| {
             let values: Vec<Option<f64>> = if *fitted {
                 fit.fit.solution.iter().map(|&v| Some(v)).collect()
             } else {

@@ -25,7 +25,7 @@ translational errors and mm/rad for angular errors (1 mm/rad = 1 µm of error ve
 error of e µm moves the tool point by g·e µm, an error of e µrad by g·e nm). Axis positions in mm \
 and degrees, kinematic parameters in mm (defaults from the machine description, overridden by \
 --param). Every rotary axis must be given; linear axes left out of --at are filled by the \
-machine's nominal tool-centre-point inverse kinematics (solver::tool_centre_point_ik: the linear \
+machine's nominal tool-centre-point inverse kinematics (solver::simulation::tool_centre_point_ik: the linear \
 positions that put the tool point on the workpiece point at the given rotary positions).
 
 JSON without --at: {\"machine\", \"model\" (null with --errors), \"units\", \"columns\", \

@@ -1,12 +1,12 @@
 //! `rtest identify`: the errors of a model from an R-test measurement, with uncertainties and
-//! what the data cannot separate (solver::estimate, solver::refine, solver::report).
+//! what the data cannot separate (solver::fitting::estimate, solver::fitting::refine, solver::io::json).
 
 use super::data::{self, Identified};
 use super::{CliError, CliResult, EXIT_CODES};
 use model_spec::Machine;
-use solver::estimate::{Constraint, IdentifyOptions};
-use solver::hmatrix::Backend;
-use solver::report::{display_factor, identify_json};
+use solver::fitting::estimate::{Constraint, IdentifyOptions};
+use solver::fitting::hmatrix::Backend;
+use solver::io::json::{display_factor, identify_json};
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -99,12 +99,12 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         if args.block == 0 {
             return Err(CliError::usage("--block: must be at least 1 sample"));
         }
-        let (ident, run) = solver::streaming::identify_file(
+        let (ident, run) = solver::fitting::streaming::identify_file(
             &m, &model, &args.data, &opts, args.block,
         )
         .map_err(|e| match e {
-            solver::streaming::StreamingError::Estimate(
-                solver::estimate::EstimateError::UnknownParameter(name, names),
+            solver::fitting::streaming::StreamingError::Estimate(
+                solver::fitting::estimate::EstimateError::UnknownParameter(name, names),
             ) => CliError::usage(format!(
                 "--constraint: `{name}` is not a parameter of the model (parameters: {names})"
             )),

@@ -89,7 +89,7 @@ pub fn parse_params(m: &Machine, text: Option<&str>) -> CliResult<Vec<f64>> {
 
 /// The pose of `--at` (axis names case-insensitive; linear mm, rotary degrees) with the
 /// parameters `params`. Every rotary axis must be given; linear axes left out are filled by the
-/// nominal tool-centre-point inverse kinematics (`solver::tool_centre_point_ik`), which puts the
+/// nominal tool-centre-point inverse kinematics (`solver::simulation::tool_centre_point_ik`), which puts the
 /// tool point on the workpiece point at the given rotary positions.
 pub fn parse_at(m: &Machine, text: &str, params: Vec<f64>) -> CliResult<Pose> {
     let mut given = Vec::new();
@@ -135,7 +135,7 @@ pub fn complete(m: &Machine, given: &[(AxisId, f64)], params: Vec<f64>) -> CliRe
     let from_ik: Vec<bool> = seen.iter().map(|s| !s).collect();
     if from_ik.iter().any(|&f| f) {
         let mut ik = commands.clone();
-        solver::tool_centre_point_ik(m, &mut ik, &params).map_err(|e| {
+        solver::simulation::tool_centre_point_ik(m, &mut ik, &params).map_err(|e| {
             CliError::failure(format!(
                 "--at: cannot fill the missing linear axes by inverse kinematics: {e} (give every axis)"
             ))

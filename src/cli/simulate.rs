@@ -3,14 +3,14 @@
 
 use super::data;
 use super::{CliError, CliResult, EXIT_CODES};
-use solver::csvio::{format_record, format_scaled, parse_scaled};
-use solver::simulate::{provenance, simulate};
-use solver::validate::statistics;
+use solver::fitting::validate::statistics;
+use solver::io::csv::{format_record, format_scaled, parse_scaled};
+use solver::simulation::readings::{provenance, simulate};
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
 Simulates an R-test measurement: the exact virtual machine (exact homogeneous transforms, no \
-linearisation; solver::simulate) runs a test path with the errors of a truth, and the readings \
+linearisation; solver::simulation::readings) runs a test path with the errors of a truth, and the readings \
 are written as a measurement CSV.
 
 The path is K1 (C 0..360 deg in 1 deg steps, A = 0; 361 samples), K2 (A -90..30 deg, C = 0; 121 \

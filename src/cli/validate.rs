@@ -3,8 +3,10 @@
 
 use super::gains::text_table;
 use super::{CliError, CliResult, EXIT_CODES};
-use solver::report::{read_identify_json, validate_json};
-use solver::validate::{Unidentified, ValidateError, ValidateOptions, Validation, validate};
+use solver::fitting::validate::{
+    Unidentified, ValidateError, ValidateOptions, Validation, validate,
+};
+use solver::io::json::{read_identify_json, validate_json};
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\

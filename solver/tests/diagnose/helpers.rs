@@ -4,12 +4,12 @@
 #![allow(dead_code)]
 
 use model_spec::Machine;
-use solver::diagnose::{DiagnoseOptions, Diagnosis, diagnose};
+use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose};
 use solver::model::{Model, Term};
-use solver::paths::{builtin_path, fill_linear_ik, record_from_commands};
 use solver::record::Record;
-use solver::simulate::simulate;
-use solver::truth::{Truth, builtin_truth};
+use solver::simulation::paths::{builtin_path, fill_linear_ik, record_from_commands};
+use solver::simulation::readings::simulate;
+use solver::simulation::truth::{Truth, builtin_truth};
 
 /// Reading noise of every scenario, mm (0.5 µm).
 pub const NOISE_MM: f64 = 0.5e-3;

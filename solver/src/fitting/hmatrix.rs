@@ -6,7 +6,7 @@
 //!   for `harmonic:K` (cos, then sin).
 //! - Entry: `g_d(pose_i) · b(sample_i)`, the position gain `g` of the term's effect (mm per mm
 //!   for translational errors, mm per rad for angular ones) times the basis value `b`
-//!   ([`crate::basis::Basis::values`] with the effect's carrier, the sample's commands and
+//!   ([`crate::model::Basis::values`] with the effect's carrier, the sample's commands and
 //!   motion, and [`Record::tau`]). The sensor offsets `dx0 dy0 dz0` have gain `+1` in their own
 //!   direction and 0 in the others.
 //!
@@ -395,7 +395,7 @@ impl GainSource {
 pub fn parameter_name(m: &Machine, term: &Term, k: usize) -> String {
     let n = term.effect.name(m);
     match term.basis {
-        crate::basis::Basis::Const => n,
+        crate::model::Basis::Const => n,
         b => {
             let names = b.column_names();
             format!("{n}@{}", names.get(k).unwrap_or(&names[0]))

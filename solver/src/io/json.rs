@@ -17,11 +17,11 @@
 //! {"measured_rms_um", "measured_max_um", "residual_rms_um", "residual_max_um"}, "y": …, "z": …},
 //! …}`, RMS over all three directions `√(Σ r² / 3N)`.
 
-use crate::basis::Basis;
-use crate::estimate::{Constraint, Identification};
-use crate::hmatrix::Backend;
+use crate::fitting::estimate::{Constraint, Identification};
+use crate::fitting::hmatrix::Backend;
+use crate::fitting::validate::{Stats, Validation};
+use crate::model::Basis;
 use crate::model::{Effect, Model, Term};
-use crate::validate::{Stats, Validation};
 use model_spec::Machine;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;

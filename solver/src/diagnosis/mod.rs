@@ -2,7 +2,7 @@
 //! the model extended with it, and the gain measured on data that were not fitted.
 //!
 //! 1. Fit the base model; analyse the structure of its residual ([`structure`]).
-//! 2. Build the candidate dictionary ([`dictionary`]): every term of the topology the model
+//! 2. Build the candidate dictionary ([`mod@dictionary`]): every term of the topology the model
 //!    lacks.
 //! 3. Forward selection ([`select`]): add the candidate that explains most of what is left,
 //!    if it is significant (F-test against the noise, corrected for the number of candidates
@@ -21,15 +21,15 @@ pub mod dictionary;
 pub mod select;
 pub mod structure;
 
-use crate::distributions::f_upper_tail;
-use crate::estimate::{
+use crate::fitting::distributions::f_upper_tail;
+use crate::fitting::estimate::{
     EstimateError, Identification, IdentifyOptions, Tolerances, measurement_vector, with_offsets,
 };
-use crate::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::refine::{RefineError, RefineOptions, identify_refined};
+use crate::fitting::validate::{ValidateError, ValidateOptions, validate_with};
 use crate::model::Model;
 use crate::record::Record;
-use crate::refine::{RefineError, RefineOptions, identify_refined};
-use crate::validate::{ValidateError, ValidateOptions, validate_with};
 use dictionary::{DictionaryOptions, dictionary};
 use model_spec::Machine;
 use model_spec::terms::Term;

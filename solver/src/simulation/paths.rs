@@ -9,19 +9,19 @@
 //!
 //! The rotary commands are computed in degrees and converted with `to_radians()`; the linear
 //! axes follow the ball by the nominal tool-centre-point inverse kinematics
-//! ([`crate::exact::VirtualMachine::tool_centre_point_ik`]) with the machine's default kinematic
+//! ([`crate::simulation::exact::VirtualMachine::tool_centre_point_ik`]) with the machine's default kinematic
 //! parameters (what the controller believes). Sample `i` is taken at `t = i·`[`SAMPLE_PERIOD_S`]
 //! (1 s): the R-test samples at rest after each step, so only the order of the samples matters
 //! for `time:K` effects, which are normalised over the record. Directions of motion come from
 //! [`crate::record::motion_directions`].
 //!
-//! A path file is a CSV in the measurement format ([`crate::csvio`]): rotary columns required
+//! A path file is a CSV in the measurement format ([`crate::io::csv`]): rotary columns required
 //! (degrees), linear columns optional (filled by the inverse kinematics), `t_s` optional,
 //! measured columns optional and ignored.
 
-use crate::csvio::{CsvError, Need, parse_csv};
-use crate::exact::{ExactError, VirtualMachine};
+use crate::io::csv::{CsvError, Need, parse_csv};
 use crate::record::{Record, Sample, motion_directions};
+use crate::simulation::exact::{ExactError, VirtualMachine};
 use model_spec::Machine;
 
 /// Time between two samples of the built-in paths, s.

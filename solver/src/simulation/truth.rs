@@ -20,7 +20,7 @@
 //!
 //! Inside, a [`Truth`] holds the terms as a [`Model`] and one coefficient per model column in
 //! mm (translations, sensor offsets) or rad (angles). The value of an effect at a sample is
-//! `Σ coefficient · basis value` over its terms ([`crate::basis::Basis::values`]). Every entry is
+//! `Σ coefficient · basis value` over its terms ([`crate::model::Basis::values`]). Every entry is
 //! validated against the machine, and every problem is a [`TruthError`] naming the file, the
 //! line and the column.
 //!
@@ -28,8 +28,8 @@
 //! (the documented default of `rtest demo`) and `seed-ac-reduced` (the 11 errors of the reduced
 //! model only, constants, no noise).
 
-use crate::basis::{Basis, Carrier};
-use crate::csvio::{format_scaled, parse_scaled};
+use crate::io::csv::{format_scaled, parse_scaled};
+use crate::model::{Basis, Carrier};
 use crate::model::{Effect, Model, Term};
 use crate::record::Sample;
 use model_spec::Machine;
@@ -39,14 +39,17 @@ use toml::de::{DeTable, DeValue};
 
 /// Name and TOML text of every built-in truth.
 pub const BUILTIN_TRUTHS: &[(&str, &str)] = &[
-    ("seed-ac-demo", include_str!("../truths/seed-ac-demo.toml")),
+    (
+        "seed-ac-demo",
+        include_str!("../../truths/seed-ac-demo.toml"),
+    ),
     (
         "seed-ac-reduced",
-        include_str!("../truths/seed-ac-reduced.toml"),
+        include_str!("../../truths/seed-ac-reduced.toml"),
     ),
     (
         "seed-ac-budget",
-        include_str!("../truths/seed-ac-budget.toml"),
+        include_str!("../../truths/seed-ac-budget.toml"),
     ),
 ];
 
@@ -103,7 +106,7 @@ pub struct Truth {
     pub coefficients: Vec<f64>,
     /// Standard deviation of the Gaussian reading noise, per direction, mm.
     pub noise_mm: f64,
-    /// Seed of the noise generator ([`crate::rng::Rng`]).
+    /// Seed of the noise generator ([`crate::simulation::rng::Rng`]).
     pub seed: u64,
     /// `true`: the readings are zeroed at the first sample (subtracted from every sample).
     pub zeroed: bool,

@@ -1,13 +1,13 @@
 //! Reading measurement and path CSVs: the header, then one row at a time. The whole-file reader
 //! ([`parse_csv`]) and the block reader for long records ([`MeasurementBlocks`]) share the same
 //! header and row parsing, so both give the same errors at the same lines and columns. The
-//! format is described in [`crate::csvio`].
+//! format is described in [`crate::io::csv`].
 
-use crate::csvio::{
+use crate::io::csv::{
     Col, CsvError, Ctx, MEASURED, Need, classify, clean_name, expected_columns, parse_scaled,
 };
-use crate::paths::{fill_linear_ik, record_from_commands};
 use crate::record::{Record, Sample};
+use crate::simulation::paths::{fill_linear_ik, record_from_commands};
 use model_spec::{AxisKind, Machine};
 use std::io::BufRead;
 use std::path::Path;

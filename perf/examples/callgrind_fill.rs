@@ -18,7 +18,7 @@ fn main() {
     let errors = m.model_errors("full").unwrap().to_vec();
     let model = codegen::GainModel::derive(&m, &errors);
     let program = codegen::compile(&m, &model);
-    let chain = solver::first_order::FirstOrderChain::new(&m, &errors);
+    let chain = perf::first_order::FirstOrderChain::new(&m, &errors);
     let params = Params::default();
     let defaults = m.default_parameters();
     let mut rows = [[0.0; full::N]; 3];
@@ -26,7 +26,7 @@ fn main() {
     let (mut scratch, mut flat) = (Vec::new(), vec![0.0; 6 * full::N]);
     let mut d = vec![[0.0; 6]; full::N];
     for i in 0..n {
-        let (pose, commands) = solver::perf::sweep_pose(i as f64 * 1e-3);
+        let (pose, commands) = perf::sweep_pose(i as f64 * 1e-3);
         match method.as_str() {
             "position" => full::position_gains(black_box(&pose), &params, &mut rows),
             "gains" => full::gains(black_box(&pose), &params, &mut six),

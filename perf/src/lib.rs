@@ -11,19 +11,27 @@
 //!    reused buffer, against a plain write of the same bytes into that buffer.
 //! 3. Streaming identification of a long record (the reduced model), with the peak memory.
 //! 4. Code generation of every built-in machine.
+//!
+//! This crate also holds the baseline the generated code is measured against, a runtime
+//! first-order product of the chain ([`first_order`]). None of it is part of the libraries'
+//! API: it serves `rtest bench`, the criterion benchmarks and the callgrind example.
 
-use crate::estimate::{Constraint, Tolerances};
-use crate::exact::{VirtualMachine, tool_centre_point_ik};
-use crate::fd::{FdSteps, fd_gains_with};
+#![warn(missing_docs)]
+
+pub mod first_order;
+
 use crate::first_order::FirstOrderChain;
-use crate::hmatrix::GainSource;
-use crate::model::Model;
-use crate::record::{Record, Sample};
-use crate::rng::Rng;
-use crate::streaming::identify_streaming;
 use codegen::{GainModel, compile};
 use generated::seed_ac::{Params, Pose, full};
 use model_spec::{AxisKind, Machine};
+use solver::fitting::estimate::{Constraint, Tolerances};
+use solver::fitting::hmatrix::GainSource;
+use solver::fitting::streaming::identify_streaming;
+use solver::model::Model;
+use solver::record::{Record, Sample};
+use solver::simulation::exact::{VirtualMachine, tool_centre_point_ik};
+use solver::simulation::fd::{FdSteps, fd_gains_with};
+use solver::simulation::rng::Rng;
 use std::hint::black_box;
 use std::time::Instant;
 

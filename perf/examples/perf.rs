@@ -1,7 +1,7 @@
 //! Prints the in-process performance comparisons (the same as `rtest bench`).
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
-    for r in solver::perf::gain_methods(quick) {
+    for r in perf::gain_methods(quick) {
         println!(
             "{:40} {:10.1} ns/pose  x{:.1}",
             r.method, r.ns_per_pose, r.ratio_to_generated
@@ -9,7 +9,7 @@ fn main() {
     }
     let poses = if quick { 100_000 } else { 1_000_000 };
     for block in [4096, 65536] {
-        let f = solver::perf::fill_bandwidth(poses, block, 3);
+        let f = perf::fill_bandwidth(poses, block, 3);
         println!(
             "fill {} poses, block {block} ({:.1} MB): {:.3} s ({:.2} GB/s), plain write {:.3} s ({:.2} GB/s): {:.0} %",
             f.poses,
@@ -21,7 +21,7 @@ fn main() {
             100.0 * f.fraction()
         );
     }
-    let s = solver::perf::streaming_identify(poses);
+    let s = perf::streaming_identify(poses);
     println!(
         "streaming {} samples: generate {:.3} s, generate+identify {:.3} s, peak RSS {:.1} MB, worst z {:.2}",
         s.samples,
@@ -30,7 +30,7 @@ fn main() {
         s.peak_rss_bytes.unwrap_or(0) as f64 / 1e6,
         s.worst_z
     );
-    for (m, t) in solver::perf::codegen_times(5) {
+    for (m, t) in perf::codegen_times(5) {
         println!("codegen {m}: {:.2} ms", t * 1e3);
     }
 }

@@ -6,7 +6,7 @@
 //!    ([`Truth::evaluate_into`]);
 //! 2. the exact chains (no linearisation) with the truth's kinematic parameters give the error
 //!    vector's position part `R_tool^T·(P_tool − P_work)` (mm, tool frame, tool minus
-//!    workpiece; [`crate::exact::ErrorVector::position`]); it includes any nominal mismatch the
+//!    workpiece; [`crate::simulation::exact::ErrorVector::position`]); it includes any nominal mismatch the
 //!    path leaves, e.g. when the truth's kinematic parameters differ from the defaults the path
 //!    was planned with;
 //! 3. the offsets `dx0 dy0 dz0` are added, then Gaussian noise of standard deviation
@@ -15,11 +15,11 @@
 //! 4. when `truth.zeroed`, the first reading is subtracted from every reading (the first is
 //!    then exactly zero), as R-test software does.
 
-use crate::exact::VirtualMachine;
 use crate::model::Effect;
 use crate::record::Record;
-use crate::rng::Rng;
-use crate::truth::Truth;
+use crate::simulation::exact::VirtualMachine;
+use crate::simulation::rng::Rng;
+use crate::simulation::truth::Truth;
 use model_spec::{Machine, Side};
 
 /// A record or truth that does not fit the machine (programming errors, reported, not panics).
@@ -148,7 +148,7 @@ fn check(m: &Machine, truth: &Truth, path: &Record) -> Result<(), SimulateError>
     Ok(())
 }
 
-/// Comment lines for the CSV of a simulation ([`crate::csvio::write_record`]): what produced
+/// Comment lines for the CSV of a simulation ([`crate::io::csv::write_record`]): what produced
 /// it, the machine, the path, the truth and the units.
 pub fn provenance(m: &Machine, path_name: &str, truth: &Truth, samples: usize) -> Vec<String> {
     vec![

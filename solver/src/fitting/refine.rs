@@ -11,7 +11,7 @@
 //! repeat: r = y − exact(v);  Δ = H⁺ r  (same scaling, rank and constraint as the fit);  v ← v + Δ
 //! ```
 //!
-//! where `exact(v)` is the virtual machine ([`crate::simulate`]) with the model's terms at the
+//! where `exact(v)` is the virtual machine ([`crate::simulation::readings`]) with the model's terms at the
 //! values `v`. `v` is the whole minimum-norm solution, undetermined parameters included (one
 //! representative of each confounded group, as in `H·v`); they get no reported value. The iteration contracts by the ratio of the
 //! second-order to the first-order terms (about 1e-4), so two or three steps reach rounding.
@@ -21,15 +21,15 @@
 //! After convergence the fit's residual, σ̂, uncertainties and covariance are those of the exact
 //! residual; the identifiability analysis is unchanged (it depends on H only).
 
-use crate::estimate::{
+use crate::fitting::estimate::{
     EstimateError, Identification, IdentifyOptions, Tolerances, identify_with, least_squares,
     measurement_vector,
 };
-use crate::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
 use crate::model::Model;
 use crate::record::Record;
-use crate::simulate::{SimulateError, simulate};
-use crate::truth::Truth;
+use crate::simulation::readings::{SimulateError, simulate};
+use crate::simulation::truth::Truth;
 use model_spec::Machine;
 use nalgebra::DVector;
 
@@ -165,7 +165,7 @@ pub fn refine(
 }
 
 /// Identifies `model` on `record` with gains from `source`
-/// ([`crate::estimate::identify_with`]) and refines the result against the exact machine
+/// ([`crate::fitting::estimate::identify_with`]) and refines the result against the exact machine
 /// ([`refine`], with the identification's tolerances).
 pub fn identify_refined(
     m: &Machine,

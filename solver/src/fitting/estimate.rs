@@ -1,10 +1,10 @@
 //! Least squares the way a calibration engineer needs it: column scaling, SVD with a stated
 //! numerical rank, residual-based standard uncertainties, covariance and correlation, condition
 //! number, and no number for a parameter the data cannot determine (see
-//! [`crate::identifiability`] and `docs/identification.md`).
+//! [`crate::fitting::identifiability`] and `docs/identification.md`).
 //!
 //! Model: `y = H·p + e`, `y` the stacked measured error vectors (mm, 3 rows per sample), `H`
-//! from [`crate::hmatrix`], `p` the parameters (mm for translational, rad for angular effects),
+//! from [`crate::fitting::hmatrix`], `p` the parameters (mm for translational, rad for angular effects),
 //! `e` independent noise of one unknown standard deviation σ.
 //!
 //! 1. Scaling: `s_j = ‖h_j‖₂` (a zero column keeps `s_j = 1`), `A = H·S⁻¹`; unit-free, so mm
@@ -19,8 +19,8 @@
 //! 5. Covariance `C = σ̂²·S⁻¹·V_r·Σ_r⁻²·V_rᵀ·S⁻¹`, std `√C_jj`, correlation
 //!    `C_jk / √(C_jj·C_kk)`; condition number `κ = σ_max / σ_r` of the scaled H.
 
-use crate::hmatrix::{Backend, GainSource, HMatrixError, h_matrix, parameter_names};
-use crate::identifiability::{
+use crate::fitting::hmatrix::{Backend, GainSource, HMatrixError, h_matrix, parameter_names};
+use crate::fitting::identifiability::{
     CORRELATION_LIMIT, DETERMINED_TOLERANCE, Identifiability, LINK_TOLERANCE, Swallowed,
     near_confounded, null_space_groups, swallowed_by_offsets,
 };
@@ -44,7 +44,7 @@ pub enum Constraint {
     /// set to zero. Their standard uncertainties are those of that estimator, around the
     /// projection of the truth, not around the truth.
     MinimumNorm,
-    /// The named parameters ([`crate::hmatrix::parameter_name`]: `XOC`, `ECC@harmonic:1:cos`)
+    /// The named parameters ([`crate::fitting::hmatrix::parameter_name`]: `XOC`, `ECC@harmonic:1:cos`)
     /// are fixed to zero before the fit (value 0, no uncertainty); the rest is fitted as with
     /// [`Constraint::None`]. The digit-zero spelling of an error (`X0C`) is accepted.
     Zero(Vec<String>),
@@ -186,7 +186,7 @@ pub fn least_squares(
 /// [`least_squares`] on a reduced system: `r` (p × p or (p+1) × p) and `z` with `rᵀr = HᵀH`
 /// and `rᵀz = Hᵀy` for the real `H` (`rows` rows) and `y`, and `rss_outside` the part of
 /// `‖y‖²` no combination of H's columns reaches (the triangular factor of a streaming QR,
-/// [`crate::streaming`]). Estimates, rank, uncertainties, covariance and identifiability are
+/// [`crate::fitting::streaming`]). Estimates, rank, uncertainties, covariance and identifiability are
 /// those of the full system; [`Fit::residual`] is the reduced system's (length of `z`).
 pub fn least_squares_reduced(
     r: &DMatrix<f64>,
@@ -403,7 +403,7 @@ pub fn with_offsets(model: &Model) -> Model {
     for d in Dir::ALL {
         let t = Term {
             effect: Effect::SensorOffset(d),
-            basis: crate::basis::Basis::Const,
+            basis: crate::model::Basis::Const,
         };
         if !out.terms.contains(&t) {
             out.terms.push(t);
@@ -462,7 +462,7 @@ pub fn identify(
         .params
         .clone()
         .unwrap_or_else(|| m.default_parameters());
-    crate::hmatrix::check_model(m, model)?;
+    crate::fitting::hmatrix::check_model(m, model)?;
     let mut source = GainSource::new(m, &model.errors(), &params)?;
     identify_with(m, model, record, &mut source, opts)
 }

@@ -4,10 +4,10 @@
 
 use codegen::{GainModel, compile};
 use model_spec::AxisKind;
-use solver::exact::tool_centre_point_ik;
-use solver::fd::fd_gains;
-use solver::first_order::FirstOrderChain;
-use solver::rng::Rng;
+use perf::first_order::FirstOrderChain;
+use solver::simulation::exact::tool_centre_point_ik;
+use solver::simulation::fd::fd_gains;
+use solver::simulation::rng::Rng;
 
 #[test]
 fn generated_evaluator_finite_differences_and_first_order_product_agree() {

@@ -5,7 +5,7 @@
 //!   axes in mm, rotary axes in degrees. Rotary columns are required; the linear columns are
 //!   all present or all missing, and when missing they are filled by the machine's nominal
 //!   tool-centre-point inverse kinematics with its default kinematic parameters
-//!   ([`crate::paths::fill_linear_ik`]);
+//!   ([`crate::simulation::paths::fill_linear_ik`]);
 //! - `dx_um,dy_um,dz_um`: the measured error vector (tool minus workpiece, tool frame, µm),
 //!   required in a measurement file, optional (all three or none) in a path file;
 //! - `t_s` (optional): time since the start, s, finite and non-decreasing. Without it, sample
@@ -24,10 +24,12 @@
 //!
 //! Files are written atomically: to a temporary file in the same directory, then renamed.
 
-pub use crate::csvread::{MeasurementBlocks, parse_csv, time_span};
+mod read;
+
 use crate::record::Record;
 use model_spec::catalogue::iso_rank;
 use model_spec::{AxisKind, Machine};
+pub use read::{FIRST_LOOKAHEAD, MeasurementBlocks, parse_csv, time_span};
 use std::io::Write;
 use std::path::Path;
 
@@ -417,7 +419,7 @@ mod tests {
         assert_eq!(parse_scaled("1.2.3", 0), None);
         assert_eq!(parse_scaled("", 0), None);
         assert_eq!(parse_scaled("-", 0), None);
-        let mut r = crate::rng::Rng::new(3);
+        let mut r = crate::simulation::rng::Rng::new(3);
         for _ in 0..20_000 {
             let x = r.normal() * 10f64.powi((r.uniform() * 40.0) as i32 - 20);
             for k in [0, 3, 6, -3] {

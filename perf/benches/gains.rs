@@ -9,7 +9,6 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use generated::seed_ac::{Params, Pose, full};
-use solver::perf;
 use std::hint::black_box;
 
 fn gains(c: &mut Criterion) {
@@ -18,10 +17,10 @@ fn gains(c: &mut Criterion) {
     let params = m.default_parameters();
     let model = codegen::GainModel::derive(&m, &errors);
     let program = codegen::compile(&m, &model);
-    let chain = solver::first_order::FirstOrderChain::new(&m, &errors);
-    let vm = solver::exact::VirtualMachine::new(&m);
+    let chain = perf::first_order::FirstOrderChain::new(&m, &errors);
+    let vm = solver::simulation::exact::VirtualMachine::new(&m);
     let mut commands = vec![0.0, -0.4, 0.9, 0.0, 0.0];
-    solver::exact::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
+    solver::simulation::exact::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
     let typed = Params::default();
     let mut g = c.benchmark_group("gains");
     g.bench_function("a-generated", |b| {
@@ -51,13 +50,13 @@ fn gains(c: &mut Criterion) {
             black_box(&out);
         })
     });
-    let steps = solver::fd::FdSteps {
+    let steps = solver::simulation::fd::FdSteps {
         richardson: false,
         ..Default::default()
     };
     g.bench_function("c-htm-finite-differences", |b| {
         b.iter(|| {
-            black_box(solver::fd::fd_gains_with(
+            black_box(solver::simulation::fd::fd_gains_with(
                 &vm,
                 black_box(&commands),
                 &params,

@@ -1,11 +1,11 @@
 //! Validation: the identified model's prediction against the measurement of another record.
 //!
 //! - Prediction `p_i = H_i·v` (mm), `H` of the model on the validation record
-//!   ([`crate::hmatrix`]), `v` the identified values; a parameter without a value (not
+//!   ([`crate::fitting::hmatrix`]), `v` the identified values; a parameter without a value (not
 //!   determined by the identification) is set by [`Unidentified`] (default 0, and
 //!   [`Validation::defaulted`] names it).
 //! - With [`ValidateOptions::exact`], `p_i` is the exact machine at the identified values
-//!   instead ([`crate::refine::exact_prediction`]).
+//!   instead ([`crate::fitting::refine::exact_prediction`]).
 //! - Zeroed readings (the record was zeroed at its first sample): `p_i = (H_i − H_0)·v`. Constant
 //!   effects cancel, so the sensor offsets and the errors they swallow do not matter.
 //! - "Before" is the nominal machine: prediction 0, residual = measured. "After" is the model:
@@ -13,8 +13,8 @@
 //! - Per direction d ∈ {x, y, z}: RMS `√(Σ_i r_id² / N)` and max `|r_id|`; over all three:
 //!   RMS `√(Σ_i Σ_d r_id² / 3N)`, max over all.
 
-use crate::estimate::{EstimateError, measurement_vector};
-use crate::hmatrix::{GainSource, HMatrixError, check_model, h_matrix, parameter_names};
+use crate::fitting::estimate::{EstimateError, measurement_vector};
+use crate::fitting::hmatrix::{GainSource, HMatrixError, check_model, h_matrix, parameter_names};
 use crate::model::Model;
 use crate::record::Record;
 use model_spec::Machine;
@@ -39,7 +39,7 @@ pub struct ValidateOptions {
     pub unidentified: Unidentified,
     /// Kinematic parameters (mm, symbol order); `None`: the machine's defaults.
     pub params: Option<Vec<f64>>,
-    /// Predict with the exact machine at the identified values ([`crate::refine::exact_prediction`])
+    /// Predict with the exact machine at the identified values ([`crate::fitting::refine::exact_prediction`])
     /// instead of the first-order `H·v`: the difference is the second-order terms (about
     /// 1e-3 µm for errors of tens of µm and µrad).
     pub exact: bool,
@@ -59,7 +59,7 @@ pub enum ValidateError {
     Shape(String),
     /// The exact prediction failed.
     #[error(transparent)]
-    Simulate(#[from] crate::simulate::SimulateError),
+    Simulate(#[from] crate::simulation::readings::SimulateError),
     /// Parameters without a value, with [`Unidentified::Refuse`].
     #[error(
         "the identification gave no value for {}; cannot predict (choose to set them to 0)",
@@ -195,7 +195,7 @@ pub fn validate_with(
     }
     let y = measurement_vector(record)?;
     let p: Vec<f64> = if opts.exact {
-        crate::refine::exact_prediction(m, model, values, record, source.params())?
+        crate::fitting::refine::exact_prediction(m, model, values, record, source.params())?
             .iter()
             .flat_map(|r| r.iter().copied())
             .collect()

@@ -19,8 +19,8 @@
 //! Carlo (a seeded generator, so results are reproducible). Under Gaussian noise this test has
 //! level α exactly, whatever the correlation between candidates.
 
-use crate::distributions::f_upper_tail;
-use crate::rng::Rng;
+use crate::fitting::distributions::f_upper_tail;
+use crate::simulation::rng::Rng;
 use nalgebra::{DMatrix, DVector};
 
 /// A column whose part outside the span of the others is below this (relative to its norm) adds

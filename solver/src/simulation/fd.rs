@@ -1,7 +1,7 @@
 //! Error gains by central finite differences of the exact virtual machine.
 //!
 //! The gain of an error `ε` at a pose is `∂v/∂ε` at `ε = 0` (every other error zero), where
-//! `v = [position; orientation]` is the exact [`ErrorVector`](crate::ErrorVector) (tool minus
+//! `v = [position; orientation]` is the exact [`ErrorVector`](crate::simulation::ErrorVector) (tool minus
 //! workpiece, tool frame). Position rows are in mm/mm for translational errors and mm/rad for
 //! angular ones; orientation rows in 1/mm (always 0) and rad/rad. They are computed as
 //! `(v(+h) − v(−h)) / 2h`: this is the reference the symbolic engine is tested against.
@@ -20,7 +20,7 @@
 //!   1e-2 rad, 7e-11 at 3e-3, 1.1e-10 at 1e-3, 8e-10 at 1e-4. The default is `h = 1e-3` rad with
 //!   Richardson: ~1e-10 mm/rad, with a margin of 10 in `h` before the `h⁴` term shows.
 
-use crate::exact::{VirtualMachine, error_vector_of};
+use crate::simulation::exact::{VirtualMachine, error_vector_of};
 use model_spec::{ErrorId, Machine, Side};
 
 /// Finite-difference steps and scheme.

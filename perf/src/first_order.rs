@@ -5,10 +5,10 @@
 //! against (a generic "first-order HTM product" library), and a third independent check of the
 //! gains.
 
-use crate::exact::coordinate_rotation;
 use model_spec::kinematics::{Step, chain_steps};
 use model_spec::{AxisKind, ErrorId, Machine, Side, Value};
 use nalgebra::{Matrix3, Vector3};
+use solver::simulation::exact::coordinate_rotation;
 
 /// A machine's chains lowered once, for repeated evaluation.
 #[derive(Clone, Debug)]

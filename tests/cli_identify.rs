@@ -7,7 +7,7 @@
 
 use model_spec::Machine;
 use serde_json::Value;
-use solver::fitting::estimate::IdentifyOptions;
+use solver::fitting::IdentifyOptions;
 use solver::io::json::display_factor;
 use solver::model::Model;
 use solver::record::Record;
@@ -831,7 +831,7 @@ fn hidden_bias(m: &Machine, t: &Truth, k4: &Record) -> Vec<f64> {
         samples: k4.samples.clone(),
         measured,
     };
-    let fit = solver::fitting::estimate::identify(m, &reduced, &alone, &IdentifyOptions::default())
+    let fit = solver::fitting::identify(m, &reduced, &alone, &IdentifyOptions::default())
         .expect("identify");
     reduced
         .terms

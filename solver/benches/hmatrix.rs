@@ -7,8 +7,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use model_spec::Machine;
 use nalgebra::DVector;
-use solver::fitting::estimate::{Constraint, IdentifyOptions, Tolerances, identify, least_squares};
 use solver::fitting::hmatrix::{GainSource, h_matrix, parameter_names};
+use solver::fitting::{Constraint, IdentifyOptions, Tolerances, identify, least_squares};
 use solver::model::Model;
 use solver::record::Record;
 use std::hint::black_box;
@@ -64,10 +64,7 @@ fn estimation(c: &mut Criterion) {
     g.bench_function("reduced/identify", |b| {
         b.iter(|| identify(&m, &model, black_box(&rec), &IdentifyOptions::default()).unwrap())
     });
-    let zeroed = IdentifyOptions {
-        zeroed: true,
-        ..Default::default()
-    };
+    let zeroed = IdentifyOptions::new().zeroed(true);
     g.bench_function("reduced/identify_zeroed", |b| {
         b.iter(|| identify(&m, &model, black_box(&rec), &zeroed).unwrap())
     });

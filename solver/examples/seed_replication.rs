@@ -6,10 +6,10 @@
 //! Run: `cargo run --release -p solver --example seed_replication`. Prints Markdown tables.
 
 use model_spec::{ErrorKind, Machine, builtin};
-use solver::fitting::estimate::{Identification, IdentifyOptions, Tolerances, identify};
 use solver::fitting::hmatrix::GainSource;
 use solver::fitting::refine::{RefineOptions, refine};
 use solver::fitting::validate::{ValidateOptions, validate};
+use solver::fitting::{Identification, IdentifyOptions, Tolerances, identify};
 use solver::io::json::display_factor;
 use solver::model::{Effect, Model};
 use solver::record::Record;

@@ -7,10 +7,10 @@ mod common;
 use common::{Rng, builtin, id};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
-use solver::fitting::estimate::{
+use solver::fitting::hmatrix::{h_matrix_auto, parameter_names};
+use solver::fitting::{
     Constraint, EstimateError, IdentifyOptions, Tolerances, identify, least_squares,
 };
-use solver::fitting::hmatrix::{h_matrix_auto, parameter_names};
 use solver::model::Model;
 use solver::record::Record;
 use solver::simulation::error_vector;
@@ -222,10 +222,7 @@ fn zeroed_readings_offsets_swallow_xoc_yoa_zoa_and_the_rest_is_right() {
     for (sigma, seed) in [(0.0, 5), (0.5e-3, 6)] {
         let y = synthetic(&h, &x, sigma, seed, true);
         let data = with_measurements(rec.clone(), &y);
-        let opts = IdentifyOptions {
-            zeroed: true,
-            ..Default::default()
-        };
+        let opts = IdentifyOptions::new().zeroed(true);
         let ident = identify(&m, &model, &data, &opts).unwrap();
         let fit = &ident.fit;
         assert_eq!(fit.names.len(), 14);
@@ -257,11 +254,13 @@ fn zeroed_readings_offsets_swallow_xoc_yoa_zoa_and_the_rest_is_right() {
         }
         // A documented constraint gives the confounded parameters a value: fixing XOC, YOA,
         // ZOA to zero leaves the offsets determined.
-        let fixed = IdentifyOptions {
-            zeroed: true,
-            constraint: Constraint::Zero(vec!["X0C".into(), "YOA".into(), "ZOA".into()]),
-            ..Default::default()
-        };
+        let fixed = IdentifyOptions::new()
+            .zeroed(true)
+            .constraint(Constraint::Zero(vec![
+                "X0C".into(),
+                "YOA".into(),
+                "ZOA".into(),
+            ]));
         let f = identify(&m, &model, &data, &fixed).unwrap().fit;
         assert!(f.identifiability.confounded.is_empty());
         assert!(f.values.iter().all(Option::is_some));

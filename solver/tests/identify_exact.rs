@@ -3,11 +3,11 @@
 //! and the validation on K1 and K2.
 
 use model_spec::{Machine, builtin};
-use solver::fitting::estimate::{Constraint, Identification, IdentifyOptions, identify};
 use solver::fitting::hmatrix::GainSource;
 use solver::fitting::hmatrix::h_matrix;
 use solver::fitting::refine::{self, RefineOptions};
 use solver::fitting::validate::{ValidateOptions, validate};
+use solver::fitting::{Constraint, Identification, IdentifyOptions, identify};
 use solver::io::json::display_factor;
 use solver::model::{Effect, Model};
 use solver::record::Record;
@@ -33,20 +33,9 @@ fn reduced(m: &Machine) -> Model {
 
 /// Identifies `model` on `record` and refines against the exact machine.
 fn identify_refined(m: &Machine, model: &Model, record: &Record, zeroed: bool) -> Identification {
-    let opts = IdentifyOptions {
-        zeroed,
-        ..Default::default()
-    };
-    let mut source = GainSource::new(m, &model.errors(), &m.default_parameters()).unwrap();
-    let (ident, r) = refine::identify_refined(
-        m,
-        model,
-        record,
-        &mut source,
-        &opts,
-        &RefineOptions::default(),
-    )
-    .unwrap();
+    let opts = IdentifyOptions::new().zeroed(zeroed);
+    let (ident, r) =
+        refine::identify_refined(m, model, record, &opts, &RefineOptions::default()).unwrap();
     assert!(r.converged, "refinement converges: steps {:?}", r.steps_mm);
     ident
 }
@@ -280,10 +269,7 @@ fn a_path_that_cannot_separate_the_model_is_reported_not_solved_into_nonsense() 
     let aoc = ident.fit.values[j].expect("AOC is determined on K1");
     assert!((aoc * 1e6 - 30.0).abs() < 0.01, "AOC {} µrad", aoc * 1e6);
     // A constraint chosen by the user gives numbers, and says so.
-    let opts = IdentifyOptions {
-        constraint: Constraint::MinimumNorm,
-        ..Default::default()
-    };
+    let opts = IdentifyOptions::new().constraint(Constraint::MinimumNorm);
     let forced = identify(&m, &reduced(&m), &k1, &opts).unwrap();
     assert!(forced.fit.values.iter().all(Option::is_some));
 }

@@ -2,11 +2,9 @@
 
 use model_spec::builtin;
 use model_spec::terms::Term;
-use solver::fitting::estimate::{
-    Constraint, Tolerances, least_squares, measurement_vector, with_offsets,
-};
 use solver::fitting::hmatrix::{GainSource, h_matrix, parameter_names};
 use solver::fitting::streaming::identify_streaming;
+use solver::fitting::{Constraint, Tolerances, least_squares, measurement_vector, with_offsets};
 use solver::model::Model;
 use solver::record::Record;
 use solver::simulation::paths::builtin_path;

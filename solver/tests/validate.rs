@@ -6,11 +6,11 @@ mod common;
 use common::{Rng, builtin};
 use model_spec::Machine;
 use nalgebra::DVector;
-use solver::fitting::estimate::{IdentifyOptions, identify};
 use solver::fitting::hmatrix::h_matrix_auto;
 use solver::fitting::validate::{
     Unidentified, ValidateError, ValidateOptions, statistics, validate,
 };
+use solver::fitting::{IdentifyOptions, identify};
 use solver::io::json::{
     ReportError, identify_json, parse_identify_json, read_identify_json, validate_json,
 };
@@ -176,10 +176,7 @@ fn zeroed_readings_predict_zeroed_and_name_what_was_set_to_zero() {
     let model = reduced(&m);
     let x = truth();
     let data = measure(&m, &model, &x, k4(&m), 0.0, 1, true);
-    let opts = IdentifyOptions {
-        zeroed: true,
-        ..Default::default()
-    };
+    let opts = IdentifyOptions::new().zeroed(true);
     let ident = identify(&m, &model, &data, &opts).unwrap();
     let rec = measure(&m, &model, &x, k1(&m), 0.0, 2, true);
     let zeroed = ValidateOptions {
@@ -213,10 +210,7 @@ fn identify_json_has_the_fields_and_reads_back() {
     let mut x = truth();
     x.extend([12e-6, -7e-6, 0.002]);
     let data = measure(&m, &model, &x, k4(&m), 0.5e-3, 9, true);
-    let opts = IdentifyOptions {
-        zeroed: true,
-        ..Default::default()
-    };
+    let opts = IdentifyOptions::new().zeroed(true);
     let ident = identify(&m, &model, &data, &opts).unwrap();
     let report = identify_json(&m, "reduced+", &ident);
     let text = serde_json::to_string_pretty(&report).unwrap();

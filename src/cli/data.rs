@@ -1,15 +1,15 @@
 //! The inputs of `simulate`, `identify`, `validate` and `demo`, read from their flags: truths,
 //! test paths, measurement files, models (`--model`, `--terms`), constraints, and the
-//! identification itself (solver::fitting::estimate, refined by solver::fitting::refine). Every error names its
+//! identification itself (solver::fitting, refined by solver::fitting::refine). Every error names its
 //! flag; exit code 2 for a wrong command line, 1 for a file that cannot be read or does not fit.
 
 use super::{CliError, CliResult};
 use model_spec::Machine;
-use solver::fitting::estimate::{
+use solver::fitting::hmatrix::{GainSource, parameter_names};
+use solver::fitting::refine::{RefineError, RefineOptions, Refinement, identify_refined_with};
+use solver::fitting::{
     Constraint, EstimateError, Identification, IdentifyOptions, identify_with, with_offsets,
 };
-use solver::fitting::hmatrix::{GainSource, parameter_names};
-use solver::fitting::refine::{RefineError, RefineOptions, Refinement, identify_refined};
 use solver::io::csv::CsvError;
 use solver::model::{Effect, Model, Term};
 use solver::record::Record;
@@ -187,7 +187,7 @@ pub struct Identified {
     pub refinement: Option<Refinement>,
 }
 
-/// Identifies `model` of `m` on `record` (solver::fitting::estimate::identify_with), then, when
+/// Identifies `model` of `m` on `record` (solver::fitting::identify_with), then, when
 /// `exact`, refines it against the exact machine (solver::fitting::refine::refine) with the same gain
 /// source. `data` names the measurement flag in error messages.
 pub fn identify(
@@ -216,7 +216,7 @@ pub fn identify(
         other => CliError::failure(format!("--data: cannot identify: {other}")),
     };
     let (ident, refinement) = if exact {
-        let (ident, r) = identify_refined(m, model, record, &mut source, opts, &RefineOptions::default())
+        let (ident, r) = identify_refined_with(m, model, record, &mut source, opts, &RefineOptions::default())
             .map_err(|e| match e {
                 RefineError::Estimate(e) => cannot_identify(e),
                 other => CliError::failure(format!(

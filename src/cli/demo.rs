@@ -10,7 +10,7 @@ use super::{CliError, CliResult, Compiled, EXIT_CODES};
 use codegen::table::{self, render};
 use model_spec::{FULL_MODEL, Machine};
 use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose};
-use solver::fitting::estimate::IdentifyOptions;
+use solver::fitting::IdentifyOptions;
 use solver::fitting::refine::exact_prediction;
 use solver::fitting::validate::{ValidateOptions, Validation, statistics, validate};
 use solver::io::csv::format_record;
@@ -428,7 +428,7 @@ fn machine_line(m: &Machine) -> String {
 fn truth_table(
     m: &Machine,
     truth: &Truth,
-    ident: &solver::fitting::estimate::Identification,
+    ident: &solver::fitting::Identification,
     bias: Option<&[Option<f64>]>,
 ) -> String {
     let fit = &ident.fit;

@@ -1076,7 +1076,7 @@ pub fn plots(
         // The fitted record: the fits' own prediction (the minimum-norm solution, so that
         // confounded groups keep their combined effect), not zeroed: the offsets of --zeroed are
         // in the models. Held out: the values, zeroed like the readings (as the gain).
-        let predict = |fit: &solver::fitting::estimate::Identification| {
+        let predict = |fit: &solver::fitting::Identification| {
             let values: Vec<Option<f64>> = if *fitted {
                 fit.fit.solution.iter().map(|&v| Some(v)).collect()
             } else {

@@ -1,11 +1,11 @@
 //! `rtest identify`: the errors of a model from an R-test measurement, with uncertainties and
-//! what the data cannot separate (solver::fitting::estimate, solver::fitting::refine, solver::io::json).
+//! what the data cannot separate (solver::fitting, solver::fitting::refine, solver::io::json).
 
 use super::data::{self, Identified};
 use super::{CliError, CliResult, EXIT_CODES};
 use model_spec::Machine;
-use solver::fitting::estimate::{Constraint, IdentifyOptions};
 use solver::fitting::hmatrix::Backend;
+use solver::fitting::{Constraint, IdentifyOptions};
 use solver::io::json::{display_factor, identify_json};
 use std::path::PathBuf;
 
@@ -89,11 +89,9 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     let (label, model) = data::model(&m, args.model.as_deref(), args.terms.as_deref())?;
     let constraint = data::constraint(args.constraint.as_deref())?;
-    let opts = IdentifyOptions {
-        zeroed: args.zeroed,
-        constraint,
-        ..Default::default()
-    };
+    let opts = IdentifyOptions::new()
+        .zeroed(args.zeroed)
+        .constraint(constraint);
     let data_name = args.data.display().to_string();
     let (result, first_reading_zero) = if args.stream {
         if args.block == 0 {
@@ -104,7 +102,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         )
         .map_err(|e| match e {
             solver::fitting::streaming::StreamingError::Estimate(
-                solver::fitting::estimate::EstimateError::UnknownParameter(name, names),
+                solver::fitting::EstimateError::UnknownParameter(name, names),
             ) => CliError::usage(format!(
                 "--constraint: `{name}` is not a parameter of the model (parameters: {names})"
             )),

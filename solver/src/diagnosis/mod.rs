@@ -22,12 +22,12 @@ pub mod select;
 pub mod structure;
 
 use crate::fitting::distributions::f_upper_tail;
-use crate::fitting::estimate::{
+use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::refine::{RefineError, RefineOptions, identify_refined_with};
+use crate::fitting::validate::{ValidateError, ValidateOptions, validate_with};
+use crate::fitting::{
     EstimateError, Identification, IdentifyOptions, Tolerances, measurement_vector, with_offsets,
 };
-use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
-use crate::fitting::refine::{RefineError, RefineOptions, identify_refined};
-use crate::fitting::validate::{ValidateError, ValidateOptions, validate_with};
 use crate::model::Model;
 use crate::record::Record;
 use dictionary::{DictionaryOptions, dictionary};
@@ -177,6 +177,19 @@ pub enum DiagnoseError {
     /// A validation failed.
     #[error(transparent)]
     Validate(#[from] ValidateError),
+    /// The refinement of a fit against the exact machine did not converge.
+    #[error(
+        "the refinement against the exact machine did not converge for the model [{model}] ({iterations} Gauss-Newton steps, the last moved the prediction by {:.3e} µm)",
+        last_step_mm * 1e3
+    )]
+    NotConverged {
+        /// The parameters of the model fitted.
+        model: String,
+        /// Steps taken.
+        iterations: usize,
+        /// The last step's largest change of the prediction, mm.
+        last_step_mm: f64,
+    },
 }
 
 /// A step of the selection, before the extended fit gives its values.
@@ -203,8 +216,15 @@ fn fit(
         tolerances: o.tolerances,
         params: None,
     };
-    let (mut ident, _) =
-        identify_refined(m, model, record, source, &opts, &RefineOptions::default())?;
+    let (mut ident, refinement) =
+        identify_refined_with(m, model, record, source, &opts, &RefineOptions::default())?;
+    if !refinement.converged {
+        return Err(DiagnoseError::NotConverged {
+            model: ident.fit.names.join(", "),
+            iterations: refinement.iterations,
+            last_step_mm: refinement.steps_mm.last().copied().unwrap_or(0.0),
+        });
+    }
     ident.zeroed = o.zeroed;
     Ok(ident)
 }

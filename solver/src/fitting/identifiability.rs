@@ -1,5 +1,5 @@
 //! What the data can and cannot tell apart, from the singular value decomposition of the
-//! column-scaled H matrix `A = H·S⁻¹` (see [`crate::fitting::estimate`]).
+//! column-scaled H matrix `A = H·S⁻¹` (see [`crate::fitting`]).
 //!
 //! - The **null space** `N` (p × (p − r)): the right singular vectors of the singular values
 //!   at or below the rank tolerance. A change `δ = S⁻¹·N·c` of the parameters changes the

@@ -3,8 +3,10 @@
 //!
 //! - [`hmatrix`]: the design matrix of a model on a record, with gains from compiled code or
 //!   the in-process evaluator ([`hmatrix::GainSource`]);
-//! - [`estimate`]: column-scaled least squares with a stated numerical rank, uncertainties, and
-//!   no number for what the data cannot determine; identification of a model on a record;
+//! - [`least_squares`]: column-scaled least squares with a stated numerical rank,
+//!   uncertainties, and no number for what the data cannot determine;
+//! - [`mod@identify`]: a model identified on a record (first order), with what the sensor
+//!   offsets swallow;
 //! - [`identifiability`]: what the data can and cannot tell apart;
 //! - [`refine`]: Gauss–Newton against the exact machine, removing the second-order bias;
 //! - [`streaming`]: identification of long records in blocks, memory bounded by the model;
@@ -12,17 +14,22 @@
 //! - [`distributions`]: the F and t distributions of the significance tests.
 
 pub mod distributions;
-pub mod estimate;
 pub mod hmatrix;
 pub mod identifiability;
+pub mod identify;
+pub mod least_squares;
 pub mod refine;
 pub mod streaming;
 pub mod validate;
 
-pub use estimate::{
-    Constraint, EstimateError, Fit, Identification, IdentifyOptions, Tolerances, identify,
-    identify_with, least_squares,
-};
 pub use hmatrix::{Backend, GainSource, HMatrixError, h_matrix};
-pub use refine::{RefineError, RefineOptions, Refinement, identify_refined};
+pub use identify::{
+    Identification, IdentifyOptions, check_readings, gain_source, identify, identify_with,
+    measurement_vector, with_offsets,
+};
+pub use least_squares::{
+    Constraint, EstimateError, Fit, RANK_RELATIVE_TOLERANCE, Tolerances, least_squares,
+    least_squares_reduced,
+};
+pub use refine::{RefineError, RefineOptions, Refinement, identify_refined, identify_refined_with};
 pub use validate::{ValidateError, ValidateOptions, Validation, validate};

@@ -21,11 +21,11 @@
 //! After convergence the fit's residual, σ̂, uncertainties and covariance are those of the exact
 //! residual; the identifiability analysis is unchanged (it depends on H only).
 
-use crate::fitting::estimate::{
-    EstimateError, Identification, IdentifyOptions, Tolerances, identify_with, least_squares,
-    measurement_vector,
-};
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::{
+    EstimateError, Identification, IdentifyOptions, Tolerances, gain_source, identify_with,
+    least_squares, measurement_vector,
+};
 use crate::model::Model;
 use crate::record::Record;
 use crate::simulation::readings::{SimulateError, simulate};
@@ -33,8 +33,9 @@ use crate::simulation::truth::Truth;
 use model_spec::Machine;
 use nalgebra::DVector;
 
-/// How far to refine.
+/// How far to refine (`RefineOptions::default()`, then set the fields wanted).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct RefineOptions {
     /// Most Gauss–Newton steps.
     pub max_iterations: usize,
@@ -59,7 +60,9 @@ pub struct Refinement {
     /// Per step, the largest change of the prediction any correction makes: `max_j |Δ_j|·‖h_j‖∞`
     /// (mm).
     pub steps_mm: Vec<f64>,
-    /// `true` when the last step was below the tolerance.
+    /// `true` when the last step was below the tolerance. `false` when the iteration limit was
+    /// reached or a step grew (divergence): the values are then not an identification, and
+    /// callers must not report them as one.
     pub converged: bool,
     /// Residual RMS of the linear fit and of the refined one (mm, over 3N rows).
     pub rms_mm: (f64, f64),
@@ -77,6 +80,14 @@ pub enum RefineError {
     /// The exact prediction failed.
     #[error(transparent)]
     Simulate(#[from] SimulateError),
+    /// A step produced a non-finite value: the iteration diverged.
+    #[error(
+        "the refinement against the exact machine diverged to non-finite values at step {iterations}"
+    )]
+    NotFinite {
+        /// The step at which it happened.
+        iterations: usize,
+    },
 }
 
 /// The exact machine's error vector (mm, tool frame) at every sample of `record` with the
@@ -136,9 +147,20 @@ pub fn refine(
             *v += d;
             step = step.max(d.abs() * influence[j]);
         }
+        if !step.is_finite() || x.iter().any(|v| !v.is_finite()) {
+            return Err(RefineError::NotFinite {
+                iterations: steps.len() + 1,
+            });
+        }
+        let growing = steps.last().is_some_and(|&last| step > last);
         steps.push(step);
         if step <= opts.tolerance_mm {
             converged = true;
+            break;
+        }
+        if growing {
+            // Gauss–Newton contracts by the ratio of the second- to the first-order terms; a
+            // step larger than the one before means it is diverging.
             break;
         }
     }
@@ -164,10 +186,30 @@ pub fn refine(
     })
 }
 
-/// Identifies `model` on `record` with gains from `source`
-/// ([`crate::fitting::estimate::identify_with`]) and refines the result against the exact machine
-/// ([`refine`], with the identification's tolerances).
+/// Identifies `model` on `record` ([`crate::fitting::identify`], with the gain source it
+/// needs built here) and refines the result against the exact machine ([`refine`], with the
+/// identification's tolerances). A refinement that did not converge is returned with
+/// [`Refinement::converged`] `false`.
+///
+/// # Errors
+/// As [`crate::fitting::identify_with`] and [`refine`].
 pub fn identify_refined(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    opts: &IdentifyOptions,
+    refine_opts: &RefineOptions,
+) -> Result<(Identification, Refinement), RefineError> {
+    let mut source = gain_source(m, model, opts)?;
+    identify_refined_with(m, model, record, &mut source, opts, refine_opts)
+}
+
+/// [`identify_refined`] with gains from `source` (covering the fitted model's errors), for
+/// callers that fit several models of one machine with one source.
+///
+/// # Errors
+/// As [`identify_refined`].
+pub fn identify_refined_with(
     m: &Machine,
     model: &Model,
     record: &Record,

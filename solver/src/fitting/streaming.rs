@@ -6,14 +6,14 @@
 //! - `R₁₁` (p × p) and `z = R₁₂` (p) satisfy `R₁₁ᵀR₁₁ = HᵀH` and `R₁₁ᵀz = Hᵀy`;
 //! - `R₂₂²` is the part of `‖y‖²` that no combination of the columns reaches,
 //!
-//! and [`crate::fitting::estimate::least_squares_reduced`] gives exactly the in-memory solver's estimate,
+//! and [`crate::fitting::least_squares_reduced`] gives exactly the in-memory solver's estimate,
 //! rank, uncertainties, covariance and identifiability. Memory: `(p+1)²` numbers plus one block,
 //! whatever the number of samples. Time: `O(rows · p²)`, like one QR of the whole H.
 
-use crate::fitting::estimate::{
+use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix_spanned, parameter_names};
+use crate::fitting::{
     Constraint, EstimateError, Fit, Tolerances, least_squares_reduced, measurement_vector,
 };
-use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix_spanned, parameter_names};
 use crate::model::Model;
 use crate::record::Record;
 use model_spec::Machine;
@@ -68,7 +68,7 @@ impl StreamingQr {
         self.r.len() * std::mem::size_of::<f64>()
     }
 
-    /// The least-squares fit of all rows seen (see [`crate::fitting::estimate::least_squares`]).
+    /// The least-squares fit of all rows seen (see [`crate::fitting::least_squares`]).
     pub fn solve(
         &self,
         names: &[String],
@@ -112,7 +112,7 @@ pub struct StreamingIdentification {
 
 /// Identifies `model` from `blocks` of one record (each a [`Record`] with measurements;
 /// `time_span` `(t0, t1)` is the whole record's, s, for `time:K` terms), with gains from
-/// `source`. First-order least squares, as [`crate::fitting::estimate::identify_with`] without the
+/// `source`. First-order least squares, as [`crate::fitting::identify_with`] without the
 /// refinement (which needs the whole record).
 pub fn identify_streaming<E: std::error::Error + 'static>(
     m: &Machine,
@@ -145,24 +145,21 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
 
 /// Identifies `model` of `m` from the measurement CSV at `path`, read in blocks of `block`
 /// samples (never the whole record, never the whole H): first-order least squares, with the
-/// options of [`crate::fitting::estimate::identify`] (zeroed readings add `dx0 dy0 dz0`). A model with
+/// options of [`crate::fitting::identify`] (zeroed readings add `dx0 dy0 dz0`). A model with
 /// `time:K` terms costs one more pass over the file for the record's time span.
 pub fn identify_file(
     m: &Machine,
     model: &Model,
     path: &std::path::Path,
-    opts: &crate::fitting::estimate::IdentifyOptions,
+    opts: &crate::fitting::IdentifyOptions,
     block: usize,
 ) -> Result<
-    (
-        crate::fitting::estimate::Identification,
-        StreamingIdentification,
-    ),
+    (crate::fitting::Identification, StreamingIdentification),
     StreamingError<crate::io::csv::CsvError>,
 > {
     use crate::io::csv::{MeasurementBlocks, time_span};
     let fitted = if opts.zeroed {
-        crate::fitting::estimate::with_offsets(model)
+        crate::fitting::with_offsets(model)
     } else {
         model.clone()
     };
@@ -190,7 +187,7 @@ pub fn identify_file(
         &opts.constraint,
         &opts.tolerances,
     )?;
-    let ident = crate::fitting::estimate::Identification::new(
+    let ident = crate::fitting::Identification::new(
         m,
         fitted,
         run.fit.clone(),

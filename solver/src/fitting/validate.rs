@@ -13,8 +13,8 @@
 //! - Per direction d ∈ {x, y, z}: RMS `√(Σ_i r_id² / N)` and max `|r_id|`; over all three:
 //!   RMS `√(Σ_i Σ_d r_id² / 3N)`, max over all.
 
-use crate::fitting::estimate::{EstimateError, measurement_vector};
 use crate::fitting::hmatrix::{GainSource, HMatrixError, check_model, h_matrix, parameter_names};
+use crate::fitting::{EstimateError, measurement_vector};
 use crate::model::Model;
 use crate::record::Record;
 use model_spec::Machine;

@@ -17,9 +17,9 @@
 //! {"measured_rms_um", "measured_max_um", "residual_rms_um", "residual_max_um"}, "y": …, "z": …},
 //! …}`, RMS over all three directions `√(Σ r² / 3N)`.
 
-use crate::fitting::estimate::{Constraint, Identification};
 use crate::fitting::hmatrix::Backend;
 use crate::fitting::validate::{Stats, Validation};
+use crate::fitting::{Constraint, Identification};
 use crate::model::Basis;
 use crate::model::{Effect, Model, Term};
 use model_spec::Machine;

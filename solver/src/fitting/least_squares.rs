@@ -19,14 +19,11 @@
 //! 5. Covariance `C = σ̂²·S⁻¹·V_r·Σ_r⁻²·V_rᵀ·S⁻¹`, std `√C_jj`, correlation
 //!    `C_jk / √(C_jj·C_kk)`; condition number `κ = σ_max / σ_r` of the scaled H.
 
-use crate::fitting::hmatrix::{Backend, GainSource, HMatrixError, h_matrix, parameter_names};
+use crate::fitting::hmatrix::HMatrixError;
 use crate::fitting::identifiability::{
-    CORRELATION_LIMIT, DETERMINED_TOLERANCE, Identifiability, LINK_TOLERANCE, Swallowed,
-    near_confounded, null_space_groups, swallowed_by_offsets,
+    CORRELATION_LIMIT, DETERMINED_TOLERANCE, Identifiability, LINK_TOLERANCE, near_confounded,
+    null_space_groups,
 };
-use crate::model::{Effect, Model, Term};
-use crate::record::Record;
-use model_spec::{Dir, Machine};
 use nalgebra::{DMatrix, DVector, SVD};
 
 /// Default `ρ`: singular values of the scaled H below `ρ·σ_max` count as zero (condition
@@ -90,6 +87,20 @@ pub enum EstimateError {
     /// A parameter named in [`Constraint::Zero`] is not in the model.
     #[error("constraint: `{0}` is not a parameter of the model (parameters: {1})")]
     UnknownParameter(String, String),
+    /// Fewer readings than parameters plus one: no degree of freedom would be left for σ̂.
+    #[error(
+        "too few samples: {samples} samples give {readings} readings (3 per sample) for {parameters} parameters; at least {} readings ({} samples) are needed",
+        parameters + 1,
+        (parameters + 3) / 3
+    )]
+    TooFewReadings {
+        /// Samples of the record.
+        samples: usize,
+        /// Readings (3 per sample).
+        readings: usize,
+        /// Parameters of the model.
+        parameters: usize,
+    },
     /// The SVD did not converge.
     #[error("the singular value decomposition of the {0}×{1} scaled H matrix did not converge")]
     Svd(usize, usize),
@@ -369,162 +380,4 @@ fn solve(
         },
         constraint: constraint.clone(),
     })
-}
-
-/// The stacked measured error vectors of `record` (mm): `[x₀, y₀, z₀, x₁, …]`.
-///
-/// # Errors
-/// No measurements, one row per sample missing, or a value that is not finite.
-pub fn measurement_vector(record: &Record) -> Result<DVector<f64>, EstimateError> {
-    if record.measured.len() != record.samples.len() {
-        return Err(EstimateError::Shape(format!(
-            "the record has {} samples but {} measured error vectors",
-            record.samples.len(),
-            record.measured.len()
-        )));
-    }
-    let y = DVector::from_iterator(
-        3 * record.measured.len(),
-        record.measured.iter().flat_map(|r| r.iter().copied()),
-    );
-    if let Some(i) = y.iter().position(|v| !v.is_finite()) {
-        return Err(EstimateError::NotFinite(format!(
-            "the measured {} of sample {}",
-            ["dx", "dy", "dz"][i % 3],
-            i / 3
-        )));
-    }
-    Ok(y)
-}
-
-/// `model` with the constant sensor offsets `dx0 dy0 dz0` appended (those it lacks).
-pub fn with_offsets(model: &Model) -> Model {
-    let mut out = model.clone();
-    for d in Dir::ALL {
-        let t = Term {
-            effect: Effect::SensorOffset(d),
-            basis: crate::model::Basis::Const,
-        };
-        if !out.terms.contains(&t) {
-            out.terms.push(t);
-        }
-    }
-    out
-}
-
-/// Options of [`identify`].
-#[derive(Clone, Debug, PartialEq, Default)]
-pub struct IdentifyOptions {
-    /// The readings were zeroed at the first sample: the constant offsets `dx0 dy0 dz0` join
-    /// the model (they absorb the unknown reading subtracted), and [`Identification::swallowed`]
-    /// says which errors they cannot be told from.
-    pub zeroed: bool,
-    /// What to do with undetermined parameters.
-    pub constraint: Constraint,
-    /// Rank and identifiability tolerances.
-    pub tolerances: Tolerances,
-    /// Kinematic parameters (mm, symbol order); `None`: the machine's defaults.
-    pub params: Option<Vec<f64>>,
-}
-
-/// An identification: the fitted model and its fit.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Identification {
-    /// The machine's name.
-    pub machine: String,
-    /// The model fitted (with `dx0 dy0 dz0` when the readings were zeroed); its columns are the
-    /// fit's parameters.
-    pub model: Model,
-    /// The least-squares fit.
-    pub fit: Fit,
-    /// Number of samples used.
-    pub samples: usize,
-    /// Whether the readings were zeroed at the first sample.
-    pub zeroed: bool,
-    /// Per confounded group with a sensor offset: the errors it swallows.
-    pub swallowed: Vec<Swallowed>,
-    /// Which code computed the gains.
-    pub backend: Backend,
-}
-
-/// Identifies `model` of `m` from the measured `record`, with the best gain source (compiled
-/// code for built-in machines, the evaluator otherwise).
-///
-/// # Errors
-/// See [`identify_with`].
-pub fn identify(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    opts: &IdentifyOptions,
-) -> Result<Identification, EstimateError> {
-    let params = opts
-        .params
-        .clone()
-        .unwrap_or_else(|| m.default_parameters());
-    crate::fitting::hmatrix::check_model(m, model)?;
-    let mut source = GainSource::new(m, &model.errors(), &params)?;
-    identify_with(m, model, record, &mut source, opts)
-}
-
-/// As [`identify`], with gains from `source` (which must cover the model's errors; its
-/// parameters are used, `opts.params` is ignored).
-///
-/// # Errors
-/// A model or record that does not fit `m`, a record without (finite) measurements, no samples,
-/// a bad constraint, an SVD that does not converge.
-pub fn identify_with(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    source: &mut GainSource,
-    opts: &IdentifyOptions,
-) -> Result<Identification, EstimateError> {
-    let fitted = if opts.zeroed {
-        with_offsets(model)
-    } else {
-        model.clone()
-    };
-    let y = measurement_vector(record)?;
-    let h = h_matrix(m, &fitted, record, source)?;
-    let names = parameter_names(m, &fitted);
-    let fit = least_squares(&h, &y, &names, &opts.constraint, &opts.tolerances)?;
-    Ok(Identification::new(
-        m,
-        fitted,
-        fit,
-        record.samples.len(),
-        opts.zeroed,
-        source.backend(),
-    ))
-}
-
-impl Identification {
-    /// An identification of `model` (the model fitted, offsets included) by `fit`, with what
-    /// the sensor offsets swallow derived from the fit's confounded groups.
-    pub fn new(
-        m: &Machine,
-        model: Model,
-        fit: Fit,
-        samples: usize,
-        zeroed: bool,
-        backend: Backend,
-    ) -> Identification {
-        let is_offset: Vec<bool> = model
-            .columns()
-            .iter()
-            .map(|&(t, _)| matches!(model.terms[t].effect, Effect::SensorOffset(_)))
-            .collect();
-        let swallowed =
-            swallowed_by_offsets(&fit.names, &fit.identifiability.confounded, &is_offset);
-        Identification {
-            machine: m.name.clone(),
-            model,
-            fit,
-            samples,
-            zeroed,
-            swallowed,
-            backend,
-        }
-    }
 }

@@ -111,7 +111,9 @@ pub(crate) fn plan_in_dir(label: &str, dir: &Path, name: &str) -> Result<Planned
             &target,
             Cause::NotADirectory(dir.to_path_buf()),
         )),
-        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+        Err(e)
+            if e.kind() == io::ErrorKind::NotFound || e.raw_os_error() == Some(libc::ENOTDIR) =>
+        {
             check_dir(label, dir).map_err(|e| match e {
                 WriteError::Cannot { label, cause, .. } => WriteError::Cannot {
                     label,
@@ -143,6 +145,8 @@ pub fn check_dir(label: &str, dir: &Path) -> Result<(), WriteError> {
             Ok(m) if m.is_dir() => return dir_writable(current).map_err(fail),
             Ok(_) => return Err(fail(Cause::NotADirectory(current.to_path_buf()))),
             Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+            // A file somewhere above: the loop finds it.
+            Err(e) if e.raw_os_error() == Some(libc::ENOTDIR) => {}
             Err(e) => return Err(fail(Cause::Io(e))),
         }
         current = match current.parent() {

@@ -9,7 +9,7 @@ use std::fs::{self, Metadata};
 use std::io;
 use std::os::unix::ffi::OsStrExt;
 use std::os::unix::fs::{FileTypeExt, MetadataExt};
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 use std::str::FromStr;
 
 use crate::error::Cause;
@@ -138,6 +138,9 @@ pub(crate) fn resolve(path: &Path) -> Result<Resolved, Cause> {
         let meta = match fs::symlink_metadata(&current) {
             Ok(meta) => meta,
             Err(e) if e.kind() == io::ErrorKind::NotFound => return missing(current),
+            Err(e) if e.raw_os_error() == Some(libc::ENOTDIR) => {
+                return Err(not_a_directory(&current, e));
+            }
             Err(e) => return Err(Cause::Io(e)),
         };
         let kind = meta.file_type();
@@ -182,32 +185,43 @@ fn missing(path: PathBuf) -> Result<Resolved, Cause> {
         Err(e) if e.kind() == io::ErrorKind::NotFound => {
             Err(Cause::MissingDirectory(dir.to_path_buf()))
         }
-        Err(e) if e.raw_os_error() == Some(libc::ENOTDIR) => {
-            Err(Cause::NotADirectory(dir.to_path_buf()))
-        }
+        Err(e) if e.raw_os_error() == Some(libc::ENOTDIR) => Err(not_a_directory(dir, e)),
         Err(e) => Err(Cause::Io(e)),
     }
+}
+
+/// The cause of `ENOTDIR` for `path`: the nearest ancestor that exists and is not a directory.
+pub(crate) fn not_a_directory(path: &Path, error: io::Error) -> Cause {
+    path.ancestors()
+        .skip(1)
+        .filter(|a| !a.as_os_str().is_empty())
+        .find(|a| fs::metadata(a).is_ok_and(|m| !m.is_dir()))
+        .map(|a| Cause::NotADirectory(a.to_path_buf()))
+        .unwrap_or(Cause::Io(error))
 }
 
 /// A path that may not exist yet, made comparable: the canonical form of its longest existing
 /// ancestor joined with the rest.
 pub(crate) fn normalize_missing(path: &Path) -> PathBuf {
     let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
-    let mut tail = Vec::new();
-    let mut current = absolute.as_path();
-    loop {
-        if let Ok(mut found) = fs::canonicalize(current) {
-            found.extend(tail.iter().rev());
-            return found;
-        }
-        match (current.parent(), current.file_name()) {
-            (Some(parent), Some(name)) => {
-                tail.push(name);
-                current = parent;
+    let parts: Vec<Component> = absolute.components().collect();
+    for known in (1..=parts.len()).rev() {
+        let Ok(mut out) = fs::canonicalize(parts[..known].iter().collect::<PathBuf>()) else {
+            continue;
+        };
+        // What follows does not exist, so holds no link: `..` is lexical there.
+        for part in &parts[known..] {
+            match part {
+                Component::ParentDir => {
+                    out.pop();
+                }
+                Component::Normal(name) => out.push(name),
+                _ => {}
             }
-            _ => return absolute.clone(),
         }
+        return out;
     }
+    absolute
 }
 
 /// Who the file at `path` is, following symbolic links: an existing file by inode, a missing one

@@ -99,10 +99,8 @@ impl Transaction {
             }
         }
         for d in missing.into_iter().rev() {
-            match fs::create_dir(&d) {
-                Ok(()) => self.created_dirs.push(d),
-                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
-                Err(e) => return Err(e),
+            if let Some(created) = temp::create_dir(&d)? {
+                self.created_dirs.push(created);
             }
         }
         Ok(())
@@ -200,6 +198,9 @@ impl Transaction {
                 temp::remove(b);
             }
         }
+        for d in &self.created_dirs {
+            temp::keep_dir(d);
+        }
     }
 
     /// Undoes everything done so far, newest first (best effort).
@@ -234,7 +235,7 @@ impl Transaction {
             temp::remove(&s.temp);
         }
         for d in self.created_dirs.iter().rev() {
-            let _ = fs::remove_dir(d);
+            temp::remove_dir(d);
         }
     }
 }

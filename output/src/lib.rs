@@ -70,10 +70,11 @@
 //!
 //! # Signals
 //!
-//! Every temporary and backup is registered process-wide while it exists. When the first one
-//! is created, SIGINT and SIGTERM get a watcher (unless they are ignored or handled already):
-//! on either signal it removes every registered temporary and then ends the process by the
-//! signal's default action, so the parent still sees death by that signal. No file work is
+//! Every temporary and backup, and every directory created for the outputs, is registered
+//! process-wide until it is kept or removed. When the first one is created, SIGINT and SIGTERM
+//! get a watcher (unless they are ignored or handled already): on either signal it removes
+//! every registered temporary (and each registered directory left empty) and then ends the
+//! process by the signal's default action, so the parent still sees death by that signal. No file work is
 //! done inside a signal handler. `SIGKILL` cannot be caught: it may leave a temporary behind
 //! (a hidden `.*.rtest-*.tmp` file that is safe to delete).
 //!

@@ -2,7 +2,8 @@
 //!
 //! The first time a temporary is about to be created, SIGINT and SIGTERM are registered with
 //! the `signal-hook` crate and a watcher thread waits on its iterator. On a signal the watcher
-//! takes the registry's lock, removes every registered temporary, and then terminates the
+//! takes the registry's lock, removes every registered temporary (and every directory created
+//! for the outputs, if empty), and then terminates the
 //! process with the signal's default action (`emulate_default_handler`), so that the parent
 //! sees death by that signal, exactly as without this crate.
 //!
@@ -57,7 +58,7 @@ pub(crate) fn install() {
                 let _ = ready.send(());
                 if let Some(signal) = signals.forever().next() {
                     let mut live = temp::lock();
-                    temp::remove_all(&mut live);
+                    live.remove_all();
                     // Keeps the lock: the process ends here.
                     let _ = emulate_default_handler(signal);
                 }

@@ -1,5 +1,6 @@
 //! Temporary files: unpredictable names, created without ever following a link, and registered
-//! process-wide so that every error path and a terminating signal can remove them.
+//! process-wide (with the directories created for outputs) so that every error path and a
+//! terminating signal can remove them.
 //!
 //! A temporary is `.{name}.rtest-{16 hex digits}.tmp` in the directory of the file it will
 //! replace (so that the final `rename` stays on one file system); the backup hard link of a file
@@ -35,11 +36,34 @@ const ATTEMPTS: usize = 100;
 /// name stays within the 255 bytes a directory entry allows.
 const NAME_BYTES: usize = 200;
 
-/// The live temporaries (and backups) of this process, as absolute paths.
-static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// What this process has created and not yet kept or removed, as absolute paths.
+pub(crate) struct Live {
+    /// Temporaries and backups.
+    files: Vec<PathBuf>,
+    /// Directories created for outputs (removed only if empty).
+    dirs: Vec<PathBuf>,
+}
+
+impl Live {
+    /// Removes every registered temporary, then every registered directory that is empty,
+    /// newest first; the caller keeps the lock so that nothing new can be created after.
+    pub(crate) fn remove_all(&mut self) {
+        for path in self.files.drain(..) {
+            let _ = fs::remove_file(path);
+        }
+        for dir in self.dirs.drain(..).rev() {
+            let _ = fs::remove_dir(dir);
+        }
+    }
+}
+
+static LIVE: Mutex<Live> = Mutex::new(Live {
+    files: Vec::new(),
+    dirs: Vec::new(),
+});
 
 /// The registry, locked; a panic elsewhere while holding it does not make it unusable.
-pub(crate) fn lock() -> MutexGuard<'static, Vec<PathBuf>> {
+pub(crate) fn lock() -> MutexGuard<'static, Live> {
     LIVE.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
@@ -87,7 +111,7 @@ fn create_with(
         let path = dir.join(name_for(name, random_bits(), suffix));
         match make(&path) {
             Ok(()) => {
-                live.push(path.clone());
+                live.files.push(path.clone());
                 return Ok(path);
             }
             Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
@@ -129,7 +153,7 @@ pub(crate) fn backup(file: &Path, dir: &Path, name: &OsStr) -> io::Result<PathBu
 pub(crate) fn rename(temp: &Path, to: &Path) -> io::Result<()> {
     let mut live = lock();
     fs::rename(temp, to)?;
-    live.retain(|p| p != temp);
+    live.files.retain(|p| p != temp);
     Ok(())
 }
 
@@ -137,20 +161,40 @@ pub(crate) fn rename(temp: &Path, to: &Path) -> io::Result<()> {
 pub(crate) fn remove(temp: &Path) {
     let mut live = lock();
     let _ = fs::remove_file(temp);
-    live.retain(|p| p != temp);
+    live.files.retain(|p| p != temp);
 }
 
 /// Forgets the registered `path` without removing it (a backup that could not be put back,
 /// which holds the only copy of a file's old contents).
 pub(crate) fn forget(path: &Path) {
-    lock().retain(|p| p != path);
+    lock().files.retain(|p| p != path);
 }
 
-/// Removes every registered temporary, keeping the lock so that none can be created after.
-pub(crate) fn remove_all(live: &mut Vec<PathBuf>) {
-    for path in live.drain(..) {
-        let _ = fs::remove_file(path);
+/// Creates the directory `dir` and registers it; `Ok(None)` if it exists already.
+pub(crate) fn create_dir(dir: &Path) -> io::Result<Option<PathBuf>> {
+    let dir = std::path::absolute(dir)?;
+    let mut live = lock();
+    signals::install();
+    match fs::create_dir(&dir) {
+        Ok(()) => {
+            live.dirs.push(dir.clone());
+            Ok(Some(dir))
+        }
+        Err(e) if e.kind() == io::ErrorKind::AlreadyExists => Ok(None),
+        Err(e) => Err(e),
     }
+}
+
+/// Removes the registered directory `dir` if it is empty, and forgets it.
+pub(crate) fn remove_dir(dir: &Path) {
+    let mut live = lock();
+    let _ = fs::remove_dir(dir);
+    live.dirs.retain(|d| d != dir);
+}
+
+/// Forgets the registered directory `dir`: it stays.
+pub(crate) fn keep_dir(dir: &Path) {
+    lock().dirs.retain(|d| d != dir);
 }
 
 #[cfg(test)]

@@ -127,3 +127,60 @@ fn stdout_is_not_written_when_a_file_fails() {
     );
     assert!(!String::from_utf8_lossy(&out.stdout).contains("x,y"));
 }
+
+#[test]
+fn standard_output_redirected_to_an_output_file_is_refused() {
+    const TEST: &str = "standard_output_redirected_to_an_output_file_is_refused";
+    if is_child(TEST) {
+        let dir = common::child_dir();
+        let mut o = Outputs::new();
+        o.add("-o", Target::Stdout, "table\n");
+        o.add("--json", Target::Path(dir.join("./out.txt")), "{}");
+        let err = o.write_all().unwrap_err();
+        eprintln!("ERROR: {err}");
+        std::process::exit(0);
+    }
+    let dir = TestDir::new(TEST);
+    let out = dir.file("out.txt", "");
+    let exe = std::env::current_exe().unwrap();
+    let child = child_command(&exe, TEST, &dir.path)
+        .stdout(fs::File::create(&out).unwrap())
+        .output()
+        .unwrap();
+    assert!(child.status.success());
+    let stderr = String::from_utf8_lossy(&child.stderr);
+    let expected = format!(
+        "ERROR: --json: `{}` is also the output of -o (standard output)\n",
+        dir.join("./out.txt").display()
+    );
+    assert!(stderr.contains(&expected), "{stderr}");
+    assert!(!read(&out).contains("table"));
+}
+
+#[test]
+fn a_character_device_stays_a_device() {
+    // A null device node made in the test's own directory (root only; skipped where the
+    // system does not allow it).
+    let dir = TestDir::new("char_device");
+    let node = dir.join("null");
+    let c = std::ffi::CString::new(node.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    let rc = unsafe { libc::mknod(c.as_ptr(), libc::S_IFCHR | 0o666, libc::makedev(1, 3)) };
+    if rc != 0 || fs::OpenOptions::new().write(true).open(&node).is_err() {
+        return;
+    }
+    symlink("null", dir.join("link")).unwrap();
+    let before = snapshot(&dir.path);
+    let mut o = Outputs::new();
+    o.add("-o", Target::Path(node.clone()), "discarded");
+    // Two outputs may share a character device (nothing is lost writing twice to it).
+    o.add("--json", Target::Path(dir.join("link")), "discarded too");
+    o.write_all().unwrap();
+    assert!(
+        fs::symlink_metadata(&node)
+            .unwrap()
+            .file_type()
+            .is_char_device()
+    );
+    assert_only_changed(&before, &snapshot(&dir.path), &[]);
+}

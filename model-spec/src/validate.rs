@@ -5,8 +5,9 @@ use crate::catalogue::{
     ErrorId, ErrorKind, ErrorTerm, Motion, component_name, iso_rank, location_motions,
     location_name, six_motions, squareness_rotations,
 };
-use crate::error::{Locator, SpecError};
+use crate::error::SpecError;
 use crate::geometry::{Dir, Direction};
+use crate::locate::Locator;
 use crate::machine::{
     Axis, AxisId, AxisKind, Chain, FULL_MODEL, Link, Machine, Offset, Side, SubModel, Symbol, Value,
 };

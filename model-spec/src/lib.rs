@@ -68,10 +68,11 @@ mod validate;
 
 pub use builtin::{BUILTIN, LoadError, all_builtin, builtin, load_machine};
 pub use catalogue::{ErrorId, ErrorKind, ErrorTerm, Motion, canonical_name};
+pub use catalogue::{build_catalogue, default_squareness_order};
 pub use error::SpecError;
 pub use geometry::{Dir, Direction};
 pub use machine::{
     Axis, AxisId, AxisKind, Chain, FULL_MODEL, Link, Machine, Offset, Side, SubModel, Symbol,
     SymbolId, Value,
 };
-pub use validate::{build_catalogue, default_squareness_order, parse_machine, reserved_names};
+pub use validate::{parse_machine, reserved_names};

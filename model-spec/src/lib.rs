@@ -59,6 +59,7 @@ pub mod catalogue;
 mod error;
 pub mod geometry;
 pub mod kinematics;
+pub mod limits;
 pub mod locate;
 pub mod machine;
 mod raw;

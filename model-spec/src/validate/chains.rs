@@ -91,11 +91,13 @@ impl Validator<'_> {
                     }
                 }
                 if let Some(l) = &e.link {
+                    self.name_length("link name", l)?;
                     links.push(Link::Fixed {
                         name: l.get_ref().clone(),
                         offset,
                     });
                 } else if let Some(n) = &e.end {
+                    self.name_length("end name", n)?;
                     end = Some((n.get_ref().clone(), offset, entry.span()));
                 }
             }

@@ -13,6 +13,7 @@ pub use names::reserved_names;
 
 use crate::catalogue::build_catalogue;
 use crate::error::SpecError;
+use crate::limits::MAX_FILE_BYTES;
 use crate::locate::Locator;
 use crate::machine::{Axis, Machine, Side, Symbol};
 use crate::raw::{Num, RawMachine};
@@ -25,6 +26,15 @@ use toml::Spanned;
 /// value or key (see `docs/model-spec.md` for the list of messages). No input panics.
 pub fn parse_machine(file: &str, text: &str) -> Result<Machine, SpecError> {
     let loc = Locator { file, text };
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(loc.error(
+            MAX_FILE_BYTES as usize..text.len(),
+            format!(
+                "the description has {} bytes, more than {MAX_FILE_BYTES} (1 MiB), the most a machine description may have",
+                text.len()
+            ),
+        ));
+    }
     let raw: RawMachine = toml::from_str(text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
         loc.error(span, e.message().trim().to_string())
@@ -60,6 +70,7 @@ impl Validator<'_> {
             );
         };
         let name = self.machine_name(raw_name)?;
+        self.counts(&raw)?;
 
         // Checked and kept in the order of the file, not the order of the map.
         let mut raw_symbols: Vec<(&Spanned<String>, &Spanned<Num>)> = raw.symbols.iter().collect();

@@ -3,6 +3,7 @@
 use super::{Res, Span, Validator, join};
 use crate::basis::Basis;
 use crate::catalogue::{ErrorId, ErrorKind, default_squareness_order};
+use crate::limits::MAX_TERMS;
 use crate::machine::{Axis, AxisId, AxisKind, Machine, SubModel};
 use crate::raw::{RawErrors, RawModel};
 use crate::terms::{Effect, Term};
@@ -172,6 +173,15 @@ impl Validator<'_> {
         m: &Machine,
         model: &str,
     ) -> Res<(Vec<ErrorId>, Vec<Term>)> {
+        if let Some(first_past) = list.get_ref().get(MAX_TERMS) {
+            return self.err(
+                first_past.span(),
+                format!(
+                    "model `{model}` has {} terms, more than {MAX_TERMS}, the most a sub-model may have",
+                    list.get_ref().len()
+                ),
+            );
+        }
         let mut terms: Vec<(Term, Span)> = Vec::new();
         for item in list.get_ref() {
             let written = item.get_ref().trim();

@@ -2,6 +2,7 @@
 
 use super::{Res, Span, Validator};
 use crate::catalogue::ErrorTerm;
+use crate::limits::MAX_NAME_CHARS;
 use crate::machine::{Axis, AxisKind, FULL_MODEL};
 use crate::raw::Num;
 use toml::Spanned;
@@ -41,8 +42,26 @@ fn is_rust_keyword(s: &str) -> bool {
 }
 
 impl Validator<'_> {
-    /// The machine's name, trimmed: letters, digits, `-` or `_`.
+    /// A name (`what`: `machine name`, `symbol name`, …) of at most [`MAX_NAME_CHARS`]
+    /// characters. Checked before anything else about the name, so that no message repeats
+    /// a longer one.
+    pub(super) fn name_length(&self, what: &str, name: &Spanned<String>) -> Res<()> {
+        let n = name.get_ref().chars().count();
+        if n <= MAX_NAME_CHARS {
+            return Ok(());
+        }
+        let start: String = name.get_ref().chars().take(16).collect();
+        self.err(
+            name.span(),
+            format!(
+                "{what} `{start}…` has {n} characters, more than {MAX_NAME_CHARS}, the longest name"
+            ),
+        )
+    }
+
+    /// The machine's name, trimmed: letters, digits, `-` or `_`, not too long.
     pub(super) fn machine_name(&self, raw_name: &Spanned<String>) -> Res<String> {
+        self.name_length("machine name", raw_name)?;
         let name = raw_name.get_ref().trim().to_string();
         if name.is_empty()
             || !name
@@ -57,8 +76,9 @@ impl Validator<'_> {
         Ok(name)
     }
 
-    /// A symbol's name: an identifier, not a Rust keyword.
+    /// A symbol's name: an identifier, not a Rust keyword, not too long.
     pub(super) fn symbol_name(&self, k: &Spanned<String>) -> Res<()> {
+        self.name_length("symbol name", k)?;
         if !is_identifier(k.get_ref()) {
             return self.err(
                 k.span(),
@@ -127,8 +147,9 @@ impl Validator<'_> {
         Ok(())
     }
 
-    /// A sub-model's name: an identifier, not `full`, not a Rust keyword.
+    /// A sub-model's name: an identifier, not `full`, not a Rust keyword, not too long.
     pub(super) fn model_name(&self, name: &Spanned<String>) -> Res<()> {
+        self.name_length("model name", name)?;
         let n = name.get_ref();
         if n == FULL_MODEL {
             return self.err(

@@ -64,6 +64,7 @@ pub mod locate;
 pub mod machine;
 mod raw;
 pub mod terms;
+pub mod text;
 pub mod units;
 mod validate;
 

@@ -67,6 +67,7 @@ pub mod terms;
 pub mod text;
 pub mod units;
 mod validate;
+pub mod write;
 
 pub use builtin::{BUILTIN, LoadError, all_builtin, builtin, load_machine};
 pub use catalogue::{ErrorId, ErrorKind, ErrorTerm, Motion, canonical_name};

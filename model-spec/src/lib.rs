@@ -57,6 +57,7 @@ pub mod basis;
 pub mod builtin;
 pub mod catalogue;
 mod error;
+pub mod fingerprint;
 pub mod geometry;
 pub mod kinematics;
 pub mod limits;

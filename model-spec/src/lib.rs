@@ -63,6 +63,7 @@ pub mod kinematics;
 pub mod limits;
 pub mod locate;
 pub mod machine;
+pub mod pose;
 mod raw;
 pub mod terms;
 pub mod text;

@@ -56,6 +56,7 @@
 pub mod basis;
 pub mod builtin;
 pub mod catalogue;
+pub mod describe;
 mod error;
 pub mod fingerprint;
 pub mod geometry;

@@ -7,6 +7,13 @@
 //! [`kinematics::chain_steps`] lowers its chains to the one list of elementary transforms that
 //! every consumer (symbolic engine, exact simulator) walks.
 //!
+//! Around the description: [`limits`] bounds what a description may hold; [`text`] reads a
+//! text file for people (bounded, UTF-8, located errors) and [`locate`] turns byte offsets into
+//! the `file:line:column` every message names; [`write`](mod@write) gives a machine's text and appends a
+//! model to it; [`Machine::fingerprint`] tells whether two descriptions are the same machine;
+//! [`Machine::check_pose`] checks commands against the strokes and ranges; [`describe`] writes
+//! a machine for people.
+//!
 //! Units: offsets and linear commands in mm, rotary commands in degrees at every boundary a
 //! person sees (radians inside), translational errors in mm inside (µm for people), angular
 //! errors in rad inside (µrad for people).

@@ -8,6 +8,7 @@
 //!
 //! A term (effect × basis) is one column of the H matrix, two for `harmonic:K` (cos, then sin).
 
+use crate::limits::MAX_BASIS_ORDER;
 use crate::{AxisKind, Machine};
 use std::fmt;
 
@@ -46,9 +47,9 @@ impl Basis {
         let s = s.trim();
         let order = |k: &str, name: &str| -> Result<u32, BasisError> {
             match k.parse::<u32>() {
-                Ok(k) if (1..=64).contains(&k) => Ok(k),
+                Ok(k) if (1..=MAX_BASIS_ORDER).contains(&k) => Ok(k),
                 _ => Err(BasisError(format!(
-                    "`{s}`: the order of `{name}:K` must be a whole number from 1 to 64"
+                    "`{s}`: the order of `{name}:K` must be a whole number from 1 to {MAX_BASIS_ORDER}"
                 ))),
             }
         };

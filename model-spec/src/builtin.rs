@@ -1,6 +1,9 @@
 //! The built-in machines (`model-spec/machines/*.toml`), compiled into the library.
 
+use crate::limits::MAX_FILE_BYTES;
+use crate::text::{TextError, read_text};
 use crate::{Machine, SpecError, parse_machine};
+use std::path::Path;
 
 /// Name and TOML text of every built-in machine, in the order `rtest machines` lists them.
 pub const BUILTIN: &[(&str, &str)] = &[
@@ -33,18 +36,24 @@ pub fn all_builtin() -> Vec<Machine> {
         .collect()
 }
 
-/// A machine given by built-in name or by the path of a TOML file.
+/// A machine given by built-in name or by the path of a TOML file. A file is read with
+/// [`crate::text::read_text`], at most [`MAX_FILE_BYTES`] bytes, and named in messages as
+/// given.
 pub fn load_machine(name_or_path: &str) -> Result<Machine, LoadError> {
     if let Some(m) = builtin(name_or_path) {
         return m.map_err(LoadError::Spec);
     }
-    let path = std::path::Path::new(name_or_path);
-    if !path.exists() {
-        return Err(LoadError::NotFound(name_or_path.to_string()));
-    }
-    let text =
-        std::fs::read_to_string(path).map_err(|e| LoadError::Io(name_or_path.to_string(), e))?;
+    let text = file_text(name_or_path)?;
     parse_machine(name_or_path, &text).map_err(LoadError::Spec)
+}
+
+/// The text of the machine description file `path`: at most [`MAX_FILE_BYTES`] bytes of UTF-8.
+pub(crate) fn file_text(path: &str) -> Result<String, LoadError> {
+    if !Path::new(path).exists() {
+        return Err(LoadError::NotFound(path.to_string()));
+    }
+    // Named as given: the display of a path given as UTF-8 text is that text.
+    read_text(Path::new(path), MAX_FILE_BYTES).map_err(LoadError::Io)
 }
 
 /// Why a machine could not be loaded.
@@ -53,9 +62,10 @@ pub enum LoadError {
     /// Neither a built-in name nor an existing file.
     #[error("no built-in machine and no file called `{0}` (built-in: {names})", names = BUILTIN.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "))]
     NotFound(String),
-    /// The file could not be read.
-    #[error("cannot read `{0}`: {1}")]
-    Io(String, std::io::Error),
+    /// The file could not be read as a machine description's text: an I/O error, more than
+    /// [`MAX_FILE_BYTES`] bytes, or a byte that is not UTF-8 (with its line and column).
+    #[error("{0}")]
+    Io(TextError),
     /// The description is invalid.
     #[error("{0}")]
     Spec(SpecError),

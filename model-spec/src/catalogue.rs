@@ -26,7 +26,7 @@
 //! block: translations x, y, z, then rotations about x, y, z.
 
 use crate::geometry::Dir;
-use crate::machine::AxisId;
+use crate::machine::{Axis, AxisId, AxisKind, Side};
 
 /// Index of an error term in [`crate::Machine::catalogue`].
 pub type ErrorId = usize;
@@ -189,4 +189,76 @@ pub fn iso_rank(name: &str) -> (usize, String) {
     const ORDER: &str = "XYZUVWABC";
     let first = name.chars().next().unwrap_or(' ');
     (ORDER.find(first).unwrap_or(ORDER.len()), name.to_string())
+}
+
+/// The default squareness order of the linear axes: by depth among the linear axes of their
+/// chain (the first linear axis from the bed has depth 0), the tool chain first on equal depth,
+/// then by ISO letter order. For the seed machine (work X; tool Y, Z) this is Y, X, Z.
+pub fn default_squareness_order(axes: &[Axis]) -> Vec<AxisId> {
+    let depth = |id: AxisId| {
+        (0..id)
+            .filter(|&j| axes[j].kind == AxisKind::Linear && axes[j].side == axes[id].side)
+            .count()
+    };
+    let mut order: Vec<AxisId> = (0..axes.len())
+        .filter(|&i| axes[i].kind == AxisKind::Linear)
+        .collect();
+    order.sort_by_key(|&i| {
+        let side_rank = match axes[i].side {
+            Side::Tool => 0,
+            Side::Work => 1,
+        };
+        (depth(i), side_rank, iso_rank(&axes[i].name))
+    });
+    order
+}
+
+/// Every ISO 230 error of the topology, in canonical order (see [`crate::catalogue`]).
+pub fn build_catalogue(axes: &[Axis], squareness_order: &[AxisId]) -> Vec<ErrorTerm> {
+    let mut by_iso: Vec<AxisId> = (0..axes.len()).collect();
+    by_iso.sort_by_key(|&i| iso_rank(&axes[i].name));
+    let mut out = Vec::new();
+    let component = |i: AxisId, out: &mut Vec<ErrorTerm>| {
+        for motion in six_motions() {
+            out.push(ErrorTerm {
+                name: component_name(motion, &axes[i].name),
+                kind: ErrorKind::Component { axis: i, motion },
+            });
+        }
+    };
+    for &i in by_iso.iter().filter(|&&i| axes[i].kind == AxisKind::Linear) {
+        component(i, &mut out);
+    }
+    if let Some(&first) = squareness_order.first() {
+        let reference = axes[first].direction.dir;
+        for (rank, &i) in squareness_order.iter().enumerate() {
+            for about in squareness_rotations(rank, axes[i].direction.dir, reference) {
+                out.push(ErrorTerm {
+                    name: location_name(Motion::Rotation(about), &axes[i].name),
+                    kind: ErrorKind::Squareness { axis: i, about },
+                });
+            }
+        }
+    }
+    for along in Dir::ALL {
+        out.push(ErrorTerm {
+            name: format!("{}OW", along.translation_letter()),
+            kind: ErrorKind::Setup { along },
+        });
+    }
+    for &i in by_iso.iter().filter(|&&i| axes[i].kind == AxisKind::Rotary) {
+        component(i, &mut out);
+        for motion in location_motions(axes[i].direction.dir) {
+            out.push(ErrorTerm {
+                name: location_name(motion, &axes[i].name),
+                kind: ErrorKind::Location { axis: i, motion },
+            });
+        }
+    }
+    debug_assert!({
+        let mut names: Vec<_> = out.iter().map(|e| e.name.clone()).collect();
+        names.sort();
+        names.windows(2).all(|w| w[0] != w[1])
+    });
+    out
 }

@@ -7,6 +7,13 @@
 //! [`kinematics::chain_steps`] lowers its chains to the one list of elementary transforms that
 //! every consumer (symbolic engine, exact simulator) walks.
 //!
+//! Around the description: [`limits`] bounds what a description may hold; [`text`] reads a
+//! text file for people (bounded, UTF-8, located errors) and [`locate`] turns byte offsets into
+//! the `file:line:column` every message names; [`write`](mod@write) gives a machine's text and appends a
+//! model to it; [`Machine::fingerprint`] tells whether two descriptions are the same machine;
+//! [`Machine::check_pose`] checks commands against the strokes and ranges; [`describe`] writes
+//! a machine for people.
+//!
 //! Units: offsets and linear commands in mm, rotary commands in degrees at every boundary a
 //! person sees (radians inside), translational errors in mm inside (µm for people), angular
 //! errors in rad inside (µrad for people).
@@ -56,21 +63,29 @@
 pub mod basis;
 pub mod builtin;
 pub mod catalogue;
+pub mod describe;
 mod error;
+pub mod fingerprint;
 pub mod geometry;
 pub mod kinematics;
+pub mod limits;
+pub mod locate;
 pub mod machine;
+pub mod pose;
 mod raw;
 pub mod terms;
+pub mod text;
 pub mod units;
 mod validate;
+pub mod write;
 
 pub use builtin::{BUILTIN, LoadError, all_builtin, builtin, load_machine};
 pub use catalogue::{ErrorId, ErrorKind, ErrorTerm, Motion, canonical_name};
+pub use catalogue::{build_catalogue, default_squareness_order};
 pub use error::SpecError;
 pub use geometry::{Dir, Direction};
 pub use machine::{
     Axis, AxisId, AxisKind, Chain, FULL_MODEL, Link, Machine, Offset, Side, SubModel, Symbol,
     SymbolId, Value,
 };
-pub use validate::{build_catalogue, default_squareness_order, parse_machine, reserved_names};
+pub use validate::{parse_machine, reserved_names};

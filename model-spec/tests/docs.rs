@@ -1,11 +1,16 @@
 //! `docs/model-spec.md` stays true: its complete TOML examples are valid (the annotated
 //! `seed-ac` is the built-in machine), and every example message it shows is one the tests in
-//! `errors.rs` check.
+//! `errors.rs`, `limits.rs` or `text.rs` check.
 
 use model_spec::{ErrorKind, builtin, parse_machine};
 
 const DOC: &str = include_str!("../../docs/model-spec.md");
-const ERROR_TESTS: &str = include_str!("errors.rs");
+/// The tests that check messages in full.
+const MESSAGE_TESTS: [&str; 3] = [
+    include_str!("errors.rs"),
+    include_str!("limits.rs"),
+    include_str!("text.rs"),
+];
 
 /// The ```toml blocks of the page that are complete machines (fragments start with
 /// `# fragment`).
@@ -71,7 +76,7 @@ fn three_axis_example_is_as_described() {
 
 #[test]
 fn example_messages_are_tested() {
-    let tests = ERROR_TESTS.replace("\\\"", "\"");
+    let tests = MESSAGE_TESTS.concat().replace("\\\"", "\"");
     let mut count = 0;
     for cell in DOC.split("``").chain(DOC.split('`')) {
         let cell = cell.trim();
@@ -79,7 +84,7 @@ fn example_messages_are_tested() {
             count += 1;
             assert!(
                 tests.contains(cell),
-                "the message `{cell}` of docs/model-spec.md is not checked in tests/errors.rs"
+                "the message `{cell}` of docs/model-spec.md is not checked in tests/errors.rs, limits.rs or text.rs"
             );
         }
     }

@@ -175,6 +175,23 @@ fn every_number_replaced_by_nan_is_reported_where_it_is() {
 }
 
 #[test]
+fn every_number_replaced_by_a_huge_one_is_reported_where_it_is() {
+    // Finite, but beyond the bounds of `model_spec::limits`: an `inf` later on.
+    for (name, text) in BUILTIN {
+        for range in numbers(text) {
+            for r in ["1e308", "-1e308", "123456"] {
+                let mut mutated = text.to_string();
+                mutated.replace_range(range.clone(), r);
+                let e = parse_machine("mut.toml", &mutated).unwrap_err();
+                let at = line_col(text, range.start);
+                assert_eq!((e.line, e.column), at, "{name}: {e}");
+                assert!(e.message.contains(" beyond ±"), "{name}: {e}");
+            }
+        }
+    }
+}
+
+#[test]
 fn every_prefix() {
     for (name, text) in BUILTIN {
         for (i, _) in text.char_indices() {

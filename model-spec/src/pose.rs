@@ -1,0 +1,139 @@
+//! Whether a pose is within the limits of a machine's axes.
+//!
+//! A pose is one command per axis, in axis order: mm for linear axes, **radians** for rotary
+//! axes (the unit inside rtest). The limits are those of the description ([`Axis::limits`]):
+//! the `stroke` in mm, the `range` in degrees; a rotary axis without a range is unlimited.
+//! Messages give values and limits in the units people see: mm and degrees.
+//!
+//! A limit is inclusive, with a margin of [`LIMIT_TOLERANCE`] in the unit people see, so that a
+//! command computed to be exactly at a limit (`120f64.to_radians()` read back as
+//! 119.99999999999999 or 120.00000000000001 degrees) is within it.
+
+use crate::machine::{Axis, AxisId, AxisKind, Machine};
+use crate::units::short;
+use std::fmt;
+
+/// How far (mm for a linear axis, degrees for a rotary axis) a command may lie beyond a limit
+/// and still be taken as at the limit: the rounding of a conversion, not a tolerance of the
+/// machine.
+pub const LIMIT_TOLERANCE: f64 = 1e-9;
+
+/// Why a pose is not one the machine can take.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PoseError {
+    /// Not one command per axis.
+    #[error("a pose of machine {machine} has one command per axis ({expected}), found {found}")]
+    WrongLength {
+        /// The machine's name.
+        machine: String,
+        /// The number of axes.
+        expected: usize,
+        /// The number of commands given.
+        found: usize,
+    },
+    /// A command that is NaN or infinite.
+    #[error("axis {name}: the command {value} is not a finite number")]
+    NotFinite {
+        /// The axis, by index into [`Machine::axes`].
+        axis: AxisId,
+        /// Its letter.
+        name: String,
+        /// The command as given (mm or rad).
+        value: f64,
+    },
+    /// The first axis, in axis order, whose command lies outside its stroke or range.
+    #[error("{0}")]
+    OutsideLimits(OutsideLimits),
+}
+
+/// A command outside the stroke or range of its axis, in the units people see.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutsideLimits {
+    /// The axis, by index into [`Machine::axes`].
+    pub axis: AxisId,
+    /// Its letter.
+    pub name: String,
+    /// Linear (values in mm) or rotary (values in degrees).
+    pub kind: AxisKind,
+    /// The command: mm, or degrees.
+    pub value: f64,
+    /// The axis's `[min, max]`: mm, or degrees.
+    pub limits: [f64; 2],
+}
+
+impl OutsideLimits {
+    /// `mm` or `degrees`.
+    pub fn unit(&self) -> &'static str {
+        match self.kind {
+            AxisKind::Linear => "mm",
+            AxisKind::Rotary => "degrees",
+        }
+    }
+}
+
+impl fmt::Display for OutsideLimits {
+    /// `axis A at 121 degrees is outside its range -120 .. 120 degrees`. The value is written
+    /// with every digit when six decimals would show it at the limit.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let [lo, hi] = self.limits;
+        let (lo_s, hi_s) = (short(lo), short(hi));
+        let mut value = short(self.value);
+        if value == lo_s || value == hi_s {
+            value = format!("{}", self.value);
+        }
+        let what = match self.kind {
+            AxisKind::Linear => "stroke",
+            AxisKind::Rotary => "range",
+        };
+        let unit = self.unit();
+        write!(
+            f,
+            "axis {} at {value} {unit} is outside its {what} {lo_s} .. {hi_s} {unit}",
+            self.name
+        )
+    }
+}
+
+/// The command `q` of axis `a` (mm or rad) in the unit people see (mm or degrees).
+fn for_people(a: &Axis, q: f64) -> f64 {
+    match a.kind {
+        AxisKind::Linear => q,
+        AxisKind::Rotary => q.to_degrees(),
+    }
+}
+
+impl Machine {
+    /// Checks that `commands` (one per axis, in axis order: mm for linear axes, rad for rotary
+    /// axes) are finite and within the axes' limits (inclusive, with a margin of
+    /// [`LIMIT_TOLERANCE`] mm or degrees). Reports the first axis that is not.
+    pub fn check_pose(&self, commands: &[f64]) -> Result<(), PoseError> {
+        if commands.len() != self.axes.len() {
+            return Err(PoseError::WrongLength {
+                machine: self.name.clone(),
+                expected: self.axes.len(),
+                found: commands.len(),
+            });
+        }
+        for (i, (a, &q)) in self.axes.iter().zip(commands).enumerate() {
+            if !q.is_finite() {
+                return Err(PoseError::NotFinite {
+                    axis: i,
+                    name: a.name.clone(),
+                    value: q,
+                });
+            }
+            let value = for_people(a, q);
+            let [lo, hi] = a.limits;
+            if value < lo - LIMIT_TOLERANCE || value > hi + LIMIT_TOLERANCE {
+                return Err(PoseError::OutsideLimits(OutsideLimits {
+                    axis: i,
+                    name: a.name.clone(),
+                    kind: a.kind,
+                    value,
+                    limits: a.limits,
+                }));
+            }
+        }
+        Ok(())
+    }
+}

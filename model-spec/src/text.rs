@@ -1,0 +1,114 @@
+//! Reading a text file for people: bounded in size, UTF-8, with located errors.
+//!
+//! [`read_text`] reads at most one byte more than its limit, so that a huge file, a device
+//! that never ends or a pipe fed without end is refused quickly and with bounded memory.
+//! [`decode_text`] drops a UTF-8 byte-order mark (some editors write one) and refuses bytes
+//! that are not UTF-8 with the line and column of the first one, counted like every other
+//! location ([`crate::locate`]).
+//!
+//! ```
+//! use model_spec::text::decode_text;
+//! let bytes = b"\xef\xbb\xbfname = \"a\"\n# r\xc3\xa9sum\xc3\xa9 \xff\n".to_vec();
+//! let e = decode_text("m.toml", bytes).unwrap_err();
+//! assert_eq!(e.to_string(), "m.toml:2:10: not UTF-8 text (byte 0xff)");
+//! assert_eq!(decode_text("m.toml", b"\xef\xbb\xbfx = 1".to_vec()).unwrap(), "x = 1");
+//! ```
+
+use crate::locate::line_col;
+use std::io::Read;
+use std::path::Path;
+
+/// The UTF-8 encoding of U+FEFF, the byte-order mark.
+const BOM: &[u8] = b"\xef\xbb\xbf";
+
+/// Why a text file could not be read. Every message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum TextError {
+    /// The file could not be opened or read.
+    #[error("cannot read `{file}`: {error}")]
+    Io {
+        /// The file, as given.
+        file: String,
+        /// What the system said.
+        error: std::io::Error,
+    },
+    /// The file has more bytes than the limit (it was read no further).
+    #[error("`{file}` is larger than {}, the most this file may have", bytes(*.limit))]
+    TooLarge {
+        /// The file, as given.
+        file: String,
+        /// The most bytes the file may have.
+        limit: u64,
+    },
+    /// A byte that is not part of UTF-8 text; the location is that of the first such byte.
+    #[error("{file}:{line}:{column}: not UTF-8 text (byte 0x{byte:02x})")]
+    NotUtf8 {
+        /// The file, as given.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column, in characters (the byte-order mark not counted).
+        column: usize,
+        /// The offending byte.
+        byte: u8,
+    },
+}
+
+/// A size for people: `1048576 bytes (1 MiB)`, `2048 bytes (2 KiB)`, `100 bytes`.
+fn bytes(n: u64) -> String {
+    const KIB: u64 = 1 << 10;
+    const MIB: u64 = 1 << 20;
+    if n >= MIB && n.is_multiple_of(MIB) {
+        format!("{n} bytes ({} MiB)", n / MIB)
+    } else if n >= KIB && n.is_multiple_of(KIB) {
+        format!("{n} bytes ({} KiB)", n / KIB)
+    } else {
+        format!("{n} bytes")
+    }
+}
+
+/// The text of the file at `path`, of at most `max_bytes` bytes, as [`decode_text`] decodes
+/// it. Reads at most `max_bytes + 1` bytes whatever the file is (a regular file, a device, a
+/// pipe): a longer one gives [`TextError::TooLarge`] without being read to its end. Messages
+/// name the file as `path.display()` writes it.
+pub fn read_text(path: &Path, max_bytes: u64) -> Result<String, TextError> {
+    let file = path.display().to_string();
+    let io = |error| TextError::Io {
+        file: file.clone(),
+        error,
+    };
+    let handle = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    handle
+        .take(max_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(TextError::TooLarge {
+            file,
+            limit: max_bytes,
+        });
+    }
+    decode_text(&file, bytes)
+}
+
+/// `bytes` as text: without a leading UTF-8 byte-order mark, or [`TextError::NotUtf8`] at the
+/// first byte that is not UTF-8 (`file_name` names the source in the message).
+pub fn decode_text(file_name: &str, mut bytes: Vec<u8>) -> Result<String, TextError> {
+    if bytes.starts_with(BOM) {
+        bytes.drain(..BOM.len());
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let bad = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        // Valid UTF-8 up to `bad`, so the lossy decoding is exact.
+        let before = String::from_utf8_lossy(&bytes[..bad]);
+        let (line, column) = line_col(&before, before.len());
+        TextError::NotUtf8 {
+            file: file_name.to_string(),
+            line,
+            column,
+            byte: bytes[bad],
+        }
+    })
+}

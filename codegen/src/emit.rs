@@ -20,6 +20,25 @@ use model_spec::Machine;
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 
+/// Why code could not be generated.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum GenerateError {
+    /// A model asked for is not a model of the machine.
+    #[error("machine `{machine}` has no model `{model}` (its models: {})", models.join(", "))]
+    UnknownModel {
+        /// The machine's name.
+        machine: String,
+        /// The model asked for.
+        model: String,
+        /// The machine's models.
+        models: Vec<String>,
+    },
+    /// The emitted tokens do not parse as a Rust file: a bug in the emitter (the parser's
+    /// message).
+    #[error("emitted code does not parse (a bug in codegen): {0}")]
+    Unparsable(String),
+}
+
 /// An exact `f64` literal (shortest round-trip decimal, `f64` suffix), negative values as a
 /// unary minus.
 pub fn float_literal(x: f64) -> TokenStream {
@@ -382,8 +401,9 @@ pub fn machine_tokens(m: &Machine, models: &[(&str, &GainModel, Vec<Part>)]) -> 
 }
 
 /// Pretty-prints a token stream as a Rust file, with a header comment.
-pub fn pretty(header: &str, tokens: TokenStream) -> Result<String, syn::Error> {
-    let file: syn::File = syn::parse2(tokens)?;
+pub fn pretty(header: &str, tokens: TokenStream) -> Result<String, GenerateError> {
+    let file: syn::File =
+        syn::parse2(tokens).map_err(|e| GenerateError::Unparsable(e.to_string()))?;
     let mut out = String::new();
     for line in header.lines() {
         out.push_str("// ");
@@ -397,7 +417,7 @@ pub fn pretty(header: &str, tokens: TokenStream) -> Result<String, syn::Error> {
 
 /// Derives, compiles and emits the models `model_names` of `m` (every model when empty) as one
 /// Rust source file; models larger than [`MAX_INSTRUCTIONS`] are split into parts.
-pub fn generate_machine(m: &Machine, model_names: &[&str]) -> Result<String, String> {
+pub fn generate_machine(m: &Machine, model_names: &[&str]) -> Result<String, GenerateError> {
     generate_machine_with(m, model_names, MAX_INSTRUCTIONS)
 }
 
@@ -406,7 +426,7 @@ pub fn generate_machine_with(
     m: &Machine,
     model_names: &[&str],
     max_instructions: usize,
-) -> Result<String, String> {
+) -> Result<String, GenerateError> {
     let names: Vec<&str> = if model_names.is_empty() {
         m.model_names()
     } else {
@@ -416,7 +436,11 @@ pub fn generate_machine_with(
     for name in &names {
         let errors = m
             .model_errors(name)
-            .ok_or_else(|| format!("machine {} has no model `{name}`", m.name))?;
+            .ok_or_else(|| GenerateError::UnknownModel {
+                machine: m.name.clone(),
+                model: name.to_string(),
+                models: m.model_names().iter().map(|s| s.to_string()).collect(),
+            })?;
         let model = GainModel::derive(m, errors);
         let parts = compile_parts(m, &model, max_instructions);
         built.push((name.replace('-', "_"), model, parts));
@@ -450,5 +474,4 @@ pub fn generate_machine_with(
         .map(|(n, g, p)| (n.as_str(), g, p.clone()))
         .collect();
     pretty(&header, machine_tokens(m, &refs))
-        .map_err(|e| format!("emitted code does not parse: {e}"))
 }

@@ -1,10 +1,10 @@
-//! The emitted code reads like the gain table: inputs keep their names, unknown models are typed
-//! errors, and colliding symbol names still give code that compiles and computes what the
-//! evaluator computes, bit for bit.
+//! The emitted code reads like the gain table: inputs keep their names, the header is short,
+//! unknown models are typed errors, and colliding symbol names still give code that compiles and
+//! computes what the evaluator computes, bit for bit.
 
-use codegen::emit::{GenerateError, generate_machine, names::snake_case};
+use codegen::emit::{GenerateError, generate_machine, generate_machine_with, names::snake_case};
 use codegen::{GainModel, compile, compile_position};
-use model_spec::{Machine, builtin, parse_machine};
+use model_spec::{Machine, all_builtin, builtin, parse_machine};
 
 mod support;
 
@@ -51,6 +51,23 @@ fn seed_ac_reduced_inputs_keep_their_names() {
             .any(is_v_name),
         "no `v` names left"
     );
+}
+
+#[test]
+fn header_lines_are_short() {
+    for m in all_builtin() {
+        for code in [
+            generate_machine(&m, &[]).unwrap(),
+            generate_machine_with(&m, &[], 20).unwrap(),
+        ] {
+            let header: Vec<&str> = code.lines().take_while(|l| l.starts_with("//")).collect();
+            assert!(header.len() >= 4, "{}: {header:?}", m.name);
+            assert!(header[0].contains(&format!("machine `{}`", m.name)));
+            for line in header {
+                assert!(line.chars().count() <= 100, "{}: {line}", m.name);
+            }
+        }
+    }
 }
 
 #[test]

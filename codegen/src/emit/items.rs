@@ -2,8 +2,10 @@
 //! with its constants, `gains`, `position_gains` and the slice helpers.
 
 use super::body::{body, float_literal, ident, position_body, position_part_body};
+use super::docs;
 use crate::GainModel;
-use crate::ir::{Input, Program};
+use crate::atoms::AtomKind;
+use crate::ir::{Input, OpCounts, Program};
 use crate::lower::Part;
 use model_spec::Machine;
 use proc_macro2::{Ident, Literal, TokenStream};
@@ -59,10 +61,10 @@ fn model_bodies(
 }
 
 /// Operation counts of a program list, added up.
-pub(crate) fn sum_counts<'a>(programs: impl Iterator<Item = &'a Program>) -> crate::ir::OpCounts {
-    programs.fold(crate::ir::OpCounts::default(), |a, p| {
+pub(crate) fn sum_counts<'a>(programs: impl Iterator<Item = &'a Program>) -> OpCounts {
+    programs.fold(OpCounts::default(), |a, p| {
         let c = p.op_counts();
-        crate::ir::OpCounts {
+        OpCounts {
             add: a.add + c.add,
             mul: a.mul + c.mul,
             neg: a.neg + c.neg,
@@ -92,28 +94,26 @@ pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStr
     let angular = &model.angular;
     let counts = sum_counts(parts.iter().map(|p| &p.gains));
     let ops_total = Literal::usize_unsuffixed(counts.total());
-    let doc_gains = [
-        format!(
-            " Gains of the {n_value} errors at `pose`: `out[i] = [gx, gy, gz, gi, gj, gk]`, the error"
-        ),
-        " vector (tool minus workpiece) and the orientation error in the tool frame per unit of"
-            .to_string(),
-        " error `i` (mm per mm for translational errors, mm per rad for angular ones).".to_string(),
-        String::new(),
-        format!(" Straight-line code, no allocation, no branches: {counts}."),
-    ];
+    let doc_gains = docs::gains(n_value, counts);
     let (body, pos_body, part_fns) = model_bodies(parts, &consts, &n, n_value);
     let pos_counts = sum_counts(parts.iter().map(|p| &p.position));
     let pos_total = Literal::usize_unsuffixed(pos_counts.total());
-    let doc_position = [
-        " Position gains only, in the layout of three rows of an H matrix: `out[d][i]` is the"
-            .to_string(),
-        " gain of error `i` in direction `d` (x, y, z of the tool frame; mm per mm or mm per rad)."
-            .to_string(),
-        " The orientation rows are not computed.".to_string(),
-        String::new(),
-        format!(" Straight-line code, no allocation, no branches: {pos_counts}."),
+    let doc_position = docs::position_gains(pos_counts);
+    let kinds = &model.atoms.kinds;
+    let n_params = kinds
+        .iter()
+        .filter(|k| matches!(k, AtomKind::Symbol(_)))
+        .count();
+    let args = [
+        (
+            "pose",
+            "one per entry of `POSE_INPUTS`",
+            kinds.len() - n_params,
+        ),
+        ("params", "one per entry of `PARAMETERS`", n_params),
     ];
+    let gains_slice_doc = docs::panics(&[args[0], args[1], ("out", "`6 * N`", 6 * n_value)]);
+    let pos_slice_doc = docs::panics(&[args[0], args[1], ("out", "`3 * N`", 3 * n_value)]);
     quote! {
         #[doc = #module_doc]
         pub mod #module {
@@ -143,8 +143,13 @@ pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStr
             pub fn position_gains(pose: &Pose, params: &Params, out: &mut [[f64; #n]; 3]) {
                 #pos_body
             }
-            /// [`position_gains`] on slices: `out` of length `3 * N`, direction after direction.
+            /// [`position_gains`] on slices: `pose` and `params` in the order of
+            /// [`super::POSE_INPUTS`] and [`super::PARAMETERS`], `out` of length `3 * N`,
+            /// direction after direction.
+            #(#[doc = #pos_slice_doc])*
+            #[track_caller]
             pub fn position_gains_slice(pose: &[f64], params: &[f64], out: &mut [f64]) {
+                assert_eq!(out.len(), 3 * N, "position_gains_slice: `out` holds 3 * N gains");
                 let mut g = [[0.0f64; N]; 3];
                 position_gains(&Pose::from_slice(pose), &Params::from_slice(params), &mut g);
                 for (dst, src) in out.chunks_exact_mut(N).zip(g.iter()) {
@@ -153,7 +158,10 @@ pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStr
             }
             /// [`gains`] on slices: `pose` and `params` in the order of [`super::POSE_INPUTS`]
             /// and [`super::PARAMETERS`], `out` of length `6 * N`, row-major.
+            #(#[doc = #gains_slice_doc])*
+            #[track_caller]
             pub fn gains_slice(pose: &[f64], params: &[f64], out: &mut [f64]) {
+                assert_eq!(out.len(), 6 * N, "gains_slice: `out` holds 6 * N gains");
                 let mut g = [[0.0f64; 6]; N];
                 gains(&Pose::from_slice(pose), &Params::from_slice(params), &mut g);
                 for (dst, src) in out.chunks_exact_mut(6).zip(g.iter()) {
@@ -168,7 +176,7 @@ pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStr
 pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
     let pose: Vec<&Input> = inputs.iter().filter(|i| !i.parameter).collect();
     let params: Vec<&Input> = inputs.iter().filter(|i| i.parameter).collect();
-    let pose_fields = pose.iter().map(|i| ident(&i.field));
+    let pose_fields: Vec<Ident> = pose.iter().map(|i| ident(&i.field)).collect();
     let pose_docs = pose.iter().map(|i| {
         let axis = i
             .field
@@ -184,7 +192,6 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
         }
     });
     let param_fields: Vec<Ident> = params.iter().map(|i| ident(&i.field)).collect();
-    let pose_fields2 = pose.iter().map(|i| ident(&i.field));
     let pose_idx = (0..pose.len()).map(Literal::usize_unsuffixed);
     let param_idx = (0..params.len()).map(Literal::usize_unsuffixed);
     let (n_pose, n_params) = (
@@ -193,21 +200,22 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
     );
     let pose_names = pose.iter().map(|i| i.name.as_str());
     let param_names = params.iter().map(|i| i.name.as_str());
-    let defaults = params.iter().map(|i| {
+    let default_of = |i: &Input| {
         let s = m
             .symbol_by_name(&i.field)
             .expect("parameter inputs are symbols");
-        float_literal(m.symbols[s].default)
-    });
+        m.symbols[s].default
+    };
+    let defaults = params.iter().map(|i| float_literal(default_of(i)));
     let param_docs = params.iter().map(|i| {
-        let s = m
-            .symbol_by_name(&i.field)
-            .expect("parameter inputs are symbols");
         format!(
             " Kinematic parameter `{}`, mm (default {}).",
-            i.field, m.symbols[s].default
+            i.field,
+            default_of(i)
         )
     });
+    let pose_panics = docs::panics(&[("v", "one per entry of `POSE_INPUTS`", pose.len())]);
+    let params_panics = docs::panics(&[("v", "one per entry of `PARAMETERS`", params.len())]);
     quote! {
         /// Axis commands at one pose: sines and cosines of the rotary commands (so that the
         /// generated bodies need no trigonometry), linear commands in mm.
@@ -226,14 +234,21 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
         /// Names of the kinematic parameters in slice order.
         pub const PARAMETERS: [&str; #n_params] = [#(#param_names),*];
         impl Pose {
-            /// A pose from a slice in the order of [`POSE_INPUTS`].
+            /// A pose from a slice in the order of [`POSE_INPUTS`]: sines and cosines of the
+            /// rotary commands, linear commands in mm.
+            #(#[doc = #pose_panics])*
+            #[track_caller]
             pub fn from_slice(v: &[f64]) -> Pose {
-                Pose { #( #pose_fields2: v[#pose_idx], )* }
+                assert_eq!(v.len(), POSE_INPUTS.len(), "Pose::from_slice: one value per pose input");
+                Pose { #( #pose_fields: v[#pose_idx], )* }
             }
         }
         impl Params {
-            /// Parameters from a slice in the order of [`PARAMETERS`].
+            /// Parameters from a slice in the order of [`PARAMETERS`], mm.
+            #(#[doc = #params_panics])*
+            #[track_caller]
             pub fn from_slice(v: &[f64]) -> Params {
+                assert_eq!(v.len(), PARAMETERS.len(), "Params::from_slice: one value per parameter");
                 Params { #( #param_fields: v[#param_idx], )* }
             }
         }

@@ -49,6 +49,18 @@ pub enum GenerateError {
     Unparsable(String),
 }
 
+/// The lints the emitted code allows, by name, and only on the items where they fire: every
+/// other rustc or default Clippy warning is avoided at the source.
+///
+/// - `non_snake_case`, on the `Params` struct: its fields keep the names of the kinematic
+///   symbols (`Zc`, `Xw`), as in the gain tables; emitted only when some symbol name is not
+///   snake case.
+///
+/// A function that does not read `pose` or `params` (a part of a split model whose gains are
+/// constants, say) names that argument `_pose` or `_params` instead of allowing
+/// `unused_variables`.
+pub const ALLOWED_LINTS: &[&str] = &["non_snake_case"];
+
 /// The longest line of the header comment, `// ` included.
 const HEADER_WIDTH: usize = 100;
 

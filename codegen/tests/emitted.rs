@@ -203,6 +203,7 @@ fn colliding_symbol_names_compile_and_equal_the_evaluator() {
             "`let {local} = ….{field};` in\n{code}"
         );
     }
+    assert_eq!(support::allowed_lints(&code), codegen::emit::ALLOWED_LINTS);
     let dir = support::scratch("colliding");
     support::check_no_std_lib(&dir, &code);
 

@@ -38,6 +38,21 @@ fn cell(locals: &[Ident], o: &Output) -> TokenStream {
     }
 }
 
+/// Which arguments a program reads: `(pose, params)`.
+pub fn reads(p: &Program) -> (bool, bool) {
+    let mut r = (false, false);
+    for op in &p.ops {
+        if let Op::Input(k) = *op {
+            if p.inputs[k as usize].parameter {
+                r.1 = true;
+            } else {
+                r.0 = true;
+            }
+        }
+    }
+    r
+}
+
 /// One `let` per instruction: `let zc = params.Zc;`, `let t3 = t1 * zc;`.
 fn lets(p: &Program, locals: &[Ident]) -> TokenStream {
     let lets = p.ops.iter().zip(locals).map(|(op, dst)| {

@@ -4,13 +4,29 @@
 
 use crate::ir::OpCounts;
 
-/// What the arguments hold.
-fn arguments() -> Vec<String> {
-    vec![
-        " `pose` holds the sines and cosines of the rotary commands and the linear commands"
-            .to_string(),
-        " (mm); `params` holds the kinematic parameters (mm).".to_string(),
-    ]
+/// What the arguments hold, and which one a function does not read (its name then starts
+/// with `_`).
+fn arguments(reads_pose: bool, reads_params: bool) -> Vec<String> {
+    let (pose, params) = (
+        if reads_pose { "pose" } else { "_pose" },
+        if reads_params { "params" } else { "_params" },
+    );
+    let mut lines = vec![
+        format!(
+            " `{pose}` holds the sines and cosines of the rotary commands and the linear commands"
+        ),
+        format!(" (mm); `{params}` holds the kinematic parameters (mm)."),
+    ];
+    lines.extend(
+        match (reads_pose, reads_params) {
+            (true, true) => None,
+            (true, false) => Some(" These gains do not depend on the kinematic parameters."),
+            (false, true) => Some(" These gains do not depend on the pose."),
+            (false, false) => Some(" These gains are constants: they depend on neither argument."),
+        }
+        .map(String::from),
+    );
+    lines
 }
 
 /// Where the gains are exact.
@@ -28,7 +44,7 @@ fn precondition() -> Vec<String> {
 }
 
 /// The doc of a model's `gains`.
-pub fn gains(n: usize, counts: OpCounts) -> Vec<String> {
+pub fn gains(n: usize, counts: OpCounts, reads_pose: bool, reads_params: bool) -> Vec<String> {
     let mut lines = vec![
         format!(" First-order gains of the {n} errors at `pose`: `out[i] = [gx, gy, gz, gi, gj, gk]`"),
         " per unit of error `i` (the error named `ERRORS[i]`), in the nominal tool frame."
@@ -43,7 +59,7 @@ pub fn gains(n: usize, counts: OpCounts) -> Vec<String> {
         " per mm of a translational error, per rad of an angular error.".to_string(),
         String::new(),
     ];
-    lines.extend(arguments());
+    lines.extend(arguments(reads_pose, reads_params));
     lines.push(String::new());
     lines.extend(precondition());
     lines.push(String::new());
@@ -54,7 +70,7 @@ pub fn gains(n: usize, counts: OpCounts) -> Vec<String> {
 }
 
 /// The doc of a model's `position_gains`.
-pub fn position_gains(counts: OpCounts) -> Vec<String> {
+pub fn position_gains(counts: OpCounts, reads_pose: bool, reads_params: bool) -> Vec<String> {
     let mut lines = vec![
         " First-order position gains only, in the layout of three rows of an H matrix: `out[d][i]`"
             .to_string(),
@@ -65,7 +81,7 @@ pub fn position_gains(counts: OpCounts) -> Vec<String> {
         " orientation rows are not computed.".to_string(),
         String::new(),
     ];
-    lines.extend(arguments());
+    lines.extend(arguments(reads_pose, reads_params));
     lines.push(String::new());
     lines.extend(precondition());
     lines.push(String::new());

@@ -1,8 +1,9 @@
 //! The items of an emitted machine: the `Pose` and `Params` structs, and one module per model
 //! with its constants, `gains`, `position_gains` and the slice helpers.
 
-use super::body::{body, float_literal, ident, position_body, position_part_body};
+use super::body::{body, float_literal, ident, position_body, position_part_body, reads};
 use super::docs;
+use super::names::snake_case;
 use crate::GainModel;
 use crate::atoms::AtomKind;
 use crate::ir::{Input, OpCounts, Program};
@@ -11,20 +12,41 @@ use model_spec::Machine;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
-/// The bodies of `gains` and `position_gains` and the part functions they call (none when the
-/// model is one part).
-fn model_bodies(
-    parts: &[Part],
-    consts: &[Ident],
-    n: &Literal,
-    n_value: usize,
-) -> (TokenStream, TokenStream, TokenStream) {
+/// The argument `name` of a function, `_name` when the function does not read it (so that no
+/// lint fires and the signature says so).
+fn argument(name: &str, read: bool) -> Ident {
+    if read {
+        ident(name)
+    } else {
+        format_ident!("_{}", name)
+    }
+}
+
+/// The `pose` and `params` arguments of a function whose body is `p`.
+fn arguments(p: &Program) -> (Ident, Ident) {
+    let (pose, params) = reads(p);
+    (argument("pose", pose), argument("params", params))
+}
+
+/// The bodies of `gains` and `position_gains`, their arguments and the part functions they call
+/// (none when the model is one part).
+struct Bodies {
+    gains: TokenStream,
+    gains_args: (Ident, Ident),
+    position: TokenStream,
+    position_args: (Ident, Ident),
+    part_fns: TokenStream,
+}
+
+fn model_bodies(parts: &[Part], consts: &[Ident], n: &Literal, n_value: usize) -> Bodies {
     if let [one] = parts {
-        return (
-            body(&one.gains, consts),
-            position_body(&one.position, n_value),
-            quote!(),
-        );
+        return Bodies {
+            gains: body(&one.gains, consts),
+            gains_args: arguments(&one.gains),
+            position: position_body(&one.position, n_value),
+            position_args: arguments(&one.position),
+            part_fns: quote!(),
+        };
     }
     let mut fns = Vec::new();
     let (mut calls, mut pos_calls) = (Vec::new(), Vec::new());
@@ -46,18 +68,25 @@ fn model_bodies(
         );
         let gb = body(&part.gains, &part_consts);
         let pb = position_part_body(&part.position, &part_consts);
+        let (gp, gq) = arguments(&part.gains);
+        let (pp, pq) = arguments(&part.position);
         fns.push(quote! {
             #[doc = #doc]
-            #[allow(clippy::all, unused_variables)]
-            fn #g(pose: &Pose, params: &Params, out: &mut [[f64; 6]; #n]) { #gb }
+            fn #g(#gp: &Pose, #gq: &Params, out: &mut [[f64; 6]; #n]) { #gb }
             #[doc = #pos_doc]
-            #[allow(clippy::all, unused_variables)]
-            fn #q(pose: &Pose, params: &Params, out: &mut [[f64; #n]; 3]) { #pb }
+            fn #q(#pp: &Pose, #pq: &Params, out: &mut [[f64; #n]; 3]) { #pb }
         });
         calls.push(quote!(#g(pose, params, out);));
         pos_calls.push(quote!(#q(pose, params, out);));
     }
-    (quote!(#(#calls)*), quote!(#(#pos_calls)*), quote!(#(#fns)*))
+    let both = (ident("pose"), ident("params"));
+    Bodies {
+        gains: quote!(#(#calls)*),
+        gains_args: both.clone(),
+        position: quote!(#(#pos_calls)*),
+        position_args: both,
+        part_fns: quote!(#(#fns)*),
+    }
 }
 
 /// Operation counts of a program list, added up.
@@ -70,6 +99,12 @@ pub(crate) fn sum_counts<'a>(programs: impl Iterator<Item = &'a Program>) -> OpC
             neg: a.neg + c.neg,
         }
     })
+}
+
+/// `(reads pose, reads params)` of a function with these arguments.
+fn read_flags(args: &(Ident, Ident)) -> (bool, bool) {
+    let read = |i: &Ident| !i.to_string().starts_with('_');
+    (read(&args.0), read(&args.1))
 }
 
 /// One model's module (`pub mod reduced { … }`).
@@ -94,11 +129,15 @@ pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStr
     let angular = &model.angular;
     let counts = sum_counts(parts.iter().map(|p| &p.gains));
     let ops_total = Literal::usize_unsuffixed(counts.total());
-    let doc_gains = docs::gains(n_value, counts);
-    let (body, pos_body, part_fns) = model_bodies(parts, &consts, &n, n_value);
+    let b = model_bodies(parts, &consts, &n, n_value);
+    let (pose_read, params_read) = read_flags(&b.gains_args);
+    let doc_gains = docs::gains(n_value, counts, pose_read, params_read);
     let pos_counts = sum_counts(parts.iter().map(|p| &p.position));
     let pos_total = Literal::usize_unsuffixed(pos_counts.total());
-    let doc_position = docs::position_gains(pos_counts);
+    let (pose_read, params_read) = read_flags(&b.position_args);
+    let doc_position = docs::position_gains(pos_counts, pose_read, params_read);
+    let (body, pos_body, part_fns) = (b.gains, b.position, b.part_fns);
+    let ((gp, gq), (pp, pq)) = (b.gains_args, b.position_args);
     let kinds = &model.atoms.kinds;
     let n_params = kinds
         .iter()
@@ -132,15 +171,13 @@ pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStr
             )*
             #part_fns
             #(#[doc = #doc_gains])*
-            #[allow(clippy::all, unused_variables)]
-            pub fn gains(pose: &Pose, params: &Params, out: &mut [[f64; 6]; #n]) {
+            pub fn gains(#gp: &Pose, #gq: &Params, out: &mut [[f64; 6]; #n]) {
                 #body
             }
             /// Arithmetic operations in [`position_gains`].
             pub const POSITION_OPERATIONS: usize = #pos_total;
             #(#[doc = #doc_position])*
-            #[allow(clippy::all, unused_variables)]
-            pub fn position_gains(pose: &Pose, params: &Params, out: &mut [[f64; #n]; 3]) {
+            pub fn position_gains(#pp: &Pose, #pq: &Params, out: &mut [[f64; #n]; 3]) {
                 #pos_body
             }
             /// [`position_gains`] on slices: `pose` and `params` in the order of
@@ -214,6 +251,12 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
             default_of(i)
         )
     });
+    // Fields keep the symbols' names (`Zc`): allow that only where a name is not snake case.
+    let params_allow = if params.iter().any(|i| snake_case(&i.field) != i.field) {
+        quote!(#[allow(non_snake_case)])
+    } else {
+        quote!()
+    };
     let pose_panics = docs::panics(&[("v", "one per entry of `POSE_INPUTS`", pose.len())]);
     let params_panics = docs::panics(&[("v", "one per entry of `PARAMETERS`", params.len())]);
     quote! {
@@ -224,7 +267,7 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
             #( #[doc = #pose_docs] pub #pose_fields: f64, )*
         }
         /// Kinematic parameters of the machine, mm.
-        #[allow(non_snake_case)]
+        #params_allow
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Params {
             #( #[doc = #param_docs] pub #param_fields: f64, )*

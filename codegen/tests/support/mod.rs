@@ -61,3 +61,16 @@ pub fn check_no_std_lib(dir: &Path, code: &str) {
     ];
     compile(&compiler(), &file, &args, &dir.join("lib.rmeta"));
 }
+
+/// The lints named in the `#[allow(…)]` attributes of `code`, in order.
+pub fn allowed_lints(code: &str) -> Vec<String> {
+    code.split("#[allow(")
+        .skip(1)
+        .flat_map(|rest| {
+            let list = &rest[..rest.find(")]").expect("an allow attribute is closed")];
+            list.split(',')
+                .map(|l| l.trim().to_string())
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}

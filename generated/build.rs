@@ -25,7 +25,8 @@ fn main() {
             .unwrap_or_else(|e| fail(&format!("cannot read {}: {e}", path.display())));
         let machine = model_spec::parse_machine(&path.display().to_string(), &text)
             .unwrap_or_else(|e| fail(&e.to_string()));
-        let code = codegen::emit::generate_machine(&machine, &[]).unwrap_or_else(|e| fail(&e));
+        let code =
+            codegen::emit::generate_machine(&machine, &[]).unwrap_or_else(|e| fail(&e.to_string()));
         let module = machine.name.replace('-', "_");
         let file = format!("{module}.rs");
         std::fs::write(out.join(&file), code)

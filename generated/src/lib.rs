@@ -8,8 +8,9 @@
 //! Each machine is a module (`seed_ac`, `seed_3axis`, `head_table_bc`) with `Pose`, `Params`
 //! and one module per model (`full`, `reduced`, …) whose `gains(pose, params, out)` writes
 //! `[gx, gy, gz, gi, gj, gk]` per error: the error vector (tool minus workpiece) and the
-//! orientation error in the tool frame per unit of error (mm per mm for translational errors,
-//! mm per rad for angular errors).
+//! orientation error in the nominal tool frame per unit of error (mm per mm for translational
+//! errors, mm per rad for angular errors). They are the exact first-order gains where the
+//! nominal tool point is on the nominal workpiece point, as at every R-test pose.
 //!
 //! ```
 //! use generated::seed_ac::{Params, Pose, reduced};

@@ -1,0 +1,132 @@
+//! Function bodies: one `let` per instruction of the IR, in order, then the stores of the
+//! outputs. Inputs are loaded into locals named after their fields, intermediates are `t0`,
+//! `t1`, … ([`super::names`]).
+
+use super::names::locals;
+use crate::ir::{Op, Output, Program};
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::quote;
+
+/// An exact `f64` literal (shortest round-trip decimal, `f64` suffix), negative values as a
+/// unary minus.
+pub fn float_literal(x: f64) -> TokenStream {
+    let lit = Literal::f64_suffixed(x.abs());
+    if x.is_sign_negative() && x != 0.0 {
+        quote!(-#lit)
+    } else {
+        quote!(#lit)
+    }
+}
+
+/// An identifier (a field, module or constant name that the machine description made valid).
+pub(crate) fn ident(name: &str) -> Ident {
+    Ident::new(name, Span::call_site())
+}
+
+/// One output cell: a value, a negated value or a literal.
+fn cell(locals: &[Ident], o: &Output) -> TokenStream {
+    match *o {
+        Output::Var(v) => {
+            let v = &locals[v as usize];
+            quote!(#v)
+        }
+        Output::Neg(v) => {
+            let v = &locals[v as usize];
+            quote!(-#v)
+        }
+        Output::Const(c) => float_literal(c),
+    }
+}
+
+/// Which arguments a program reads: `(pose, params)`.
+pub fn reads(p: &Program) -> (bool, bool) {
+    let mut r = (false, false);
+    for op in &p.ops {
+        if let Op::Input(k) = *op {
+            if p.inputs[k as usize].parameter {
+                r.1 = true;
+            } else {
+                r.0 = true;
+            }
+        }
+    }
+    r
+}
+
+/// One `let` per instruction: `let zc = params.Zc;`, `let t3 = t1 * zc;`.
+fn lets(p: &Program, locals: &[Ident]) -> TokenStream {
+    let lets = p.ops.iter().zip(locals).map(|(op, dst)| {
+        let l = |v: u32| &locals[v as usize];
+        let rhs = match *op {
+            Op::Input(k) => {
+                let input = &p.inputs[k as usize];
+                let f = ident(&input.field);
+                if input.parameter {
+                    quote!(params.#f)
+                } else {
+                    quote!(pose.#f)
+                }
+            }
+            Op::Const(bits) => float_literal(f64::from_bits(bits)),
+            Op::Add(a, b) => {
+                let (a, b) = (l(a), l(b));
+                quote!(#a + #b)
+            }
+            Op::Sub(a, b) => {
+                let (a, b) = (l(a), l(b));
+                quote!(#a - #b)
+            }
+            Op::Mul(a, b) => {
+                let (a, b) = (l(a), l(b));
+                quote!(#a * #b)
+            }
+            Op::Neg(a) => {
+                let a = l(a);
+                quote!(-#a)
+            }
+        };
+        quote!(let #dst = #rhs;)
+    });
+    quote!(#(#lets)*)
+}
+
+/// The statements of a six-row program's body: one `let` per instruction, then one store of
+/// `[gx, gy, gz, gi, gj, gk]` per error.
+pub fn body(p: &Program, error_consts: &[Ident]) -> TokenStream {
+    let locals = locals(p);
+    let lets = lets(p, &locals);
+    let stores = p.outputs.chunks(6).zip(error_consts).map(|(row, name)| {
+        let cells = row.iter().map(|o| cell(&locals, o));
+        quote!(out[#name] = [#(#cells),*];)
+    });
+    quote!(#lets #(#stores)*)
+}
+
+/// The statements of a position program's body ([`crate::compile_position`]): one `let` per
+/// instruction, then one store per direction of the gains of all `n` errors.
+pub fn position_body(p: &Program, n: usize) -> TokenStream {
+    let locals = locals(p);
+    let lets = lets(p, &locals);
+    let stores = p.outputs.chunks(n.max(1)).enumerate().map(|(d, row)| {
+        let d = Literal::usize_unsuffixed(d);
+        let cells = row.iter().map(|o| cell(&locals, o));
+        quote!(out[#d] = [#(#cells),*];)
+    });
+    quote!(#lets #(#stores)*)
+}
+
+/// The body of one part of a split position program: its `let`s, then one store per cell
+/// `out[d][ERROR] = …` (the part's errors only).
+pub(crate) fn position_part_body(p: &Program, error_consts: &[Ident]) -> TokenStream {
+    let locals = locals(p);
+    let lets = lets(p, &locals);
+    let n = error_consts.len().max(1);
+    let stores = p.outputs.chunks(n).enumerate().flat_map(|(d, row)| {
+        let (d, locals) = (Literal::usize_unsuffixed(d), &locals);
+        row.iter().zip(error_consts).map(move |(o, name)| {
+            let c = cell(locals, o);
+            quote!(out[#d][#name] = #c;)
+        })
+    });
+    quote!(#lets #(#stores)*)
+}

@@ -11,10 +11,14 @@
 //! - `t_s` (optional): time since the start, s, finite and non-decreasing. Without it, sample
 //!   `i` (0-based) is taken at `t = i` s.
 //!
-//! Column names are matched without regard to case and surrounding spaces (or double quotes).
-//! Lines whose first non-blank character is `#` are comments, blank lines are skipped. Fields
-//! are separated by commas, without quoting. Every other deviation is a [`CsvError`] naming the
-//! file, the line and, where there is one, the column (1-based index and header name).
+//! The text is UTF-8 (a byte-order mark at the start is accepted), lines end with `\n` or
+//! `\r\n`, and no line is longer than [`ReadOptions::max_line_bytes`] (64 KiB by default): the
+//! readers never hold more of a line, so an endless stream without line ends is refused after
+//! that many bytes. Column names are matched without regard to case and surrounding spaces (or
+//! double quotes). Lines whose first non-blank character is `#` are comments, blank lines are
+//! skipped. Fields are separated by commas, without quoting. Every other deviation is a
+//! [`CsvError::Format`] naming the file, the line and, where there is one, the column (1-based
+//! index and header name, or the character position in a line that is not UTF-8).
 //!
 //! Numbers are converted without double rounding: a µm value is read by moving the decimal
 //! point of its text three places ([`parse_scaled`]), and written as the shortest decimal of the
@@ -23,18 +27,53 @@
 //! command that was itself read from degrees (files, built-in paths) round-trips bit for bit.
 //!
 //! Files are written atomically: to a temporary file in the same directory, then renamed.
+//!
+//! Files: `lines` (the bounded line reader), `read` (header and rows), `whole` and `blocks`
+//! (the two readers), `write`, `numbers`.
 
+mod blocks;
+mod lines;
 mod numbers;
 mod read;
+mod whole;
 mod write;
 
 use crate::record::Record;
+pub use blocks::{FIRST_LOOKAHEAD, MeasurementBlocks, time_span};
+pub use lines::READ_BUFFER_BYTES;
 use model_spec::catalogue::iso_rank;
 use model_spec::{AxisKind, Machine};
 pub use numbers::{degrees_for, format_scaled, parse_scaled};
-pub use read::{FIRST_LOOKAHEAD, MeasurementBlocks, parse_csv, time_span};
 use std::path::Path;
+pub use whole::{parse_csv, read_csv};
 pub use write::{format_record, write_atomically, write_record};
+
+/// How the readers judge a file: the bounds of what they accept.
+///
+/// `ReadOptions::default()` (or [`ReadOptions::new`]) is what the command line uses; set the
+/// fields to change one (`let mut o = ReadOptions::new(); o.max_line_bytes = 4096;`).
+#[non_exhaustive]
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReadOptions {
+    /// Longest line, bytes (its line end not counted). Default 65 536. The readers never hold
+    /// more of a line, and read at most this plus [`READ_BUFFER_BYTES`] of a longer one.
+    pub max_line_bytes: usize,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            max_line_bytes: 65_536,
+        }
+    }
+}
+
+impl ReadOptions {
+    /// The default options (see the fields).
+    pub fn new() -> Self {
+        ReadOptions::default()
+    }
+}
 
 /// A problem with a CSV file.
 #[derive(Debug, thiserror::Error)]
@@ -121,19 +160,28 @@ impl Ctx<'_> {
 /// # Errors
 /// [`CsvError::Format`] for the first problem: empty file, header only, unknown, duplicate or
 /// missing column, ragged row, text or a non-finite number where a number belongs, time going
-/// backwards, inverse kinematics without a solution.
-pub fn parse_measurement(file: &str, text: &str, m: &Machine) -> Result<Record, CsvError> {
-    parse_csv(file, text, m, Need::Measured)
+/// backwards, inverse kinematics without a solution, a line too long or not UTF-8.
+pub fn parse_measurement(
+    file: &str,
+    text: &str,
+    m: &Machine,
+    opts: &ReadOptions,
+) -> Result<Record, CsvError> {
+    parse_csv(file, text, m, Need::Measured, opts)
 }
 
-/// Reads the measurement CSV file `path` of machine `m`; see [`parse_measurement`].
-pub fn read_measurement(path: &Path, m: &Machine) -> Result<Record, CsvError> {
+/// Reads the measurement CSV file `path` of machine `m` through the bounded line reader (the
+/// file is never read whole into memory as text); see [`parse_measurement`].
+///
+/// # Errors
+/// As [`parse_measurement`]; [`CsvError::Io`] when the file cannot be opened or read.
+pub fn read_measurement(path: &Path, m: &Machine, opts: &ReadOptions) -> Result<Record, CsvError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| CsvError::Io {
+    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
         file: file.clone(),
         source,
     })?;
-    parse_measurement(&file, &text, m)
+    read_csv(&file, f, m, Need::Measured, opts)
 }
 
 pub(crate) fn clean_name(s: &str) -> &str {

@@ -889,7 +889,12 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
 
     let m = machine();
     let t = truth(&m, "seed-ac-demo");
-    let k4 = solver::io::csv::read_measurement(&demo.join("k4.csv"), &m).unwrap();
+    let k4 = solver::io::csv::read_measurement(
+        &demo.join("k4.csv"),
+        &m,
+        &solver::io::csv::ReadOptions::default(),
+    )
+    .unwrap();
     assert_eq!(k4.samples.len(), 241);
     let json = read_json(&demo.join("identify.json"));
     assert_eq!(json["machine"], "seed-ac");

@@ -1,7 +1,7 @@
 //! Reading a measurement file in blocks gives exactly the slices of the whole-file record.
 
 use model_spec::builtin;
-use solver::io::csv::{MeasurementBlocks, format_record, parse_measurement};
+use solver::io::csv::{MeasurementBlocks, ReadOptions, format_record, parse_measurement};
 use solver::record::Record;
 use solver::simulation::paths::{builtin_path, fill_linear_ik, record_from_commands};
 use solver::simulation::readings::simulate;
@@ -10,9 +10,15 @@ use std::io::Cursor;
 
 fn concatenated(text: &str, m: &model_spec::Machine, block: usize) -> Record {
     let mut out = Record::default();
-    for (i, b) in MeasurementBlocks::new("m.csv".into(), Cursor::new(text.as_bytes()), m, block)
-        .unwrap()
-        .enumerate()
+    for (i, b) in MeasurementBlocks::new(
+        "m.csv".into(),
+        Cursor::new(text.as_bytes()),
+        m,
+        block,
+        &ReadOptions::default(),
+    )
+    .unwrap()
+    .enumerate()
     {
         let b = b.unwrap();
         assert!(
@@ -45,7 +51,7 @@ fn blocks_equal_the_whole_record_with_reversals_and_without_times() {
     let truth = builtin_truth("seed-ac-demo", &m).unwrap().unwrap();
     let rec = simulate(&m, &truth, &path).unwrap();
     let text = format_record(&m, &rec, &[]).unwrap();
-    let whole = parse_measurement("m.csv", &text, &m).unwrap();
+    let whole = parse_measurement("m.csv", &text, &m, &ReadOptions::default()).unwrap();
     for block in [1, 7, 64, 299, 300, 1000] {
         assert_eq!(concatenated(&text, &m, block), whole, "block {block}");
     }
@@ -69,7 +75,7 @@ fn blocks_equal_the_whole_record_with_reversals_and_without_times() {
             keep.iter().map(|&i| f[i]).collect::<Vec<_>>().join(",") + "\n"
         })
         .collect();
-    let whole = parse_measurement("m.csv", &reduced, &m).unwrap();
+    let whole = parse_measurement("m.csv", &reduced, &m, &ReadOptions::default()).unwrap();
     assert_eq!(concatenated(&reduced, &m, 50), whole);
 }
 
@@ -81,8 +87,14 @@ fn an_error_deep_in_the_file_names_its_line_and_column() {
         text.push_str(&format!("{i},{i},{i},{i},{i},0,0,0\n"));
     }
     text.push_str("1,2,3,4,5,6,seven,8\n");
-    let mut blocks =
-        MeasurementBlocks::new("m.csv".into(), Cursor::new(text.as_bytes()), &m, 30).unwrap();
+    let mut blocks = MeasurementBlocks::new(
+        "m.csv".into(),
+        Cursor::new(text.as_bytes()),
+        &m,
+        30,
+        &ReadOptions::default(),
+    )
+    .unwrap();
     let results: Vec<_> = blocks.by_ref().collect();
     assert_eq!(
         results.len(),
@@ -101,6 +113,7 @@ fn an_error_deep_in_the_file_names_its_line_and_column() {
         Cursor::new(&b"X,Y,Z,A,C,dx_um,dy_um,dz_um\n"[..]),
         &m,
         10,
+        &ReadOptions::default(),
     )
     .unwrap()
     .next();

@@ -7,7 +7,9 @@ mod common;
 
 use common::builtin;
 use model_spec::Machine;
-use solver::io::csv::{CsvError, format_record, parse_measurement, read_measurement, write_record};
+use solver::io::csv::{
+    CsvError, ReadOptions, format_record, parse_measurement, read_measurement, write_record,
+};
 use solver::record::Record;
 use solver::simulation::paths::builtin_path;
 use solver::simulation::readings::{provenance, simulate};
@@ -19,7 +21,7 @@ fn seed_ac() -> Machine {
 }
 
 fn message(text: &str) -> String {
-    match parse_measurement("m.csv", text, &seed_ac()) {
+    match parse_measurement("m.csv", text, &seed_ac(), &ReadOptions::default()) {
         Ok(r) => panic!("accepted: {r:?}"),
         Err(e) => e.to_string(),
     }
@@ -145,6 +147,7 @@ fn errors_carry_their_parts() {
         "m.csv",
         &format!("{H}{ROW}1,2,3,0,0,0.5,abc,-1,1\n"),
         &seed_ac(),
+        &ReadOptions::default(),
     )
     .unwrap_err();
     match e {
@@ -161,7 +164,12 @@ fn errors_carry_their_parts() {
         }
         other => panic!("{other:?}"),
     }
-    let e = read_measurement(std::path::Path::new("/no/such/file.csv"), &seed_ac()).unwrap_err();
+    let e = read_measurement(
+        std::path::Path::new("/no/such/file.csv"),
+        &seed_ac(),
+        &ReadOptions::default(),
+    )
+    .unwrap_err();
     assert!(e.to_string().starts_with("/no/such/file.csv: "), "{e}");
 }
 
@@ -169,7 +177,7 @@ fn errors_carry_their_parts() {
 fn units_order_case_comments_and_line_endings() {
     let m = seed_ac();
     let text = "\u{feff}# comment\r\n\r\n  \"t_s\" , c,A , z,Y,x,DZ_UM,dy_um,dx_um\r\n# another\r\n2.5,90,-45,3,2,1,12.5,-0.25,1000\r\n";
-    let r = parse_measurement("m.csv", text, &m).unwrap();
+    let r = parse_measurement("m.csv", text, &m, &ReadOptions::default()).unwrap();
     assert_eq!(r.samples.len(), 1);
     let s = &r.samples[0];
     let ax = |n: &str| s.commands[m.axis_by_name(n).unwrap()];
@@ -188,6 +196,7 @@ fn without_time_the_sample_index_is_the_time() {
         "m.csv",
         "X,Y,Z,A,C,dx_um,dy_um,dz_um\n0,0,0,0,0,0,0,0\n0,0,0,0,1,0,0,0\n0,0,0,0,2,0,0,0\n",
         &m,
+        &ReadOptions::default(),
     )
     .unwrap();
     let t: Vec<f64> = r.samples.iter().map(|s| s.t).collect();
@@ -208,7 +217,7 @@ fn missing_linear_columns_are_filled_by_inverse_kinematics() {
             s.t
         );
     }
-    let r = parse_measurement("m.csv", &text, &m).unwrap();
+    let r = parse_measurement("m.csv", &text, &m, &ReadOptions::default()).unwrap();
     assert_eq!(r.samples, k4.samples);
     assert!(r.measured.iter().all(|v| *v == [0.001, 0.002, 0.003]));
 }
@@ -220,7 +229,7 @@ fn the_fixture_reads() {
         env!("CARGO_MANIFEST_DIR"),
         "/tests/data/measurement-small.csv"
     );
-    let r = read_measurement(std::path::Path::new(f), &m).unwrap();
+    let r = read_measurement(std::path::Path::new(f), &m, &ReadOptions::default()).unwrap();
     assert_eq!(r.samples.len(), 2);
     assert_eq!(r.measured[0], [0.0015, -0.00225, 0.000125]);
     assert_eq!(r.measured[1], [-0.003, 0.0045, -0.0005]);
@@ -245,7 +254,7 @@ fn write_then_read_is_bit_exact() {
     assert!(text.starts_with("# simulated by rtest "), "{text}");
     assert!(text.contains("# machine: seed-ac\n# path: K4 (241 samples)\n# truth seed-ac-demo: "));
     assert!(text.contains("\nX,Y,Z,A,C,dx_um,dy_um,dz_um,t_s\n"));
-    let back = read_measurement(&f, &m).unwrap();
+    let back = read_measurement(&f, &m, &ReadOptions::default()).unwrap();
     assert_eq!(back.samples.len(), r.samples.len());
     for (a, b) in back.samples.iter().zip(&r.samples) {
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -278,7 +287,8 @@ fn a_bare_path_is_written_without_measured_columns() {
     assert_eq!(lines.next(), Some("X,Y,Z,A,C,t_s"));
     assert!(lines.next().unwrap().ends_with(",0,0,0"), "{text}");
     assert_eq!(lines.nth(89).unwrap().split(',').nth(4), Some("90"));
-    let back = solver::simulation::paths::parse_path("k1.csv", &text, &m).unwrap();
+    let back = solver::simulation::paths::parse_path("k1.csv", &text, &m, &ReadOptions::default())
+        .unwrap();
     assert_eq!(back, k1);
 }
 

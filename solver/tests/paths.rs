@@ -6,6 +6,7 @@ mod common;
 
 use common::builtin;
 use model_spec::Machine;
+use solver::io::csv::ReadOptions;
 use solver::record::Record;
 use solver::simulation::VirtualMachine;
 use solver::simulation::paths::{
@@ -94,7 +95,7 @@ fn builtin_names_ignore_case_and_others_are_not_builtin() {
     let b = builtin_path(&m, "K4").unwrap().unwrap();
     assert_eq!(a, b);
     assert!(builtin_path(&m, "K3").is_none());
-    let e = load_path(&m, "K3").unwrap_err();
+    let e = load_path(&m, "K3", &ReadOptions::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
         "`K3` is neither a built-in path (K1, K2, K4) nor an existing file"
@@ -103,13 +104,13 @@ fn builtin_names_ignore_case_and_others_are_not_builtin() {
 
 #[test]
 fn builtin_paths_need_rotary_axes_a_and_c() {
-    let e = load_path(&builtin("head-table-bc"), "K4").unwrap_err();
+    let e = load_path(&builtin("head-table-bc"), "K4", &ReadOptions::default()).unwrap_err();
     assert!(matches!(e, PathError::NotAC { .. }));
     assert_eq!(
         e.to_string(),
         "path K4 is defined only for machines whose rotary axes are A and C (like seed-ac); machine head-table-bc has rotary axes B, C: give the path as a CSV file"
     );
-    let e = load_path(&builtin("seed-3axis"), "k1").unwrap_err();
+    let e = load_path(&builtin("seed-3axis"), "k1", &ReadOptions::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
         "path K1 is defined only for machines whose rotary axes are A and C (like seed-ac); machine seed-3axis has no rotary axes: give the path as a CSV file"
@@ -135,7 +136,7 @@ fn a_path_file_without_linear_columns_is_filled_by_inverse_kinematics() {
     std::fs::create_dir_all(&dir).unwrap();
     let f = dir.join("k4-rotary.csv");
     std::fs::write(&f, &text).unwrap();
-    let r = load_path(&m, f.to_str().unwrap()).unwrap();
+    let r = load_path(&m, f.to_str().unwrap(), &ReadOptions::default()).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(r, k4, "same commands bit for bit, t = i s, same motion");
     assert_closed(&m, &r);
@@ -145,7 +146,7 @@ fn a_path_file_without_linear_columns_is_filled_by_inverse_kinematics() {
 fn path_fixture_on_disk() {
     let m = seed_ac();
     let f = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/path-ac.csv");
-    let r = load_path(&m, f).unwrap();
+    let r = load_path(&m, f, &ReadOptions::default()).unwrap();
     assert_eq!(r.samples.len(), 5);
     assert_eq!(
         r.samples.iter().map(|s| s.t).collect::<Vec<_>>(),
@@ -158,7 +159,13 @@ fn path_fixture_on_disk() {
 #[test]
 fn a_path_file_with_every_axis_is_taken_as_written() {
     let m = seed_ac();
-    let r = parse_path("p.csv", "X,Y,Z,A,C\n1,2,3,0,90\n1,2,4,0,90\n", &m).unwrap();
+    let r = parse_path(
+        "p.csv",
+        "X,Y,Z,A,C\n1,2,3,0,90\n1,2,4,0,90\n",
+        &m,
+        &ReadOptions::default(),
+    )
+    .unwrap();
     let z = m.axis_by_name("Z").unwrap();
     assert_eq!(r.samples[1].commands[z], 4.0);
     assert_eq!(r.samples[0].commands[m.axis_by_name("X").unwrap()], 1.0);
@@ -166,30 +173,42 @@ fn a_path_file_with_every_axis_is_taken_as_written() {
     // A three-axis machine: linear axes only.
     let m3 = builtin("seed-3axis");
     let names: Vec<&str> = m3.axes.iter().map(|a| a.name.as_str()).collect();
-    let r = parse_path("p.csv", &format!("{}\n1,2,3\n", names.join(",")), &m3).unwrap();
+    let r = parse_path(
+        "p.csv",
+        &format!("{}\n1,2,3\n", names.join(",")),
+        &m3,
+        &ReadOptions::default(),
+    )
+    .unwrap();
     assert_eq!(r.samples[0].commands, vec![1.0, 2.0, 3.0]);
 }
 
 #[test]
 fn path_file_errors() {
     let m = seed_ac();
-    let e = parse_path("p.csv", "X,A,C\n0,0,0\n", &m).unwrap_err();
+    let e = parse_path("p.csv", "X,A,C\n0,0,0\n", &m, &ReadOptions::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
         "p.csv:1: missing column(s) Y, Z (linear axes, mm): give every linear axis or none (then they are filled by the nominal inverse kinematics)"
     );
-    let e = parse_path("p.csv", "A\n0\n", &m).unwrap_err();
+    let e = parse_path("p.csv", "A\n0\n", &m, &ReadOptions::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
         "p.csv:1: missing column(s) C (rotary axes, degrees): every rotary axis needs a column"
     );
-    let e = parse_path("p.csv", "A,C,dx_um\n0,0,1\n", &m).unwrap_err();
+    let e = parse_path("p.csv", "A,C,dx_um\n0,0,1\n", &m, &ReadOptions::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
         "p.csv:1: missing column(s) dy_um, dz_um (measured error vector, µm): a measurement file needs dx_um, dy_um and dz_um"
     );
     // Measured columns are allowed in a path file and ignored.
-    let r = parse_path("p.csv", "A,C,dx_um,dy_um,dz_um\n0,0,1,2,3\n", &m).unwrap();
+    let r = parse_path(
+        "p.csv",
+        "A,C,dx_um,dy_um,dz_um\n0,0,1,2,3\n",
+        &m,
+        &ReadOptions::default(),
+    )
+    .unwrap();
     assert!(r.measured.is_empty());
 }
 
@@ -229,7 +248,7 @@ end = "probe"
         e.to_string().contains("needs exactly three linear axes"),
         "{e}"
     );
-    let err = parse_path("p.csv", "# c\nC\n0\n10\n", &m2).unwrap_err();
+    let err = parse_path("p.csv", "# c\nC\n0\n10\n", &m2, &ReadOptions::default()).unwrap_err();
     assert!(
         err.to_string().starts_with(
             "p.csv:3: the linear axes are not given and the nominal inverse kinematics cannot fill them: machine `two-linear`: the tool-centre-point inverse kinematics needs exactly three linear axes"

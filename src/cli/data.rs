@@ -10,7 +10,7 @@ use solver::fitting::refine::{RefineError, RefineOptions, Refinement, identify_r
 use solver::fitting::{
     Constraint, EstimateError, Identification, IdentifyOptions, identify_with, with_offsets,
 };
-use solver::io::csv::CsvError;
+use solver::io::csv::{CsvError, ReadOptions};
 use solver::model::{Effect, Model, Term};
 use solver::record::Record;
 use solver::simulation::paths::PathError;
@@ -53,7 +53,7 @@ pub fn default_truth(m: &Machine) -> CliResult<Truth> {
 
 /// The path of `--path`: `K1`, `K2`, `K4` (any case) or a path CSV file.
 pub fn path(m: &Machine, name: &str) -> CliResult<Record> {
-    solver::simulation::paths::load_path(m, name).map_err(|e| match e {
+    solver::simulation::paths::load_path(m, name, &ReadOptions::default()).map_err(|e| match e {
         PathError::NotFound(_) | PathError::NotAC { .. } => CliError::usage(format!("--path: {e}")),
         PathError::Ik { .. } => CliError::failure(format!("--path: {e}")),
         PathError::Csv(c) => CliError::failure(format!("--path: {}", csv_message(&c))),
@@ -70,7 +70,7 @@ fn csv_message(e: &CsvError) -> String {
 
 /// The measurement CSV of `flag` (`--data`): commands, readings (mm inside), times.
 pub fn measurement(flag: &str, m: &Machine, file: &Path) -> CliResult<Record> {
-    solver::io::csv::read_measurement(file, m)
+    solver::io::csv::read_measurement(file, m, &ReadOptions::default())
         .map_err(|e| CliError::failure(format!("{flag}: {}", csv_message(&e))))
 }
 

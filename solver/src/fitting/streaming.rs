@@ -157,7 +157,7 @@ pub fn identify_file(
     (crate::fitting::Identification, StreamingIdentification),
     StreamingError<crate::io::csv::CsvError>,
 > {
-    use crate::io::csv::{MeasurementBlocks, time_span};
+    use crate::io::csv::{MeasurementBlocks, ReadOptions, time_span};
     let fitted = if opts.zeroed {
         crate::fitting::with_offsets(model)
     } else {
@@ -173,11 +173,12 @@ pub fn identify_file(
         .iter()
         .any(|t| matches!(t.basis, model_spec::basis::Basis::Time(_)));
     let span = if has_time {
-        Some(time_span(path, m).map_err(StreamingError::Read)?)
+        Some(time_span(path, m, &ReadOptions::default()).map_err(StreamingError::Read)?)
     } else {
         None
     };
-    let blocks = MeasurementBlocks::open(path, m, block).map_err(StreamingError::Read)?;
+    let blocks = MeasurementBlocks::open(path, m, block, &ReadOptions::default())
+        .map_err(StreamingError::Read)?;
     let run = identify_streaming(
         m,
         &fitted,

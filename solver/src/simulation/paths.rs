@@ -17,9 +17,10 @@
 //!
 //! A path file is a CSV in the measurement format ([`crate::io::csv`]): rotary columns required
 //! (degrees), linear columns optional (filled by the inverse kinematics), `t_s` optional,
-//! measured columns optional and ignored.
+//! measured columns optional and ignored. It is read by the same bounded line reader as a
+//! measurement file, under the same [`ReadOptions`].
 
-use crate::io::csv::{CsvError, Need, parse_csv};
+use crate::io::csv::{CsvError, Need, ReadOptions, read_csv};
 use crate::record::{Record, Sample, motion_directions};
 use crate::simulation::exact::{ExactError, VirtualMachine};
 use model_spec::Machine;
@@ -141,11 +142,12 @@ fn not_ac(m: &Machine, name: &str, rotary: &[usize]) -> PathError {
     }
 }
 
-/// A path given by built-in name ([`BUILTIN_PATHS`]) or by the name of a CSV file.
+/// A path given by built-in name ([`BUILTIN_PATHS`]) or by the name of a CSV file, read with
+/// `opts` (a built-in path is made, not read: `opts` do not apply to it).
 ///
 /// # Errors
-/// [`PathError::NotFound`] when it is neither; see [`builtin_path`] and [`parse_path`].
-pub fn load_path(m: &Machine, name_or_file: &str) -> Result<Record, PathError> {
+/// [`PathError::NotFound`] when it is neither; see [`builtin_path`] and [`read_path`].
+pub fn load_path(m: &Machine, name_or_file: &str, opts: &ReadOptions) -> Result<Record, PathError> {
     if let Some(r) = builtin_path(m, name_or_file) {
         return r;
     }
@@ -153,20 +155,39 @@ pub fn load_path(m: &Machine, name_or_file: &str) -> Result<Record, PathError> {
     if !path.is_file() {
         return Err(PathError::NotFound(name_or_file.to_string()));
     }
-    let text = std::fs::read_to_string(path).map_err(|source| CsvError::Io {
+    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
         file: name_or_file.to_string(),
         source,
     })?;
-    Ok(parse_path(name_or_file, &text, m)?)
+    Ok(read_path(name_or_file, f, m, opts)?)
 }
 
-/// Reads a path CSV (text `text`, named `file` in messages) of machine `m`: a record without
+/// Reads a path CSV (text `text`, named `file` in messages) of machine `m`; see [`read_path`].
+///
+/// # Errors
+/// As [`read_path`].
+pub fn parse_path(
+    file: &str,
+    text: &str,
+    m: &Machine,
+    opts: &ReadOptions,
+) -> Result<Record, CsvError> {
+    read_path(file, text.as_bytes(), m, opts)
+}
+
+/// Reads a path CSV of machine `m` from `reader` (named `file` in messages): a record without
 /// measurements (commands in mm and rad, times in s; see the module documentation).
 ///
 /// # Errors
-/// [`CsvError::Format`] naming the line and column of the first problem.
-pub fn parse_path(file: &str, text: &str, m: &Machine) -> Result<Record, CsvError> {
-    let mut r = parse_csv(file, text, m, Need::Path)?;
+/// [`CsvError::Format`] naming the line and column of the first problem (a line too long or
+/// not UTF-8 included); [`CsvError::Io`] when `reader` fails.
+pub fn read_path<R: std::io::Read>(
+    file: &str,
+    reader: R,
+    m: &Machine,
+    opts: &ReadOptions,
+) -> Result<Record, CsvError> {
+    let mut r = read_csv(file, reader, m, Need::Path, opts)?;
     r.measured.clear();
     Ok(r)
 }

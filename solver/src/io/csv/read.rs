@@ -1,26 +1,26 @@
-//! Reading measurement and path CSVs: the header, then one row at a time. The whole-file reader
-//! ([`parse_csv`]) and the block reader for long records ([`MeasurementBlocks`]) share the same
-//! header and row parsing, so both give the same errors at the same lines and columns. The
-//! format is described in [`crate::io::csv`].
+//! The header and the rows of measurement and path CSVs, shared by the whole-file reader
+//! ([`crate::io::csv::read_csv`]) and the block reader for long records
+//! ([`crate::io::csv::MeasurementBlocks`]), so both give the same errors at the same lines and
+//! columns. The format is described in [`crate::io::csv`].
 
+use crate::io::csv::lines::Lines;
 use crate::io::csv::{
     Col, CsvError, Ctx, MEASURED, Need, classify, clean_name, expected_columns, parse_scaled,
 };
-use crate::record::{Record, Sample};
-use crate::simulation::paths::{fill_linear_ik, record_from_commands};
+use crate::simulation::paths::fill_linear_ik;
 use model_spec::{AxisKind, Machine};
-use std::io::BufRead;
-use std::path::Path;
+use std::io::Read;
 
 /// The parsed header of a CSV: what each column holds.
 pub(crate) struct Header {
-    line: usize,
+    /// Its line number.
+    pub(crate) line: usize,
     names: Vec<String>,
     cols: Vec<Col>,
     /// The linear axes are absent and filled by the nominal inverse kinematics.
     fill_ik: bool,
     /// The three measured columns are present.
-    measured: bool,
+    pub(crate) measured: bool,
 }
 
 /// One parsed row: commands (mm, rad), time (s, `None` without a `t_s` column) and the
@@ -196,7 +196,7 @@ impl Header {
     }
 
     /// Fills the linear commands by inverse kinematics when the file has none.
-    fn fill(
+    pub(crate) fn fill(
         &self,
         cx: &Ctx,
         m: &Machine,
@@ -212,246 +212,45 @@ impl Header {
     }
 }
 
-/// The lines of a text that hold data: 1-based line numbers, without `#` comments and blank
-/// lines, `\r` removed.
-fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.split('\n')
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.strip_suffix('\r').unwrap_or(l)))
-        .filter(|(_, l)| {
-            let t = l.trim();
-            !t.is_empty() && !t.starts_with('#')
-        })
+/// Whether a line holds data: neither blank nor a `#` comment.
+pub(crate) fn is_data(text: &str) -> bool {
+    let t = text.trim_start();
+    !t.is_empty() && !t.starts_with('#')
 }
 
-/// Reads a CSV of machine `m`; `need` says whether the measured columns are required.
-pub fn parse_csv(file: &str, text: &str, m: &Machine, need: Need) -> Result<Record, CsvError> {
-    let cx = Ctx { file };
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut lines = data_lines(text);
-    let Some((header_line, header)) = lines.next() else {
-        let last = text.split('\n').count().max(1);
-        return Err(cx.err(
-            last,
-            None,
-            format!(
-                "empty file: expected a header line naming the columns ({})",
-                expected_columns(m)
-            ),
-        ));
-    };
-    let header = Header::parse(&cx, header_line, header, m, need)?;
-    let (mut commands, mut times, mut measured, mut row_lines) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let mut last_t = None;
-    for (line, row) in lines {
-        let (c, t, d) = header.row(&cx, line, row, m, &mut last_t)?;
-        times.push(t.unwrap_or(commands.len() as f64));
-        commands.push(c);
-        measured.push(d);
-        row_lines.push(line);
-    }
-    if commands.is_empty() {
-        return Err(cx.err(
-            header.line,
-            None,
-            "header only: the file has no samples (one row per sample expected after the header)",
-        ));
-    }
-    header.fill(&cx, m, &mut commands, &row_lines)?;
-    let mut record = record_from_commands(commands, times);
-    if header.measured {
-        record.measured = measured;
-    }
-    Ok(record)
-}
-
-/// Most samples the first block of a [`MeasurementBlocks`] holds while waiting for every axis to
-/// move.
-pub const FIRST_LOOKAHEAD: usize = 65_536;
-
-/// A long measurement file read in blocks of samples, without holding the record: each block
-/// is a [`Record`] with its measurements. The direction of motion of every axis carries over
-/// from one block to the next, and times (the `t_s` column, or the sample index in s) keep
-/// counting, so the blocks are exactly the slices of [`parse_csv`]'s record. (The direction of
-/// an axis before its first move is that of its first move; the first block grows until every
-/// axis has moved, up to [`FIRST_LOOKAHEAD`] samples. An axis whose first move comes later
-/// starts at +1 here, as if it had not moved.)
-pub struct MeasurementBlocks<'m, R: BufRead> {
-    m: &'m Machine,
-    file: String,
-    lines: std::io::Lines<R>,
-    line: usize,
-    header: Header,
-    block: usize,
-    samples: usize,
-    last_t: Option<(f64, usize)>,
-    /// The previous sample's commands and directions of motion.
-    previous: Option<(Vec<f64>, Vec<i8>)>,
-    failed: bool,
-}
-
-impl<'m> MeasurementBlocks<'m, std::io::BufReader<std::fs::File>> {
-    /// Opens `path` (a measurement CSV of machine `m`) and reads its header; blocks hold
-    /// `block` samples (the last one fewer).
-    pub fn open(path: &Path, m: &'m Machine, block: usize) -> Result<Self, CsvError> {
-        let file = path.display().to_string();
-        let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-            file: file.clone(),
-            source,
-        })?;
-        MeasurementBlocks::new(file, std::io::BufReader::new(f), m, block)
-    }
-}
-
-impl<'m, R: BufRead> MeasurementBlocks<'m, R> {
-    /// Reads the header from `reader` (named `file` in messages).
-    pub fn new(file: String, reader: R, m: &'m Machine, block: usize) -> Result<Self, CsvError> {
-        let mut lines = reader.lines();
-        let mut line = 0;
-        let cx = Ctx { file: &file };
-        let header = loop {
-            let Some(l) = lines.next() else {
-                return Err(cx.err(
-                    line.max(1),
-                    None,
-                    format!(
-                        "empty file: expected a header line naming the columns ({})",
-                        expected_columns(m)
-                    ),
-                ));
-            };
-            line += 1;
-            let l = l.map_err(|source| CsvError::Io {
-                file: file.clone(),
-                source,
-            })?;
-            let t = l
-                .strip_prefix('\u{feff}')
-                .unwrap_or(&l)
-                .trim_end_matches('\r');
-            if t.trim().is_empty() || t.trim().starts_with('#') {
-                continue;
-            }
-            break Header::parse(&cx, line, t, m, Need::Measured)?;
+/// Reads lines up to the header and parses it.
+///
+/// # Errors
+/// An empty file (no header before the end, at the line number after the last line), or what
+/// [`Header::parse`] finds wrong.
+pub(crate) fn read_header<R: Read>(
+    cx: &Ctx,
+    lines: &mut Lines<R>,
+    m: &Machine,
+    need: Need,
+) -> Result<Header, CsvError> {
+    loop {
+        let Some((line, text)) = lines.next_line(cx)? else {
+            return Err(cx.err(
+                lines.number_at_end(),
+                None,
+                format!(
+                    "empty file: expected a header line naming the columns ({})",
+                    expected_columns(m)
+                ),
+            ));
         };
-        Ok(MeasurementBlocks {
-            m,
-            file,
-            lines,
-            line,
-            header,
-            block: block.max(1),
-            samples: 0,
-            last_t: None,
-            previous: None,
-            failed: false,
-        })
-    }
-
-    fn next_block(&mut self) -> Result<Option<Record>, CsvError> {
-        let cx = Ctx { file: &self.file };
-        let (mut commands, mut times, mut measured, mut row_lines) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        // The first block looks ahead until every axis has moved (its direction before the first
-        // move is that of the first move, as in the whole-file reader), up to FIRST_LOOKAHEAD.
-        let first = self.previous.is_none();
-        let all_moved = |commands: &[Vec<f64>]| {
-            commands
-                .first()
-                .is_none_or(|c0| (0..c0.len()).all(|a| commands.iter().any(|c| c[a] != c0[a])))
-        };
-        while commands.len() < self.block
-            || (first && commands.len() < FIRST_LOOKAHEAD && !all_moved(&commands))
-        {
-            let Some(l) = self.lines.next() else { break };
-            self.line += 1;
-            let l = l.map_err(|source| CsvError::Io {
-                file: self.file.clone(),
-                source,
-            })?;
-            let t = l.trim_end_matches('\r');
-            if t.trim().is_empty() || t.trim().starts_with('#') {
-                continue;
-            }
-            let (c, time, d) = self
-                .header
-                .row(&cx, self.line, t, self.m, &mut self.last_t)?;
-            times.push(time.unwrap_or((self.samples + commands.len()) as f64));
-            commands.push(c);
-            measured.push(d);
-            row_lines.push(self.line);
-        }
-        if commands.is_empty() {
-            if self.samples == 0 {
-                return Err(cx.err(self.header.line, None, "header only: the file has no samples (one row per sample expected after the header)"));
-            }
-            return Ok(None);
-        }
-        self.header.fill(&cx, self.m, &mut commands, &row_lines)?;
-        self.samples += commands.len();
-        // Directions of motion, continuing from the previous block.
-        let motion = match self.previous.take() {
-            None => crate::record::motion_directions(&commands),
-            Some((mut last, mut dir)) => commands
-                .iter()
-                .map(|c| {
-                    for a in 0..c.len() {
-                        if c[a] > last[a] {
-                            dir[a] = 1;
-                        } else if c[a] < last[a] {
-                            dir[a] = -1;
-                        }
-                    }
-                    last.clone_from(c);
-                    dir.clone()
-                })
-                .collect(),
-        };
-        self.previous = Some((
-            commands.last().cloned().unwrap_or_default(),
-            motion.last().cloned().unwrap_or_default(),
-        ));
-        let samples = commands
-            .into_iter()
-            .zip(times)
-            .zip(motion)
-            .map(|((commands, t), motion)| Sample {
-                commands,
-                t,
-                motion,
-            })
-            .collect();
-        Ok(Some(Record { samples, measured }))
-    }
-}
-
-impl<R: BufRead> Iterator for MeasurementBlocks<'_, R> {
-    type Item = Result<Record, CsvError>;
-
-    fn next(&mut self) -> Option<Self::Item> {
-        if self.failed {
-            return None;
-        }
-        match self.next_block() {
-            Ok(b) => b.map(Ok),
-            Err(e) => {
-                self.failed = true;
-                Some(Err(e))
-            }
+        if is_data(text) {
+            return Header::parse(cx, line, text, m, need);
         }
     }
 }
 
-/// The first and last time of a measurement file (s), for normalising `time:K` terms over the
-/// whole record when it is read in blocks (a pass over the file that keeps nothing else).
-pub fn time_span(path: &Path, m: &Machine) -> Result<(f64, f64), CsvError> {
-    let mut span: Option<(f64, f64)> = None;
-    for block in MeasurementBlocks::open(path, m, 65_536)? {
-        let b = block?;
-        if let (Some(first), Some(last)) = (b.samples.first(), b.samples.last()) {
-            span = Some(span.map_or((first.t, last.t), |(a, _)| (a, last.t)));
-        }
-    }
-    Ok(span.unwrap_or((0.0, 0.0)))
+/// The error of a file with a header and no samples.
+pub(crate) fn header_only(cx: &Ctx, header: &Header) -> CsvError {
+    cx.err(
+        header.line,
+        None,
+        "header only: the file has no samples (one row per sample expected after the header)",
+    )
 }

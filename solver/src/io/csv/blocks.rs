@@ -1,0 +1,191 @@
+//! The block reader: a long measurement file read in blocks of samples, never held whole.
+
+use crate::io::csv::lines::Lines;
+use crate::io::csv::read::{Header, header_only, is_data, read_header};
+use crate::io::csv::{CsvError, Ctx, Need, ReadOptions};
+use crate::record::{Record, Sample};
+use model_spec::Machine;
+use std::io::Read;
+use std::path::Path;
+
+/// Most samples the first block of a [`MeasurementBlocks`] holds while waiting for every axis to
+/// move.
+pub const FIRST_LOOKAHEAD: usize = 65_536;
+
+/// A long measurement file read in blocks of samples, without holding the record: each block
+/// is a [`Record`] with its measurements (commands mm and rad, readings mm, times s). The
+/// direction of motion of every axis carries over from one block to the next, and times (the
+/// `t_s` column, or the sample index in s) keep counting, so the blocks are exactly the slices
+/// of [`crate::io::csv::parse_csv`]'s record. (The direction of an axis before its first move is
+/// that of its first move; the first block grows until every axis has moved, up to
+/// [`FIRST_LOOKAHEAD`] samples. An axis whose first move comes later starts at +1 here, as if it
+/// had not moved.)
+///
+/// Lines go through the same bounded line reader as the whole-file reader. After an error the
+/// iterator ends.
+pub struct MeasurementBlocks<'m, R: Read> {
+    m: &'m Machine,
+    file: String,
+    lines: Lines<R>,
+    header: Header,
+    block: usize,
+    samples: usize,
+    last_t: Option<(f64, usize)>,
+    /// The previous sample's commands and directions of motion.
+    previous: Option<(Vec<f64>, Vec<i8>)>,
+    failed: bool,
+}
+
+impl<'m> MeasurementBlocks<'m, std::fs::File> {
+    /// Opens `path` (a measurement CSV of machine `m`) and reads its header; blocks hold
+    /// `block` samples (the last one fewer).
+    ///
+    /// # Errors
+    /// [`CsvError::Io`] when the file cannot be opened; see [`MeasurementBlocks::new`].
+    pub fn open(
+        path: &Path,
+        m: &'m Machine,
+        block: usize,
+        opts: &ReadOptions,
+    ) -> Result<Self, CsvError> {
+        let file = path.display().to_string();
+        let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
+            file: file.clone(),
+            source,
+        })?;
+        MeasurementBlocks::new(file, f, m, block, opts)
+    }
+}
+
+impl<'m, R: Read> MeasurementBlocks<'m, R> {
+    /// Reads the header from `reader` (named `file` in messages); blocks hold `block` samples
+    /// (the last one fewer).
+    ///
+    /// # Errors
+    /// [`CsvError::Format`] for an empty file or a malformed header (or a line before it that
+    /// is too long or not UTF-8); [`CsvError::Io`] when `reader` fails.
+    pub fn new(
+        file: String,
+        reader: R,
+        m: &'m Machine,
+        block: usize,
+        opts: &ReadOptions,
+    ) -> Result<Self, CsvError> {
+        let mut lines = Lines::new(reader, opts);
+        let header = read_header(&Ctx { file: &file }, &mut lines, m, Need::Measured)?;
+        Ok(MeasurementBlocks {
+            m,
+            file,
+            lines,
+            header,
+            block: block.max(1),
+            samples: 0,
+            last_t: None,
+            previous: None,
+            failed: false,
+        })
+    }
+
+    fn next_block(&mut self) -> Result<Option<Record>, CsvError> {
+        let cx = Ctx { file: &self.file };
+        let (mut commands, mut times, mut measured, mut row_lines) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        // The first block looks ahead until every axis has moved (its direction before the first
+        // move is that of the first move, as in the whole-file reader), up to FIRST_LOOKAHEAD.
+        let first = self.previous.is_none();
+        let all_moved = |commands: &[Vec<f64>]| {
+            commands
+                .first()
+                .is_none_or(|c0| (0..c0.len()).all(|a| commands.iter().any(|c| c[a] != c0[a])))
+        };
+        while commands.len() < self.block
+            || (first && commands.len() < FIRST_LOOKAHEAD && !all_moved(&commands))
+        {
+            let Some((line, text)) = self.lines.next_line(&cx)? else {
+                break;
+            };
+            if !is_data(text) {
+                continue;
+            }
+            let (c, time, d) = self.header.row(&cx, line, text, self.m, &mut self.last_t)?;
+            times.push(time.unwrap_or((self.samples + commands.len()) as f64));
+            commands.push(c);
+            measured.push(d);
+            row_lines.push(line);
+        }
+        if commands.is_empty() {
+            if self.samples == 0 {
+                return Err(header_only(&cx, &self.header));
+            }
+            return Ok(None);
+        }
+        self.header.fill(&cx, self.m, &mut commands, &row_lines)?;
+        self.samples += commands.len();
+        // Directions of motion, continuing from the previous block.
+        let motion = match self.previous.take() {
+            None => crate::record::motion_directions(&commands),
+            Some((mut last, mut dir)) => commands
+                .iter()
+                .map(|c| {
+                    for a in 0..c.len() {
+                        if c[a] > last[a] {
+                            dir[a] = 1;
+                        } else if c[a] < last[a] {
+                            dir[a] = -1;
+                        }
+                    }
+                    last.clone_from(c);
+                    dir.clone()
+                })
+                .collect(),
+        };
+        self.previous = Some((
+            commands.last().cloned().unwrap_or_default(),
+            motion.last().cloned().unwrap_or_default(),
+        ));
+        let samples = commands
+            .into_iter()
+            .zip(times)
+            .zip(motion)
+            .map(|((commands, t), motion)| Sample {
+                commands,
+                t,
+                motion,
+            })
+            .collect();
+        Ok(Some(Record { samples, measured }))
+    }
+}
+
+impl<R: Read> Iterator for MeasurementBlocks<'_, R> {
+    type Item = Result<Record, CsvError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.failed {
+            return None;
+        }
+        match self.next_block() {
+            Ok(b) => b.map(Ok),
+            Err(e) => {
+                self.failed = true;
+                Some(Err(e))
+            }
+        }
+    }
+}
+
+/// The first and last time of a measurement file (s), for normalising `time:K` terms over the
+/// whole record when it is read in blocks (a pass over the file that keeps nothing else).
+///
+/// # Errors
+/// As [`MeasurementBlocks`].
+pub fn time_span(path: &Path, m: &Machine, opts: &ReadOptions) -> Result<(f64, f64), CsvError> {
+    let mut span: Option<(f64, f64)> = None;
+    for block in MeasurementBlocks::open(path, m, 65_536, opts)? {
+        let b = block?;
+        if let (Some(first), Some(last)) = (b.samples.first(), b.samples.last()) {
+            span = Some(span.map_or((first.t, last.t), |(a, _)| (a, last.t)));
+        }
+    }
+    Ok(span.unwrap_or((0.0, 0.0)))
+}

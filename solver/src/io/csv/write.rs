@@ -1,0 +1,131 @@
+//! Writing a record as a measurement or path CSV: the text, then the file, atomically. Every
+//! number is the shortest decimal that reads back to the same value ([`crate::io::csv`]).
+
+use crate::io::csv::{CsvError, MEASURED, column_order, degrees_for, format_scaled};
+use crate::record::Record;
+use model_spec::{AxisKind, Machine};
+use std::io::Write;
+use std::path::Path;
+
+/// The CSV text of `record` of machine `m`: `comments` as `# ` lines, then the header
+/// (axes as in [`column_order`], `dx_um,dy_um,dz_um` when the record is measured, `t_s`), then
+/// one row per sample. Linear axes in mm, rotary in degrees, measured in µm, time in s, each the
+/// shortest decimal that reads back to the same bits.
+///
+/// # Errors
+/// [`CsvError::Record`] when a sample has the wrong number of commands, `measured` is neither
+/// empty nor one per sample, or a value is not finite.
+pub fn format_record(
+    m: &Machine,
+    record: &Record,
+    comments: &[String],
+) -> Result<String, CsvError> {
+    let n = record.samples.len();
+    let measured = !record.measured.is_empty();
+    if measured && record.measured.len() != n {
+        return Err(CsvError::Record(format!(
+            "it has {n} samples but {} measured vectors",
+            record.measured.len()
+        )));
+    }
+    let axes = column_order(m);
+    let mut out = String::new();
+    for c in comments {
+        for l in c.lines() {
+            out += "# ";
+            out += l;
+            out.push('\n');
+        }
+    }
+    let mut header: Vec<&str> = axes.iter().map(|&a| m.axes[a].name.as_str()).collect();
+    if measured {
+        header.extend(MEASURED);
+    }
+    header.push("t_s");
+    out += &header.join(",");
+    out.push('\n');
+    for (i, s) in record.samples.iter().enumerate() {
+        if s.commands.len() != m.axes.len() {
+            return Err(CsvError::Record(format!(
+                "sample {i} has {} commands, machine {} has {} axes",
+                s.commands.len(),
+                m.name,
+                m.axes.len()
+            )));
+        }
+        let mut fields: Vec<String> = Vec::with_capacity(header.len());
+        for &a in &axes {
+            let x = s.commands[a];
+            fields.push(match m.axes[a].kind {
+                AxisKind::Linear => format_scaled(x, 0),
+                AxisKind::Rotary => format_scaled(degrees_for(x), 0),
+            });
+        }
+        if measured {
+            fields.extend(record.measured[i].iter().map(|&v| format_scaled(v, 3)));
+        }
+        fields.push(format_scaled(s.t, 0));
+        let bad = |v: &f64| !v.is_finite();
+        if s.commands.iter().any(bad)
+            || !s.t.is_finite()
+            || (measured && record.measured[i].iter().any(bad))
+        {
+            return Err(CsvError::Record(format!(
+                "sample {i} has a non-finite value"
+            )));
+        }
+        out += &fields.join(",");
+        out.push('\n');
+    }
+    Ok(out)
+}
+
+/// Writes `record` of machine `m` to `path` atomically (see [`format_record`]).
+///
+/// # Errors
+/// See [`format_record`]; [`CsvError::Io`] when the file cannot be written (then nothing is
+/// left behind).
+pub fn write_record(
+    path: &Path,
+    m: &Machine,
+    record: &Record,
+    comments: &[String],
+) -> Result<(), CsvError> {
+    let text = format_record(m, record, comments)?;
+    write_atomically(path, text.as_bytes()).map_err(|source| CsvError::Io {
+        file: path.display().to_string(),
+        source,
+    })
+}
+
+/// Writes `bytes` to `path` atomically: to a temporary file in the same directory, flushed to
+/// disk, then renamed over `path`. On failure the temporary file is removed and `path` is
+/// untouched.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::other("the path names no file"))?
+        .to_string_lossy();
+    let tmp = dir.join(format!(
+        ".{name}.tmp-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        drop(f);
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}

@@ -1,5 +1,6 @@
 //! The block reader: a long measurement file read in blocks of samples, never held whole.
 
+use crate::io::csv::checks::SampleChecks;
 use crate::io::csv::lines::Lines;
 use crate::io::csv::read::{Header, header_only, is_data, read_header};
 use crate::io::csv::{CsvError, Ctx, Need, ReadOptions};
@@ -21,13 +22,16 @@ pub const FIRST_LOOKAHEAD: usize = 65_536;
 /// [`FIRST_LOOKAHEAD`] samples. An axis whose first move comes later starts at +1 here, as if it
 /// had not moved.)
 ///
-/// Lines go through the same bounded line reader as the whole-file reader. After an error the
-/// iterator ends.
+/// Lines go through the same bounded line reader as the whole-file reader, and each block is
+/// checked as the whole file is (nest on the ball, strokes, plausible readings): a block that
+/// fails a check is an error that lists the offending samples of that block (the reader cannot
+/// look ahead). After an error the iterator ends.
 pub struct MeasurementBlocks<'m, R: Read> {
     m: &'m Machine,
     file: String,
     lines: Lines<R>,
     header: Header,
+    checks: SampleChecks<'m>,
     block: usize,
     samples: usize,
     last_t: Option<(f64, usize)>,
@@ -77,6 +81,7 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
             m,
             file,
             lines,
+            checks: header.checks(m, opts),
             header,
             block: block.max(1),
             samples: 0,
@@ -120,6 +125,8 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
             return Ok(None);
         }
         self.header.fill(&cx, self.m, &mut commands, &row_lines)?;
+        self.checks
+            .check(&self.file, &commands, Some(&measured), &row_lines)?;
         self.samples += commands.len();
         // Directions of motion, continuing from the previous block.
         let motion = match self.previous.take() {
@@ -175,7 +182,8 @@ impl<R: Read> Iterator for MeasurementBlocks<'_, R> {
 }
 
 /// The first and last time of a measurement file (s), for normalising `time:K` terms over the
-/// whole record when it is read in blocks (a pass over the file that keeps nothing else).
+/// whole record when it is read in blocks (a pass over the file that keeps nothing else; the
+/// samples are read and checked as [`MeasurementBlocks`] reads them).
 ///
 /// # Errors
 /// As [`MeasurementBlocks`].

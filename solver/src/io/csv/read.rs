@@ -3,9 +3,11 @@
 //! ([`crate::io::csv::MeasurementBlocks`]), so both give the same errors at the same lines and
 //! columns. The format is described in [`crate::io::csv`].
 
+use crate::io::csv::checks::SampleChecks;
 use crate::io::csv::lines::Lines;
 use crate::io::csv::{
-    Col, CsvError, Ctx, MEASURED, Need, classify, clean_name, expected_columns, parse_scaled,
+    Col, CsvError, Ctx, MEASURED, Need, ReadOptions, classify, clean_name, expected_columns,
+    parse_scaled,
 };
 use crate::simulation::paths::fill_linear_ik;
 use model_spec::{AxisKind, Machine};
@@ -209,6 +211,11 @@ impl Header {
         fill_linear_ik(m, &m.default_parameters(), commands).map_err(|(i, e)| {
             cx.err(lines[i], None, format!("the linear axes are not given and the nominal inverse kinematics cannot fill them: {e}"))
         })
+    }
+
+    /// The checks of the samples of this file ([`SampleChecks`]).
+    pub(crate) fn checks<'m>(&self, m: &'m Machine, opts: &ReadOptions) -> SampleChecks<'m> {
+        SampleChecks::new(m, !self.fill_ik, opts)
     }
 }
 

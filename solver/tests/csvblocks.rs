@@ -77,6 +77,19 @@ fn blocks_equal_the_whole_record_with_reversals_and_without_times() {
         .collect();
     let whole = parse_measurement("m.csv", &reduced, &m, &ReadOptions::default()).unwrap();
     assert_eq!(concatenated(&reduced, &m, 50), whole);
+    // The linear axes filled by the inverse kinematics move from the second sample on, like the
+    // rotary ones: the first block does not look ahead.
+    let sizes: Vec<usize> = MeasurementBlocks::new(
+        "m.csv".into(),
+        Cursor::new(reduced.as_bytes()),
+        &m,
+        50,
+        &ReadOptions::default(),
+    )
+    .unwrap()
+    .map(|b| b.unwrap().samples.len())
+    .collect();
+    assert_eq!(sizes, vec![50, 50, 50, 50, 41]);
 }
 
 #[test]

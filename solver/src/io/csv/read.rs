@@ -9,6 +9,7 @@ use crate::io::csv::{
     Col, CsvError, Ctx, MEASURED, Need, ReadOptions, classify, clean_name, expected_columns,
     parse_scaled,
 };
+use crate::simulation::exact::{ExactError, VirtualMachine};
 use crate::simulation::paths::fill_linear_ik;
 use model_spec::{AxisKind, Machine};
 use std::io::Read;
@@ -208,15 +209,44 @@ impl Header {
         if !self.fill_ik {
             return Ok(());
         }
-        fill_linear_ik(m, &m.default_parameters(), commands).map_err(|(i, e)| {
-            cx.err(lines[i], None, format!("the linear axes are not given and the nominal inverse kinematics cannot fill them: {e}"))
-        })
+        fill_linear_ik(m, &m.default_parameters(), commands)
+            .map_err(|(i, e)| ik_error(cx, lines[i], e))
+    }
+
+    /// The nominal inverse kinematics that fills the linear commands of one row at a time
+    /// (machine lowered once, default kinematic parameters), when the file has no linear
+    /// columns.
+    pub(crate) fn row_ik<'m>(&self, m: &'m Machine) -> Option<RowIk<'m>> {
+        self.fill_ik
+            .then(|| RowIk(VirtualMachine::new(m), m.default_parameters()))
     }
 
     /// The checks of the samples of this file ([`SampleChecks`]).
     pub(crate) fn checks<'m>(&self, m: &'m Machine, opts: &ReadOptions) -> SampleChecks<'m> {
         SampleChecks::new(m, !self.fill_ik, opts)
     }
+}
+
+/// The nominal inverse kinematics of a machine at its default kinematic parameters (mm).
+pub(crate) struct RowIk<'m>(VirtualMachine<'m>, Vec<f64>);
+
+impl RowIk<'_> {
+    /// Fills the linear entries (mm) of the commands `c` of the row at line `line`.
+    pub(crate) fn fill(&self, cx: &Ctx, line: usize, c: &mut [f64]) -> Result<(), CsvError> {
+        self.0
+            .tool_centre_point_ik(c, &self.1)
+            .map_err(|e| ik_error(cx, line, e))
+    }
+}
+
+fn ik_error(cx: &Ctx, line: usize, e: ExactError) -> CsvError {
+    cx.err(
+        line,
+        None,
+        format!(
+            "the linear axes are not given and the nominal inverse kinematics cannot fill them: {e}"
+        ),
+    )
 }
 
 /// Whether a line holds data: neither blank nor a `#` comment.

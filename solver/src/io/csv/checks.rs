@@ -26,11 +26,12 @@ pub const LISTED: usize = 5;
 /// What an R-test record is, said when the nest is off the ball.
 const R_TEST_RECORD: &str = "; in an R-test record the linear axes follow the ball (the sensor nest stays on the ball) and the readings are the small error vector in µm; leave the linear columns out to have them filled by the nominal inverse kinematics";
 
-/// The checks of one reader: the machine lowered once, what the file gives.
+/// The checks of one reader: the machine, what the file gives.
 pub(crate) struct SampleChecks<'m> {
     m: &'m Machine,
-    /// Present when the file gives the linear axes: the nest must be on the ball.
-    on_ball: Option<(VirtualMachine<'m>, Vec<f64>)>,
+    /// Present when the file gives the linear axes (the nest must be on the ball): the nominal
+    /// machine ([`nominal_machine`]) and the default kinematic parameters (mm).
+    on_ball: Option<(Machine, Vec<f64>)>,
     /// The linear axes are filled by the inverse kinematics (said in the stroke message).
     filled: bool,
     opts: ReadOptions,
@@ -44,7 +45,7 @@ impl<'m> SampleChecks<'m> {
         SampleChecks {
             m,
             on_ball: (linear_given && has_linear)
-                .then(|| (VirtualMachine::new(m), m.default_parameters())),
+                .then(|| (nominal_machine(m), m.default_parameters())),
             filled: has_linear && !linear_given,
             opts: opts.clone(),
         }
@@ -75,9 +76,10 @@ impl<'m> SampleChecks<'m> {
         commands: &[Vec<f64>],
         lines: &[usize],
     ) -> Result<(), CsvError> {
-        let Some((vm, params)) = &self.on_ball else {
+        let Some((nominal, params)) = &self.on_ball else {
             return Ok(());
         };
+        let vm = VirtualMachine::new(nominal);
         let tol = self.opts.on_ball_tolerance_mm;
         let mut off = Offenders::default();
         for (c, &line) in commands.iter().zip(lines) {
@@ -164,6 +166,17 @@ impl<'m> SampleChecks<'m> {
             "",
         )
     }
+}
+
+/// `m` without its errors: its chains lowered without error steps (they are identities when
+/// every error is zero), so that [`VirtualMachine::nominal_error_vector`] of it gives that of
+/// `m` with a few matrix products per chain instead of dozens.
+fn nominal_machine(m: &Machine) -> Machine {
+    let mut nominal = m.clone();
+    nominal.catalogue.clear();
+    nominal.errors.clear();
+    nominal.models.clear();
+    nominal
 }
 
 /// Whether `commands` (mm, rad; one per axis) lies within the strokes (mm) and ranges (degrees)
@@ -268,5 +281,41 @@ fn people(x: f64) -> String {
         short(x)
     } else {
         format!("{x:.6e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulation::rng::Rng;
+
+    #[test]
+    fn the_nominal_machine_has_the_nominal_error_vector_of_the_machine() {
+        for name in ["seed-ac", "seed-3axis", "head-table-bc"] {
+            let m = model_spec::builtin(name).unwrap().unwrap();
+            let nominal = nominal_machine(&m);
+            let (full, bare) = (VirtualMachine::new(&m), VirtualMachine::new(&nominal));
+            assert!(
+                bare.steps(model_spec::Side::Work).len() < full.steps(model_spec::Side::Work).len()
+            );
+            let mut rng = Rng::new(7);
+            let mut params = m.default_parameters();
+            for _ in 0..200 {
+                params.iter_mut().for_each(|p| *p += 10.0 * rng.normal());
+                let q: Vec<f64> = m
+                    .axes
+                    .iter()
+                    .map(|a| match a.kind {
+                        AxisKind::Linear => 300.0 * rng.normal(),
+                        AxisKind::Rotary => 3.0 * rng.normal(),
+                    })
+                    .collect();
+                assert_eq!(
+                    bare.nominal_error_vector(&q, &params),
+                    full.nominal_error_vector(&q, &params),
+                    "{name} at {q:?}"
+                );
+            }
+        }
     }
 }

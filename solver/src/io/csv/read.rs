@@ -128,14 +128,13 @@ impl Header {
         m: &Machine,
         last_t: &mut Option<(f64, usize)>,
     ) -> Result<Row, CsvError> {
-        let fields: Vec<&str> = text.split(',').collect();
-        if fields.len() != self.cols.len() {
+        let n_fields = text.bytes().filter(|&b| b == b',').count() + 1;
+        if n_fields != self.cols.len() {
             return Err(cx.err(
                 line,
                 None,
                 format!(
-                    "ragged row: {} field(s), the header (line {}) has {} columns",
-                    fields.len(),
+                    "ragged row: {n_fields} field(s), the header (line {}) has {} columns",
                     self.line,
                     self.cols.len()
                 ),
@@ -144,58 +143,74 @@ impl Header {
         let mut c = vec![0.0; m.axes.len()];
         let mut t = None;
         let mut d = [0.0; 3];
-        for (i, (field, &col)) in fields.iter().zip(&self.cols).enumerate() {
-            let at = Some((i, self.names[i].as_str()));
+        for (i, (field, &col)) in text.split(',').zip(&self.cols).enumerate() {
             let f = field.trim();
-            let unit = match col {
-                Col::Axis(a) if m.axes[a].kind == AxisKind::Rotary => "degrees",
-                Col::Axis(_) => "mm",
-                Col::Time => "s",
-                Col::Measured(_) => "µm",
-            };
-            let x = match f.parse::<f64>() {
-                _ if f.is_empty() => {
-                    return Err(cx.err(
-                        line,
-                        at,
-                        format!("empty field: expected a number ({unit})"),
-                    ));
-                }
-                Ok(x) if x.is_finite() => x,
-                Ok(_) => {
-                    return Err(cx.err(line, at, format!("`{f}` is not a finite number ({unit})")));
-                }
-                Err(_) => return Err(cx.err(line, at, format!("`{f}` is not a number ({unit})"))),
-            };
+            let bad = || self.bad_number(cx, line, i, f, col, m);
             match col {
+                Col::Measured(k) => {
+                    d[k] = match parse_scaled(f, -3) {
+                        Some(v) if v.is_finite() => v,
+                        _ => return Err(bad()),
+                    }
+                }
                 Col::Axis(a) => {
+                    let x = f
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(bad)?;
                     c[a] = match m.axes[a].kind {
                         AxisKind::Rotary => x.to_radians(),
                         AxisKind::Linear => x,
                     }
                 }
                 Col::Time => {
+                    let x = f
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(bad)?;
                     if let Some((prev, prev_line)) = *last_t
                         && x < prev
                     {
                         return Err(cx.err(
                             line,
-                            at,
+                            Some((i, self.names[i].as_str())),
                             format!("time {f} s is before the time of the previous sample ({prev} s, line {prev_line}): times must not decrease"),
                         ));
                     }
                     *last_t = Some((x, line));
                     t = Some(x);
                 }
-                Col::Measured(k) => {
-                    d[k] = match parse_scaled(f, -3) {
-                        Some(v) if v.is_finite() => v,
-                        _ => return Err(cx.err(line, at, format!("`{f}` is out of range (µm)"))),
-                    }
-                }
             }
         }
         Ok((c, t, d))
+    }
+
+    /// Why the field `f` of column `i` (holding `col`) on line `line` is not a number that can
+    /// be read.
+    fn bad_number(
+        &self,
+        cx: &Ctx,
+        line: usize,
+        i: usize,
+        f: &str,
+        col: Col,
+        m: &Machine,
+    ) -> CsvError {
+        let unit = match col {
+            Col::Axis(a) if m.axes[a].kind == AxisKind::Rotary => "degrees",
+            Col::Axis(_) => "mm",
+            Col::Time => "s",
+            Col::Measured(_) => "µm",
+        };
+        let why = match f.parse::<f64>() {
+            _ if f.is_empty() => format!("empty field: expected a number ({unit})"),
+            Err(_) => format!("`{f}` is not a number ({unit})"),
+            Ok(x) if !x.is_finite() => format!("`{f}` is not a finite number ({unit})"),
+            Ok(_) => format!("`{f}` is out of range ({unit})"),
+        };
+        cx.err(line, Some((i, self.names[i].as_str())), why)
     }
 
     /// Fills the linear commands by inverse kinematics when the file has none.

@@ -164,13 +164,15 @@ fn errors_carry_their_parts() {
         }
         other => panic!("{other:?}"),
     }
-    let e = read_measurement(
-        std::path::Path::new("/no/such/file.csv"),
-        &seed_ac(),
-        &ReadOptions::default(),
-    )
-    .unwrap_err();
-    assert!(e.to_string().starts_with("/no/such/file.csv: "), "{e}");
+    // A file that does not exist, in a fresh scratch directory.
+    let dir = Scratch::new("missing");
+    let f = dir.0.join("no-such-file.csv");
+    let e = read_measurement(&f, &seed_ac(), &ReadOptions::default()).unwrap_err();
+    assert!(matches!(e, CsvError::Io { .. }), "{e}");
+    assert!(
+        e.to_string().starts_with(&format!("{}: ", f.display())),
+        "{e}"
+    );
 }
 
 #[test]

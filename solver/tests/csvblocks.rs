@@ -77,16 +77,45 @@ fn blocks_equal_the_whole_record_with_reversals_and_without_times() {
         .collect();
     let whole = parse_measurement("m.csv", &reduced, &m, &ReadOptions::default()).unwrap();
     assert_eq!(concatenated(&reduced, &m, 50), whole);
+    // The linear axes filled by the inverse kinematics move from the second sample on, like the
+    // rotary ones: the first block does not look ahead.
+    let sizes: Vec<usize> = MeasurementBlocks::new(
+        "m.csv".into(),
+        Cursor::new(reduced.as_bytes()),
+        &m,
+        50,
+        &ReadOptions::default(),
+    )
+    .unwrap()
+    .map(|b| b.unwrap().samples.len())
+    .collect();
+    assert_eq!(sizes, vec![50, 50, 50, 50, 41]);
 }
 
 #[test]
 fn an_error_deep_in_the_file_names_its_line_and_column() {
     let m = builtin("seed-ac").unwrap().unwrap();
+    // Every axis moves from the second sample on (the nest follows the ball), so the first
+    // block does not look ahead.
+    let (ia, ic) = (m.axis_by_name("A").unwrap(), m.axis_by_name("C").unwrap());
+    let mut commands: Vec<Vec<f64>> = (0..100)
+        .map(|i| {
+            let mut c = vec![0.0; m.axes.len()];
+            c[ia] = (0.5 * i as f64).to_radians();
+            c[ic] = (i as f64).to_radians();
+            c
+        })
+        .collect();
+    fill_linear_ik(&m, &m.default_parameters(), &mut commands).unwrap();
+    let path = record_from_commands(commands, (0..100).map(f64::from).collect());
+    // The path's rows with zero readings instead of the time, then a bad reading.
     let mut text = String::from("X,Y,Z,A,C,dx_um,dy_um,dz_um\n");
-    for i in 0..100 {
-        text.push_str(&format!("{i},{i},{i},{i},{i},0,0,0\n"));
+    let mut last = String::new();
+    for l in format_record(&m, &path, &[]).unwrap().lines().skip(1) {
+        last = l.rsplit_once(',').unwrap().0.to_string();
+        text += &format!("{last},0,0,0\n");
     }
-    text.push_str("1,2,3,4,5,6,seven,8\n");
+    text += &format!("{last},6,seven,8\n");
     let mut blocks = MeasurementBlocks::new(
         "m.csv".into(),
         Cursor::new(text.as_bytes()),

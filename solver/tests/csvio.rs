@@ -164,24 +164,27 @@ fn errors_carry_their_parts() {
         }
         other => panic!("{other:?}"),
     }
-    let e = read_measurement(
-        std::path::Path::new("/no/such/file.csv"),
-        &seed_ac(),
-        &ReadOptions::default(),
-    )
-    .unwrap_err();
-    assert!(e.to_string().starts_with("/no/such/file.csv: "), "{e}");
+    // A file that does not exist, in a fresh scratch directory.
+    let dir = Scratch::new("missing");
+    let f = dir.0.join("no-such-file.csv");
+    let e = read_measurement(&f, &seed_ac(), &ReadOptions::default()).unwrap_err();
+    assert!(matches!(e, CsvError::Io { .. }), "{e}");
+    assert!(
+        e.to_string().starts_with(&format!("{}: ", f.display())),
+        "{e}"
+    );
 }
 
 #[test]
 fn units_order_case_comments_and_line_endings() {
     let m = seed_ac();
-    let text = "\u{feff}# comment\r\n\r\n  \"t_s\" , c,A , z,Y,x,DZ_UM,dy_um,dx_um\r\n# another\r\n2.5,90,-45,3,2,1,12.5,-0.25,1000\r\n";
+    // At A = -45°, C = 90° the nest is on the ball at X, Y, Z = -0.279, 16.848, 139.775 mm.
+    let text = "\u{feff}# comment\r\n\r\n  \"t_s\" , c,A , z,Y,x,DZ_UM,dy_um,dx_um\r\n# another\r\n2.5,90,-45,139.775,16.848,-0.279,12.5,-0.25,1000\r\n";
     let r = parse_measurement("m.csv", text, &m, &ReadOptions::default()).unwrap();
     assert_eq!(r.samples.len(), 1);
     let s = &r.samples[0];
     let ax = |n: &str| s.commands[m.axis_by_name(n).unwrap()];
-    assert_eq!((ax("X"), ax("Y"), ax("Z")), (1.0, 2.0, 3.0));
+    assert_eq!((ax("X"), ax("Y"), ax("Z")), (-0.279, 16.848, 139.775));
     assert_eq!(ax("A"), (-45f64).to_radians());
     assert_eq!(ax("C"), 90f64.to_radians());
     assert_eq!(s.t, 2.5);
@@ -194,7 +197,7 @@ fn without_time_the_sample_index_is_the_time() {
     let m = seed_ac();
     let r = parse_measurement(
         "m.csv",
-        "X,Y,Z,A,C,dx_um,dy_um,dz_um\n0,0,0,0,0,0,0,0\n0,0,0,0,1,0,0,0\n0,0,0,0,2,0,0,0\n",
+        "A,C,dx_um,dy_um,dz_um\n0,0,0,0,0\n0,1,0,0,0\n0,2,0,0,0\n",
         &m,
         &ReadOptions::default(),
     )

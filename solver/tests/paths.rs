@@ -159,28 +159,31 @@ fn path_fixture_on_disk() {
 #[test]
 fn a_path_file_with_every_axis_is_taken_as_written() {
     let m = seed_ac();
+    // At A = 0°, C = 90° the nest is on the ball at X, Y, Z = -0.279, -217.504, 56.661 mm;
+    // the second sample is 0.239 mm above it, within the tolerance.
     let r = parse_path(
         "p.csv",
-        "X,Y,Z,A,C\n1,2,3,0,90\n1,2,4,0,90\n",
+        "X,Y,Z,A,C\n-0.279,-217.504,56.661,0,90\n-0.279,-217.504,56.9,0,90\n",
         &m,
         &ReadOptions::default(),
     )
     .unwrap();
     let z = m.axis_by_name("Z").unwrap();
-    assert_eq!(r.samples[1].commands[z], 4.0);
-    assert_eq!(r.samples[0].commands[m.axis_by_name("X").unwrap()], 1.0);
+    assert_eq!(r.samples[1].commands[z], 56.9);
+    assert_eq!(r.samples[0].commands[m.axis_by_name("X").unwrap()], -0.279);
     assert_eq!(r.samples[1].t, 1.0, "no t_s: t = sample index");
-    // A three-axis machine: linear axes only.
+    // A three-axis machine: linear axes only; its ball is fixed at the origin, the nest within
+    // 0.37 mm of it.
     let m3 = builtin("seed-3axis");
     let names: Vec<&str> = m3.axes.iter().map(|a| a.name.as_str()).collect();
     let r = parse_path(
         "p.csv",
-        &format!("{}\n1,2,3\n", names.join(",")),
+        &format!("{}\n0.1,0.2,0.3\n", names.join(",")),
         &m3,
         &ReadOptions::default(),
     )
     .unwrap();
-    assert_eq!(r.samples[0].commands, vec![1.0, 2.0, 3.0]);
+    assert_eq!(r.samples[0].commands, vec![0.1, 0.2, 0.3]);
 }
 
 #[test]

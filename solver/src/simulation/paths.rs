@@ -17,8 +17,10 @@
 //!
 //! A path file is a CSV in the measurement format ([`crate::io::csv`]): rotary columns required
 //! (degrees), linear columns optional (filled by the inverse kinematics), `t_s` optional,
-//! measured columns optional and ignored. It is read by the same bounded line reader as a
-//! measurement file, under the same [`ReadOptions`].
+//! measured columns optional and ignored. It is read by the same bounded line reader and
+//! checked as a measurement file is (nest on the ball when the linear axes are given, strokes
+//! and ranges, and the plausibility of the readings when there are any), under the same
+//! [`ReadOptions`]. The built-in paths lie within the strokes and ranges of `seed-ac`.
 
 use crate::io::csv::{CsvError, Need, ReadOptions, read_csv};
 use crate::record::{Record, Sample, motion_directions};
@@ -180,7 +182,8 @@ pub fn parse_path(
 ///
 /// # Errors
 /// [`CsvError::Format`] naming the line and column of the first problem (a line too long or
-/// not UTF-8 included); [`CsvError::Io`] when `reader` fails.
+/// not UTF-8 included); [`CsvError::Refused`] for poses off the ball or off the strokes, or
+/// implausible readings; [`CsvError::Io`] when `reader` fails.
 pub fn read_path<R: std::io::Read>(
     file: &str,
     reader: R,

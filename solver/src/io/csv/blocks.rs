@@ -1,7 +1,8 @@
 //! The block reader: a long measurement file read in blocks of samples, never held whole.
 
+use crate::io::csv::checks::SampleChecks;
 use crate::io::csv::lines::Lines;
-use crate::io::csv::read::{Header, header_only, is_data, read_header};
+use crate::io::csv::read::{Header, RowIk, header_only, is_data, read_header};
 use crate::io::csv::{CsvError, Ctx, Need, ReadOptions};
 use crate::record::{Record, Sample};
 use model_spec::Machine;
@@ -17,17 +18,22 @@ pub const FIRST_LOOKAHEAD: usize = 65_536;
 /// direction of motion of every axis carries over from one block to the next, and times (the
 /// `t_s` column, or the sample index in s) keep counting, so the blocks are exactly the slices
 /// of [`crate::io::csv::parse_csv`]'s record. (The direction of an axis before its first move is
-/// that of its first move; the first block grows until every axis has moved, up to
-/// [`FIRST_LOOKAHEAD`] samples. An axis whose first move comes later starts at +1 here, as if it
-/// had not moved.)
+/// that of its first move; the first block grows until every axis, linear axes filled by the
+/// inverse kinematics included, has moved, up to [`FIRST_LOOKAHEAD`] samples. An axis whose
+/// first move comes later starts at +1 here, as if it had not moved.)
 ///
-/// Lines go through the same bounded line reader as the whole-file reader. After an error the
-/// iterator ends.
+/// Lines go through the same bounded line reader as the whole-file reader, and each block is
+/// checked as the whole file is (nest on the ball, strokes, plausible readings): a block that
+/// fails a check is an error that lists the offending samples of that block (the reader cannot
+/// look ahead). After an error the iterator ends.
 pub struct MeasurementBlocks<'m, R: Read> {
     m: &'m Machine,
     file: String,
     lines: Lines<R>,
     header: Header,
+    /// Fills the linear axes row by row when the file has none.
+    ik: Option<RowIk<'m>>,
+    checks: SampleChecks<'m>,
     block: usize,
     samples: usize,
     last_t: Option<(f64, usize)>,
@@ -77,6 +83,8 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
             m,
             file,
             lines,
+            ik: header.row_ik(m),
+            checks: header.checks(m, opts),
             header,
             block: block.max(1),
             samples: 0,
@@ -88,18 +96,17 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
 
     fn next_block(&mut self) -> Result<Option<Record>, CsvError> {
         let cx = Ctx { file: &self.file };
-        let (mut commands, mut times, mut measured, mut row_lines) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut commands: Vec<Vec<f64>> = Vec::new();
+        let (mut times, mut measured, mut row_lines) = (Vec::new(), Vec::new(), Vec::new());
         // The first block looks ahead until every axis has moved (its direction before the first
         // move is that of the first move, as in the whole-file reader), up to FIRST_LOOKAHEAD.
+        // The linear axes are filled as the rows come, so their moves count too.
         let first = self.previous.is_none();
-        let all_moved = |commands: &[Vec<f64>]| {
-            commands
-                .first()
-                .is_none_or(|c0| (0..c0.len()).all(|a| commands.iter().any(|c| c[a] != c0[a])))
-        };
+        let n_axes = self.m.axes.len();
+        let mut moved = vec![false; n_axes];
+        let mut n_moved = 0;
         while commands.len() < self.block
-            || (first && commands.len() < FIRST_LOOKAHEAD && !all_moved(&commands))
+            || (first && commands.len() < FIRST_LOOKAHEAD && n_moved < n_axes)
         {
             let Some((line, text)) = self.lines.next_line(&cx)? else {
                 break;
@@ -107,7 +114,18 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
             if !is_data(text) {
                 continue;
             }
-            let (c, time, d) = self.header.row(&cx, line, text, self.m, &mut self.last_t)?;
+            let (mut c, time, d) = self.header.row(&cx, line, text, self.m, &mut self.last_t)?;
+            if let Some(ik) = &self.ik {
+                ik.fill(&cx, line, &mut c)?;
+            }
+            if first && let Some(c0) = commands.first() {
+                for a in 0..n_axes {
+                    if !moved[a] && c[a] != c0[a] {
+                        moved[a] = true;
+                        n_moved += 1;
+                    }
+                }
+            }
             times.push(time.unwrap_or((self.samples + commands.len()) as f64));
             commands.push(c);
             measured.push(d);
@@ -119,7 +137,8 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
             }
             return Ok(None);
         }
-        self.header.fill(&cx, self.m, &mut commands, &row_lines)?;
+        self.checks
+            .check(&self.file, &commands, Some(&measured), &row_lines)?;
         self.samples += commands.len();
         // Directions of motion, continuing from the previous block.
         let motion = match self.previous.take() {
@@ -175,7 +194,8 @@ impl<R: Read> Iterator for MeasurementBlocks<'_, R> {
 }
 
 /// The first and last time of a measurement file (s), for normalising `time:K` terms over the
-/// whole record when it is read in blocks (a pass over the file that keeps nothing else).
+/// whole record when it is read in blocks (a pass over the file that keeps nothing else; the
+/// samples are read and checked as [`MeasurementBlocks`] reads them).
 ///
 /// # Errors
 /// As [`MeasurementBlocks`].

@@ -20,6 +20,19 @@
 //! [`CsvError::Format`] naming the file, the line and, where there is one, the column (1-based
 //! index and header name, or the character position in a line that is not UTF-8).
 //!
+//! Well-formed samples must still be an R-test record of the machine ([`CsvError::Refused`]
+//! otherwise, with how many samples or readings offend and the first few by line; the block
+//! reader checks each block, so it lists those of the first block that has any):
+//! - when the file gives the linear axes, each pose puts the nominal tool point on the nominal
+//!   workpiece point (the sensor nest on the ball) within [`ReadOptions::on_ball_tolerance_mm`]
+//!   (0.5 mm), at the machine's default kinematic parameters. In an R-test record the linear
+//!   axes follow the ball and the readings are the small error vector; leaving the linear
+//!   columns out has them filled by the inverse kinematics;
+//! - every pose, linear axes filled, lies within the machine's strokes (mm) and ranges
+//!   (degrees), inclusive to within 1e-9 of the axis unit, unless
+//!   [`ReadOptions::allow_off_stroke`];
+//! - every reading lies within ±[`ReadOptions::max_reading_mm`] (1000 µm) in each direction.
+//!
 //! Numbers are converted without double rounding: a µm value is read by moving the decimal
 //! point of its text three places ([`parse_scaled`]), and written as the shortest decimal of the
 //! mm value with the point moved back ([`format_scaled`]), so write → read gives the same bits.
@@ -29,9 +42,10 @@
 //! Files are written atomically: to a temporary file in the same directory, then renamed.
 //!
 //! Files: `lines` (the bounded line reader), `read` (header and rows), `whole` and `blocks`
-//! (the two readers), `write`, `numbers`.
+//! (the two readers), `checks` (what samples must satisfy), `write`, `numbers`.
 
 mod blocks;
+mod checks;
 mod lines;
 mod numbers;
 mod read;
@@ -40,6 +54,7 @@ mod write;
 
 use crate::record::Record;
 pub use blocks::{FIRST_LOOKAHEAD, MeasurementBlocks, time_span};
+pub use checks::{LIMIT_MARGIN, LISTED};
 pub use lines::READ_BUFFER_BYTES;
 use model_spec::catalogue::iso_rank;
 use model_spec::{AxisKind, Machine};
@@ -51,10 +66,20 @@ pub use write::{format_record, write_atomically, write_record};
 /// How the readers judge a file: the bounds of what they accept.
 ///
 /// `ReadOptions::default()` (or [`ReadOptions::new`]) is what the command line uses; set the
-/// fields to change one (`let mut o = ReadOptions::new(); o.max_line_bytes = 4096;`).
+/// fields to change one (`let mut o = ReadOptions::new(); o.allow_off_stroke = true;`).
 #[non_exhaustive]
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReadOptions {
+    /// Largest magnitude of a reading (each of `dx`, `dy`, `dz`), mm; beyond it the file is
+    /// refused. Default 1.0 mm (1000 µm): an R-test reads a small error vector.
+    /// `f64::INFINITY` turns the check off.
+    pub max_reading_mm: f64,
+    /// Accept poses outside the machine's strokes (mm) and ranges (degrees). Default `false`.
+    pub allow_off_stroke: bool,
+    /// Largest distance between the nominal tool point and the nominal workpiece point, mm,
+    /// when the file gives the linear axes. Default 0.5 mm. `f64::INFINITY` turns the check
+    /// off.
+    pub on_ball_tolerance_mm: f64,
     /// Longest line, bytes (its line end not counted). Default 65 536. The readers never hold
     /// more of a line, and read at most this plus [`READ_BUFFER_BYTES`] of a longer one.
     pub max_line_bytes: usize,
@@ -63,6 +88,9 @@ pub struct ReadOptions {
 impl Default for ReadOptions {
     fn default() -> Self {
         ReadOptions {
+            max_reading_mm: 1.0,
+            allow_off_stroke: false,
+            on_ball_tolerance_mm: 0.5,
             max_line_bytes: 65_536,
         }
     }
@@ -88,6 +116,20 @@ pub enum CsvError {
         /// The column: 1-based index and header name.
         column: Option<(usize, String)>,
         /// What is wrong.
+        message: String,
+    },
+    /// Well-formed samples that cannot be an R-test record of the machine: nest off the ball,
+    /// poses outside the strokes, implausible readings (see the module documentation).
+    #[error("{file}: {message}")]
+    Refused {
+        /// The file name.
+        file: String,
+        /// How many samples (poses) or readings offend (in the block, for the block reader).
+        count: usize,
+        /// The 1-based lines of the offending samples listed in the message (the first few, at
+        /// most [`LISTED`], each once).
+        lines: Vec<usize>,
+        /// What is wrong, with the offending samples listed by line.
         message: String,
     },
     /// A record that cannot be written (not a file problem: a programming error reported).
@@ -160,7 +202,8 @@ impl Ctx<'_> {
 /// # Errors
 /// [`CsvError::Format`] for the first problem: empty file, header only, unknown, duplicate or
 /// missing column, ragged row, text or a non-finite number where a number belongs, time going
-/// backwards, inverse kinematics without a solution, a line too long or not UTF-8.
+/// backwards, inverse kinematics without a solution, a line too long; [`CsvError::Refused`]
+/// for samples off the ball, off the strokes or with implausible readings.
 pub fn parse_measurement(
     file: &str,
     text: &str,

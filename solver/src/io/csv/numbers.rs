@@ -48,7 +48,40 @@ pub fn parse_scaled(text: &str, shift: i32) -> Option<f64> {
     let e = exp
         .checked_sub(frac.len() as i64)?
         .checked_add(shift as i64)?;
-    format!("{sign}{int}{frac}e{e}").parse().ok()
+    // The digits and the exponent, written without allocating when they are short.
+    let mut digits = [0u8; 20];
+    let exponent = decimal(e, &mut digits);
+    let parts = [sign, int, frac, "e", exponent];
+    let mut buf = [0u8; 64];
+    let len: usize = parts.iter().map(|p| p.len()).sum();
+    if len > buf.len() {
+        return parts.concat().parse().ok();
+    }
+    let mut n = 0;
+    for p in parts {
+        buf[n..n + p.len()].copy_from_slice(p.as_bytes());
+        n += p.len();
+    }
+    std::str::from_utf8(&buf[..n]).ok()?.parse().ok()
+}
+
+/// `e` in decimal, written at the end of `buf` (20 bytes hold every `i64`).
+fn decimal(e: i64, buf: &mut [u8; 20]) -> &str {
+    let mut i = buf.len();
+    let mut u = e.unsigned_abs();
+    loop {
+        i -= 1;
+        buf[i] = b'0' + (u % 10) as u8;
+        u /= 10;
+        if u == 0 {
+            break;
+        }
+    }
+    if e < 0 {
+        i -= 1;
+        buf[i] = b'-';
+    }
+    std::str::from_utf8(&buf[i..]).unwrap_or("0")
 }
 
 /// The shortest decimal of `x` (the one that reads back to the same `f64`) times `10^shift`,
@@ -110,6 +143,13 @@ mod tests {
         assert_eq!(parse_scaled("1.2.3", 0), None);
         assert_eq!(parse_scaled("", 0), None);
         assert_eq!(parse_scaled("-", 0), None);
+        assert_eq!(parse_scaled("-1e-5", -3), Some(-1e-8));
+        assert_eq!(parse_scaled("25e-9223372036854775807", 0), Some(0.0));
+        assert_eq!(parse_scaled("1e-9223372036854775808", 0), Some(0.0));
+        assert_eq!(parse_scaled("1.5e-9223372036854775808", 0), None);
+        // Longer than the stack buffer.
+        let long = format!("{}.{}", "1".repeat(70), "2".repeat(30));
+        assert_eq!(parse_scaled(&long, -3), format!("{long}e-3").parse().ok());
         let mut r = crate::simulation::rng::Rng::new(3);
         for _ in 0..20_000 {
             let x = r.normal() * 10f64.powi((r.uniform() * 40.0) as i32 - 20);

@@ -3,10 +3,13 @@
 //! ([`crate::io::csv::MeasurementBlocks`]), so both give the same errors at the same lines and
 //! columns. The format is described in [`crate::io::csv`].
 
+use crate::io::csv::checks::SampleChecks;
 use crate::io::csv::lines::Lines;
 use crate::io::csv::{
-    Col, CsvError, Ctx, MEASURED, Need, classify, clean_name, expected_columns, parse_scaled,
+    Col, CsvError, Ctx, MEASURED, Need, ReadOptions, classify, clean_name, expected_columns,
+    parse_scaled,
 };
+use crate::simulation::exact::{ExactError, VirtualMachine};
 use crate::simulation::paths::fill_linear_ik;
 use model_spec::{AxisKind, Machine};
 use std::io::Read;
@@ -125,14 +128,13 @@ impl Header {
         m: &Machine,
         last_t: &mut Option<(f64, usize)>,
     ) -> Result<Row, CsvError> {
-        let fields: Vec<&str> = text.split(',').collect();
-        if fields.len() != self.cols.len() {
+        let n_fields = text.bytes().filter(|&b| b == b',').count() + 1;
+        if n_fields != self.cols.len() {
             return Err(cx.err(
                 line,
                 None,
                 format!(
-                    "ragged row: {} field(s), the header (line {}) has {} columns",
-                    fields.len(),
+                    "ragged row: {n_fields} field(s), the header (line {}) has {} columns",
                     self.line,
                     self.cols.len()
                 ),
@@ -141,58 +143,74 @@ impl Header {
         let mut c = vec![0.0; m.axes.len()];
         let mut t = None;
         let mut d = [0.0; 3];
-        for (i, (field, &col)) in fields.iter().zip(&self.cols).enumerate() {
-            let at = Some((i, self.names[i].as_str()));
+        for (i, (field, &col)) in text.split(',').zip(&self.cols).enumerate() {
             let f = field.trim();
-            let unit = match col {
-                Col::Axis(a) if m.axes[a].kind == AxisKind::Rotary => "degrees",
-                Col::Axis(_) => "mm",
-                Col::Time => "s",
-                Col::Measured(_) => "µm",
-            };
-            let x = match f.parse::<f64>() {
-                _ if f.is_empty() => {
-                    return Err(cx.err(
-                        line,
-                        at,
-                        format!("empty field: expected a number ({unit})"),
-                    ));
-                }
-                Ok(x) if x.is_finite() => x,
-                Ok(_) => {
-                    return Err(cx.err(line, at, format!("`{f}` is not a finite number ({unit})")));
-                }
-                Err(_) => return Err(cx.err(line, at, format!("`{f}` is not a number ({unit})"))),
-            };
+            let bad = || self.bad_number(cx, line, i, f, col, m);
             match col {
+                Col::Measured(k) => {
+                    d[k] = match parse_scaled(f, -3) {
+                        Some(v) if v.is_finite() => v,
+                        _ => return Err(bad()),
+                    }
+                }
                 Col::Axis(a) => {
+                    let x = f
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(bad)?;
                     c[a] = match m.axes[a].kind {
                         AxisKind::Rotary => x.to_radians(),
                         AxisKind::Linear => x,
                     }
                 }
                 Col::Time => {
+                    let x = f
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(bad)?;
                     if let Some((prev, prev_line)) = *last_t
                         && x < prev
                     {
                         return Err(cx.err(
                             line,
-                            at,
+                            Some((i, self.names[i].as_str())),
                             format!("time {f} s is before the time of the previous sample ({prev} s, line {prev_line}): times must not decrease"),
                         ));
                     }
                     *last_t = Some((x, line));
                     t = Some(x);
                 }
-                Col::Measured(k) => {
-                    d[k] = match parse_scaled(f, -3) {
-                        Some(v) if v.is_finite() => v,
-                        _ => return Err(cx.err(line, at, format!("`{f}` is out of range (µm)"))),
-                    }
-                }
             }
         }
         Ok((c, t, d))
+    }
+
+    /// Why the field `f` of column `i` (holding `col`) on line `line` is not a number that can
+    /// be read.
+    fn bad_number(
+        &self,
+        cx: &Ctx,
+        line: usize,
+        i: usize,
+        f: &str,
+        col: Col,
+        m: &Machine,
+    ) -> CsvError {
+        let unit = match col {
+            Col::Axis(a) if m.axes[a].kind == AxisKind::Rotary => "degrees",
+            Col::Axis(_) => "mm",
+            Col::Time => "s",
+            Col::Measured(_) => "µm",
+        };
+        let why = match f.parse::<f64>() {
+            _ if f.is_empty() => format!("empty field: expected a number ({unit})"),
+            Err(_) => format!("`{f}` is not a number ({unit})"),
+            Ok(x) if !x.is_finite() => format!("`{f}` is not a finite number ({unit})"),
+            Ok(_) => format!("`{f}` is out of range ({unit})"),
+        };
+        cx.err(line, Some((i, self.names[i].as_str())), why)
     }
 
     /// Fills the linear commands by inverse kinematics when the file has none.
@@ -206,10 +224,44 @@ impl Header {
         if !self.fill_ik {
             return Ok(());
         }
-        fill_linear_ik(m, &m.default_parameters(), commands).map_err(|(i, e)| {
-            cx.err(lines[i], None, format!("the linear axes are not given and the nominal inverse kinematics cannot fill them: {e}"))
-        })
+        fill_linear_ik(m, &m.default_parameters(), commands)
+            .map_err(|(i, e)| ik_error(cx, lines[i], e))
     }
+
+    /// The nominal inverse kinematics that fills the linear commands of one row at a time
+    /// (machine lowered once, default kinematic parameters), when the file has no linear
+    /// columns.
+    pub(crate) fn row_ik<'m>(&self, m: &'m Machine) -> Option<RowIk<'m>> {
+        self.fill_ik
+            .then(|| RowIk(VirtualMachine::new(m), m.default_parameters()))
+    }
+
+    /// The checks of the samples of this file ([`SampleChecks`]).
+    pub(crate) fn checks<'m>(&self, m: &'m Machine, opts: &ReadOptions) -> SampleChecks<'m> {
+        SampleChecks::new(m, !self.fill_ik, opts)
+    }
+}
+
+/// The nominal inverse kinematics of a machine at its default kinematic parameters (mm).
+pub(crate) struct RowIk<'m>(VirtualMachine<'m>, Vec<f64>);
+
+impl RowIk<'_> {
+    /// Fills the linear entries (mm) of the commands `c` of the row at line `line`.
+    pub(crate) fn fill(&self, cx: &Ctx, line: usize, c: &mut [f64]) -> Result<(), CsvError> {
+        self.0
+            .tool_centre_point_ik(c, &self.1)
+            .map_err(|e| ik_error(cx, line, e))
+    }
+}
+
+fn ik_error(cx: &Ctx, line: usize, e: ExactError) -> CsvError {
+    cx.err(
+        line,
+        None,
+        format!(
+            "the linear axes are not given and the nominal inverse kinematics cannot fill them: {e}"
+        ),
+    )
 }
 
 /// Whether a line holds data: neither blank nor a `#` comment.

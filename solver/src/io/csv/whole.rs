@@ -25,11 +25,13 @@ pub fn parse_csv(
 
 /// Reads a CSV of machine `m` from `reader` (named `file` in messages) through the bounded line
 /// reader: commands in mm and rad, readings in mm (zero-length without measured columns),
-/// times in s. `need` says whether the measured columns are required.
+/// times in s. `need` says whether the measured columns are required. The samples are checked
+/// as a whole once read ([`crate::io::csv`]: nest on the ball, strokes, plausible readings).
 ///
 /// # Errors
 /// [`CsvError::Format`] at the line (and column) of the first malformed line, including a line
-/// longer than [`ReadOptions::max_line_bytes`] or not UTF-8; [`CsvError::Io`] when `reader`
+/// longer than [`ReadOptions::max_line_bytes`] or not UTF-8; [`CsvError::Refused`] for samples
+/// that are well formed but cannot be an R-test record of `m`; [`CsvError::Io`] when `reader`
 /// fails.
 pub fn read_csv<R: Read>(
     file: &str,
@@ -58,6 +60,12 @@ pub fn read_csv<R: Read>(
         return Err(header_only(&cx, &header));
     }
     header.fill(&cx, m, &mut commands, &row_lines)?;
+    header.checks(m, opts).check(
+        file,
+        &commands,
+        header.measured.then_some(&measured[..]),
+        &row_lines,
+    )?;
     let mut record = record_from_commands(commands, times);
     if header.measured {
         record.measured = measured;

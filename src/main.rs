@@ -1,7 +1,8 @@
 //! `rtest`: geometric error models of machine tools from R-test measurements.
 //!
-//! A thin command line: every verb parses its flags and calls the libraries (`model-spec`,
-//! `codegen`, `solver`). Verbs live in [`cli`], one module each.
+//! A thin command line: every verb parses its flags, calls the libraries (`model-spec`,
+//! `codegen`, `solver`, `plots`, `output`, `perf`) and prints. Verbs live in [`cli`], one
+//! module each.
 
 mod cli;
 

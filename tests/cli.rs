@@ -469,7 +469,11 @@ fn generate_writes_a_rust_file() {
 fn every_verb_documents_units_and_exit_codes() {
     for verb in ["machines", "gains", "generate", "demo"] {
         let help = ok(&[verb, "--help"]);
-        assert!(help.contains("Exit codes: 0 success; 2"), "{verb}: {help}");
+        assert!(
+            help.contains("Exit codes: 0 success; 1 bad input"),
+            "{verb}: {help}"
+        );
+        assert!(help.contains("3 a computation failed"), "{verb}: {help}");
         assert!(help.contains("mm"), "{verb}: {help}");
     }
     let gains = ok(&["gains", "--help"]);

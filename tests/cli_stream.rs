@@ -67,7 +67,7 @@ fn streaming_identify_equals_the_in_memory_fit() {
     );
     assert!(b.status.success(), "{}", String::from_utf8_lossy(&b.stderr));
     let text = String::from_utf8_lossy(&b.stdout);
-    assert!(text.contains("block(s) of at most"), "{text}");
+    assert!(text.contains("blocks of up to 17 samples"), "{text}");
     assert!(
         text.contains("dx0 swallows XOC"),
         "the identifiability analysis is the same: {text}"

@@ -1,4 +1,4 @@
-"""SymPy baseline for the seed-ac derivation (issue 2: "a SymPy derivation of the same 44 gains").
+"""SymPy baseline for the seed-ac derivation: the same 44 gains derived with SymPy.
 
 The way an engineer writes it without rtest: build the seed's HTMs with all 44 error symbols
 (small-angle matrices as printed in the seed), multiply the chains, take the error vector

@@ -1,4 +1,4 @@
-//! The basis vocabulary of position-dependent errors and other effects (DESIGN.md):
+//! The basis vocabulary of position-dependent errors and other effects (docs/conventions.md):
 //! - `const`: 1;
 //! - `harmonic:K`: the pair cos(K·θ), sin(K·θ) of the effect's own rotary axis;
 //! - `poly:K`: the Legendre polynomial of order K of the effect's own linear axis position,

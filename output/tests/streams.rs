@@ -64,9 +64,11 @@ fn the_fifo_is_written_after_the_files() {
     let r = {
         let (fifo, file) = (fifo.clone(), file.clone());
         thread::spawn(move || {
-            let f = fs::File::open(&fifo).unwrap();
+            let mut f = fs::File::open(&fifo).unwrap();
             let seen = read(&file);
-            drop(f);
+            // Read the stream to its end: closing it early would break the writer's pipe.
+            let mut rest = Vec::new();
+            std::io::Read::read_to_end(&mut f, &mut rest).unwrap();
             seen
         })
     };

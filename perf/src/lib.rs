@@ -19,6 +19,7 @@
 #![warn(missing_docs)]
 
 pub mod first_order;
+pub mod report;
 
 use crate::first_order::FirstOrderChain;
 use codegen::{GainModel, compile};

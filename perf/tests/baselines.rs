@@ -1,4 +1,4 @@
-//! The four ways to compute the gains agree (issue 5's baselines): (a) the generated code,
+//! The four ways to compute the gains agree: (a) the generated code,
 //! (b) the in-process IR evaluator, (c) the exact HTM chain with central finite differences,
 //! (d) the runtime first-order product of the chain without code generation.
 

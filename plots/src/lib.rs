@@ -15,13 +15,12 @@
 //!
 //! Every function validates its input first: a NaN or infinite value, an empty series or a series
 //! whose length differs from the abscissa is a [`PlotError`] that names the series (and index).
-//! Output is deterministic: the same input gives the same bytes.
+//! Output is deterministic: the same input gives the same bytes. Figures are returned as SVG
+//! text; writing them to files is the caller's (rtest writes every file through its `output`
+//! crate).
 
 use std::fmt::Write as _;
-use std::io::Write as _;
-use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
@@ -35,7 +34,7 @@ pub const FONT_FAMILY: &str = "DejaVu Sans";
 /// The vendored font file (DejaVu Sans, Bitstream Vera licence, see `fonts/DejaVuSans.LICENSE`).
 static FONT_BYTES: &[u8] = include_bytes!("../fonts/DejaVuSans.ttf");
 
-/// Why a figure could not be made or written.
+/// Why a figure could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
     /// A value is NaN or infinite. `series` names the series (as `panel: label` for path
@@ -72,14 +71,6 @@ pub enum PlotError {
     /// plotters failed while drawing.
     #[error("drawing the figure failed: {0}")]
     Render(String),
-    /// Writing the SVG file failed; no file was left at `path`.
-    #[error("cannot write {}: {source}", path.display())]
-    Io {
-        /// The file that was to be written.
-        path: PathBuf,
-        /// The underlying I/O error.
-        source: std::io::Error,
-    },
 }
 
 /// One named series of values along a path; all values in **µm**.
@@ -708,52 +699,6 @@ where
         root.present().map_err(render_err)?;
     }
     Ok(svg)
-}
-
-// ---------------------------------------------------------------------------------------------
-// Writing
-// ---------------------------------------------------------------------------------------------
-
-/// Write `svg` to `path` atomically: the text goes to a temporary file in the same directory,
-/// which is flushed to disk and then renamed over `path`. On any error the temporary file is
-/// removed and `path` is untouched (no partial file is ever visible at `path`).
-pub fn write_svg(path: &Path, svg: &str) -> Result<(), PlotError> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let io = |source| PlotError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file_name = path.file_name().ok_or_else(|| {
-        io(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "the path has no file name",
-        ))
-    })?;
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let tmp = dir.join(format!(
-        ".{}.{}.{}.tmp",
-        file_name.to_string_lossy(),
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = (|| {
-        let mut f = std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)?;
-        f.write_all(svg.as_bytes())?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io(e));
-    }
-    Ok(())
 }
 
 #[cfg(test)]

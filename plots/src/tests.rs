@@ -221,58 +221,13 @@ fn output_is_deterministic() {
     assert_eq!(a, b);
 }
 
-fn scratch_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("plots-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-#[test]
-fn write_svg_is_atomic() {
-    let dir = scratch_dir("atomic");
-    let path = dir.join("fig.svg");
-    write_svg(&path, "<svg/>").unwrap();
-    assert_eq!(std::fs::read_to_string(&path).unwrap(), "<svg/>");
-    write_svg(&path, "<svg>2</svg>").unwrap();
-    assert_eq!(std::fs::read_to_string(&path).unwrap(), "<svg>2</svg>");
-    let names: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(names.len(), 1, "leftover files: {names:?}");
-
-    // Rename onto a directory fails after the temp file was written: nothing may remain.
-    let target_dir = dir.join("occupied.svg");
-    std::fs::create_dir(&target_dir).unwrap();
-    let err = write_svg(&target_dir, "<svg/>").unwrap_err();
-    assert!(matches!(err, PlotError::Io { .. }));
-    assert!(err.to_string().contains("occupied.svg"));
-    let mut names: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    names.sort();
-    assert_eq!(names, ["fig.svg", "occupied.svg"]);
-    assert!(std::fs::read_dir(&target_dir).unwrap().next().is_none());
-
-    // Missing parent directory: error, no file.
-    let missing = dir.join("no/such/dir/fig.svg");
-    assert!(matches!(
-        write_svg(&missing, "<svg/>"),
-        Err(PlotError::Io { .. })
-    ));
-    assert!(!missing.exists());
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
 /// Renders the two example figures to `$PLOTS_EXAMPLE_DIR` (default: the system temp dir) for
 /// a person to look at: `cargo test -p plots -- --ignored render_examples`.
 #[test]
 #[ignore]
 fn render_examples() {
     let dir = std::env::var_os("PLOTS_EXAMPLE_DIR")
-        .map(PathBuf::from)
+        .map(std::path::PathBuf::from)
         .unwrap_or_else(std::env::temp_dir);
     let (x, panels) = k1_like();
     let svg = path_comparison(
@@ -282,7 +237,7 @@ fn render_examples() {
         &panels,
     )
     .unwrap();
-    write_svg(&dir.join("plots-example-path.svg"), &svg).unwrap();
+    std::fs::write(dir.join("plots-example-path.svg"), &svg).unwrap();
     let svg = spectrum(
         "K4: residual amplitude per harmonic and direction",
         "base model",
@@ -290,7 +245,7 @@ fn render_examples() {
         &spectrum_rows(),
     )
     .unwrap();
-    write_svg(&dir.join("plots-example-spectrum.svg"), &svg).unwrap();
+    std::fs::write(dir.join("plots-example-spectrum.svg"), &svg).unwrap();
 
     // Edge cases: a constant record and a spectrum with a negative value.
     let x: Vec<f64> = (0..50).map(f64::from).collect();
@@ -300,13 +255,13 @@ fn render_examples() {
         predictions: vec![Series::new("model", vec![3.0; 50])],
     }];
     let svg = path_comparison("constant record", "sample index", &x, &panels).unwrap();
-    write_svg(&dir.join("plots-example-constant.svg"), &svg).unwrap();
+    std::fs::write(dir.join("plots-example-constant.svg"), &svg).unwrap();
     let rows = [
         ("signed coefficient".to_string(), -2.0, 0.5),
         ("zero".to_string(), 0.0, 0.0),
     ];
     let svg = spectrum("signed values", "before", "after", &rows).unwrap();
-    write_svg(&dir.join("plots-example-signed.svg"), &svg).unwrap();
+    std::fs::write(dir.join("plots-example-signed.svg"), &svg).unwrap();
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! The whole diagnosis of `seed-ac` (issue 4): fitted on K4 (241 samples, 723 rows), K1 and K2
+//! The whole diagnosis of `seed-ac`: fitted on K4 (241 samples, 723 rows), K1 and K2
 //! held out, the full dictionary (harmonics 1–4, polynomials 1–3, time 1–2: every error of the
 //! topology the reduced model lacks), default options (α = 0.01, 1000 Monte-Carlo draws). It
 //! includes the base and extended fits refined against the exact machine and the exact
@@ -47,14 +47,7 @@ fn records(m: &Machine, name: &str) -> Vec<(String, Record)> {
 fn bench(c: &mut Criterion) {
     let m = seed_ac();
     let base = Model::of(&m, "reduced").expect("reduced model");
-    let wide = DiagnoseOptions {
-        dictionary: DictionaryOptions {
-            harmonics: 8,
-            poly: 5,
-            time: 4,
-        },
-        ..DiagnoseOptions::default()
-    };
+    let wide = DiagnoseOptions::new().dictionary(DictionaryOptions::new(8, 5, 4));
     let cases = [
         ("demo", "seed-ac-demo", DiagnoseOptions::default()),
         ("budget", "seed-ac-budget", DiagnoseOptions::default()),

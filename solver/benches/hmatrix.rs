@@ -78,7 +78,7 @@ fn estimation(c: &mut Criterion) {
 criterion_group!(benches, hmatrix, estimation);
 criterion_main!(benches);
 
-/// The built-in test path K4 of DESIGN.md.
+/// The built-in test path K4 (docs/conventions.md).
 fn k4(m: &Machine) -> Record {
     solver::simulation::paths::builtin_path(m, "K4")
         .unwrap()

@@ -184,10 +184,7 @@ fn residual(m: &Machine, d: &Diagnosis, record: &Record, extended: bool) -> Vec<
     } else {
         &d.base_fit
     };
-    let o = ValidateOptions {
-        exact: true,
-        ..Default::default()
-    };
+    let o = ValidateOptions::new().exact(true);
     validate(m, &fit.model, &fit.fit.values, record, &o)
         .unwrap()
         .residual

@@ -10,7 +10,6 @@ use solver::fitting::hmatrix::GainSource;
 use solver::fitting::refine::{RefineOptions, refine};
 use solver::fitting::validate::{ValidateOptions, validate};
 use solver::fitting::{Identification, IdentifyOptions, Tolerances, identify};
-use solver::io::json::display_factor;
 use solver::model::{Effect, Model};
 use solver::record::Record;
 use solver::simulation::paths::builtin_path;
@@ -49,10 +48,7 @@ fn run(m: &Machine, truth: &Truth) -> Run {
         &RefineOptions::default(),
     )
     .unwrap();
-    let opts = ValidateOptions {
-        exact: true,
-        ..Default::default()
-    };
+    let opts = ValidateOptions::new().exact(true);
     let paths = records
         .iter()
         .map(|(name, rec)| {
@@ -112,7 +108,7 @@ fn main() {
     println!("| error | truth | identified ± std | bias / std |");
     println!("|---|---|---|---|");
     for (j, term) in full.ident.model.terms.iter().enumerate() {
-        let f = display_factor(&m, term.effect);
+        let f = term.effect.display_factor(&m);
         let unit = term
             .effect
             .unit(&m)

@@ -13,7 +13,7 @@
 //! - [`diagnosis`]: what a model lacks, named, with the extended model and its gain.
 //!
 //! [`record`] (samples along a path, with readings) and [`model`] (the terms a fit has) are the
-//! contract between the stages.
+//! contract between the stages; [`demo`] replays the seed's experiment through all of them.
 //!
 //! Units inside: lengths and translational errors in mm, rotary commands and angular errors in
 //! rad. Conversions to degrees, µm and µrad happen at the boundaries people see
@@ -47,6 +47,7 @@
 
 #![warn(missing_docs)]
 
+pub mod demo;
 pub mod diagnosis;
 pub mod fitting;
 pub mod io;

@@ -24,6 +24,12 @@ pub struct Record {
 }
 
 impl Record {
+    /// `true` when the first reading is exactly zero and there are others, as R-test software
+    /// leaves readings zeroed at the first sample.
+    pub fn looks_zeroed(&self) -> bool {
+        self.measured.first() == Some(&[0.0; 3]) && self.measured.len() > 1
+    }
+
     /// Normalised time τ ∈ [−1, 1] of sample `i` (0 when the record has no time span).
     pub fn tau(&self, i: usize) -> f64 {
         let (t0, t1) = match (self.samples.first(), self.samples.last()) {

@@ -170,7 +170,8 @@ fn errors_carry_their_parts() {
     let e = read_measurement(&f, &seed_ac(), &ReadOptions::default()).unwrap_err();
     assert!(matches!(e, CsvError::Io { .. }), "{e}");
     assert!(
-        e.to_string().starts_with(&format!("{}: ", f.display())),
+        e.to_string()
+            .starts_with(&format!("cannot read `{}`: ", f.display())),
         "{e}"
     );
 }

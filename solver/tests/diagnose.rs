@@ -1,4 +1,4 @@
-//! The diagnosis finds effects hidden in data from the exact virtual machine (issue 4).
+//! The diagnosis finds effects hidden in data from the exact virtual machine.
 //!
 //! Set-up of every scenario (helpers in `tests/diagnose/helpers.rs`):
 //! - machine `seed-ac`; base truth: the 11 errors of the reduced model as in `seed-ac-reduced`
@@ -29,7 +29,7 @@
 mod helpers;
 
 use helpers::*;
-use solver::diagnosis::{DiagnoseOptions, Diagnosis};
+use solver::diagnosis::Diagnosis;
 use solver::model::Term;
 
 /// One hidden-effect scenario.
@@ -267,14 +267,13 @@ fn two_hidden_effects_are_both_found() {
 // ---------------------------------------------------------------------------------------------
 // 3. Nothing hidden: the false-finding rate is α.
 
-/// Noise seeds of the null test: 200 in release; 40 in the dev profile, where solver is not
-/// optimised and a diagnosis takes about 1 s (the binomial interval is then wide). The
-/// environment variable `NULL_SEEDS` overrides it (1000 for docs/diagnosis.md).
+/// Noise seeds of the null test: 200; the environment variable `NULL_SEEDS` overrides it (1000
+/// for docs/diagnosis.md).
 fn null_seeds() -> u64 {
     std::env::var("NULL_SEEDS")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(if cfg!(debug_assertions) { 40 } else { 200 })
+        .unwrap_or(200)
 }
 
 /// `[lo, hi]`: the central interval of Binomial(n, p) holding at least `level` of its mass
@@ -314,7 +313,7 @@ fn no_hidden_effect_gives_findings_at_rate_alpha() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(0.05);
-    let o = DiagnoseOptions { alpha, ..options() };
+    let o = options().alpha(alpha);
     let seeds = null_seeds();
     let (mut found, mut below_half) = (0, 0);
     for s in 0..seeds {
@@ -501,10 +500,7 @@ fn visibility() {
         let sig = signature_rms(&m, &truth, std::slice::from_ref(&h), "K4");
         let truth = with_hidden(&m, &truth, std::slice::from_ref(&h));
         let recs = records(&m, &truth, K4_K1_K2, 0);
-        let o = DiagnoseOptions {
-            max_findings: 0,
-            ..options()
-        };
+        let o = options().max_findings(0);
         let d = run(&m, &base_model(&m, &[]), &recs, &o);
         let left = d.fit_rms.0 * 1e3;
         println!(
@@ -559,7 +555,7 @@ fn budget_on_more_paths() {
 #[ignore]
 fn nestings() {
     use solver::diagnosis::dictionary::dictionary;
-    use solver::diagnosis::select::Basis;
+    use solver::diagnosis::select::Span;
     use solver::fitting::hmatrix::{GainSource, h_matrix};
     let m = machine();
     let base = base_model(&m, &[]);
@@ -574,7 +570,7 @@ fn nestings() {
         groups.push(h.columns(at, t.basis.width()).into_owned());
         at += t.basis.width();
     }
-    let mut q = Basis::empty(h.nrows());
+    let mut q = Span::empty(h.nrows());
     for g in &groups[..base.terms.len()] {
         let d = q.new_directions(g);
         q.extend(&d);

@@ -412,14 +412,14 @@ fn exact_machine_data_are_recovered_to_second_order() {
     let _ = id(&m, "XOC");
 }
 
-/// The built-in test path K4 of DESIGN.md.
+/// The built-in test path K4 (docs/conventions.md).
 fn k4(m: &Machine) -> Record {
     solver::simulation::paths::builtin_path(m, "K4")
         .unwrap()
         .unwrap()
 }
 
-/// The built-in test path K1 of DESIGN.md.
+/// The built-in test path K1 (docs/conventions.md).
 fn k1(m: &Machine) -> Record {
     solver::simulation::paths::builtin_path(m, "K1")
         .unwrap()

@@ -230,7 +230,7 @@ fn bad_input_is_an_error_not_a_panic() {
     assert_eq!(h.shape(), (0, 1));
 }
 
-/// The built-in test path K4 of DESIGN.md.
+/// The built-in test path K4 (docs/conventions.md).
 fn k4(m: &Machine) -> Record {
     solver::simulation::paths::builtin_path(m, "K4")
         .unwrap()

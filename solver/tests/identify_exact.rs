@@ -1,6 +1,5 @@
-//! Identification end to end on the exact virtual machine (issue 3, "what must show that it
-//! works"): simulate `seed-ac` with a truth, identify the reduced model on K4, check the values
-//! and the validation on K1 and K2.
+//! Identification end to end on the exact virtual machine: simulate `seed-ac` with a truth,
+//! identify the reduced model on K4, check the values and the validation on K1 and K2.
 
 use model_spec::{Machine, builtin};
 use solver::fitting::hmatrix::GainSource;
@@ -8,7 +7,6 @@ use solver::fitting::hmatrix::h_matrix;
 use solver::fitting::refine::{self, RefineOptions};
 use solver::fitting::validate::{ValidateOptions, validate};
 use solver::fitting::{Constraint, Identification, IdentifyOptions, identify};
-use solver::io::json::display_factor;
 use solver::model::{Effect, Model};
 use solver::record::Record;
 use solver::simulation::paths::builtin_path;
@@ -65,7 +63,7 @@ fn noise_free_reduced_truth_is_recovered_and_validates_on_k1_k2() {
         .iter()
         .zip(&linear.fit.values)
         .map(|(term, v)| {
-            ((v.unwrap() - true_value(&t, term.effect)) * display_factor(&m, term.effect)).abs()
+            ((v.unwrap() - true_value(&t, term.effect)) * term.effect.display_factor(&m)).abs()
         })
         .fold(0.0, f64::max);
     println!("first-order fit: worst error {linear_worst:.2e} µm/µrad");
@@ -76,7 +74,7 @@ fn noise_free_reduced_truth_is_recovered_and_validates_on_k1_k2() {
 
     let ident = identify_refined(&m, &model, &k4, false);
     for (term, v) in model.terms.iter().zip(&ident.fit.values) {
-        let err_um = (v.unwrap() - true_value(&t, term.effect)) * display_factor(&m, term.effect);
+        let err_um = (v.unwrap() - true_value(&t, term.effect)) * term.effect.display_factor(&m);
         assert!(
             err_um.abs() < 1e-4,
             "{}: off by {err_um:e} µm or µrad",
@@ -85,10 +83,7 @@ fn noise_free_reduced_truth_is_recovered_and_validates_on_k1_k2() {
     }
     for name in ["K1", "K2"] {
         let data = simulate(&m, &t, &path(&m, name)).unwrap();
-        let opts = ValidateOptions {
-            exact: true,
-            ..Default::default()
-        };
+        let opts = ValidateOptions::new().exact(true);
         let v = validate(&m, &ident.model, &ident.fit.values, &data, &opts).unwrap();
         let first_order = validate(
             &m,
@@ -149,10 +144,7 @@ fn with_noise_estimates_are_within_four_uncertainties_and_validation_is_at_noise
         for (k, (name, p)) in [("K1", &k1), ("K2", &k2)].into_iter().enumerate() {
             t.seed = 1000 + seed;
             let data = simulate(&m, &t, p).unwrap();
-            let opts = ValidateOptions {
-                exact: true,
-                ..Default::default()
-            };
+            let opts = ValidateOptions::new().exact(true);
             let v = validate(&m, &ident.model, &ident.fit.values, &data, &opts).unwrap();
             let mut source =
                 GainSource::new(&m, &ident.model.errors(), &m.default_parameters()).unwrap();
@@ -217,7 +209,7 @@ fn zeroed_readings_name_the_swallowed_errors_and_the_rest_is_right() {
             }
             _ => {
                 let err = (ident.fit.values[j].unwrap() - true_value(&t, term.effect))
-                    * display_factor(&m, term.effect);
+                    * term.effect.display_factor(&m);
                 assert!(err.abs() < 1e-4, "{name}: off by {err:e}");
             }
         }

@@ -333,7 +333,23 @@ fn every_invalid_entry_names_file_line_and_column() {
         // Other values.
         (
             "noise_um = -0.5\n",
-            "t.toml:1:12: `noise_um` (standard deviation of the reading noise, µm) must not be negative",
+            "t.toml:1:12: `noise_um` (standard deviation of the reading noise, µm) must be from 0 to 1000 µm, not -0.5",
+        ),
+        (
+            "noise_um = 1e308\n",
+            "t.toml:1:12: `noise_um` (standard deviation of the reading noise, µm) must be from 0 to 1000 µm, not 1e308",
+        ),
+        (
+            "[errors]\nXOC = 2e6\n",
+            "t.toml:2:7: XOC `const` (µm): 2e6 is beyond the largest magnitude a truth may have, 1000000 µm",
+        ),
+        (
+            "[errors]\nECC = { \"harmonic:2\" = [1, -1e308] }\n",
+            "t.toml:2:28: ECC `harmonic:2` (µrad): -1e308 is beyond the largest magnitude a truth may have, 1000000 µrad",
+        ),
+        (
+            "[parameters]\nZc = 1e308\n",
+            "t.toml:2:6: parameter `Zc` (mm): 1e308 is beyond the largest magnitude a truth may have, 100000 mm",
         ),
         (
             "seed = -1\n",

@@ -11,8 +11,10 @@ use solver::fitting::validate::{
     Unidentified, ValidateError, ValidateOptions, statistics, validate,
 };
 use solver::fitting::{IdentifyOptions, identify};
-use solver::io::json::{
-    ReportError, identify_json, parse_identify_json, read_identify_json, validate_json,
+use solver::io::report::read::parse_identification;
+use solver::io::report::{
+    IdentificationReport, IdentificationSource, ReportError, ValidationReport, ValidationSource,
+    read_identification,
 };
 use solver::model::{Model, Term};
 use solver::record::{Record, Sample, motion_directions};
@@ -144,7 +146,15 @@ fn identified_on_k4_predicts_k1_and_k2() {
             if sigma > 0.0 {
                 assert!(v.overall.residual_rms > 0.4e-3, "at the noise level");
             }
-            let j = validate_json(&format!("{name}.csv"), &v);
+            let data = format!("{name}.csv");
+            let source = ValidationSource {
+                machine: "seed-ac",
+                model: "reduced",
+                params: "id.json",
+                data: &data,
+                exact: false,
+            };
+            let j = ValidationReport::new(source, &v).unwrap();
             let text = serde_json::to_value(&j).unwrap();
             for key in [
                 "data",
@@ -164,7 +174,7 @@ fn identified_on_k4_predicts_k1_and_k2() {
             ] {
                 assert!(x_dir.get(key).is_some(), "{key}");
             }
-            assert!((j.measured_rms_um - v.overall.measured_rms * 1e3).abs() < 1e-12);
+            assert!((j.overall.measured_rms_um - v.overall.measured_rms * 1e3).abs() < 1e-12);
             assert_eq!(j.samples, rec.samples.len());
         }
     }
@@ -179,20 +189,15 @@ fn zeroed_readings_predict_zeroed_and_name_what_was_set_to_zero() {
     let opts = IdentifyOptions::new().zeroed(true);
     let ident = identify(&m, &model, &data, &opts).unwrap();
     let rec = measure(&m, &model, &x, k1(&m), 0.0, 2, true);
-    let zeroed = ValidateOptions {
-        zeroed: true,
-        ..Default::default()
-    };
+    let zeroed = ValidateOptions::new().zeroed(true);
     let v = validate(&m, &ident.model, &ident.fit.values, &rec, &zeroed).unwrap();
     assert!(v.overall.residual_rms < 1e-12, "{}", v.overall.residual_rms);
     assert_eq!(v.prediction[0], [0.0, 0.0, 0.0]);
     assert_eq!(v.defaulted, ["YOA", "ZOA", "XOC", "dx0", "dy0", "dz0"]);
     // The caller may refuse to predict with parameters that have no value.
-    let refuse = ValidateOptions {
-        zeroed: true,
-        unidentified: Unidentified::Refuse,
-        ..Default::default()
-    };
+    let refuse = ValidateOptions::new()
+        .zeroed(true)
+        .unidentified(Unidentified::Refuse);
     let e = validate(&m, &ident.model, &ident.fit.values, &rec, &refuse).unwrap_err();
     assert!(matches!(e, ValidateError::Unidentified(_)));
     assert_eq!(
@@ -212,12 +217,20 @@ fn identify_json_has_the_fields_and_reads_back() {
     let data = measure(&m, &model, &x, k4(&m), 0.5e-3, 9, true);
     let opts = IdentifyOptions::new().zeroed(true);
     let ident = identify(&m, &model, &data, &opts).unwrap();
-    let report = identify_json(&m, "reduced+", &ident);
+    let source = IdentificationSource {
+        data: "k4.csv",
+        label: "reduced+",
+        base_model: Some("reduced"),
+    };
+    let report = IdentificationReport::new(&m, source, &ident, None).unwrap();
     let text = serde_json::to_string_pretty(&report).unwrap();
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     for key in [
         "machine",
+        "fingerprint",
         "model",
+        "base_model",
+        "terms",
         "parameters",
         "residual_rms_um",
         "rank",
@@ -252,7 +265,7 @@ fn identify_json_has_the_fields_and_reads_back() {
         report.notes
     );
     // Read back: same model and values (µm, µrad → mm, rad).
-    let back = parse_identify_json("id.json", &text, &m).unwrap();
+    let back = parse_identification("id.json", &text, &m).unwrap();
     assert_eq!(back.model, ident.model);
     assert_eq!(back.model_name, "reduced+");
     for (a, b) in back.values.iter().zip(&ident.fit.values) {
@@ -264,16 +277,13 @@ fn identify_json_has_the_fields_and_reads_back() {
     }
     // The values validate.
     let rec = measure(&m, &model, &x, k1(&m), 0.0, 2, true);
-    let zeroed = ValidateOptions {
-        zeroed: true,
-        ..Default::default()
-    };
+    let zeroed = ValidateOptions::new().zeroed(true);
     let v = validate(&m, &back.model, &back.values, &rec, &zeroed).unwrap();
     assert!(v.overall.residual_rms < 2e-3);
 }
 
 fn field_error(text: &str, m: &Machine) -> String {
-    let e = parse_identify_json("id.json", text, m).unwrap_err();
+    let e = parse_identification("id.json", text, m).unwrap_err();
     assert!(matches!(
         e,
         ReportError::Field { .. } | ReportError::Json { .. }
@@ -284,11 +294,14 @@ fn field_error(text: &str, m: &Machine) -> String {
 #[test]
 fn bad_identify_json_names_the_file_and_the_field() {
     let m = builtin("seed-ac");
-    let ok = r#"{"machine": "seed-ac", "model": "m", "parameters": [
+    let ok = r#"{"machine": "seed-ac", "fingerprint": "FP", "model": "m",
+        "base_model": null, "terms": ["XOC", "ECC@harmonic:1"], "parameters": [
         {"error": "XOC", "basis": "const", "value": 1.5, "std": 0.1, "unit": "um"},
         {"error": "ECC", "basis": "harmonic:1:cos", "value": 2, "std": null, "unit": "urad"},
-        {"error": "ECC", "basis": "harmonic:1:sin", "value": null, "std": null, "unit": "urad"}]}"#;
-    let v = parse_identify_json("id.json", ok, &m).unwrap();
+        {"error": "ECC", "basis": "harmonic:1:sin", "value": null, "std": null, "unit": "urad"}]}"#
+        .replace("FP", &m.fingerprint());
+    let ok = ok.as_str();
+    let v = parse_identification("id.json", ok, &m).unwrap();
     assert_eq!(v.values, vec![Some(1.5e-3), Some(2e-6), None]);
     assert_eq!(v.model.terms.len(), 2);
     let cases = [
@@ -332,31 +345,60 @@ fn bad_identify_json_names_the_file_and_the_field() {
             "[]".to_string(),
             "id.json: field `(top level)`: expected a JSON object",
         ),
+        (
+            ok.replace(&m.fingerprint(), "0123456789abcdef"),
+            &format!(
+                "id.json: field `fingerprint`: `0123456789abcdef` is not this description of machine seed-ac's (`{}`): the values were identified on a machine with another topology or other kinematic defaults, and do not apply to this one",
+                m.fingerprint()
+            ),
+        ),
+        (
+            ok.replace(&format!("\"fingerprint\": \"{}\",", m.fingerprint()), ""),
+            "id.json: field `fingerprint`: missing: the report does not say which machine description it was identified on (identify again with this rtest)",
+        ),
+        (
+            ok.replace("\"base_model\": null", "\"base_model\": \"tiny\""),
+            "id.json: field `base_model`: machine seed-ac has no model `tiny` (models: full, reduced)",
+        ),
+        (
+            ok.replace(
+                "[\"XOC\", \"ECC@harmonic:1\"]",
+                "[\"XOC\", \"ECC@harmonic:1\", \"YOC\"]",
+            ),
+            "id.json: field `terms`: [XOC, ECC@harmonic:1, YOC] are not the terms of the parameters [XOC, ECC@harmonic:1]: a parameter is missing or extra",
+        ),
+        (
+            ok.replace("1.5", "1e999"),
+            "id.json: not valid JSON: number out of range at line 3 column 57",
+        ),
     ];
     for (text, message) in cases {
-        assert_eq!(field_error(&text, &m), message);
+        assert_eq!(field_error(&text, &m), message, "{text}");
     }
+    // A byte-order mark is accepted, as in CSV and TOML files.
+    assert!(parse_identification("id.json", &format!("\u{feff}{ok}"), &m).is_ok());
     let e = field_error("{\"machine\": ", &m);
     assert!(
         e.starts_with("id.json: not valid JSON: EOF while parsing a value at line 1 column 12"),
         "{e}"
     );
-    let e = read_identify_json(std::path::Path::new("/nonexistent/id.json"), &m).unwrap_err();
+    let missing = std::env::temp_dir().join(format!("rtest-no-such-{}.json", std::process::id()));
+    let e = read_identification(&missing, &m).unwrap_err();
     assert!(
         e.to_string()
-            .starts_with("/nonexistent/id.json: cannot read: "),
+            .starts_with(&format!("cannot read `{}`: ", missing.display())),
         "{e}"
     );
 }
 
-/// The built-in test path K4 of DESIGN.md.
+/// The built-in test path K4.
 fn k4(m: &Machine) -> Record {
     solver::simulation::paths::builtin_path(m, "K4")
         .unwrap()
         .unwrap()
 }
 
-/// The built-in test path K1 of DESIGN.md.
+/// The built-in test path K1.
 fn k1(m: &Machine) -> Record {
     solver::simulation::paths::builtin_path(m, "K1")
         .unwrap()

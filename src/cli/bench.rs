@@ -1,8 +1,6 @@
-//! `rtest bench`: the performance comparisons, in-process, in a few seconds.
+//! `rtest bench`: what the generated code buys, measured on this computer (the `perf` crate).
 
-use super::json::Json;
-use super::{CliResult, EXIT_CODES};
-use perf;
+use super::{CliError, CliResult, EXIT_CODES};
 
 const LONG_ABOUT: &str = "\
 Measures, on this computer and in this process, what the generated code buys (medians of \
@@ -22,145 +20,29 @@ BENCHMARKS.md has the careful versions (criterion, callgrind instruction counts)
 
 /// Flags of `rtest bench`.
 #[derive(Debug, clap::Args)]
-#[command(about = "Measure the generated code against its baselines on this computer", long_about = LONG_ABOUT, after_help = EXIT_CODES)]
+#[command(
+    about = "Measure the generated code against its baselines on this computer",
+    long_about = LONG_ABOUT,
+    after_help = EXIT_CODES
+)]
 pub struct BenchArgs {
-    /// Fewer poses, samples and repetitions (about a second).
+    /// Smaller sizes (10^5 instead of 10^6 poses and samples), fewer runs.
     #[arg(long)]
     quick: bool,
-    /// Print the results as JSON instead of tables.
+    /// Print the results as JSON (times in s, ns and ms as the keys say; bandwidths in GB/s).
     #[arg(long)]
     json: bool,
 }
 
 /// Runs `rtest bench`.
 pub fn run(args: &BenchArgs) -> CliResult {
-    let n = if args.quick { 100_000 } else { 1_000_000 };
-    let streaming = perf::streaming_identify(n);
-    let methods = perf::gain_methods(args.quick);
-    let fills: Vec<perf::FillBandwidth> = [4096, 65536]
-        .iter()
-        .map(|&b| perf::fill_bandwidth(n, b, if args.quick { 2 } else { 3 }))
-        .collect();
-    let codegen = perf::codegen_times(if args.quick { 3 } else { 9 });
+    let report = perf::report::run(args.quick);
     if args.json {
-        let obj = Json::Obj(vec![
-            (
-                "streaming_identify".into(),
-                Json::Obj(vec![
-                    ("samples".into(), Json::Num(streaming.samples as f64)),
-                    ("seconds".into(), Json::Num(streaming.total_seconds)),
-                    (
-                        "data_generation_seconds".into(),
-                        Json::Num(streaming.generate_seconds),
-                    ),
-                    (
-                        "peak_rss_mb".into(),
-                        streaming
-                            .peak_rss_bytes
-                            .map_or(Json::Null, |b| Json::Num(b as f64 / 1e6)),
-                    ),
-                    ("worst_z".into(), Json::Num(streaming.worst_z)),
-                ]),
-            ),
-            (
-                "gains_per_pose".into(),
-                Json::Arr(
-                    methods
-                        .iter()
-                        .map(|m| {
-                            Json::Obj(vec![
-                                ("method".into(), Json::str(m.method)),
-                                ("ns".into(), Json::Num(m.ns_per_pose)),
-                                ("ratio_to_generated".into(), Json::Num(m.ratio_to_generated)),
-                            ])
-                        })
-                        .collect(),
-                ),
-            ),
-            (
-                "h_fill".into(),
-                Json::Arr(
-                    fills
-                        .iter()
-                        .map(|f| {
-                            Json::Obj(vec![
-                                ("poses".into(), Json::Num(f.poses as f64)),
-                                ("block_poses".into(), Json::Num(f.block as f64)),
-                                (
-                                    "fill_gb_per_s".into(),
-                                    Json::Num(f.bytes / f.fill_seconds / 1e9),
-                                ),
-                                (
-                                    "plain_write_gb_per_s".into(),
-                                    Json::Num(f.bytes / f.write_seconds / 1e9),
-                                ),
-                                ("fraction".into(), Json::Num(f.fraction())),
-                            ])
-                        })
-                        .collect(),
-                ),
-            ),
-            (
-                "codegen_ms".into(),
-                Json::Obj(
-                    codegen
-                        .iter()
-                        .map(|(m, s)| (m.clone(), Json::Num(s * 1e3)))
-                        .collect(),
-                ),
-            ),
-        ]);
-        print!("{}", obj.render());
-        return Ok(());
-    }
-    println!(
-        "rtest bench{}: medians on this computer, one core\n",
-        if args.quick { " --quick" } else { "" }
-    );
-    println!("Gains of seed-ac, full model (44 errors x 6), per pose, sines and cosines included:");
-    println!("  {:<40} {:>12} {:>12}", "method", "ns/pose", "x generated");
-    for m in &methods {
-        println!(
-            "  {:<40} {:>12.1} {:>12.1}",
-            m.method, m.ns_per_pose, m.ratio_to_generated
-        );
-    }
-    println!(
-        "\nH matrix of the full model, {} poses (3 x 44 per pose, {:.0} MB in all):",
-        n,
-        n as f64 * 3.0 * 44.0 * 8.0 / 1e6
-    );
-    println!(
-        "  {:<34} {:>14} {:>18} {:>10}",
-        "block", "fill GB/s", "plain write GB/s", "fraction"
-    );
-    for f in &fills {
-        let label = format!(
-            "{} poses ({:.1} MB)",
-            f.block,
-            (f.block * 3 * 44 * 8) as f64 / 1e6
-        );
-        println!(
-            "  {:<34} {:>14.2} {:>18.2} {:>9.0}%",
-            label,
-            f.bytes / f.fill_seconds / 1e9,
-            f.bytes / f.write_seconds / 1e9,
-            100.0 * f.fraction()
-        );
-    }
-    println!(
-        "\nStreaming identification, reduced model, {} samples: {:.2} s ({:.2} s of it generating the synthetic record), peak memory {}; worst estimate {:.1} std from the values used",
-        streaming.samples,
-        streaming.total_seconds,
-        streaming.generate_seconds,
-        streaming
-            .peak_rss_bytes
-            .map_or("unknown".into(), |b| format!("{:.0} MB", b as f64 / 1e6)),
-        streaming.worst_z
-    );
-    println!("\nCode generation (every model, Rust source):");
-    for (m, s) in &codegen {
-        println!("  {m:<16} {:.2} ms", s * 1e3);
+        let json = serde_json::to_string_pretty(&report)
+            .map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        println!("{json}");
+    } else {
+        print!("{}", perf::report::text(&report));
     }
     Ok(())
 }

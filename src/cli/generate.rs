@@ -1,7 +1,7 @@
 //! `rtest generate`: standalone `no_std` Rust code for a machine's gains.
 
-use super::{CliError, CliResult, EXIT_CODES};
-use std::path::PathBuf;
+use super::{CliError, CliResult, EXIT_CODES, args, check_outputs, write};
+use output::{Outputs, Target};
 
 const LONG_ABOUT: &str = "\
 Generates a standalone Rust source file with the error-gain functions of a machine: \
@@ -10,8 +10,9 @@ rotary commands are inputs). It holds `Pose` (sin/cos of rotary commands, linear
 `Params` (kinematic parameters in mm, defaulting to the machine description) and one module per \
 model whose `pub fn gains(pose, params, out)` writes [gx, gy, gz, gi, gj, gk] per error: tool \
 point minus workpiece point in the tool frame, mm per mm of a translational error and mm per rad \
-of an angular error. Errors themselves are in mm and rad inside the code (µm and µrad for \
-people). The file has no crate attributes, so it can be `include!`d or used as a module.";
+of an angular error, valid where the nominal tool point is on the workpiece point (every R-test \
+pose). Errors themselves are in mm and rad inside the code (µm and µrad for people). The file \
+has no crate attributes, so it can be `include!`d or used as a module (docs/codegen.md).";
 
 /// Flags of `rtest generate`.
 #[derive(Debug, clap::Args)]
@@ -28,30 +29,35 @@ pub struct GenerateArgs {
     /// the machine.
     #[arg(long, value_name = "NAME")]
     model: Vec<String>,
-    /// Write the code to FILE (atomically: through a temporary file in the same directory)
-    /// instead of standard output.
+    /// Write the code to FILE instead of standard output.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
-    output: Option<PathBuf>,
+    output: Option<Target>,
 }
 
 /// Runs `rtest generate`.
 pub fn run(args: &GenerateArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     for (i, name) in args.model.iter().enumerate() {
-        super::model_errors(&m, name)?;
+        args::model_errors(&m, name)?;
         if args.model[..i].contains(name) {
             return Err(CliError::usage(format!("--model: `{name}` is given twice")));
         }
     }
+    let target = args.output.clone().unwrap_or(Target::Stdout);
+    let inputs: Vec<_> = super::machine_file(&args.machine)
+        .map(|p| ("--machine", p))
+        .into_iter()
+        .collect();
+    check_outputs(&inputs, &[("-o", &target)], &[])?;
     let models: Vec<&str> = args.model.iter().map(String::as_str).collect();
     let code = codegen::emit::generate_machine(&m, &models)
-        .map_err(|e| CliError::failure(format!("generate: machine {}: {e}", m.name)))?;
-    match &args.output {
-        Some(path) => {
-            super::write_atomic("-o", path, &code)?;
-            eprintln!("wrote {}", path.display());
+        .map_err(|e| CliError::computation(format!("generate: machine {}: {e}", m.name)))?;
+    let mut files = Outputs::new();
+    files.add("-o", target.clone(), code);
+    for w in write(files)? {
+        if !matches!(w.target, Target::Stdout) {
+            eprintln!("wrote {w}");
         }
-        None => print!("{code}"),
     }
     Ok(())
 }

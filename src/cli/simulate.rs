@@ -1,32 +1,37 @@
 //! `rtest simulate`: R-test readings of the exact virtual machine along a test path, written as
-//! a measurement CSV.
+//! a measurement CSV that `identify` reads back.
 
-use super::data;
-use super::{CliError, CliResult, EXIT_CODES};
-use solver::fitting::validate::statistics;
-use solver::io::csv::{format_record, format_scaled, parse_scaled};
-use solver::simulation::readings::{provenance, simulate};
-use std::path::PathBuf;
+use super::args::Limits;
+use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write};
+use output::{Outputs, Target};
+use solver::io::csv::{format_record, parse_measurement, parse_scaled};
+use solver::io::text::simulation;
+use solver::simulation::paths::PathError;
+use solver::simulation::truth::{MAX_NOISE_UM, Truth, TruthError};
+use solver::simulation::{load_path, provenance, simulate};
+use std::path::Path;
 
 const LONG_ABOUT: &str = "\
 Simulates an R-test measurement: the exact virtual machine (exact homogeneous transforms, no \
-linearisation; solver::simulation::readings) runs a test path with the errors of a truth, and the readings \
-are written as a measurement CSV.
+linearisation) runs a test path with the errors of a truth, and the readings are written as a \
+measurement CSV.
 
 The path is K1 (C 0..360 deg in 1 deg steps, A = 0; 361 samples), K2 (A -90..30 deg, C = 0; 121 \
 samples), K4 (C = 1.5·i deg, A = -45·(1 - cos C) deg, i = 0..240; 241 samples) of a machine \
 whose rotary axes are A and C, or a path CSV file (rotary columns in degrees, linear columns in \
-mm optional: they are filled by the nominal tool-centre-point inverse kinematics). The truth \
-(docs/truth.md) says the real machine: error values (translational in µm, angular in µrad, \
-constants or position-dependent), R-test zero offsets dx0 dy0 dz0 (µm), noise (µm) and its \
-seed, zeroing at the first sample. Default truth: the machine's built-in demo truth if it has \
-one (seed-ac-demo for seed-ac), else the nominal machine. --noise-um, --seed and --zeroed \
-override the truth's.
+mm optional: they are filled by the nominal tool-centre-point inverse kinematics; poses must be \
+within the strokes and keep the nest on the ball). The truth (docs/truth.md) says the real \
+machine: error values (translational in µm, angular in µrad, constants or position-dependent), \
+R-test zero offsets dx0 dy0 dz0 (µm), noise (µm) and its seed, zeroing at the first sample. \
+Default truth: the machine's built-in demo truth if it has one (seed-ac-demo for seed-ac), else \
+the nominal machine. --noise-um, --seed and --zeroed override the truth's.
 
-The CSV (DESIGN.md) has a comment header saying what produced it, then the columns of the \
-machine's axes (linear mm, rotary degrees), dx_um,dy_um,dz_um (tool minus workpiece, tool \
-frame, µm) and t_s (s). It is written atomically. Prints one line: the samples and the RMS of \
-the readings (µm).";
+The CSV (docs/conventions.md) has a comment header saying what produced it, then the columns of \
+the machine's axes (linear mm, rotary degrees), dx_um,dy_um,dz_um (tool minus workpiece, tool \
+frame, µm) and t_s (s). It is read back before it is written: a simulation whose readings \
+`identify` would refuse (beyond --max-reading-um) is an error (exit code 3) and writes nothing. \
+`-o -` writes the CSV to standard output (the summary then goes to standard error). Prints one \
+line: the samples and the RMS of the readings (µm).";
 
 /// Flags of `rtest simulate`.
 #[derive(Debug, clap::Args)]
@@ -47,80 +52,97 @@ pub struct SimulateArgs {
     /// (docs/truth.md). Default: the machine's demo truth, else the nominal machine.
     #[arg(long, value_name = "NAME|FILE")]
     truth: Option<String>,
-    /// Standard deviation of the Gaussian reading noise per direction, µm (overrides the
-    /// truth's).
+    /// Standard deviation of the Gaussian reading noise per direction, µm, from 0 to 1000
+    /// (overrides the truth's).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     noise_um: Option<String>,
-    /// Seed of the noise generator (overrides the truth's).
-    #[arg(long, value_name = "N")]
+    /// Seed of the noise generator, 0 to 9223372036854775807 (overrides the truth's).
+    #[arg(long, value_name = "N",
+          value_parser = clap::value_parser!(u64).range(0..=i64::MAX as u64))]
     seed: Option<u64>,
     /// Zero the readings at the first sample, as R-test software does (overrides the truth).
     #[arg(long)]
     zeroed: bool,
-    /// The measurement CSV to write (atomically).
+    /// The measurement CSV to write (`-`: standard output).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
-    output: PathBuf,
+    output: Target,
+    #[command(flatten)]
+    limits: Limits,
 }
 
-/// Parses `--noise-um` (µm, finite, not negative) into mm, without double rounding.
+/// Parses `--noise-um` (µm, finite, 0 to [`MAX_NOISE_UM`]) into mm, without double rounding.
 fn noise_mm(text: &str) -> CliResult<f64> {
     let bad = |why: &str| CliError::usage(format!("--noise-um: `{text}` {why}"));
     let x: f64 = text
         .trim()
         .parse()
         .map_err(|_| bad("is not a number (µm)"))?;
-    if !x.is_finite() || x < 0.0 {
-        return Err(bad("must be a finite number ≥ 0 (µm)"));
+    if !x.is_finite() || !(0.0..=MAX_NOISE_UM).contains(&x) {
+        return Err(bad(&format!(
+            "must be a finite number from 0 to {MAX_NOISE_UM} µm"
+        )));
     }
     parse_scaled(text, -3).ok_or_else(|| bad("is not a plain decimal number (µm)"))
+}
+
+/// The truth of `--truth`, else the machine's demo truth, else the nominal machine.
+fn truth(m: &model_spec::Machine, name: Option<&str>) -> CliResult<Truth> {
+    let found = match name {
+        Some(n) => solver::simulation::load_truth(n, m),
+        None => solver::simulation::truth::default_truth(m),
+    };
+    found.map_err(|e| match e {
+        TruthError::NotFound(_) => CliError::usage(format!("--truth: {e}")),
+        _ => CliError::input(format!("--truth: {e}")),
+    })
 }
 
 /// Runs `rtest simulate`.
 pub fn run(args: &SimulateArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     let noise = args.noise_um.as_deref().map(noise_mm).transpose()?;
-    let mut truth = data::truth(&m, args.truth.as_deref())?;
-    let path = data::path(&m, &args.path)?;
+    let mut inputs: Vec<(&str, &Path)> = Vec::new();
+    inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
+    let path_file = Path::new(&args.path);
+    if path_file.exists() {
+        inputs.push(("--path", path_file));
+    }
+    if let Some(t) = args.truth.as_deref().map(Path::new).filter(|p| p.exists()) {
+        inputs.push(("--truth", t));
+    }
+    check_outputs(&inputs, &[("-o", &args.output)], &[])?;
+    let mut truth = truth(&m, args.truth.as_deref())?;
+    let read = args.limits.read_options();
+    let path = load_path(&m, &args.path, &read).map_err(|e| match e {
+        PathError::NotFound(_) | PathError::NotAC { .. } => CliError::usage(format!("--path: {e}")),
+        other => CliError::input(format!("--path: {other}")),
+    })?;
     if let Some(n) = noise {
         truth.noise_mm = n;
     }
     if let Some(s) = args.seed {
         truth.seed = s;
     }
-    if args.zeroed {
-        truth.zeroed = true;
-    }
+    truth.zeroed |= args.zeroed;
     let record =
-        simulate(&m, &truth, &path).map_err(|e| CliError::failure(format!("--truth: {e}")))?;
-    let n = record.samples.len();
-    let comments = provenance(&m, &args.path, &truth, n);
-    let text =
-        format_record(&m, &record, &comments).map_err(|e| CliError::failure(format!("-o: {e}")))?;
-    super::write_atomic("-o", &args.output, &text)?;
-    let zeros = vec![[0.0; 3]; n];
-    let (per, all) = statistics(&record.measured, &zeros);
-    println!(
-        "simulated {} on {} (truth {}, noise {} µm, seed {}, {}): {n} samples, RMS of the readings {} µm (x {}, y {}, z {}); wrote {}",
-        args.path,
-        m.name,
-        truth.source,
-        format_scaled(truth.noise_mm, 3),
-        truth.seed,
-        if truth.zeroed {
-            "zeroed at the first sample"
-        } else {
-            "not zeroed"
-        },
-        short_um(all.measured_rms),
-        short_um(per[0].measured_rms),
-        short_um(per[1].measured_rms),
-        short_um(per[2].measured_rms),
-        args.output.display()
-    );
+        simulate(&m, &truth, &path).map_err(|e| CliError::computation(format!("--truth: {e}")))?;
+    let comments = provenance(&m, &args.path, &truth, record.samples.len());
+    let csv = format_record(&m, &record, &comments)
+        .map_err(|e| CliError::computation(format!("-o: {e}")))?;
+    // What is written is what identify reads: read it back with the same rules.
+    parse_measurement(&args.output.to_string(), &csv, &m, &read).map_err(|e| {
+        CliError::computation(format!(
+            "-o: the simulated record would not be accepted by identify, so it is not written: {e}"
+        ))
+    })?;
+    let mut files = Outputs::new();
+    files.add("-o", args.output.clone(), csv);
+    write(files)?;
+    // One line: the summary, and the file written.
+    let mut text = simulation(&m, &args.path, &truth, &record);
+    if let Target::Path(p) = &args.output {
+        text.insert_str(text.len() - 1, &format!("; wrote {}", p.display()));
+    }
+    print_text(&text, matches!(args.output, Target::Stdout));
     Ok(())
-}
-
-/// mm (not negative) as µm with three decimals.
-fn short_um(mm: f64) -> String {
-    format!("{:.3}", mm * 1e3)
 }

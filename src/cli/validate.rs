@@ -1,12 +1,15 @@
 //! `rtest validate`: identified values (an `identify` JSON) predict another measurement;
 //! residuals before (nominal machine) and after (identified model), per direction.
 
-use super::gains::text_table;
-use super::{CliError, CliResult, EXIT_CODES};
-use solver::fitting::validate::{
-    Unidentified, ValidateError, ValidateOptions, Validation, validate,
-};
-use solver::io::json::{read_identify_json, validate_json};
+use super::args::Limits;
+use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use output::{Outputs, Target};
+use solver::fitting::hmatrix::parameter_names;
+use solver::fitting::sanity::check_model_values;
+use solver::fitting::validate::Unidentified;
+use solver::fitting::{ValidateError, ValidateOptions, validate};
+use solver::io::report::{ValidationReport, ValidationSource, read_identification, to_json};
+use solver::io::text::validate::{LOOKS_ZEROED, validation};
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -16,6 +19,10 @@ dx_um,dy_um,dz_um in µm), and the residual (measured minus predicted) is report
 x, y, z of the tool frame and overall: RMS and maximum in µm, before (the nominal machine: \
 prediction 0) and after (the identified model). Overall RMS = sqrt(Σ r² / 3N).
 
+The values must belong to the machine: the JSON's machine name and fingerprint (topology and \
+machine-side kinematic defaults) must be this machine's, its base model must exist, every \
+parameter must be there, and every value within --max-error-um / --max-error-urad.
+
 The prediction is the exact virtual machine at the identified values (no linearisation); with \
 --first-order it is the first-order model H·v (the difference is the second-order terms, about \
 1e-3 µm for errors of tens of µm and µrad). With --zeroed (readings zeroed at the first sample) \
@@ -24,9 +31,10 @@ the prediction is zeroed at the first sample too, so constant effects cancel.
 Parameters the identification could not determine (value null) are set to 0 and named; \
 --refuse-undetermined makes that an error instead.
 
---json writes {data, samples, measured_rms_um, residual_rms_um, measured_max_um, \
-residual_max_um, per_direction: {x, y, z: {measured_rms_um, measured_max_um, residual_rms_um, \
-residual_max_um}}, zeroed, unidentified_set_to_zero} (docs/identification.md), atomically.";
+--json writes {machine, model, params, data, samples, prediction, measured_rms_um, \
+residual_rms_um, measured_max_um, residual_max_um, per_direction: {x, y, z: {measured_rms_um, \
+measured_max_um, residual_rms_um, residual_max_um}}, zeroed, unidentified_set_to_zero} \
+(docs/identification.md); `--json -` writes it to standard output.";
 
 /// Flags of `rtest validate`.
 #[derive(Debug, clap::Args)]
@@ -54,129 +62,72 @@ pub struct ValidateArgs {
     /// Fail when a parameter has no value, instead of setting it to 0.
     #[arg(long)]
     refuse_undetermined: bool,
-    /// Also write the result as JSON to FILE (atomically).
+    /// Also write the report as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE")]
-    json: Option<PathBuf>,
+    json: Option<Target>,
+    #[command(flatten)]
+    limits: Limits,
 }
 
 /// Runs `rtest validate`.
 pub fn run(args: &ValidateArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
-    let params = read_identify_json(&args.params, &m)
-        .map_err(|e| CliError::failure(format!("--params: {e}")))?;
-    let record = super::data::measurement("--data", &m, &args.data)?;
-    let opts = ValidateOptions {
-        zeroed: args.zeroed,
-        unidentified: if args.refuse_undetermined {
-            Unidentified::Refuse
-        } else {
-            Unidentified::Zero
-        },
-        params: None,
-        exact: !args.first_order,
-    };
+    let mut inputs = vec![
+        ("--params", args.params.as_path()),
+        ("--data", args.data.as_path()),
+    ];
+    inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
+    let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
+    check_outputs(&inputs, &outputs, &[])?;
+    let params = read_identification(&args.params, &m)
+        .map_err(|e| CliError::input(format!("--params: {e}")))?;
+    let names = parameter_names(&m, &params.model);
+    check_model_values(
+        &m,
+        &params.model,
+        &names,
+        &params.values,
+        &args.limits.values(),
+    )
+    .map_err(|e| CliError::input(format!("--params: {e}")))?;
+    let record = super::read_record("--data", &m, &args.data, &args.limits.read_options())?;
+    let mut opts = ValidateOptions::default();
+    opts.zeroed = args.zeroed;
+    opts.exact = !args.first_order;
+    if args.refuse_undetermined {
+        opts.unidentified = Unidentified::Refuse;
+    }
     let v = validate(&m, &params.model, &params.values, &record, &opts).map_err(|e| match e {
-        ValidateError::Unidentified(names) => CliError::failure(format!(
+        ValidateError::Unidentified(names) => CliError::input(format!(
             "--params: {} gave no value for {} (not determined by the identification) and --refuse-undetermined is set (without it they are set to 0)",
             args.params.display(),
             names.join(", ")
         )),
-        other => CliError::failure(format!("--data: cannot validate: {other}")),
+        other => CliError::computation(format!("--data: cannot validate: {other}")),
     })?;
-    let data_name = args.data.display().to_string();
-    let mut text = format!(
-        "Validation on {data_name} ({} samples, readings {}): machine {}, model {} with the values of {}\n",
-        v.samples,
-        if v.zeroed {
-            "zeroed at the first sample"
-        } else {
-            "not zeroed"
-        },
-        m.name,
-        params.model_name,
-        args.params.display()
+    let (params_file, data) = (
+        args.params.display().to_string(),
+        args.data.display().to_string(),
     );
-    text.push_str(&format!(
-        "Prediction: {}; before = nominal machine (prediction 0), after = identified model.\n\n",
-        if args.first_order {
-            "first-order model H·v (--first-order)"
-        } else {
-            "the exact virtual machine at the identified values"
-        }
-    ));
-    text.push_str(&residual_table(&[(data_name.as_str(), &v)]));
-    text.push_str(&defaulted_note(&v));
-    if super::data::looks_zeroed(&record) && !args.zeroed {
-        text.push_str(
-            "Note: the first reading is exactly 0: if the readings were zeroed at the first sample, give --zeroed.\n",
-        );
+    let source = ValidationSource {
+        machine: &m.name,
+        model: &params.model_name,
+        params: &params_file,
+        data: &data,
+        exact: !args.first_order,
+    };
+    let report = ValidationReport::new(source, &v)
+        .map_err(|e| CliError::computation(format!("--data: {e}")))?;
+    let mut text = validation(&report);
+    if record.looks_zeroed() && !args.zeroed {
+        text.push_str(LOOKS_ZEROED);
     }
-    if let Some(path) = &args.json {
-        let json = validate_json(&data_name, &v);
-        let body = serde_json::to_string_pretty(&json)
-            .map_err(|e| CliError::failure(format!("--json: {e}")))?;
-        super::write_atomic("--json", path, &(body + "\n"))?;
-        text.push_str(&format!("Wrote {}\n", path.display()));
+    let mut files = Outputs::new();
+    if let Some(target) = &args.json {
+        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        files.add("--json", target.clone(), json);
     }
-    print!("{text}");
+    text.push_str(&wrote(&write(files)?));
+    print_text(&text, matches!(args.json, Some(Target::Stdout)));
     Ok(())
-}
-
-/// The line naming the parameters set to 0, or nothing.
-pub fn defaulted_note(v: &Validation) -> String {
-    if v.defaulted.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "Set to 0 in the prediction (no value: not determined by the identification): {}\n",
-            v.defaulted.join(", ")
-        )
-    }
-}
-
-/// Residual RMS and max per direction and overall (µm), before and after, one block of rows
-/// per validation.
-pub fn residual_table(rows: &[(&str, &Validation)]) -> String {
-    let header = [
-        "data",
-        "dir",
-        "before RMS µm",
-        "before max µm",
-        "after RMS µm",
-        "after max µm",
-    ]
-    .map(String::from);
-    let mut table = Vec::new();
-    for (name, v) in rows {
-        let blocks = [
-            ("x", &v.per_direction[0]),
-            ("y", &v.per_direction[1]),
-            ("z", &v.per_direction[2]),
-            ("all", &v.overall),
-        ];
-        for (i, (dir, s)) in blocks.into_iter().enumerate() {
-            table.push([
-                if i == 0 {
-                    name.to_string()
-                } else {
-                    String::new()
-                },
-                dir.to_string(),
-                format!("{:.3}", s.measured_rms * 1e3),
-                format!("{:.3}", s.measured_max * 1e3),
-                small(s.residual_rms * 1e3),
-                small(s.residual_max * 1e3),
-            ]);
-        }
-    }
-    text_table(&header, &table)
-}
-
-/// A non-negative µm value with three decimals, or in scientific notation below 5e-4.
-fn small(x: f64) -> String {
-    if x != 0.0 && x < 5e-4 {
-        format!("{x:.1e}")
-    } else {
-        format!("{x:.3}")
-    }
 }

@@ -1,7 +1,6 @@
 //! The seed's gain tables as the PDF extraction shows them, cell by cell, typos included.
 //!
-//! Source: `../shared/seed/000_e3262d939559e0c0.txt` (Y.-Y. Hsu's project report, extracted from
-//! a PDF). Three tables:
+//! Source: the text extracted from the PDF of Y.-Y. Hsu's project report (the seed). Three tables:
 //! - [`TABLE_1`]: the five-axis R-test paper's Table 1 ("Error model and sensitivity analysis",
 //!   44 errors, columns ΔXp ΔYp ΔZp ΔIp ΔJp ΔKp). The extraction is cut after row EYC: the rows
 //!   EZC EAC EBC ECC XOC YOC AOC BOC are not there ([`Table::missing_rows`]).

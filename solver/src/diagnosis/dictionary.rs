@@ -15,8 +15,9 @@ use model_spec::basis::Basis;
 use model_spec::terms::{Effect, Term};
 use model_spec::{AxisKind, Dir, ErrorKind, Machine, Motion};
 
-/// How far the dictionary goes.
+/// How far the dictionary goes (`DictionaryOptions::default()` or [`DictionaryOptions::new`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct DictionaryOptions {
     /// Highest harmonic K of rotary-axis errors.
     pub harmonics: u32,
@@ -24,6 +25,18 @@ pub struct DictionaryOptions {
     pub poly: u32,
     /// Highest Legendre order T in time of the sensor offsets.
     pub time: u32,
+}
+
+impl DictionaryOptions {
+    /// Harmonics 1..`harmonics` of rotary-axis errors, Legendre orders 1..`poly` of
+    /// linear-axis errors, orders 1..`time` in time of the sensor offsets.
+    pub fn new(harmonics: u32, poly: u32, time: u32) -> DictionaryOptions {
+        DictionaryOptions {
+            harmonics,
+            poly,
+            time,
+        }
+    }
 }
 
 impl Default for DictionaryOptions {

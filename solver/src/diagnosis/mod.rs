@@ -18,6 +18,9 @@
 //!    RMS before and after on the fitted record and on every held-out record.
 
 pub mod dictionary;
+pub mod figures;
+pub mod harmonic;
+pub mod hidden;
 pub mod select;
 pub mod structure;
 
@@ -34,11 +37,12 @@ use dictionary::{DictionaryOptions, dictionary};
 use model_spec::Machine;
 use model_spec::terms::Term;
 use nalgebra::{DMatrix, DVector};
-use select::{Basis, Scored, f_p_value, f_statistic, monte_carlo_p};
+use select::{Scored, Span, f_p_value, f_statistic, monte_carlo_p};
 use structure::Component;
 
-/// Options of [`diagnose`].
+/// Options of [`diagnose`] (`DiagnoseOptions::default()`, then set the fields wanted).
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct DiagnoseOptions {
     /// The candidate dictionary's extent.
     pub dictionary: DictionaryOptions,
@@ -71,6 +75,55 @@ impl Default for DiagnoseOptions {
             params: None,
             tolerances: Tolerances::default(),
         }
+    }
+}
+
+impl DiagnoseOptions {
+    /// The defaults.
+    pub fn new() -> DiagnoseOptions {
+        DiagnoseOptions::default()
+    }
+
+    /// With the dictionary's extent.
+    pub fn dictionary(mut self, dictionary: DictionaryOptions) -> DiagnoseOptions {
+        self.dictionary = dictionary;
+        self
+    }
+
+    /// With the significance level of each step.
+    pub fn alpha(mut self, alpha: f64) -> DiagnoseOptions {
+        self.alpha = alpha;
+        self
+    }
+
+    /// With at most `n` findings.
+    pub fn max_findings(mut self, n: usize) -> DiagnoseOptions {
+        self.max_findings = n;
+        self
+    }
+
+    /// With `draws` Monte-Carlo draws.
+    pub fn draws(mut self, draws: usize) -> DiagnoseOptions {
+        self.draws = draws;
+        self
+    }
+
+    /// With the seed of the Monte-Carlo draws.
+    pub fn seed(mut self, seed: u64) -> DiagnoseOptions {
+        self.seed = seed;
+        self
+    }
+
+    /// With readings zeroed at the first sample (or not).
+    pub fn zeroed(mut self, zeroed: bool) -> DiagnoseOptions {
+        self.zeroed = zeroed;
+        self
+    }
+
+    /// With the kinematic parameters `params` (mm, symbol order).
+    pub fn params(mut self, params: Vec<f64>) -> DiagnoseOptions {
+        self.params = Some(params);
+        self
     }
 }
 
@@ -134,6 +187,8 @@ pub struct Stop {
 /// A diagnosis.
 #[derive(Clone, Debug)]
 pub struct Diagnosis {
+    /// The base model as given (without the offsets of zeroed readings).
+    pub base_given: Model,
     /// The base model as fitted (with the offsets when zeroed).
     pub base: Model,
     /// The base model's fit (refined against the exact machine).
@@ -244,6 +299,7 @@ pub fn diagnose(
     held_out: &[(String, Record)],
     o: &DiagnoseOptions,
 ) -> Result<Diagnosis, DiagnoseError> {
+    let base_given = base.clone();
     let base = if o.zeroed {
         with_offsets(base)
     } else {
@@ -272,7 +328,7 @@ pub fn diagnose(
     let group = |t: usize| h_all.columns(starts[t], widths[t]).into_owned();
     let nb = base.terms.len();
 
-    let mut q_base = Basis::empty(n);
+    let mut q_base = Span::empty(n);
     for t in 0..nb {
         let d = q_base.new_directions(&group(t));
         q_base.extend(&d);
@@ -288,7 +344,7 @@ pub fn diagnose(
 
     // One selection step on the model `q` (orthonormal) over the candidates `pool`: the
     // significant candidate named, or why there is none.
-    let step = |q: &Basis, pool: &[usize], seed: u64| -> Result<Chosen, Stop> {
+    let step = |q: &Span, pool: &[usize], seed: u64| -> Result<Chosen, Stop> {
         let r = q.project_out(&y);
         let rss = r.norm_squared();
         let scored: Vec<Scored> = pool
@@ -395,7 +451,7 @@ pub fn diagnose(
         // What candidate `a` adds beyond candidate `b` (and the model): the ΔRSS of its
         // directions outside their span, how many, and the RSS left with both.
         let beyond = |a: &Scored, b: &Scored| -> (f64, usize, f64, usize) {
-            let extra = Basis {
+            let extra = Span {
                 q: b.directions.clone(),
             }
             .new_directions(&a.directions);
@@ -453,8 +509,8 @@ pub fn diagnose(
         })
     };
     // The model's basis: the base and the chosen terms (but `skip`).
-    let basis_of = |chosen: &[Chosen], skip: Option<usize>| -> Basis {
-        let mut q = Basis::empty(n);
+    let basis_of = |chosen: &[Chosen], skip: Option<usize>| -> Span {
+        let mut q = Span::empty(n);
         let terms = (0..nb).chain(
             chosen
                 .iter()
@@ -629,6 +685,7 @@ pub fn diagnose(
             (base_fit.fit.rss / rows).sqrt(),
             (extended_fit.fit.rss / rows).sqrt(),
         ),
+        base_given,
         base,
         base_fit,
         dictionary_size: candidates.len(),
@@ -640,6 +697,42 @@ pub fn diagnose(
         extended_fit,
         validation,
     })
+}
+
+impl Diagnosis {
+    /// The extended model as a sub-model lists it: the base model's terms as given (without
+    /// the offsets zeroed readings add) followed by the findings.
+    pub fn extended_terms(&self) -> Model {
+        let mut out = self.base_given.clone();
+        for f in &self.findings {
+            if !out.terms.contains(&f.term) {
+                out.terms.push(f.term);
+            }
+        }
+        out
+    }
+
+    /// The extended model's label: the base model's `label` and the findings
+    /// (`reduced + ECC@harmonic:2`).
+    pub fn extended_label(&self, m: &Machine, label: &str) -> String {
+        std::iter::once(label.to_string())
+            .chain(self.findings.iter().map(|f| f.term.spelling(m)))
+            .collect::<Vec<_>>()
+            .join(" + ")
+    }
+
+    /// The held-out records the extended model predicts worse than the base model: name and
+    /// relative change of the residual RMS.
+    pub fn worse_held_out(&self) -> Vec<(String, f64)> {
+        if self.findings.is_empty() {
+            return Vec::new();
+        }
+        self.validation
+            .iter()
+            .filter(|(_, b, a)| a > b && *b > 0.0)
+            .map(|(n, b, a)| (n.clone(), (a - b) / b))
+            .collect()
+    }
 }
 
 /// The seed of the Monte-Carlo draws of a step: a function of the model the step starts from
@@ -669,7 +762,7 @@ fn same_span(a: &Scored, b: &Scored) -> bool {
 /// The norm of the least-squares coefficients (minimum norm) of `r` on the columns of `g`, each
 /// scaled to unit norm and with the model `q` projected out: how large a change of the
 /// candidate explains what it explains.
-fn scaled_size(q: &Basis, g: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
+fn scaled_size(q: &Span, g: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
     let cols: Vec<DVector<f64>> = g
         .column_iter()
         .filter_map(|c| {
@@ -692,7 +785,7 @@ fn confounded_with(
     candidates: &[Term],
     chosen: &[usize],
     unexcited: &[Term],
-    q: &Basis,
+    q: &Span,
     group: &dyn Fn(usize) -> DMatrix<f64>,
     nb: usize,
     h_all: &DMatrix<f64>,

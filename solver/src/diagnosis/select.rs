@@ -27,17 +27,17 @@ use nalgebra::{DMatrix, DVector};
 /// nothing: the model spans it.
 pub const SPAN_TOLERANCE: f64 = 1e-7;
 
-/// An orthonormal basis, grown column by column.
+/// The span of a model's columns, held as an orthonormal basis grown column by column.
 #[derive(Clone, Debug)]
-pub struct Basis {
+pub struct Span {
     /// Orthonormal columns, n × r.
     pub q: DMatrix<f64>,
 }
 
-impl Basis {
+impl Span {
     /// An empty basis in n dimensions.
-    pub fn empty(n: usize) -> Basis {
-        Basis {
+    pub fn empty(n: usize) -> Span {
+        Span {
             q: DMatrix::zeros(n, 0),
         }
     }
@@ -89,7 +89,7 @@ impl Basis {
         }
     }
 
-    /// Appends orthonormal directions orthogonal to the basis (from [`Basis::new_directions`]).
+    /// Appends orthonormal directions orthogonal to the basis (from [`Span::new_directions`]).
     pub fn extend(&mut self, directions: &DMatrix<f64>) {
         if directions.ncols() == 0 {
             return;
@@ -141,7 +141,7 @@ pub fn f_statistic(delta_rss: f64, rss: f64, q: usize, n: usize, rank: usize) ->
 /// corrections together keep level α. (With F as the statistic, a two-column candidate's F
 /// and a one-column candidate's F are on different scales, and the bound does not hold.)
 pub fn monte_carlo_p(
-    model: &Basis,
+    model: &Span,
     scored: &[Scored],
     p_observed: f64,
     draws: usize,
@@ -211,7 +211,7 @@ mod tests {
 
     #[test]
     fn spanned_columns_add_no_direction() {
-        let mut b = Basis::empty(4);
+        let mut b = Span::empty(4);
         let h = DMatrix::from_row_slice(4, 2, &[1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 0.0]);
         let d = b.new_directions(&h);
         assert_eq!(d.ncols(), 2);
@@ -227,7 +227,7 @@ mod tests {
     fn monte_carlo_level_for_a_single_candidate_matches_the_f_distribution() {
         // One candidate of one column: the Monte-Carlo p must equal the F-distribution p.
         let n = 200;
-        let model = Basis::empty(n);
+        let model = Span::empty(n);
         let dir = DMatrix::from_fn(n, 1, |i, _| if i == 0 { 1.0 } else { 0.0 });
         let scored = vec![Scored {
             index: 0,

@@ -47,8 +47,10 @@ pub enum Constraint {
     Zero(Vec<String>),
 }
 
-/// The tolerances of the rank and identifiability decisions.
+/// The tolerances of the rank and identifiability decisions (`Tolerances::default()`, then set
+/// the fields wanted).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct Tolerances {
     /// `ρ` of the rank tolerance `σ_max · max(ρ, max(m, n)·ε)`.
     pub rank_relative: f64,

@@ -19,6 +19,7 @@ pub mod identifiability;
 pub mod identify;
 pub mod least_squares;
 pub mod refine;
+pub mod sanity;
 pub mod streaming;
 pub mod validate;
 
@@ -32,4 +33,5 @@ pub use least_squares::{
     least_squares_reduced,
 };
 pub use refine::{RefineError, RefineOptions, Refinement, identify_refined, identify_refined_with};
+pub use sanity::{Implausible, ValueLimits, check_values};
 pub use validate::{ValidateError, ValidateOptions, Validation, validate};

@@ -12,8 +12,11 @@
 
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix_spanned, parameter_names};
 use crate::fitting::{
-    Constraint, EstimateError, Fit, Tolerances, least_squares_reduced, measurement_vector,
+    Constraint, EstimateError, Fit, Identification, IdentifyOptions, Tolerances, check_readings,
+    gain_source, least_squares_reduced, measurement_vector,
 };
+use crate::io::csv::{CsvError, MeasurementBlocks, ReadOptions, time_span};
+use crate::model::Basis;
 use crate::model::Model;
 use crate::record::Record;
 use model_spec::Machine;
@@ -108,6 +111,8 @@ pub struct StreamingIdentification {
     pub blocks: usize,
     /// Largest block, samples.
     pub largest_block: usize,
+    /// The first block, samples (a block reader may read ahead in it).
+    pub first_block: usize,
 }
 
 /// Identifies `model` from `blocks` of one record (each a [`Record`] with measurements;
@@ -124,9 +129,10 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
     tol: &Tolerances,
 ) -> Result<StreamingIdentification, StreamingError<E>> {
     let mut qr = StreamingQr::new(model.width());
-    let (mut samples, mut count, mut largest) = (0, 0, 0);
+    let (mut samples, mut count, mut largest, mut first) = (0, 0, 0, None);
     for block in blocks {
         let block = block.map_err(StreamingError::Read)?;
+        first.get_or_insert(block.samples.len());
         let h = h_matrix_spanned(m, model, &block, source, time_span)?;
         let y = measurement_vector(&block)?;
         qr.add(&h, &y);
@@ -140,45 +146,35 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
         samples,
         blocks: count,
         largest_block: largest,
+        first_block: first.unwrap_or(0),
     })
 }
 
 /// Identifies `model` of `m` from the measurement CSV at `path`, read in blocks of `block`
-/// samples (never the whole record, never the whole H): first-order least squares, with the
-/// options of [`crate::fitting::identify`] (zeroed readings add `dx0 dy0 dz0`). A model with
-/// `time:K` terms costs one more pass over the file for the record's time span.
+/// samples with `read` (never the whole record, never the whole H): first-order least
+/// squares, with the options of [`crate::fitting::identify`] (zeroed readings add
+/// `dx0 dy0 dz0`). A model with `time:K` terms costs one more pass over the file for the
+/// record's time span. Fewer readings than parameters plus one is an error, as in memory.
 pub fn identify_file(
     m: &Machine,
     model: &Model,
     path: &std::path::Path,
-    opts: &crate::fitting::IdentifyOptions,
+    opts: &IdentifyOptions,
     block: usize,
-) -> Result<
-    (crate::fitting::Identification, StreamingIdentification),
-    StreamingError<crate::io::csv::CsvError>,
-> {
-    use crate::io::csv::{MeasurementBlocks, ReadOptions, time_span};
-    let fitted = if opts.zeroed {
-        crate::fitting::with_offsets(model)
-    } else {
-        model.clone()
-    };
-    let params = opts
-        .params
-        .clone()
-        .unwrap_or_else(|| m.default_parameters());
-    let mut source = GainSource::new(m, &fitted.errors(), &params)?;
+    read: &ReadOptions,
+) -> Result<(Identification, StreamingIdentification), StreamingError<CsvError>> {
+    let fitted = opts.fitted_model(model);
+    let mut source = gain_source(m, model, opts)?;
     let has_time = fitted
         .terms
         .iter()
-        .any(|t| matches!(t.basis, model_spec::basis::Basis::Time(_)));
+        .any(|t| matches!(t.basis, Basis::Time(_)));
     let span = if has_time {
-        Some(time_span(path, m, &ReadOptions::default()).map_err(StreamingError::Read)?)
+        Some(time_span(path, m, read).map_err(StreamingError::Read)?)
     } else {
         None
     };
-    let blocks = MeasurementBlocks::open(path, m, block, &ReadOptions::default())
-        .map_err(StreamingError::Read)?;
+    let blocks = MeasurementBlocks::open(path, m, block, read).map_err(StreamingError::Read)?;
     let run = identify_streaming(
         m,
         &fitted,
@@ -188,7 +184,8 @@ pub fn identify_file(
         &opts.constraint,
         &opts.tolerances,
     )?;
-    let ident = crate::fitting::Identification::new(
+    check_readings(run.samples, fitted.width())?;
+    let ident = Identification::new(
         m,
         fitted,
         run.fit.clone(),

@@ -30,8 +30,9 @@ pub enum Unidentified {
     Refuse,
 }
 
-/// Options of [`validate`].
+/// Options of [`validate`] (`ValidateOptions::default()`, then set the fields wanted).
 #[derive(Clone, Debug, PartialEq, Default)]
+#[non_exhaustive]
 pub struct ValidateOptions {
     /// The record's readings were zeroed at its first sample.
     pub zeroed: bool,
@@ -43,6 +44,38 @@ pub struct ValidateOptions {
     /// instead of the first-order `H·v`: the difference is the second-order terms (about
     /// 1e-3 µm for errors of tens of µm and µrad).
     pub exact: bool,
+}
+
+impl ValidateOptions {
+    /// The defaults: not zeroed, undetermined parameters set to 0, default kinematic
+    /// parameters, first-order prediction.
+    pub fn new() -> ValidateOptions {
+        ValidateOptions::default()
+    }
+
+    /// With the prediction zeroed at the first sample (or not).
+    pub fn zeroed(mut self, zeroed: bool) -> ValidateOptions {
+        self.zeroed = zeroed;
+        self
+    }
+
+    /// With what parameters without a value become.
+    pub fn unidentified(mut self, unidentified: Unidentified) -> ValidateOptions {
+        self.unidentified = unidentified;
+        self
+    }
+
+    /// With the kinematic parameters `params` (mm, symbol order).
+    pub fn params(mut self, params: Vec<f64>) -> ValidateOptions {
+        self.params = Some(params);
+        self
+    }
+
+    /// With the exact prediction (or the first-order one).
+    pub fn exact(mut self, exact: bool) -> ValidateOptions {
+        self.exact = exact;
+        self
+    }
 }
 
 /// Why a validation could not be made.

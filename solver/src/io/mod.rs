@@ -2,8 +2,10 @@
 //!
 //! - [`csv`]: the R-test measurement CSV, read whole or in blocks, written so that it reads
 //!   back bit for bit;
-//! - [`json`]: the JSON reports (identification, validation) as serde types, and the reading
-//!   of an identification back into model values.
+//! - [`report`]: the reports (identification, validation, diagnosis, gain tables) as serde
+//!   types, written as JSON; an identification read back;
+//! - [`text`]: the same reports as text for people.
 
 pub mod csv;
-pub mod json;
+pub mod report;
+pub mod text;

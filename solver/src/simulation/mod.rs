@@ -13,6 +13,7 @@
 pub mod exact;
 pub mod fd;
 pub mod paths;
+pub mod pose;
 pub mod readings;
 pub mod rng;
 pub mod truth;

@@ -53,6 +53,17 @@ pub const BUILTIN_TRUTHS: &[(&str, &str)] = &[
     ),
 ];
 
+/// The largest standard deviation of the reading noise a truth may have, µm: larger noise
+/// would give readings beyond any plausible R-test reading.
+pub const MAX_NOISE_UM: f64 = 1000.0;
+
+/// The largest truth file read, bytes: a truth lists at most a few hundred terms.
+pub const MAX_TRUTH_BYTES: u64 = 1 << 20;
+
+/// The largest magnitude of an error value or sensor offset in a truth, µm or µrad (1 m or
+/// 1 rad): beyond it a first-order error model has no meaning.
+pub const MAX_VALUE: f64 = 1e6;
+
 /// Decimal places between the unit people write and the unit inside: µm → mm is 3, µrad → rad
 /// is 6.
 fn places(m: &Machine, effect: Effect) -> i32 {
@@ -74,14 +85,9 @@ pub enum TruthError {
         /// What is wrong and what would be right.
         message: String,
     },
-    /// The file could not be read.
-    #[error("cannot read truth file `{file}`: {source}")]
-    Io {
-        /// The file.
-        file: String,
-        /// Why.
-        source: std::io::Error,
-    },
+    /// The file cannot be read, is larger than [`MAX_TRUTH_BYTES`] or is not UTF-8 text.
+    #[error("truth file: {0}")]
+    Text(#[from] model_spec::text::TextError),
     /// Neither a built-in truth nor an existing file.
     #[error("no built-in truth and no file called `{0}` (built-in: {names})", names = BUILTIN_TRUTHS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "))]
     NotFound(String),
@@ -157,14 +163,11 @@ impl Truth {
     /// Reads the truth file `path` for machine `m`.
     ///
     /// # Errors
-    /// [`TruthError::Io`] when the file cannot be read; see [`Truth::parse`].
+    /// [`TruthError::Text`] when the file cannot be read (or is too large, or not UTF-8); see
+    /// [`Truth::parse`].
     pub fn load(path: &std::path::Path, m: &Machine) -> Result<Truth, TruthError> {
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| TruthError::Io {
-            file: file.clone(),
-            source,
-        })?;
-        Truth::parse(&file, &text, m)
+        let text = model_spec::text::read_text(path, MAX_TRUTH_BYTES)?;
+        Truth::parse(&path.display().to_string(), &text, m)
     }
 
     /// The coefficient(s) of `term` (mm or rad; two for `harmonic:K`), if the truth has it.
@@ -385,6 +388,20 @@ pub fn load_truth(name_or_path: &str, m: &Machine) -> Result<Truth, TruthError> 
     Truth::load(path, m)
 }
 
+/// The default truth of machine `m`: its built-in demo truth `<machine>-demo` if there is one
+/// (`seed-ac-demo`), else the nominal machine.
+///
+/// # Errors
+/// A built-in demo truth that does not fit this description of the machine (a machine file
+/// named like a built-in machine but different from it).
+pub fn default_truth(m: &Machine) -> Result<Truth, TruthError> {
+    let name = format!("{}-demo", m.name);
+    match builtin_truth(&name, m) {
+        Some(t) => t,
+        None => Ok(Truth::nominal(m)),
+    }
+}
+
 /// The default demo truth of `seed-ac` (`solver/truths/seed-ac-demo.toml`, documented in
 /// `docs/truth.md`): location errors of A and C and ball set-up errors of 10–30 µm and µrad,
 /// an angular positioning error of C twice per revolution (`ECC@harmonic:2`, amplitude
@@ -424,7 +441,7 @@ const TOP_KEYS: &str = "machine, description, noise_um, seed, zeroed, [parameter
 
 impl Parser<'_> {
     fn err(&self, span: Range<usize>, message: impl Into<String>) -> TruthError {
-        let (line, column) = line_col(self.text, span.start);
+        let (line, column) = model_spec::locate::line_col(self.text, span.start);
         TruthError::Invalid {
             file: self.file.to_string(),
             line,
@@ -434,7 +451,7 @@ impl Parser<'_> {
     }
 
     fn line(&self, span: &Range<usize>) -> usize {
-        line_col(self.text, span.start).0
+        model_spec::locate::line_col(self.text, span.start).0
     }
 
     fn truth(&self, root: &DeTable<'_>) -> Res<Truth> {
@@ -461,8 +478,11 @@ impl Parser<'_> {
                 "noise_um" => {
                     let what = "`noise_um` (standard deviation of the reading noise, µm)";
                     let (x, text) = self.number(v, what)?;
-                    if x < 0.0 {
-                        return Err(self.err(v.span(), format!("{what} must not be negative")));
+                    if !(0.0..=MAX_NOISE_UM).contains(&x) {
+                        return Err(self.err(
+                            v.span(),
+                            format!("{what} must be from 0 to {MAX_NOISE_UM} µm, not {text}"),
+                        ));
                     }
                     t.noise_mm = self.scaled(&text, 3, v, what)?;
                 }
@@ -544,6 +564,27 @@ impl Parser<'_> {
         }
     }
 
+    /// `x` (read at `v`, written `text`) if its magnitude is at most `max` (in `unit`).
+    fn bounded(
+        &self,
+        v: &Val<'_>,
+        what: &str,
+        (x, text): (f64, &str),
+        max: f64,
+        unit: &str,
+    ) -> Res<f64> {
+        if x.abs() <= max {
+            Ok(x)
+        } else {
+            Err(self.err(
+                v.span(),
+                format!(
+                    "{what}: {text} is beyond the largest magnitude a truth may have, {max} {unit}"
+                ),
+            ))
+        }
+    }
+
     /// The number `text` (already checked) with the decimal point moved `places` to the left.
     fn scaled(&self, text: &str, places: i32, v: &Val<'_>, what: &str) -> Res<f64> {
         match parse_scaled(text, -places) {
@@ -580,7 +621,15 @@ impl Parser<'_> {
                     ),
                 ));
             };
-            params[i] = self.number(v, &format!("parameter `{name}` (mm)"))?.0;
+            let what = format!("parameter `{name}` (mm)");
+            let (x, text) = self.number(v, &what)?;
+            params[i] = self.bounded(
+                v,
+                &what,
+                (x, &text),
+                model_spec::limits::MAX_LENGTH_MM,
+                "mm",
+            )?;
         }
         Ok(())
     }
@@ -689,7 +738,8 @@ impl Parser<'_> {
             };
             let mut out = Vec::with_capacity(2);
             for x in arr.iter() {
-                let (_, text) = self.number(x, &what)?;
+                let (value, text) = self.number(x, &what)?;
+                self.bounded(x, &what, (value, &text), MAX_VALUE, &unit)?;
                 out.push(self.scaled(&text, p, x, &what)?);
             }
             out
@@ -700,7 +750,8 @@ impl Parser<'_> {
                     format!("{what} takes one number; only `harmonic:K` takes a pair [cos, sin]"),
                 ));
             }
-            let (_, text) = self.number(v, &what)?;
+            let (value, text) = self.number(v, &what)?;
+            self.bounded(v, &what, (value, &text), MAX_VALUE, &unit)?;
             vec![self.scaled(&text, p, v, &what)?]
         };
         terms.push((term, values, at.clone()));
@@ -713,16 +764,4 @@ fn sorted<'t, 'i>(t: &'t DeTable<'i>) -> Vec<(&'t Key<'i>, &'t Val<'i>)> {
     let mut v: Vec<_> = t.iter().collect();
     v.sort_by_key(|(k, _)| k.span().start);
     v
-}
-
-/// The 1-based line and column (in characters) of byte offset `at` of `text`.
-pub fn line_col(text: &str, at: usize) -> (usize, usize) {
-    let mut at = at.min(text.len());
-    while !text.is_char_boundary(at) {
-        at -= 1;
-    }
-    let before = &text[..at];
-    let line = before.matches('\n').count() + 1;
-    let start = before.rfind('\n').map_or(0, |i| i + 1);
-    (line, text[start..at].chars().count() + 1)
 }

@@ -14,15 +14,9 @@ use solver::simulation::truth::{Truth, builtin_truth};
 /// Reading noise of every scenario, mm (0.5 µm).
 pub const NOISE_MM: f64 = 0.5e-3;
 
-/// The diagnosis options of the tests: the defaults (α = 0.01, 1000 Monte-Carlo draws), but 199
-/// draws in the dev profile, where solver is not optimised and the draws dominate the run time
-/// (with 199 draws the Monte-Carlo p-value `(count + 1)/200` still has level α exactly for
-/// α = 0.05 or 0.01).
+/// The diagnosis options of the tests: the defaults (α = 0.01, 1000 Monte-Carlo draws).
 pub fn options() -> DiagnoseOptions {
-    DiagnoseOptions {
-        draws: if cfg!(debug_assertions) { 199 } else { 1000 },
-        ..DiagnoseOptions::default()
-    }
+    DiagnoseOptions::new()
 }
 
 /// The seed machine.

@@ -135,8 +135,8 @@ pub enum CsvError {
     /// A record that cannot be written (not a file problem: a programming error reported).
     #[error("cannot write the record: {0}")]
     Record(String),
-    /// The file could not be read or written.
-    #[error("{file}: {source}")]
+    /// The file could not be read.
+    #[error("cannot read `{file}`: {source}")]
     Io {
         /// The file name.
         file: String,

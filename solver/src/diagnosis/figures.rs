@@ -1,0 +1,246 @@
+//! The data of the diagnosis figures, as plain series for a plotting library: per record, the
+//! measured error against the base and extended predictions along the path (x, y, z), and the
+//! residual components before and after the extension.
+
+use super::structure::{self, Component};
+use super::{DiagnoseOptions, Diagnosis};
+use crate::fitting::{Identification, ValidateError, ValidateOptions, validate};
+use crate::record::Record;
+use model_spec::Machine;
+use std::path::Path;
+
+/// How many components a spectrum figure shows.
+pub const SPECTRUM_ROWS: usize = 12;
+
+/// One named series of values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// Its legend.
+    pub label: String,
+    /// One value per abscissa point.
+    pub values: Vec<f64>,
+}
+
+/// One panel of a path figure: a direction of the error vector.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Panel {
+    /// `x error`, `y error`, `z error`.
+    pub name: String,
+    /// The measured error, µm.
+    pub measured: Series,
+    /// The predictions, µm: base model, then extended model.
+    pub predictions: Vec<Series>,
+}
+
+/// Measured against predicted error along a path.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathFigure {
+    /// The file name it is written to (`k4-path.svg`).
+    pub file_name: String,
+    /// Its title.
+    pub title: String,
+    /// What the abscissa is (`C (deg)` or `sample index`).
+    pub x_label: String,
+    /// The abscissa.
+    pub x: Vec<f64>,
+    /// x, y and z.
+    pub panels: Vec<Panel>,
+}
+
+/// The largest residual components before the extension, each with its size after.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpectrumFigure {
+    /// The file name it is written to (`k4-spectrum.svg`).
+    pub file_name: String,
+    /// Its title.
+    pub title: String,
+    /// The legend of the bars before (base model).
+    pub before_label: String,
+    /// The legend of the bars after (extended model).
+    pub after_label: String,
+    /// Component label (`C harmonic:2 y`), RMS before and after, µm.
+    pub rows: Vec<(String, f64, f64)>,
+}
+
+/// The figures of a diagnosis.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Figures {
+    /// One per record.
+    pub paths: Vec<PathFigure>,
+    /// One per record with residual structure.
+    pub spectra: Vec<SpectrumFigure>,
+}
+
+/// `C harmonic:2 y`.
+pub fn component_label(c: &Component) -> String {
+    format!("{} {} {}", c.source, c.shape, ["x", "y", "z"][c.direction])
+}
+
+/// The largest `n` components of `before`, each with its explained RMS in `after` (0 if gone).
+pub fn component_rows(
+    before: &[Component],
+    after: &[Component],
+    n: usize,
+) -> Vec<(String, f64, f64)> {
+    before
+        .iter()
+        .take(n)
+        .map(|c| {
+            let a = after
+                .iter()
+                .find(|x| x.source == c.source && x.shape == c.shape && x.direction == c.direction)
+                .map_or(0.0, |x| x.explained_rms_um);
+            (component_label(c), c.explained_rms_um, a)
+        })
+        .collect()
+}
+
+/// A file stem for a record's figures: the file's stem with unsafe characters replaced,
+/// unique among `taken`.
+fn stem(name: &str, taken: &mut Vec<String>) -> String {
+    let raw = Path::new(name)
+        .file_stem()
+        .map_or("data".to_string(), |s| s.to_string_lossy().into_owned());
+    let mut s: String = raw
+        .chars()
+        .map(|c| {
+            if c.is_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if s.is_empty() {
+        s = "data".into();
+    }
+    let mut out = s.clone();
+    let mut i = 2;
+    while taken.contains(&out) {
+        out = format!("{s}-{i}");
+        i += 1;
+    }
+    taken.push(out.clone());
+    out
+}
+
+/// The abscissa of a path figure: the rotary axis that moves most while moving one way
+/// (degrees), else the sample index.
+fn abscissa(m: &Machine, record: &Record) -> (String, Vec<f64>) {
+    let mut best: Option<(usize, f64)> = None;
+    for a in m.rotary_axes() {
+        let q: Vec<f64> = record.samples.iter().map(|s| s.commands[a]).collect();
+        let range = q.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+            - q.iter().cloned().fold(f64::INFINITY, f64::min);
+        let monotonic = q.windows(2).all(|w| w[1] >= w[0]) || q.windows(2).all(|w| w[1] <= w[0]);
+        if range > 1e-9 && monotonic && best.is_none_or(|(_, r)| range > r) {
+            best = Some((a, range));
+        }
+    }
+    match best {
+        Some((a, _)) => (
+            format!("{} (deg)", m.axes[a].name),
+            record
+                .samples
+                .iter()
+                .map(|s| s.commands[a].to_degrees())
+                .collect(),
+        ),
+        None => (
+            "sample index".into(),
+            (0..record.samples.len()).map(|i| i as f64).collect(),
+        ),
+    }
+}
+
+/// The figures of diagnosis `d` of the model labelled `label`, for every record (name,
+/// record, fitted?): the fitted record first, then the held-out ones.
+///
+/// # Errors
+/// A prediction that fails.
+pub fn figures(
+    m: &Machine,
+    d: &Diagnosis,
+    label: &str,
+    o: &DiagnoseOptions,
+    records: &[(String, &Record, bool)],
+) -> Result<Figures, ValidateError> {
+    let mut out = Figures::default();
+    let mut taken = Vec::new();
+    let ext_label = d.extended_label(m, label);
+    for (name, record, fitted) in records {
+        // The fitted record: the fits' own prediction (the minimum-norm solution, so that
+        // confounded groups keep their combined effect), not zeroed: the offsets of zeroed
+        // readings are in the models. Held out: the values, zeroed like the readings.
+        let predict = |fit: &Identification| {
+            let values: Vec<Option<f64>> = if *fitted {
+                fit.fit.solution.iter().map(|&v| Some(v)).collect()
+            } else {
+                fit.fit.values.clone()
+            };
+            let mut opts = ValidateOptions::new()
+                .zeroed(o.zeroed && !fitted)
+                .exact(true);
+            opts.params = o.params.clone();
+            validate(m, &fit.model, &values, record, &opts)
+        };
+        let before = predict(&d.base_fit)?;
+        let after = predict(&d.extended_fit)?;
+        let (x_label, x) = abscissa(m, record);
+        let um = |v: &[[f64; 3]], k: usize| v.iter().map(|r| r[k] * 1e3).collect::<Vec<f64>>();
+        let measured: Vec<[f64; 3]> = before
+            .prediction
+            .iter()
+            .zip(&before.residual)
+            .map(|(p, r)| [p[0] + r[0], p[1] + r[1], p[2] + r[2]])
+            .collect();
+        let panels = (0..3)
+            .map(|k| Panel {
+                name: format!("{} error", ["x", "y", "z"][k]),
+                measured: Series {
+                    label: "measured".into(),
+                    values: um(&measured, k),
+                },
+                predictions: vec![
+                    Series {
+                        label: format!("base model ({label})"),
+                        values: um(&before.prediction, k),
+                    },
+                    Series {
+                        label: format!("extended model ({ext_label})"),
+                        values: um(&after.prediction, k),
+                    },
+                ],
+            })
+            .collect();
+        let role = if *fitted { "fitted" } else { "held out" };
+        let s = stem(name, &mut taken);
+        out.paths.push(PathFigure {
+            file_name: format!("{s}-path.svg"),
+            title: format!("{name} ({role}): measured and predicted error, µm"),
+            x_label,
+            x,
+            panels,
+        });
+        let k = &o.dictionary;
+        let (sb, sa) = if *fitted {
+            (d.structure_before.clone(), d.structure_after.clone())
+        } else {
+            (
+                structure::analyse(m, record, &before.residual, k.harmonics, k.poly, k.time),
+                structure::analyse(m, record, &after.residual, k.harmonics, k.poly, k.time),
+            )
+        };
+        let rows = component_rows(&sb, &sa, SPECTRUM_ROWS);
+        if !rows.is_empty() {
+            out.spectra.push(SpectrumFigure {
+                file_name: format!("{s}-spectrum.svg"),
+                title: format!("{name} ({role}): residual components, µm"),
+                before_label: format!("base model ({label})"),
+                after_label: format!("extended model ({ext_label})"),
+                rows,
+            });
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,114 @@
+//! Bounds of plausibility for identified values: a fit that "finds" an angular error of 71.7
+//! rad or a location error of −2 m does not describe a machine tool, whatever its statistics
+//! say. Such a result is refused, not reported.
+//!
+//! The defaults ([`ValueLimits::default`]): 1 mm for translational values (errors and sensor
+//! offsets), 10 mrad for angular values, per coefficient (a harmonic's cos and sin, a
+//! polynomial's coefficient). Real geometric errors of machine tools are tens of µm and µrad;
+//! the bounds leave two orders of magnitude for set-ups far off nominal. They are a data
+//! sanity check, separate from the diagnosis's plausibility budget of a finding.
+
+use super::identify::Identification;
+use crate::model::Model;
+use model_spec::Machine;
+use model_spec::units::{UM_PER_MM, URAD_PER_RAD, short};
+
+/// The largest magnitudes an identified value may have.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct ValueLimits {
+    /// Translational errors and sensor offsets, mm.
+    pub translation_mm: f64,
+    /// Angular errors, rad.
+    pub angle_rad: f64,
+}
+
+impl Default for ValueLimits {
+    /// 1 mm and 10 mrad.
+    fn default() -> Self {
+        ValueLimits {
+            translation_mm: 1.0,
+            angle_rad: 0.01,
+        }
+    }
+}
+
+impl ValueLimits {
+    /// The defaults.
+    pub fn new() -> ValueLimits {
+        ValueLimits::default()
+    }
+
+    /// With the translational bound `um` (µm) and the angular bound `urad` (µrad).
+    pub fn from_display(um: f64, urad: f64) -> ValueLimits {
+        ValueLimits {
+            translation_mm: um / UM_PER_MM,
+            angle_rad: urad / URAD_PER_RAD,
+        }
+    }
+}
+
+/// Identified values beyond the bounds.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "implausible result: {} beyond the plausibility bounds ({} µm, {} µrad): {}; the fit does not describe this machine (too few or unsuitable data, or a model the data cannot determine)",
+    if .values.len() == 1 { "a value is" } else { "values are" },
+    short(.limits.translation_mm * UM_PER_MM),
+    short(.limits.angle_rad * URAD_PER_RAD),
+    .values.iter().map(|(n, v, u)| format!("{n} = {} {u}", short(*v))).collect::<Vec<_>>().join(", ")
+)]
+pub struct Implausible {
+    /// The offending parameters: name, value in µm or µrad, unit symbol.
+    pub values: Vec<(String, f64, &'static str)>,
+    /// The bounds.
+    pub limits: ValueLimits,
+}
+
+/// Checks the values (`None`: undetermined, not checked) of `model`'s columns against `limits`.
+///
+/// # Errors
+/// [`Implausible`] naming every offending parameter.
+pub fn check_model_values(
+    m: &Machine,
+    model: &Model,
+    names: &[String],
+    values: &[Option<f64>],
+    limits: &ValueLimits,
+) -> Result<(), Implausible> {
+    let mut bad = Vec::new();
+    for (j, (t, _)) in model.columns().into_iter().enumerate() {
+        let Some(v) = values.get(j).copied().flatten() else {
+            continue;
+        };
+        let effect = model.terms[t].effect;
+        let (bound, unit) = if effect.is_angular(m) {
+            (limits.angle_rad, "µrad")
+        } else {
+            (limits.translation_mm, "µm")
+        };
+        // A NaN is beyond every bound.
+        if v.abs() > bound || v.is_nan() {
+            bad.push((names[j].clone(), v * effect.display_factor(m), unit));
+        }
+    }
+    if bad.is_empty() {
+        Ok(())
+    } else {
+        Err(Implausible {
+            values: bad,
+            limits: *limits,
+        })
+    }
+}
+
+/// Checks the values of an identification against `limits`.
+///
+/// # Errors
+/// [`Implausible`] naming every offending parameter.
+pub fn check_values(
+    m: &Machine,
+    ident: &Identification,
+    limits: &ValueLimits,
+) -> Result<(), Implausible> {
+    check_model_values(m, &ident.model, &ident.fit.names, &ident.fit.values, limits)
+}

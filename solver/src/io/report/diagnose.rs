@@ -1,0 +1,389 @@
+//! The diagnosis report (`rtest diagnose --json`): the base fit, the residual structure, the
+//! findings with their significance, what the data cannot see, the extended model and its gain
+//! on the fitted and the held-out records. Values in µm and µrad.
+
+use super::{NonFinite, finite, finite_opt};
+use crate::diagnosis::harmonic::harmonic;
+use crate::diagnosis::structure::Component;
+use crate::diagnosis::{Correction, DiagnoseOptions, Diagnosis};
+use crate::model::{Carrier, Term};
+use model_spec::Machine;
+use model_spec::units::UM_PER_MM;
+use serde::{Deserialize, Serialize};
+
+/// How many residual components the report lists, before and after.
+pub const COMPONENTS_LISTED: usize = 12;
+
+/// The base model's fit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BaseFitReport {
+    /// The terms fitted (offsets of zeroed readings included).
+    pub terms: Vec<String>,
+    /// Residual RMS over all readings, µm.
+    pub residual_rms_um: f64,
+    /// σ̂, µm; `null` without degrees of freedom.
+    pub sigma_um: Option<f64>,
+    /// Degrees of freedom.
+    pub dof: usize,
+}
+
+/// One shape of the residual.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ComponentReport {
+    /// What it follows: an axis name, or `time`.
+    pub source: String,
+    /// The shape: `harmonic:2`, `poly:1`, `time:1`, `reversal`.
+    pub shape: String,
+    /// `x`, `y` or `z`.
+    pub direction: String,
+    /// RMS of what the shape alone explains, µm.
+    pub explained_rms_um: f64,
+}
+
+/// The residual structure before and after the extension.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StructureReport {
+    /// Of the base fit, largest first.
+    pub before: Vec<ComponentReport>,
+    /// Of the extended fit, largest first.
+    pub after: Vec<ComponentReport>,
+}
+
+/// One significant effect found.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FindingReport {
+    /// Effect name (`ECC`).
+    pub error: String,
+    /// Basis (`harmonic:2`).
+    pub basis: String,
+    /// The term's name for people.
+    pub description: String,
+    /// The axis whose position the basis follows (`C` for `ECC@harmonic:2`); absent for
+    /// effects of no axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<String>,
+    /// Its value(s) in the extended model, µm or µrad (`[cos, sin]` for a harmonic); `null`
+    /// where undetermined.
+    pub values: Vec<Option<f64>>,
+    /// Their standard uncertainties.
+    pub stds: Vec<Option<f64>>,
+    /// `um` or `urad`.
+    pub unit: String,
+    /// The column names of the basis (`harmonic:2:cos`, `harmonic:2:sin`).
+    pub columns: Vec<String>,
+    /// A harmonic's amplitude and phase (written as the fields `amplitude`, `amplitude_std`,
+    /// `phase_deg`, `phase_std_deg`); absent for other bases.
+    #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
+    pub harmonic: Option<HarmonicReport>,
+    /// Share of the base model's residual sum of squares it explains beyond the other findings.
+    pub explained_fraction: f64,
+    /// The F statistic of its step.
+    pub f: f64,
+    /// Its p-value corrected for the candidates tried.
+    pub p_value: f64,
+    /// `bonferroni` or `monte-carlo`.
+    pub correction: String,
+    /// Candidates tried at that step.
+    pub candidates_tried: usize,
+    /// Candidates the data cannot tell from it (`NAME@BASIS`).
+    pub alternatives: Vec<String>,
+}
+
+/// The amplitude and phase of a harmonic finding.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HarmonicReport {
+    /// √(cos² + sin²), µm or µrad.
+    pub amplitude: f64,
+    /// Its standard uncertainty; `null` when undetermined.
+    pub amplitude_std: Option<f64>,
+    /// atan2(sin, cos), degrees.
+    pub phase_deg: f64,
+    /// Its standard uncertainty, degrees; `null` when undetermined.
+    pub phase_std_deg: Option<f64>,
+}
+
+/// Why the selection stopped.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StopReport {
+    /// For people.
+    pub reason: String,
+    /// The best remaining candidate; absent when no candidate was left.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub best_remaining: Option<String>,
+    /// Its corrected p-value.
+    pub p_value: f64,
+}
+
+/// A candidate the model spans.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ConfoundedReport {
+    /// Effect name.
+    pub error: String,
+    /// Basis.
+    pub basis: String,
+    /// The model's terms it is a combination of.
+    pub with: Vec<String>,
+}
+
+/// The extended model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExtendedModelReport {
+    /// `reduced + ECC@harmonic:2`.
+    pub label: String,
+    /// Its terms, as a sub-model lists them.
+    pub terms: Vec<String>,
+    /// The terms added.
+    pub added: Vec<String>,
+    /// The model's name in the machine description written (`--model-out`); absent when none
+    /// was written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// That file; absent when none was written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+}
+
+/// Residual RMS on one record, before and after, µm.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GainRow {
+    /// The record's file.
+    pub data: String,
+    /// With the base model, µm.
+    pub residual_rms_um_before: f64,
+    /// With the extended model, µm.
+    pub residual_rms_um_after: f64,
+}
+
+/// The gain of the extension.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GainReport {
+    /// On the fitted record.
+    pub fit: GainRow,
+    /// On every held-out record.
+    pub validation: Vec<GainRow>,
+}
+
+/// The diagnosis report.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DiagnosisReport {
+    /// Machine name.
+    pub machine: String,
+    /// `--machine` as given (a built-in name or a file), for the commands it suggests.
+    pub machine_source: String,
+    /// The fitted record's file.
+    pub data: String,
+    /// Its samples.
+    pub samples: usize,
+    /// The held-out records: file and samples.
+    pub held_out: Vec<(String, usize)>,
+    /// The base model's label.
+    pub base_model: String,
+    /// Whether the readings were zeroed at the first sample.
+    pub zeroed: bool,
+    /// Significance level of each step.
+    pub alpha: f64,
+    /// Monte-Carlo draws of the corrected p-values.
+    pub draws: usize,
+    /// Highest harmonic, Legendre order and time order of the candidates.
+    pub dictionary_extent: [u32; 3],
+    /// The base fit.
+    pub base_fit: BaseFitReport,
+    /// The residual structure.
+    pub structure: StructureReport,
+    /// Candidates in the dictionary.
+    pub dictionary_size: usize,
+    /// Candidates that do not vary on the fitted path.
+    pub unexcited: Vec<String>,
+    /// The findings, in the order they were added.
+    pub findings: Vec<FindingReport>,
+    /// Why the selection stopped.
+    pub stop: StopReport,
+    /// Candidates the extended model spans.
+    pub confounded: Vec<ConfoundedReport>,
+    /// The extended model.
+    pub extended_model: ExtendedModelReport,
+    /// The gain.
+    pub gain: GainReport,
+}
+
+/// What the report says besides the diagnosis: where things come from and go.
+#[derive(Clone, Debug)]
+pub struct DiagnosisSource<'a> {
+    /// `--machine` as given.
+    pub machine_source: &'a str,
+    /// The base model's label.
+    pub label: &'a str,
+    /// The fitted record's file.
+    pub data: &'a str,
+    /// Its samples.
+    pub samples: usize,
+    /// The held-out records: file and samples.
+    pub held_out: Vec<(String, usize)>,
+    /// The options of the diagnosis.
+    pub opts: &'a DiagnoseOptions,
+    /// The extended machine description written: the model's name and the file.
+    pub model_out: Option<(String, String)>,
+}
+
+fn spell(m: &Machine, ts: &[Term]) -> Vec<String> {
+    ts.iter().map(|t| t.spelling(m)).collect()
+}
+
+fn components(field: &str, c: &[Component]) -> Result<Vec<ComponentReport>, NonFinite> {
+    c.iter()
+        .take(COMPONENTS_LISTED)
+        .enumerate()
+        .map(|(i, c)| {
+            Ok(ComponentReport {
+                source: c.source.clone(),
+                shape: c.shape.clone(),
+                direction: ["x", "y", "z"][c.direction].into(),
+                explained_rms_um: finite(
+                    || format!("structure.{field}[{i}].explained_rms_um"),
+                    c.explained_rms_um,
+                )?,
+            })
+        })
+        .collect()
+}
+
+fn gain_row(field: &str, data: &str, before: f64, after: f64) -> Result<GainRow, NonFinite> {
+    Ok(GainRow {
+        data: data.into(),
+        residual_rms_um_before: finite(
+            || format!("{field}.residual_rms_um_before"),
+            before * UM_PER_MM,
+        )?,
+        residual_rms_um_after: finite(
+            || format!("{field}.residual_rms_um_after"),
+            after * UM_PER_MM,
+        )?,
+    })
+}
+
+impl DiagnosisReport {
+    /// The report of `d` on machine `m`.
+    ///
+    /// # Errors
+    /// [`NonFinite`] when a value or statistic is not finite.
+    pub fn new(
+        m: &Machine,
+        source: &DiagnosisSource,
+        d: &Diagnosis,
+    ) -> Result<DiagnosisReport, NonFinite> {
+        let o = source.opts;
+        let mut findings = Vec::new();
+        for (i, f) in d.findings.iter().enumerate() {
+            let field = |what: &str| format!("findings[{i}].{what}");
+            let k = f.term.effect.display_factor(m);
+            let h = harmonic(m, d, f);
+            findings.push(FindingReport {
+                error: f.term.effect.name(m),
+                basis: f.term.basis.to_string(),
+                description: f.description.clone(),
+                axis: match f.term.effect.carrier(m) {
+                    Carrier::Axis(a) => Some(m.axes[a].name.clone()),
+                    Carrier::None => None,
+                },
+                // A value the extended fit cannot determine is NaN in the finding: undetermined.
+                values: f
+                    .values
+                    .iter()
+                    .map(|v| v.is_finite().then_some(v * k))
+                    .collect(),
+                stds: f
+                    .stds
+                    .iter()
+                    .map(|s| finite_opt(|| field("stds"), s.map(|s| s * k)))
+                    .collect::<Result<_, _>>()?,
+                unit: f.term.effect.unit(m).into(),
+                columns: f.term.basis.column_names(),
+                harmonic: match h {
+                    Some(h) => Some(HarmonicReport {
+                        amplitude: finite(|| field("amplitude"), h.amplitude)?,
+                        amplitude_std: finite_opt(|| field("amplitude_std"), h.amplitude_std)?,
+                        phase_deg: finite(|| field("phase_deg"), h.phase_deg)?,
+                        phase_std_deg: finite_opt(|| field("phase_std_deg"), h.phase_std_deg)?,
+                    }),
+                    None => None,
+                },
+                explained_fraction: finite(|| field("explained_fraction"), f.explained_fraction)?,
+                f: finite(|| field("f"), f.f)?,
+                p_value: finite(|| field("p_value"), f.p_value)?,
+                correction: match f.correction {
+                    Correction::Bonferroni => "bonferroni",
+                    Correction::MonteCarlo => "monte-carlo",
+                }
+                .into(),
+                candidates_tried: f.candidates_tried,
+                alternatives: spell(m, &f.alternatives),
+            });
+        }
+        let (name, file) = match &source.model_out {
+            Some((n, f)) => (Some(n.clone()), Some(f.clone())),
+            None => (None, None),
+        };
+        let fit = &d.base_fit.fit;
+        Ok(DiagnosisReport {
+            machine: m.name.clone(),
+            machine_source: source.machine_source.into(),
+            data: source.data.into(),
+            samples: source.samples,
+            held_out: source.held_out.clone(),
+            base_model: source.label.into(),
+            zeroed: o.zeroed,
+            alpha: o.alpha,
+            draws: o.draws,
+            dictionary_extent: [o.dictionary.harmonics, o.dictionary.poly, o.dictionary.time],
+            base_fit: BaseFitReport {
+                terms: spell(m, &d.base.terms),
+                residual_rms_um: finite(
+                    || "base_fit.residual_rms_um".into(),
+                    d.fit_rms.0 * UM_PER_MM,
+                )?,
+                sigma_um: finite_opt(
+                    || "base_fit.sigma_um".into(),
+                    fit.sigma.map(|s| s * UM_PER_MM),
+                )?,
+                dof: fit.dof,
+            },
+            structure: StructureReport {
+                before: components("before", &d.structure_before)?,
+                after: components("after", &d.structure_after)?,
+            },
+            dictionary_size: d.dictionary_size,
+            unexcited: spell(m, &d.unexcited),
+            findings,
+            stop: StopReport {
+                reason: d.stop.reason.clone(),
+                best_remaining: d.stop.best.map(|t| t.spelling(m)),
+                p_value: finite(|| "stop.p_value".into(), d.stop.p_value)?,
+            },
+            confounded: d
+                .confounded
+                .iter()
+                .map(|c| ConfoundedReport {
+                    error: c.term.effect.name(m),
+                    basis: c.term.basis.to_string(),
+                    with: spell(m, &c.with),
+                })
+                .collect(),
+            extended_model: ExtendedModelReport {
+                label: d.extended_label(m, source.label),
+                terms: spell(m, &d.extended_terms().terms),
+                added: d.findings.iter().map(|f| f.term.spelling(m)).collect(),
+                name,
+                file,
+            },
+            gain: GainReport {
+                fit: gain_row("gain.fit", source.data, d.fit_rms.0, d.fit_rms.1)?,
+                validation: d
+                    .validation
+                    .iter()
+                    .enumerate()
+                    .map(|(i, (n, b, a))| gain_row(&format!("gain.validation[{i}]"), n, *b, *a))
+                    .collect::<Result<_, _>>()?,
+            },
+        })
+    }
+}

@@ -1,0 +1,323 @@
+//! The identification report (`rtest identify --json`).
+//!
+//! ```json
+//! {"machine": "seed-ac", "fingerprint": "fnv1a64:…", "model": "reduced", "base_model": "reduced",
+//!  "terms": ["XOW", …, "BOC"],
+//!  "parameters": [{"name": "XOC", "error": "XOC", "basis": "const", "value": 12.3, "std": 0.05,
+//!                  "unit": "um", "determined": true, "fixed": false}, …],
+//!  "residual_rms_um": 0.49, "rank": 11, "condition": 4.2, "confounded": [["XOC", "dx0"]], …,
+//!  "refinement": {"method": "exact", "iterations": 3, "converged": true, …}, "notes": […]}
+//! ```
+//! `value` and `std` are `null` where the data do not determine the parameter; `basis` is
+//! `const`, `harmonic:K:cos`, `harmonic:K:sin`, `poly:K`, `reversal` or `time:K`; `unit` is
+//! `um` (translational errors, sensor offsets) or `urad` (angular errors). Readers of the values
+//! need `machine`, `fingerprint`, `model`, `base_model`, `terms` and `parameters`
+//! ([`super::read`]).
+
+use super::{NonFinite, finite, finite_opt};
+use crate::fitting::hmatrix::Backend;
+use crate::fitting::identifiability::Swallowed;
+use crate::fitting::refine::Refinement;
+use crate::fitting::{Constraint, Identification};
+use model_spec::Machine;
+use model_spec::units::UM_PER_MM;
+use serde::{Deserialize, Serialize};
+
+/// One parameter (H-matrix column) of an identification, in µm or µrad.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParameterReport {
+    /// The parameter's name (`XOC`, `ECC@harmonic:2:cos`, `dx0`).
+    pub name: String,
+    /// Effect name (`XOC`, `dx0`).
+    pub error: String,
+    /// Basis column (`const`, `harmonic:2:cos`, `reversal`, …).
+    pub basis: String,
+    /// Estimate, µm or µrad; `null` when the data do not determine it (and no constraint gives
+    /// it a value).
+    pub value: Option<f64>,
+    /// Standard uncertainty, µm or µrad; `null` when undetermined, fixed, or without a degree
+    /// of freedom.
+    pub std: Option<f64>,
+    /// `um` or `urad`.
+    pub unit: String,
+    /// Whether the data determine it (fixed parameters count as determined).
+    pub determined: bool,
+    /// Fixed to 0 by the constraint.
+    pub fixed: bool,
+}
+
+/// A pair of determined parameters with a high correlation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NearPairReport {
+    /// The two parameter names.
+    pub parameters: [String; 2],
+    /// Correlation of their estimates, in [−1, 1].
+    pub correlation: f64,
+}
+
+/// What the refinement against the exact machine did.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RefinementReport {
+    /// `exact` (refined against the exact machine) or `first-order` (not refined).
+    pub method: String,
+    /// Gauss–Newton steps taken (0 for `first-order`).
+    pub iterations: usize,
+    /// Whether the last step was below the tolerance (always `true` for `first-order`, whose
+    /// linear solution is exact). An identification that did not converge is not a result:
+    /// `rtest identify` refuses it (exit code 3) and writes no file.
+    pub converged: bool,
+    /// Per step, the largest change of the prediction any correction made, µm.
+    pub steps_um: Vec<f64>,
+    /// Residual RMS of the first-order fit, µm.
+    pub first_order_rms_um: f64,
+}
+
+/// A group of sensor offsets and the errors they cannot be told from (zeroed readings).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SwallowedReport {
+    /// The offsets (`dx0`).
+    pub offsets: Vec<String>,
+    /// The errors (`XOC`); empty when the offsets are confounded with each other only.
+    pub errors: Vec<String>,
+}
+
+/// The identification report.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IdentificationReport {
+    /// Machine name.
+    pub machine: String,
+    /// The machine's fingerprint (topology and machine-side kinematic defaults): values are
+    /// applied only to a machine with the same fingerprint.
+    pub fingerprint: String,
+    /// The measurement file fitted.
+    pub data: String,
+    /// The model's label (`reduced`, `reduced + ECC@harmonic:2`, `XOC + EXX@poly:1`).
+    pub model: String,
+    /// The machine's model it starts from (`--model`); absent when the model is a list of
+    /// terms only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_model: Option<String>,
+    /// The terms fitted, in order (`XOC`, `ECC@harmonic:2`, `dx0`), offsets of zeroed readings
+    /// included.
+    pub terms: Vec<String>,
+    /// Every parameter (H column), in model order.
+    pub parameters: Vec<ParameterReport>,
+    /// `√(RSS / 3N)`, µm.
+    pub residual_rms_um: f64,
+    /// Numerical rank of the column-scaled H.
+    pub rank: usize,
+    /// Free parameters (not fixed by the constraint).
+    pub free_parameters: usize,
+    /// Condition number of the scaled H over the identifiable part; `null` when the rank is 0.
+    pub condition: Option<f64>,
+    /// Groups of parameters the data cannot separate (parameter names).
+    pub confounded: Vec<Vec<String>>,
+    /// Number of samples fitted.
+    pub samples: usize,
+    /// Readings fitted (3 per sample).
+    pub readings: usize,
+    /// Degrees of freedom `3N − rank`.
+    pub dof: usize,
+    /// Whether the readings were zeroed at the first sample (then `dx0 dy0 dz0` were fitted).
+    pub zeroed: bool,
+    /// `none`, `minimum-norm` or `zero: NAME, …`.
+    pub constraint: String,
+    /// σ̂ = √(RSS / (3N − rank)), µm; `null` without degrees of freedom.
+    pub sigma_um: Option<f64>,
+    /// Determined pairs with |correlation| > 0.99.
+    pub near_confounded: Vec<NearPairReport>,
+    /// What the sensor offsets swallow (zeroed readings).
+    pub swallowed: Vec<SwallowedReport>,
+    /// `compiled`, `evaluator` or `mixed`: the code that computed the gains.
+    pub gains: String,
+    /// The refinement against the exact machine.
+    pub refinement: RefinementReport,
+    /// Statements for people (what was swallowed, what has no value and why, non-convergence).
+    pub notes: Vec<String>,
+}
+
+/// The text of a constraint, as the report writes it.
+pub fn constraint_text(c: &Constraint) -> String {
+    match c {
+        Constraint::None => "none".into(),
+        Constraint::MinimumNorm => "minimum-norm".into(),
+        Constraint::Zero(names) => format!("zero: {}", names.join(", ")),
+    }
+}
+
+/// The name of a gain backend in reports.
+pub fn backend_name(b: Backend) -> &'static str {
+    match b {
+        Backend::Compiled => "compiled",
+        Backend::Evaluator => "evaluator",
+        Backend::Mixed => "mixed",
+    }
+}
+
+/// What an identification report says besides the identification.
+#[derive(Clone, Copy, Debug)]
+pub struct IdentificationSource<'a> {
+    /// The measurement file fitted.
+    pub data: &'a str,
+    /// The model's label.
+    pub label: &'a str,
+    /// The machine's model it starts from (`--model`), if any.
+    pub base_model: Option<&'a str>,
+}
+
+impl IdentificationReport {
+    /// The report of `ident` on machine `m`, refined as `refinement` says (`None`: first
+    /// order).
+    ///
+    /// # Errors
+    /// [`NonFinite`] when a value, uncertainty or statistic is not finite.
+    pub fn new(
+        m: &Machine,
+        source: IdentificationSource,
+        ident: &Identification,
+        refinement: Option<&Refinement>,
+    ) -> Result<IdentificationReport, NonFinite> {
+        let fit = &ident.fit;
+        let id = &fit.identifiability;
+        let mut parameters = Vec::with_capacity(fit.names.len());
+        for (j, (t, k)) in ident.model.columns().into_iter().enumerate() {
+            let term = ident.model.terms[t];
+            let f = term.effect.display_factor(m);
+            let names = term.basis.column_names();
+            let field = |what: &str| format!("parameters[{j}].{what}");
+            parameters.push(ParameterReport {
+                name: fit.names[j].clone(),
+                error: term.effect.name(m),
+                basis: names.get(k).unwrap_or(&names[0]).clone(),
+                value: finite_opt(|| field("value"), fit.values[j].map(|v| v * f))?,
+                std: finite_opt(|| field("std"), fit.std[j].map(|v| v * f))?,
+                unit: term.effect.unit(m).to_string(),
+                determined: id.determined[j],
+                fixed: fit.fixed[j],
+            });
+        }
+        let name = |j: usize| fit.names[j].clone();
+        let refinement = match refinement {
+            Some(r) => RefinementReport {
+                method: "exact".into(),
+                iterations: r.iterations,
+                converged: r.converged,
+                steps_um: r
+                    .steps_mm
+                    .iter()
+                    .enumerate()
+                    .map(|(i, s)| finite(|| format!("refinement.steps_um[{i}]"), s * UM_PER_MM))
+                    .collect::<Result<_, _>>()?,
+                first_order_rms_um: finite(
+                    || "refinement.first_order_rms_um".into(),
+                    r.rms_mm.0 * UM_PER_MM,
+                )?,
+            },
+            None => RefinementReport {
+                method: "first-order".into(),
+                iterations: 0,
+                converged: true,
+                steps_um: Vec::new(),
+                first_order_rms_um: finite(
+                    || "refinement.first_order_rms_um".into(),
+                    fit.residual_rms() * UM_PER_MM,
+                )?,
+            },
+        };
+        Ok(IdentificationReport {
+            machine: m.name.clone(),
+            fingerprint: m.fingerprint(),
+            data: source.data.to_string(),
+            model: source.label.to_string(),
+            base_model: source.base_model.map(str::to_string),
+            terms: ident.model.terms.iter().map(|t| t.spelling(m)).collect(),
+            parameters,
+            residual_rms_um: finite(|| "residual_rms_um".into(), fit.residual_rms() * UM_PER_MM)?,
+            rank: fit.rank,
+            free_parameters: fit.fixed.iter().filter(|f| !**f).count(),
+            condition: finite_opt(|| "condition".into(), fit.condition)?,
+            confounded: id
+                .confounded
+                .iter()
+                .map(|g| g.iter().map(|&j| name(j)).collect())
+                .collect(),
+            samples: ident.samples,
+            readings: fit.rows(),
+            dof: fit.dof,
+            zeroed: ident.zeroed,
+            constraint: constraint_text(&fit.constraint),
+            sigma_um: finite_opt(|| "sigma_um".into(), fit.sigma.map(|s| s * UM_PER_MM))?,
+            near_confounded: id
+                .near_confounded
+                .iter()
+                .map(|p| {
+                    Ok(NearPairReport {
+                        parameters: [name(p.a), name(p.b)],
+                        correlation: finite(
+                            || "near_confounded.correlation".into(),
+                            p.correlation,
+                        )?,
+                    })
+                })
+                .collect::<Result<_, NonFinite>>()?,
+            swallowed: ident
+                .swallowed
+                .iter()
+                .map(|s: &Swallowed| SwallowedReport {
+                    offsets: s.offsets.clone(),
+                    errors: s.errors.clone(),
+                })
+                .collect(),
+            gains: backend_name(ident.backend).into(),
+            notes: notes(ident, &refinement),
+            refinement,
+        })
+    }
+}
+
+/// The statements for people: what the offsets swallow, what has no value, no uncertainty,
+/// no convergence.
+fn notes(ident: &Identification, refinement: &RefinementReport) -> Vec<String> {
+    let fit = &ident.fit;
+    let id = &fit.identifiability;
+    let mut notes = Vec::new();
+    if !refinement.converged {
+        notes.push(format!(
+            "the refinement against the exact machine did not converge in {} steps (last step {} µm): these values are not an identification",
+            refinement.iterations,
+            refinement.steps_um.last().map_or("?".into(), |s| format!("{s:.3e}"))
+        ));
+    }
+    for s in &ident.swallowed {
+        notes.push(format!(
+            "zeroed readings: the sensor offset{} {} cannot be told from {} (constant gains)",
+            if s.offsets.len() > 1 { "s" } else { "" },
+            s.offsets.join(", "),
+            if s.errors.is_empty() {
+                "each other".to_string()
+            } else {
+                s.errors.join(", ")
+            }
+        ));
+    }
+    let undetermined: Vec<&str> = (0..fit.names.len())
+        .filter(|&j| !id.determined[j])
+        .map(|j| fit.names[j].as_str())
+        .collect();
+    if !undetermined.is_empty() {
+        notes.push(match fit.constraint {
+            Constraint::MinimumNorm => format!(
+                "{} are not determined by the data; their values are the minimum-norm (scaled) solution, not measurements",
+                undetermined.join(", ")
+            ),
+            _ => format!(
+                "no value for {}: the data cannot determine them (see `confounded`)",
+                undetermined.join(", ")
+            ),
+        });
+    }
+    if fit.sigma.is_none() {
+        notes.push("no degree of freedom left (3N = rank): no uncertainties".into());
+    }
+    notes
+}

@@ -1,0 +1,306 @@
+//! A diagnosis for people: the base fit, the residual structure, the findings with their
+//! significance, what the data cannot see, the gain on the fitted and held-out records, and the
+//! commands that use the extended model.
+
+use super::{header, indent, shell, table, wrap, zeroed_text};
+use crate::io::report::diagnose::{ComponentReport, DiagnosisReport, FindingReport, GainRow};
+use model_spec::units::{fixed, p_value, readable, symbol};
+
+/// A value in µm or µrad for people.
+fn value(x: f64) -> String {
+    readable(x, 4)
+}
+
+/// `ECC harmonic:2` from `ECC@harmonic:2` (a constant term is its name).
+fn words(spelling: &str) -> String {
+    spelling.replacen('@', " ", 1)
+}
+
+/// How the p-value of a finding was corrected, for people.
+fn correction(f: &FindingReport, draws: usize) -> String {
+    if f.correction == "bonferroni" {
+        format!(
+            "Bonferroni-corrected: raw p × {} candidates tried",
+            f.candidates_tried
+        )
+    } else {
+        format!(
+            "corrected by a Monte-Carlo null of the selection over the {} candidates tried ({draws} draws)",
+            f.candidates_tried
+        )
+    }
+}
+
+/// `7.7512 ± 0.3012 (cos), 6.1003 ± 0.2710 (sin) µrad`.
+pub fn values(f: &FindingReport) -> String {
+    let parts: Vec<String> = f
+        .values
+        .iter()
+        .zip(&f.stds)
+        .enumerate()
+        .map(|(i, (v, s))| {
+            let v = v.map_or("not determined".into(), value);
+            let s = s.map_or(String::new(), |s| format!(" ± {}", value(s)));
+            let suffix = if f.columns.len() > 1 {
+                let n = &f.columns[i];
+                format!(" ({})", n.rsplit(':').next().unwrap_or(n))
+            } else {
+                String::new()
+            };
+            format!("{v}{s}{suffix}")
+        })
+        .collect();
+    format!("{} {}", parts.join(", "), symbol(&f.unit))
+}
+
+/// The findings, one block each: name, values, amplitude and phase, share, F and p,
+/// alternatives.
+pub fn findings(r: &DiagnosisReport) -> String {
+    let mut out = String::new();
+    for (i, f) in r.findings.iter().enumerate() {
+        let unit = symbol(&f.unit);
+        out.push_str(&format!("  {}. {}: {}\n", i + 1, f.description, values(f)));
+        if let (Some(h), Some(k)) = (&f.harmonic, f.basis.strip_prefix("harmonic:")) {
+            let pm = |s: Option<f64>, digits: usize| {
+                s.map_or(String::new(), |s| format!(" ± {}", fixed(s, digits)))
+            };
+            let axis = f.axis.as_deref().unwrap_or("θ");
+            out.push_str(&format!(
+                "     amplitude {}{} {unit}, phase {}{}° (amplitude·cos({k}·{axis} − phase))\n",
+                value(h.amplitude),
+                pm(h.amplitude_std, 4),
+                fixed(h.phase_deg, 1),
+                pm(h.phase_std_deg, 1),
+            ));
+        }
+        out.push_str(&format!(
+            "     explains {} % of the base model's residual (sum of squares); F = {}, p = {} ({})\n",
+            fixed(100.0 * f.explained_fraction, 1),
+            fixed(f.f, 1),
+            p_value(f.p_value),
+            correction(f, r.draws)
+        ));
+        if !f.alternatives.is_empty() {
+            let alts: Vec<String> = f.alternatives.iter().map(|t| words(t)).collect();
+            out.push_str(&format!(
+                "     the data cannot tell it from: {}\n",
+                alts.join(", ")
+            ));
+        }
+    }
+    out
+}
+
+/// The residual RMS before and after, fitted and held out, as a table.
+pub fn gain(r: &DiagnosisReport) -> String {
+    let row = |name: String, g: &GainRow| {
+        let (b, a) = (g.residual_rms_um_before, g.residual_rms_um_after);
+        vec![
+            name,
+            value(b),
+            value(a),
+            if b > 0.0 {
+                format!("{:+.1} %", 100.0 * (a - b) / b)
+            } else {
+                "-".into()
+            },
+        ]
+    };
+    let mut rows = vec![row(format!("{} (fitted)", r.data), &r.gain.fit)];
+    for g in &r.gain.validation {
+        rows.push(row(format!("{} (held out)", g.data), g));
+    }
+    indent(
+        &table(&header(&["data", "before µm", "after µm", "change"]), &rows),
+        "  ",
+    )
+}
+
+/// A warning for every held-out record the extended model predicts worse than the base model.
+pub fn worse(r: &DiagnosisReport) -> String {
+    if r.findings.is_empty() {
+        return String::new();
+    }
+    let worse: Vec<String> = r
+        .gain
+        .validation
+        .iter()
+        .filter(|g| g.residual_rms_um_after > g.residual_rms_um_before)
+        .map(|g| {
+            let (b, a) = (g.residual_rms_um_before, g.residual_rms_um_after);
+            format!("{} ({:+.1} %)", g.data, 100.0 * (a - b) / b)
+        })
+        .collect();
+    if worse.is_empty() {
+        return String::new();
+    }
+    format!(
+        "Warning: the extended model predicts {} worse than the base model: a finding may stand for one of the candidates the data cannot tell it from, or the fitted path does not separate the cause; try those alternatives (identify --terms) on the held-out data.\n",
+        worse.join(", ")
+    )
+}
+
+/// What to do with the result: the commands that use the extended model, or that nothing was
+/// found.
+pub fn next_steps(r: &DiagnosisReport) -> String {
+    let zeroed = if r.zeroed { " --zeroed" } else { "" };
+    let mut out = String::new();
+    if r.findings.is_empty() {
+        out.push_str(&format!(
+            "Nothing to add: no candidate of the dictionary is significant at α = {} after the correction for the candidates tried. This does not show that the residual of model {} on {} ({} µm RMS) is measurement noise: what remains is not explained by any candidate.\n",
+            r.alpha,
+            r.base_model,
+            r.data,
+            value(r.base_fit.residual_rms_um)
+        ));
+    } else {
+        let terms: Vec<String> = r
+            .findings
+            .iter()
+            .map(|f| {
+                if f.basis == "const" {
+                    f.error.clone()
+                } else {
+                    format!("{}@{}", f.error, f.basis)
+                }
+            })
+            .collect();
+        out.push_str(&format!(
+            "Use the extended model: rtest identify --machine {} --model {} --terms {} --data {}{zeroed}\n",
+            shell(&r.machine_source),
+            shell(&r.base_model),
+            terms.join(","),
+            shell(&r.data)
+        ));
+    }
+    if let (Some(name), Some(file)) = (&r.extended_model.name, &r.extended_model.file) {
+        out.push_str(&format!(
+            "The extended model is `{name}` of {file}: rtest identify --machine {} --model {name} --data {}{zeroed}; rtest generate --machine {} --model {name}\n",
+            shell(file),
+            shell(&r.data),
+            shell(file)
+        ));
+    }
+    out
+}
+
+/// Why the selection stopped, one line.
+pub fn stop(r: &DiagnosisReport) -> String {
+    let best = r.stop.best_remaining.as_ref().map_or(String::new(), |t| {
+        format!("; best remaining candidate: {}", words(t))
+    });
+    format!("Stopped: {}{best}.\n", r.stop.reason)
+}
+
+/// The residual components of the base fit, each with its size after the extension.
+fn structure(r: &DiagnosisReport) -> String {
+    let after = |c: &ComponentReport| {
+        r.structure
+            .after
+            .iter()
+            .find(|x| x.source == c.source && x.shape == c.shape && x.direction == c.direction)
+            .map_or(0.0, |x| x.explained_rms_um)
+    };
+    let rows: Vec<Vec<String>> = r
+        .structure
+        .before
+        .iter()
+        .take(8)
+        .map(|c| {
+            vec![
+                c.source.clone(),
+                c.shape.clone(),
+                c.direction.clone(),
+                fixed(c.explained_rms_um, 4),
+                fixed(after(c), 4),
+            ]
+        })
+        .collect();
+    if rows.is_empty() {
+        return "  none (nothing moves on this path)\n".into();
+    }
+    indent(
+        &table(
+            &header(&["axis", "shape", "dir", "base µm", "extended µm"]),
+            &rows,
+        ),
+        "  ",
+    )
+}
+
+/// The whole diagnosis text.
+pub fn diagnosis(r: &DiagnosisReport) -> String {
+    let mut out = format!(
+        "Diagnosis on {} ({} samples, readings {}): machine {}, model {} ({} terms)\n",
+        r.data,
+        r.samples,
+        zeroed_text(r.zeroed),
+        r.machine,
+        r.base_model,
+        r.base_fit.terms.len()
+    );
+    if r.held_out.is_empty() {
+        out.push_str("Held out: none (--validate gives files to measure the gain on)\n");
+    } else {
+        let h: Vec<String> = r
+            .held_out
+            .iter()
+            .map(|(n, s)| format!("{n} ({s} samples)"))
+            .collect();
+        out.push_str(&format!("Held out (not fitted): {}\n", h.join(", ")));
+    }
+    out.push_str(&format!(
+        "\nBase fit: model {} on {}, refined against the exact machine: residual RMS {} µm, σ̂ {} ({} degrees of freedom)\n",
+        r.base_model,
+        r.data,
+        value(r.base_fit.residual_rms_um),
+        r.base_fit
+            .sigma_um
+            .map_or("undefined".into(), |s| format!("{} µm", value(s))),
+        r.base_fit.dof
+    ));
+    out.push_str(
+        "\nResidual structure of the base fit: the largest shapes, each fitted alone per direction (RMS of what it explains, µm; shapes of axes that move together overlap, so these are indications: the selection decides):\n",
+    );
+    out.push_str(&structure(r));
+    let [k, p, t] = r.dictionary_extent;
+    out.push_str(&format!(
+        "\nCandidates: {} terms the model lacks (harmonic:1..{k} of rotary-axis errors, poly:1..{p} of linear-axis errors, reversal of positioning errors, const location, squareness and set-up errors, dx0 dy0 dz0 const and time:1..{t}); {} do not vary on {} (unexcited).\n",
+        r.dictionary_size,
+        r.unexcited.len(),
+        r.data
+    ));
+    out.push_str(&format!(
+        "Forward selection, significance α = {} per step after the correction for the candidates tried:\n",
+        r.alpha
+    ));
+    if r.findings.is_empty() {
+        out.push_str("  no finding\n");
+    } else {
+        out.push_str(&findings(r));
+    }
+    out.push_str(&stop(r));
+    if r.confounded.is_empty() {
+        out.push_str("\nConfounded: none (the model spans no candidate)\n");
+    } else {
+        out.push_str(&format!(
+            "\nConfounded ({}: the extended model spans them, the data cannot see them apart from what it has; candidate [model terms it is a combination of]):\n",
+            r.confounded.len()
+        ));
+        let items: Vec<String> = r
+            .confounded
+            .iter()
+            .map(|c| format!("{} {} [{}]", c.error, c.basis, c.with.join(" ")))
+            .collect();
+        out.push_str(&wrap(&items, "; ", "  ", 100));
+    }
+    out.push_str(&format!(
+        "\nGain: residual RMS, base model {} → extended model {}:\n",
+        r.base_model, r.extended_model.label
+    ));
+    out.push_str(&gain(r));
+    out.push_str(&worse(r));
+    out.push('\n');
+    out.push_str(&next_steps(r));
+    out
+}

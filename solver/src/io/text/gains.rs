@@ -1,0 +1,118 @@
+//! Numeric gains at one pose for people (text, Markdown or LaTeX): per error `[gx, gy, gz]` in
+//! the tool frame, mm/mm for translational errors and mm/rad for angular errors.
+
+use super::{header, table};
+use crate::simulation::pose::Pose;
+use codegen::table::Format;
+use model_spec::units::{fixed, short};
+use model_spec::{AxisKind, Machine};
+
+/// `Error gains of seed-ac, model full (44 errors)`, or `chosen errors (3)` for a list.
+pub fn title(m: &Machine, model: Option<&str>, n: usize) -> String {
+    match model {
+        Some(name) => format!("Error gains of {}, model {name} ({n} errors)", m.name),
+        None => format!("Error gains of {}, chosen errors ({n})", m.name),
+    }
+}
+
+/// The pose for people: `X = 12.5 mm (IK), A = 30°, …`.
+pub fn describe_pose(m: &Machine, pose: &Pose) -> String {
+    m.axes
+        .iter()
+        .enumerate()
+        .map(|(i, a)| match a.kind {
+            AxisKind::Linear => format!(
+                "{} = {} mm{}",
+                a.name,
+                short(pose.shown[i]),
+                if pose.from_ik[i] { " (IK)" } else { "" }
+            ),
+            AxisKind::Rotary => format!("{} = {}°", a.name, short(pose.shown[i])),
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The table of the gains `gains` of the errors `names` (`angular[i]`: an angular error) at
+/// `pose`, titled `title`.
+pub fn pose_gains(
+    m: &Machine,
+    title: &str,
+    pose: &Pose,
+    names: &[String],
+    angular: &[bool],
+    gains: &[[f64; 3]],
+    format: Format,
+) -> String {
+    let params = m
+        .symbols
+        .iter()
+        .zip(&pose.params)
+        .map(|(s, v)| format!("{} = {}", s.name, short(*v)))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let notes = [
+        format!("At {}.", describe_pose(m, pose)),
+        format!(
+            "Kinematic parameters (mm): {}.",
+            if params.is_empty() { "none" } else { &params }
+        ),
+        "Error vector = tool point minus workpiece point, in the tool frame (first order).".into(),
+        "gx gy gz: mm/mm for translational errors, mm/rad for angular errors (1 mm/rad = 1 µm per mrad).".into(),
+    ];
+    let head = header(&["error", "unit", "gx", "gy", "gz"]);
+    let rows: Vec<Vec<String>> = names
+        .iter()
+        .zip(angular)
+        .zip(gains)
+        .map(|((n, &ang), g)| {
+            vec![
+                n.clone(),
+                if ang { "mm/rad" } else { "mm/mm" }.to_string(),
+                fixed(g[0], 6),
+                fixed(g[1], 6),
+                fixed(g[2], 6),
+            ]
+        })
+        .collect();
+    match format {
+        Format::Markdown => {
+            let mut out = format!("### {title}\n\n");
+            for n in &notes {
+                out.push_str(&format!("{n}  \n"));
+            }
+            out.push_str(&format!("\n| {} |\n", head.join(" | ")));
+            out.push_str("|---|---|---:|---:|---:|\n");
+            for r in &rows {
+                out.push_str(&format!("| {} |\n", r.join(" | ")));
+            }
+            out
+        }
+        Format::Latex => {
+            let mut out = String::from("% requires \\usepackage{longtable}\n");
+            for n in &notes {
+                out.push_str(&format!("% {n}\n"));
+            }
+            out.push_str("\\begin{longtable}{llrrr}\n");
+            out.push_str(&format!("\\caption{{{title}}}\\\\\n\\hline\n"));
+            out.push_str("error & unit & $g_x$ & $g_y$ & $g_z$ \\\\\n\\hline\n\\endhead\n");
+            for r in &rows {
+                out.push_str(&format!(
+                    "${}$ & {} & {} & {} & {} \\\\\n",
+                    r[0], r[1], r[2], r[3], r[4]
+                ));
+            }
+            out.push_str("\\hline\n\\end{longtable}\n");
+            out
+        }
+        Format::Text => {
+            let mut out = format!("{title}\n");
+            for n in &notes {
+                out.push_str(&format!("{n}\n"));
+            }
+            out.push('\n');
+            out.push_str(&table(&head, &rows));
+            out
+        }
+    }
+}

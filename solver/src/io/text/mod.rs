@@ -1,0 +1,106 @@
+//! The reports as text for people: rendered from the report types of [`crate::io::report`],
+//! so that the text and the JSON say the same thing. Numbers are written with
+//! [`model_spec::units`].
+
+pub mod diagnose;
+pub mod gains;
+pub mod identify;
+pub mod simulate;
+pub mod validate;
+
+pub use simulate::simulation;
+
+/// An aligned text table: the first two columns left-aligned, the others right-aligned; every
+/// row has the header's number of cells.
+pub fn table<R: AsRef<[String]>>(header: &[String], rows: &[R]) -> String {
+    let mut widths = vec![0usize; header.len()];
+    for r in std::iter::once(header).chain(rows.iter().map(AsRef::as_ref)) {
+        for (w, c) in widths.iter_mut().zip(r) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let line = |r: &[String]| {
+        let cells: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(i, (c, &w))| {
+                if i < 2 {
+                    format!("{c:<w$}")
+                } else {
+                    format!("{c:>w$}")
+                }
+            })
+            .collect();
+        format!("{}\n", cells.join("  ").trim_end())
+    };
+    let mut out = line(header);
+    let rule: Vec<String> = widths.iter().map(|&w| "-".repeat(w)).collect();
+    out.push_str(&format!("{}\n", rule.join("  ")));
+    for r in rows {
+        out.push_str(&line(r.as_ref()));
+    }
+    out
+}
+
+/// Header cells from string literals.
+pub fn header(cells: &[&str]) -> Vec<String> {
+    cells.iter().map(|c| c.to_string()).collect()
+}
+
+/// Every line of `text` with `pad` in front.
+pub fn indent(text: &str, pad: &str) -> String {
+    text.lines().map(|l| format!("{pad}{l}\n")).collect()
+}
+
+/// `items` joined by `sep` in lines of at most `width` characters, each starting with `pad`.
+pub fn wrap(items: &[String], sep: &str, pad: &str, width: usize) -> String {
+    let mut out = String::new();
+    let mut line = String::new();
+    for (i, item) in items.iter().enumerate() {
+        let piece = if i + 1 < items.len() {
+            format!("{item}{}", sep.trim_end())
+        } else {
+            item.clone()
+        };
+        if !line.is_empty() && pad.len() + line.chars().count() + 1 + piece.chars().count() > width
+        {
+            out.push_str(&format!("{pad}{line}\n"));
+            line.clear();
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(&piece);
+    }
+    if !line.is_empty() {
+        out.push_str(&format!("{pad}{line}\n"));
+    }
+    out
+}
+
+/// A path or argument for a shell command line, quoted when needed.
+pub fn shell(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./:@,+=".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// `s` when `n` is not 1 (`plural(3, "s")`), for counts in sentences.
+pub fn plural(n: usize, s: &str) -> &str {
+    if n == 1 { "" } else { s }
+}
+
+/// "zeroed at the first sample" or "not zeroed".
+pub fn zeroed_text(zeroed: bool) -> &'static str {
+    if zeroed {
+        "zeroed at the first sample"
+    } else {
+        "not zeroed"
+    }
+}

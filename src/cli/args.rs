@@ -1,0 +1,313 @@
+//! Flags shared by several verbs, parsed into library values: models and terms, constraints,
+//! file lists, `NAME=VALUE` lists, and the plausibility bounds. Every error names its flag and
+//! is a usage error (exit code 2).
+
+use super::{CliError, CliResult};
+use model_spec::{AxisId, ErrorId, Machine};
+use solver::fitting::{Constraint, ValueLimits};
+use solver::io::csv::ReadOptions;
+use solver::model::{Effect, Model, Term};
+use std::path::PathBuf;
+
+/// The plausibility bounds and the stroke check, shared by the verbs that read records or
+/// identify values.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Limits {
+    /// Largest plausible reading, µm: a record with a larger |dx|, |dy| or |dz| is refused,
+    /// naming its lines.
+    #[arg(long, value_name = "UM", default_value = "1000", value_parser = positive)]
+    pub max_reading_um: f64,
+    /// Largest plausible identified translational value (errors and sensor offsets), µm.
+    #[arg(long, value_name = "UM", default_value = "1000", value_parser = positive)]
+    pub max_error_um: f64,
+    /// Largest plausible identified angular value, µrad.
+    #[arg(long, value_name = "URAD", default_value = "10000", value_parser = positive)]
+    pub max_error_urad: f64,
+    /// Accept poses outside the machine's strokes and ranges (refused by default, naming the
+    /// first offending lines).
+    #[arg(long)]
+    pub allow_off_stroke: bool,
+}
+
+impl Limits {
+    /// The options of the record readers.
+    pub fn read_options(&self) -> ReadOptions {
+        let mut o = ReadOptions::default();
+        o.max_reading_mm = self.max_reading_um / 1e3;
+        o.allow_off_stroke = self.allow_off_stroke;
+        o
+    }
+
+    /// The bounds of identified values.
+    pub fn values(&self) -> ValueLimits {
+        ValueLimits::from_display(self.max_error_um, self.max_error_urad)
+    }
+}
+
+/// A finite number above zero (µm, µrad).
+pub fn positive(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("`{s}` is not a finite number above zero")),
+    }
+}
+
+/// A model chosen by `--model` and `--terms`, with a label for reports
+/// (`reduced`, `reduced + ECC@harmonic:2`, `XOC + ECC@harmonic:2`).
+pub fn model(m: &Machine, name: Option<&str>, terms: Option<&str>) -> CliResult<(String, Model)> {
+    let mut label = Vec::new();
+    let mut model = Model::default();
+    if let Some(name) = name {
+        model = Model::of(m, name).ok_or_else(|| {
+            CliError::usage(format!(
+                "--model: machine {} has no model `{name}` (models: {})",
+                m.name,
+                m.model_names().join(", ")
+            ))
+        })?;
+        label.push(name.to_string());
+    }
+    let from_model = model.terms.len();
+    if let Some(list) = terms {
+        for (text, term) in parse_terms(m, list)? {
+            if let Some(i) = model.terms.iter().position(|t| *t == term) {
+                return Err(CliError::usage(if i < from_model {
+                    format!("--terms: `{text}` is already in model {}", label[0])
+                } else {
+                    format!("--terms: `{text}` is given twice")
+                }));
+            }
+            model.terms.push(term);
+            label.push(text);
+        }
+    }
+    if model.terms.is_empty() {
+        return Err(CliError::usage(match name {
+            Some(n) => format!(
+                "--model: model `{n}` of machine {} has no terms (its `errors` list is empty): add terms with --terms (e.g. --terms XOC,ECC@harmonic:2)",
+                m.name
+            ),
+            None => {
+                "--model: give a model (e.g. --model reduced) or terms (--terms XOC,ECC@harmonic:2)"
+                    .into()
+            }
+        }));
+    }
+    Ok((label.join(" + "), model))
+}
+
+/// Parses `--terms`: a comma list of `NAME` (constant) or `NAME@BASIS` terms
+/// (`ECC@harmonic:2,dx0@time:1`); each with its text as written (trimmed).
+pub fn parse_terms(m: &Machine, list: &str) -> CliResult<Vec<(String, Term)>> {
+    let example = "expected a comma list of NAME or NAME@BASIS, e.g. ECC@harmonic:2,dx0@time:1";
+    let mut out = Vec::new();
+    for item in items("--terms", list, example)? {
+        let term = Term::parse(m, item).map_err(|e| {
+            let name = item.split_once('@').map_or(item, |(n, _)| n);
+            let hint = if Effect::parse(m, name).is_none() {
+                format!(" (its errors: `rtest machines --machine {}`)", m.name)
+            } else {
+                String::new()
+            };
+            CliError::usage(format!("--terms: `{item}`: {e}{hint}"))
+        })?;
+        out.push((item.to_string(), term));
+    }
+    Ok(out)
+}
+
+/// The trimmed items of a comma list, none empty.
+fn items<'a>(flag: &str, list: &'a str, example: &str) -> CliResult<Vec<&'a str>> {
+    if list.trim().is_empty() {
+        return Err(CliError::usage(format!("{flag}: empty list ({example})")));
+    }
+    list.split(',')
+        .map(|item| {
+            let item = item.trim();
+            if item.is_empty() {
+                Err(CliError::usage(format!(
+                    "{flag}: empty item in `{list}` ({example})"
+                )))
+            } else {
+                Ok(item)
+            }
+        })
+        .collect()
+}
+
+/// Parses `--constraint`: `none`, `min-norm` (or `minimum-norm`), or `zero:NAME,NAME`.
+pub fn constraint(text: Option<&str>) -> CliResult<Constraint> {
+    let Some(text) = text else {
+        return Ok(Constraint::None);
+    };
+    match text.trim() {
+        "none" => return Ok(Constraint::None),
+        "min-norm" | "minimum-norm" => return Ok(Constraint::MinimumNorm),
+        _ => {}
+    }
+    let Some(list) = text.trim().strip_prefix("zero:") else {
+        return Err(CliError::usage(format!(
+            "--constraint: `{text}` is not one of none, min-norm, zero:NAME,NAME (e.g. zero:XOC,YOA,ZOA)"
+        )));
+    };
+    let mut names: Vec<String> = Vec::new();
+    for item in items(
+        "--constraint",
+        list,
+        "expected zero:NAME,NAME, e.g. zero:XOC,YOA,ZOA",
+    )? {
+        if names.iter().any(|n| n == item) {
+            return Err(CliError::usage(format!(
+                "--constraint: `{item}` is given twice"
+            )));
+        }
+        names.push(item.to_string());
+    }
+    Ok(Constraint::Zero(names))
+}
+
+/// Parses a comma list of files (`--validate`), none empty, none twice.
+pub fn files(flag: &str, list: &str) -> CliResult<Vec<PathBuf>> {
+    let example = "expected a comma list of measurement CSV files, e.g. k1.csv,k2.csv";
+    let mut out: Vec<PathBuf> = Vec::new();
+    for item in items(flag, list, example)? {
+        let p = PathBuf::from(item);
+        if out.contains(&p) {
+            return Err(CliError::usage(format!("{flag}: `{item}` is given twice")));
+        }
+        out.push(p);
+    }
+    Ok(out)
+}
+
+/// The errors chosen by `--model` / `--errors` (default: the full model), with a label for
+/// titles (`Some(model name)`, or `None` for an explicit list).
+pub fn select_errors(
+    m: &Machine,
+    model: Option<&str>,
+    errors: Option<&str>,
+) -> CliResult<(Option<String>, Vec<ErrorId>)> {
+    if let Some(list) = errors {
+        return parse_error_list(m, list).map(|ids| (None, ids));
+    }
+    let name = model.unwrap_or(model_spec::FULL_MODEL);
+    Ok((Some(name.to_string()), model_errors(m, name)?))
+}
+
+/// The errors of the model `name` of `m`, or a usage error listing its models.
+pub fn model_errors(m: &Machine, name: &str) -> CliResult<Vec<ErrorId>> {
+    m.model_errors(name)
+        .map(<[ErrorId]>::to_vec)
+        .ok_or_else(|| {
+            CliError::usage(format!(
+                "--model: machine {} has no model `{name}` (models: {})",
+                m.name,
+                m.model_names().join(", ")
+            ))
+        })
+}
+
+/// Parses `--errors`: a comma list of catalogue names (digit-zero spelling accepted), kept in
+/// the given order.
+pub fn parse_error_list(m: &Machine, list: &str) -> CliResult<Vec<ErrorId>> {
+    let example = "expected a comma list of error names, e.g. XOC,YOC,BOA";
+    let mut ids = Vec::new();
+    for item in items("--errors", list, example)? {
+        let Some(id) = m.error_by_name(item) else {
+            let names: Vec<&str> = m.catalogue.iter().map(|e| e.name.as_str()).collect();
+            return Err(CliError::usage(format!(
+                "--errors: machine {} has no error `{item}` (its errors: {})",
+                m.name,
+                names.join(" ")
+            )));
+        };
+        if ids.contains(&id) {
+            return Err(CliError::usage(format!(
+                "--errors: error {} given twice",
+                m.catalogue[id].name
+            )));
+        }
+        ids.push(id);
+    }
+    Ok(ids)
+}
+
+/// Parses a `NAME=VALUE,NAME=VALUE` list of finite numbers for `flag`; names as written,
+/// duplicates (by `same`) rejected.
+fn assignments(
+    flag: &str,
+    text: &str,
+    same: impl Fn(&str, &str) -> bool,
+) -> CliResult<Vec<(String, f64)>> {
+    let mut out: Vec<(String, f64)> = Vec::new();
+    for item in items(flag, text, "expected NAME=VALUE,NAME=VALUE,...")? {
+        let Some((name, value)) = item.split_once('=') else {
+            return Err(CliError::usage(format!(
+                "{flag}: `{item}` is not NAME=VALUE"
+            )));
+        };
+        let (name, value) = (name.trim(), value.trim());
+        if name.is_empty() {
+            return Err(CliError::usage(format!("{flag}: `{item}` has no name")));
+        }
+        let x: f64 = value
+            .parse()
+            .map_err(|_| CliError::usage(format!("{flag}: `{item}`: `{value}` is not a number")))?;
+        if !x.is_finite() {
+            return Err(CliError::usage(format!(
+                "{flag}: `{item}`: the value must be a finite number"
+            )));
+        }
+        if out.iter().any(|(n, _)| same(n, name)) {
+            return Err(CliError::usage(format!("{flag}: `{name}` is given twice")));
+        }
+        out.push((name.to_string(), x));
+    }
+    Ok(out)
+}
+
+/// Kinematic parameters: the machine's defaults (mm), overridden by `--param` (exact symbol
+/// names).
+pub fn params(m: &Machine, text: Option<&str>) -> CliResult<Vec<f64>> {
+    let mut params = m.default_parameters();
+    let Some(text) = text else {
+        return Ok(params);
+    };
+    for (name, x) in assignments("--param", text, |a, b| a == b)? {
+        let Some(s) = m.symbol_by_name(&name) else {
+            let names: Vec<&str> = m.symbols.iter().map(|s| s.name.as_str()).collect();
+            return Err(CliError::usage(format!(
+                "--param: machine {} has no kinematic symbol `{name}` (symbols: {})",
+                m.name,
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )));
+        };
+        params[s] = x;
+    }
+    Ok(params)
+}
+
+/// The axis positions of `--at` (axis names case-insensitive; linear mm, rotary degrees).
+pub fn at(m: &Machine, text: &str) -> CliResult<Vec<(AxisId, f64)>> {
+    let mut given = Vec::new();
+    for (name, x) in assignments("--at", text, |a, b| a.eq_ignore_ascii_case(b))? {
+        let Some(i) = m
+            .axes
+            .iter()
+            .position(|a| a.name.eq_ignore_ascii_case(&name))
+        else {
+            let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
+            return Err(CliError::usage(format!(
+                "--at: machine {} has no axis `{name}` (axes: {})",
+                m.name,
+                names.join(", ")
+            )));
+        };
+        given.push((i, x));
+    }
+    Ok(given)
+}

@@ -1,0 +1,34 @@
+//! The diagnosis figures drawn: the plain series of `solver::diagnosis::figures` handed to the
+//! `plots` crate, which returns SVG text.
+
+use super::{CliError, CliResult};
+use solver::diagnosis::figures::{Figures, Series};
+
+fn series(s: &Series) -> plots::Series {
+    plots::Series::new(s.label.clone(), s.values.clone())
+}
+
+/// Every figure as (file name, SVG text).
+pub fn svgs(figures: &Figures) -> CliResult<Vec<(String, String)>> {
+    let failed = |e: plots::PlotError| CliError::computation(format!("--plot: {e}"));
+    let mut out = Vec::new();
+    for f in &figures.paths {
+        let panels: Vec<plots::Panel> = f
+            .panels
+            .iter()
+            .map(|p| plots::Panel {
+                name: p.name.clone(),
+                measured: series(&p.measured),
+                predictions: p.predictions.iter().map(series).collect(),
+            })
+            .collect();
+        let svg = plots::path_comparison(&f.title, &f.x_label, &f.x, &panels).map_err(failed)?;
+        out.push((f.file_name.clone(), svg));
+    }
+    for s in &figures.spectra {
+        let svg =
+            plots::spectrum(&s.title, &s.before_label, &s.after_label, &s.rows).map_err(failed)?;
+        out.push((s.file_name.clone(), svg));
+    }
+    Ok(out)
+}

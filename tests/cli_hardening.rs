@@ -1,0 +1,686 @@
+//! End-to-end tests of what the command line must never do: lose data through an output,
+//! overwrite an input, report a failed computation as a result, accept implausible or foreign
+//! data, or grow without bound. Each test checks the message and that no input or unrelated
+//! file changed. Everything happens in fresh temporary directories: FIFOs, symlinks, hard links
+//! and read-only files are made there; no system path is opened.
+
+mod common;
+
+use common::{TempDir, check_fails, fails, ok, run, stderr};
+use std::collections::BTreeMap;
+use std::io::{Read, Write};
+use std::os::unix::fs::{MetadataExt, PermissionsExt};
+use std::path::Path;
+use std::process::Command;
+
+fn temp_dir(name: &str) -> TempDir {
+    common::temp_dir_tagged("hard", name)
+}
+
+/// Every entry of `dir` (recursively): its kind, mode and contents.
+fn snapshot(dir: &Path) -> BTreeMap<String, (String, u32, Vec<u8>)> {
+    let mut out = BTreeMap::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let e = e.unwrap();
+        let p = e.path();
+        let name = e.file_name().to_string_lossy().into_owned();
+        let meta = std::fs::symlink_metadata(&p).unwrap();
+        let ft = meta.file_type();
+        let entry = if ft.is_symlink() {
+            let t = std::fs::read_link(&p).unwrap();
+            (
+                "link".to_string(),
+                0,
+                t.to_string_lossy().as_bytes().to_vec(),
+            )
+        } else if ft.is_dir() {
+            for (k, v) in snapshot(&p) {
+                out.insert(format!("{name}/{k}"), v);
+            }
+            ("dir".to_string(), meta.mode() & 0o7777, Vec::new())
+        } else if ft.is_file() {
+            (
+                "file".to_string(),
+                meta.mode() & 0o7777,
+                std::fs::read(&p).unwrap(),
+            )
+        } else {
+            ("special".to_string(), meta.mode() & 0o7777, Vec::new())
+        };
+        out.insert(name, entry);
+    }
+    out
+}
+
+/// Simulates `path` of seed-ac with the reduced truth into `out` in `dir`.
+fn simulate(dir: &Path, path: &str, out: &str) {
+    ok(
+        dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            path,
+            "--truth",
+            "seed-ac-reduced",
+            "-o",
+            out,
+        ],
+    );
+}
+
+fn mkfifo(path: &Path) {
+    let s = Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
+    assert!(s.success(), "mkfifo {}", path.display());
+}
+
+/// A thread that reads the FIFO `path` to its end.
+fn reader(path: &Path) -> std::thread::JoinHandle<Vec<u8>> {
+    let path = path.to_path_buf();
+    std::thread::spawn(move || {
+        let mut buf = Vec::new();
+        std::fs::File::open(path)
+            .unwrap()
+            .read_to_end(&mut buf)
+            .unwrap();
+        buf
+    })
+}
+
+fn is_root() -> bool {
+    std::fs::metadata("/proc/self")
+        .map(|m| m.uid())
+        .unwrap_or(1)
+        == 0
+}
+
+// ---------------------------------------------------------------- A. outputs
+
+#[test]
+fn outputs_follow_symlinks_keep_modes_and_links_and_stream_to_fifos() {
+    let dir = temp_dir("kinds");
+    simulate(&dir, "K4", "k4.csv");
+    let expected = std::fs::read(dir.join("k4.csv")).unwrap();
+    let sim = |out: &str| {
+        ok(
+            &dir,
+            &[
+                "simulate",
+                "--machine",
+                "seed-ac",
+                "--path",
+                "K4",
+                "--truth",
+                "seed-ac-reduced",
+                "-o",
+                out,
+            ],
+        )
+    };
+
+    // A symlink is followed: the target gets the content, the link stays, the mode is kept.
+    std::fs::write(dir.join("target.csv"), "old").unwrap();
+    std::fs::set_permissions(
+        dir.join("target.csv"),
+        std::fs::Permissions::from_mode(0o640),
+    )
+    .unwrap();
+    std::os::unix::fs::symlink("target.csv", dir.join("link.csv")).unwrap();
+    sim("link.csv");
+    assert!(
+        std::fs::symlink_metadata(dir.join("link.csv"))
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    assert_eq!(std::fs::read(dir.join("target.csv")).unwrap(), expected);
+    let mode = std::fs::metadata(dir.join("target.csv")).unwrap().mode() & 0o777;
+    assert_eq!(mode, 0o640);
+
+    // A hard link survives: both names see the new content.
+    std::fs::write(dir.join("one.csv"), "old").unwrap();
+    std::fs::hard_link(dir.join("one.csv"), dir.join("two.csv")).unwrap();
+    let inode = std::fs::metadata(dir.join("one.csv")).unwrap().ino();
+    sim("two.csv");
+    assert_eq!(std::fs::read(dir.join("one.csv")).unwrap(), expected);
+    assert_eq!(std::fs::metadata(dir.join("one.csv")).unwrap().ino(), inode);
+    assert_eq!(std::fs::metadata(dir.join("two.csv")).unwrap().nlink(), 2);
+
+    // A FIFO, directly and through a symlink, is written to and stays a FIFO.
+    mkfifo(&dir.join("pipe"));
+    std::os::unix::fs::symlink("pipe", dir.join("pipe-link")).unwrap();
+    for name in ["pipe", "pipe-link"] {
+        let r = reader(&dir.join("pipe"));
+        sim(name);
+        assert_eq!(r.join().unwrap(), expected, "{name}");
+        let ft = std::fs::metadata(dir.join("pipe")).unwrap().file_type();
+        assert!(std::os::unix::fs::FileTypeExt::is_fifo(&ft));
+    }
+
+    // `-o -`: the CSV on standard output, the summary on standard error.
+    let o = run(
+        Some(&dir),
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "K4",
+            "--truth",
+            "seed-ac-reduced",
+            "-o",
+            "-",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(o.stdout, expected);
+    assert!(
+        stderr(&o).contains("simulated K4 on seed-ac"),
+        "{}",
+        stderr(&o)
+    );
+
+    // No temporary file is left anywhere.
+    let names: Vec<String> = snapshot(&dir).into_keys().collect();
+    assert_eq!(
+        names,
+        [
+            "k4.csv",
+            "link.csv",
+            "one.csv",
+            "pipe",
+            "pipe-link",
+            "target.csv",
+            "two.csv"
+        ]
+    );
+}
+
+#[test]
+fn a_read_only_file_is_refused_as_a_shell_would_and_left_alone() {
+    let dir = temp_dir("read-only");
+    simulate(&dir, "K4", "k4.csv");
+    std::fs::write(dir.join("ro.csv"), "keep").unwrap();
+    std::fs::set_permissions(dir.join("ro.csv"), std::fs::Permissions::from_mode(0o444)).unwrap();
+    std::fs::set_permissions(&*dir, std::fs::Permissions::from_mode(0o777)).unwrap();
+    let before = snapshot(&dir);
+    let args = [
+        "simulate",
+        "--machine",
+        "seed-ac",
+        "--path",
+        "K4",
+        "--truth",
+        "seed-ac-reduced",
+        "-o",
+        "ro.csv",
+    ];
+    // As root a read-only file is writable (as it is to a shell): run as an ordinary user.
+    let mut c = Command::new(env!("CARGO_BIN_EXE_rtest"));
+    c.args(args).current_dir(&*dir);
+    if is_root() {
+        std::os::unix::process::CommandExt::uid(&mut c, 65534);
+        std::os::unix::process::CommandExt::gid(&mut c, 65534);
+    }
+    let o = c.output().expect("rtest runs");
+    check_fails(&o, &args, 1, &["-o: cannot write `ro.csv`"]);
+    assert_eq!(snapshot(&dir), before);
+}
+
+#[test]
+fn an_output_that_names_an_input_is_refused_before_any_work() {
+    let dir = temp_dir("input");
+    simulate(&dir, "K4", "k4.csv");
+    ok(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--first-order",
+            "--json",
+            "id.json",
+        ],
+    );
+    std::fs::write(
+        dir.join("m.toml"),
+        model_spec::write::source_text("seed-ac").unwrap(),
+    )
+    .unwrap();
+    std::fs::write(dir.join("path.csv"), "A,C\n0,0\n0,10\n0,20\n").unwrap();
+    std::os::unix::fs::symlink("k4.csv", dir.join("k4-link.csv")).unwrap();
+    std::fs::hard_link(dir.join("k4.csv"), dir.join("k4-hard.csv")).unwrap();
+    let before = snapshot(&dir);
+    let id = [
+        "identify",
+        "--machine",
+        "seed-ac",
+        "--model",
+        "reduced",
+        "--data",
+        "k4.csv",
+    ];
+    for json in ["k4.csv", "./k4.csv", "k4-link.csv", "k4-hard.csv"] {
+        let mut args = id.to_vec();
+        args.extend(["--json", json]);
+        fails(
+            &dir,
+            &args,
+            2,
+            &["--json: `", "is also the input of --data"],
+        );
+    }
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &[
+                "validate",
+                "--machine",
+                "seed-ac",
+                "--params",
+                "id.json",
+                "--data",
+                "k4.csv",
+                "--json",
+                "id.json",
+            ],
+            "--json: `id.json` is also the input of --params",
+        ),
+        (
+            &["generate", "--machine", "m.toml", "-o", "m.toml"],
+            "-o: `m.toml` is also the input of --machine",
+        ),
+        (
+            &[
+                "diagnose",
+                "--machine",
+                "m.toml",
+                "--model",
+                "reduced",
+                "--data",
+                "k4.csv",
+                "--model-out",
+                "m.toml",
+            ],
+            "--model-out: `m.toml` is also the input of --machine",
+        ),
+        (
+            &[
+                "simulate",
+                "--machine",
+                "seed-ac",
+                "--path",
+                "path.csv",
+                "-o",
+                "path.csv",
+            ],
+            "-o: `path.csv` is also the input of --path",
+        ),
+        (
+            &[
+                "diagnose",
+                "--machine",
+                "seed-ac",
+                "--model",
+                "reduced",
+                "--data",
+                "k4.csv",
+                "--json",
+                "x.json",
+                "--model-out",
+                "x.json",
+            ],
+            "is also the output of",
+        ),
+    ];
+    for (args, message) in cases {
+        fails(&dir, args, 2, &[message]);
+    }
+    assert_eq!(snapshot(&dir), before);
+}
+
+// ---------------------------------------------------------------- B. failures
+
+#[test]
+fn a_refinement_that_does_not_converge_is_an_error_and_writes_nothing() {
+    let dir = temp_dir("diverge");
+    simulate(&dir, "K4", "k4.csv");
+    // The first five samples of K4: 15 readings for 11 parameters, which the first-order fit
+    // takes but which do not determine the exact machine.
+    let text = std::fs::read_to_string(dir.join("k4.csv")).unwrap();
+    let mut lines: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+    lines.truncate(6);
+    std::fs::write(dir.join("few.csv"), lines.join("\n") + "\n").unwrap();
+    let before = snapshot(&dir);
+    let err = fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "few.csv",
+            "--json",
+            "few.json",
+        ],
+        3,
+        &["--data: "],
+    );
+    assert!(
+        err.contains("did not converge") || err.contains("implausible"),
+        "{err}"
+    );
+    assert_eq!(snapshot(&dir), before, "no file written on exit code 3");
+    // Fewer readings than parameters plus one: an error before fitting, naming both numbers.
+    lines.truncate(4);
+    std::fs::write(dir.join("three.csv"), lines.join("\n") + "\n").unwrap();
+    fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "three.csv",
+        ],
+        1,
+        &["too few samples: 3 samples give 9 readings (3 per sample) for 11 parameters"],
+    );
+}
+
+#[test]
+fn non_finite_and_implausible_inputs_are_refused_naming_the_cause() {
+    let dir = temp_dir("non-finite");
+    simulate(&dir, "K4", "k4.csv");
+    let text = std::fs::read_to_string(dir.join("k4.csv")).unwrap();
+    // The tenth data line gets a reading of 1e308 µm, the twelfth one of -2400 µm.
+    let mut n = 0;
+    let mut line_no = Vec::new();
+    let edited: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if l.starts_with('#') || l.starts_with('X') {
+                return l.to_string();
+            }
+            n += 1;
+            let mut f: Vec<String> = l.split(',').map(String::from).collect();
+            match n {
+                10 => f[5] = "1e308".into(),
+                12 => f[7] = "-2400".into(),
+                _ => return l.to_string(),
+            }
+            line_no.push(i + 1);
+            f.join(",")
+        })
+        .collect();
+    std::fs::write(dir.join("bad.csv"), edited.join("\n") + "\n").unwrap();
+    let before = snapshot(&dir);
+    fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "bad.csv",
+        ],
+        1,
+        &[
+            "bad.csv: 2 readings beyond the plausibility bound of 1000 µm",
+            &format!("line {} dx_um = 1e308", line_no[0]),
+            &format!("line {} dz_um = -2400", line_no[1]),
+        ],
+    );
+    // --noise-um beyond its range.
+    fails(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "K4",
+            "--noise-um",
+            "1e308",
+            "-o",
+            "n.csv",
+        ],
+        2,
+        &["--noise-um: `1e308` must be a finite number from 0 to 1000 µm"],
+    );
+    // A machine whose offset or stroke is 1e308.
+    let seed = model_spec::write::source_text("seed-ac").unwrap();
+    for (name, text) in [
+        ("zc.toml", seed.replace("Zc = 29.794", "Zc = 1e308")),
+        (
+            "stroke.toml",
+            seed.replace("[-500.0, 500.0]", "[-1e308, 1e308]"),
+        ),
+    ] {
+        std::fs::write(dir.join(name), text).unwrap();
+        fails(
+            &dir,
+            &[
+                "identify",
+                "--machine",
+                name,
+                "--model",
+                "reduced",
+                "--data",
+                "k4.csv",
+            ],
+            1,
+            &[&format!("--machine: {name}:"), "1e308"],
+        );
+    }
+    // Identified values beyond the bounds are an error, not a result, and nothing is written.
+    let snap = snapshot(&dir);
+    fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--max-error-um",
+            "1",
+            "--json",
+            "id.json",
+        ],
+        3,
+        &[
+            "implausible result",
+            "beyond the plausibility bounds (1 µm, 10000 µrad)",
+        ],
+    );
+    assert_eq!(snapshot(&dir), snap);
+    let mut now = snapshot(&dir);
+    for name in ["zc.toml", "stroke.toml"] {
+        now.remove(name);
+    }
+    assert_eq!(now, before);
+}
+
+#[test]
+fn poses_off_stroke_or_off_the_ball_are_refused_unless_allowed() {
+    let dir = temp_dir("poses");
+    // A beyond its range of ±120°, the linear axes filled by inverse kinematics.
+    std::fs::write(dir.join("path.csv"), "A,C\n0,0\n-60,10\n-125,20\n").unwrap();
+    fails(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "path.csv",
+            "-o",
+            "p.csv",
+        ],
+        1,
+        &["path.csv", "line 4", "A = -125"],
+    );
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "path.csv",
+            "--allow-off-stroke",
+            "-o",
+            "p.csv",
+        ],
+    );
+    // gains --at checks the pose too.
+    fails(
+        &dir,
+        &["gains", "--machine", "seed-ac", "--at", "A=130,C=0"],
+        2,
+        &["--at: ", "A", "--allow-off-stroke"],
+    );
+    // A three-axis grid with the commanded motion in the readings is not an R-test record.
+    let mut grid = String::from("X,Y,Z,dx_um,dy_um,dz_um\n");
+    for (i, x) in [0.0, 10.0, 20.0, 30.0].iter().enumerate() {
+        grid.push_str(&format!("{x},{},0,{},0,0\n", 5 * i, x * 1e3));
+    }
+    std::fs::write(dir.join("grid.csv"), grid).unwrap();
+    let err = fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-3axis",
+            "--model",
+            "full",
+            "--data",
+            "grid.csv",
+        ],
+        1,
+        &["grid.csv", "line 3", "R-test"],
+    );
+    assert!(err.contains("follow the ball"), "{err}");
+}
+
+#[test]
+fn values_of_another_machine_are_refused() {
+    let dir = temp_dir("foreign");
+    simulate(&dir, "K4", "k4.csv");
+    ok(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--json",
+            "id.json",
+        ],
+    );
+    // The same machine with C turning the other way: another fingerprint.
+    let seed = model_spec::write::source_text("seed-ac").unwrap();
+    let reversed = seed.replacen(
+        "direction = \"+z\"\noffset = [0, 0, \"Zc\"]",
+        "direction = \"-z\"\noffset = [0, 0, \"Zc\"]",
+        1,
+    );
+    assert_ne!(reversed, seed);
+    std::fs::write(dir.join("reversed.toml"), reversed).unwrap();
+    let before = snapshot(&dir);
+    fails(
+        &dir,
+        &[
+            "validate",
+            "--machine",
+            "reversed.toml",
+            "--params",
+            "id.json",
+            "--data",
+            "k4.csv",
+        ],
+        1,
+        &["--params: id.json: field `fingerprint`", "another topology"],
+    );
+    // A parameter missing from the file.
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("id.json")).unwrap()).unwrap();
+    json["parameters"].as_array_mut().unwrap().remove(0);
+    std::fs::write(dir.join("short.json"), json.to_string()).unwrap();
+    fails(
+        &dir,
+        &[
+            "validate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "short.json",
+            "--data",
+            "k4.csv",
+        ],
+        1,
+        &[
+            "--params: short.json: field `terms`",
+            "a parameter is missing or extra",
+        ],
+    );
+    let mut now = snapshot(&dir);
+    now.remove("short.json");
+    assert_eq!(now, before);
+}
+
+// ---------------------------------------------------------------- D. bounded resources
+
+#[test]
+fn an_endless_stream_without_line_ends_ends_quickly_with_an_error() {
+    let dir = temp_dir("endless");
+    mkfifo(&dir.join("zeros"));
+    for stream in [true, false] {
+        let path = dir.join("zeros");
+        let feeder = std::thread::spawn(move || {
+            let mut f = std::fs::OpenOptions::new().write(true).open(path).unwrap();
+            let block = vec![0u8; 1 << 16];
+            // Until the reader goes away (EPIPE), at most 1 GiB.
+            for _ in 0..(1 << 14) {
+                if f.write_all(&block).is_err() {
+                    break;
+                }
+            }
+        });
+        let mut args = vec![
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "zeros",
+        ];
+        if stream {
+            args.push("--stream");
+        }
+        fails(&dir, &args, 1, &["--data: ", "longer than 65536 bytes"]);
+        feeder.join().unwrap();
+    }
+    assert_eq!(snapshot(&dir).len(), 1);
+}

@@ -684,3 +684,228 @@ fn an_endless_stream_without_line_ends_ends_quickly_with_an_error() {
     }
     assert_eq!(snapshot(&dir).len(), 1);
 }
+
+#[test]
+fn simulate_never_writes_a_record_that_identify_would_refuse() {
+    let dir = temp_dir("unreadable");
+    // A set-up error of 5 mm: every reading beyond the plausibility bound of 1000 µm.
+    std::fs::write(
+        dir.join("far.toml"),
+        "machine = \"seed-ac\"\n[errors]\nXOW = 5000\n",
+    )
+    .unwrap();
+    let before = snapshot(&dir);
+    fails(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "K4",
+            "--truth",
+            "far.toml",
+            "-o",
+            "k4.csv",
+        ],
+        3,
+        &[
+            "-o: the simulated record would not be accepted by identify, so it is not written",
+            "beyond the plausibility bound of 1000 µm",
+        ],
+    );
+    assert_eq!(snapshot(&dir), before);
+    // With a bound that admits it, simulate and identify agree.
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "K4",
+            "--truth",
+            "far.toml",
+            "-o",
+            "k4.csv",
+            "--max-reading-um",
+            "10000",
+        ],
+    );
+    fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+        ],
+        1,
+        &["k4.csv: ", "beyond the plausibility bound of 1000 µm"],
+    );
+    let out = ok(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--max-reading-um",
+            "10000",
+            "--max-error-um",
+            "10000",
+        ],
+    );
+    assert!(out.contains("XOW"), "{out}");
+}
+
+#[test]
+fn messages_say_what_happened() {
+    let dir = temp_dir("messages");
+    simulate(&dir, "K4", "k4.csv");
+    // Blocks of one sample: the first block reads ahead until every axis has moved, and says so.
+    let out = ok(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--stream",
+            "--block",
+            "1",
+        ],
+    );
+    assert!(
+        out.contains("Read in 240 blocks of up to 1 sample (the first read ahead to 2 samples, until every axis had moved)"),
+        "{out}"
+    );
+    fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--stream",
+            "--block",
+            "0",
+        ],
+        2,
+        &["--block"],
+    );
+    // A model with no terms.
+    let seed = model_spec::write::source_text("seed-ac").unwrap();
+    std::fs::write(
+        dir.join("empty.toml"),
+        format!("{seed}\n[models.empty]\ndescription = \"nothing\"\nerrors = []\n"),
+    )
+    .unwrap();
+    fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "empty.toml",
+            "--model",
+            "empty",
+            "--data",
+            "k4.csv",
+        ],
+        2,
+        &["--model: model `empty` of machine seed-ac has no terms (its `errors` list is empty)"],
+    );
+    // An identification report with a byte-order mark is read; one that is not UTF-8 is
+    // refused with its line and column.
+    ok(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--json",
+            "id.json",
+        ],
+    );
+    let json = std::fs::read(dir.join("id.json")).unwrap();
+    let mut bom = b"\xef\xbb\xbf".to_vec();
+    bom.extend(&json);
+    std::fs::write(dir.join("bom.json"), bom).unwrap();
+    ok(
+        &dir,
+        &[
+            "validate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "bom.json",
+            "--data",
+            "k4.csv",
+        ],
+    );
+    let mut bad = json.clone();
+    let at = bad.iter().position(|&b| b == b'\n').unwrap() + 3;
+    bad[at] = 0xff;
+    std::fs::write(dir.join("bad.json"), bad).unwrap();
+    fails(
+        &dir,
+        &[
+            "validate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "bad.json",
+            "--data",
+            "k4.csv",
+        ],
+        1,
+        &["--params: bad.json:2:3: not UTF-8 text (byte 0xff)"],
+    );
+    // The seed has one range everywhere.
+    fails(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "K4",
+            "--seed",
+            "9223372036854775808",
+            "-o",
+            "s.csv",
+        ],
+        2,
+        &["--seed"],
+    );
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "K4",
+            "--seed",
+            "9223372036854775807",
+            "-o",
+            "s.csv",
+        ],
+    );
+}

@@ -72,8 +72,8 @@ impl OutsideLimits {
 }
 
 impl fmt::Display for OutsideLimits {
-    /// `axis A at 121 degrees is outside its range -120 .. 120 degrees`. The value is written
-    /// with every digit when six decimals would show it at the limit.
+    /// `A = 121° outside its range -120 .. 120°`, `X = 612.3 mm outside its stroke -500 .. 500
+    /// mm`. The value is written with every digit when six decimals would show it at the limit.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let [lo, hi] = self.limits;
         let (lo_s, hi_s) = (short(lo), short(hi));
@@ -85,10 +85,13 @@ impl fmt::Display for OutsideLimits {
             AxisKind::Linear => "stroke",
             AxisKind::Rotary => "range",
         };
-        let unit = self.unit();
+        let unit = match self.kind {
+            AxisKind::Linear => " mm",
+            AxisKind::Rotary => "°",
+        };
         write!(
             f,
-            "axis {} at {value} {unit} is outside its {what} {lo_s} .. {hi_s} {unit}",
+            "{} = {value}{unit} outside its {what} {lo_s} .. {hi_s}{unit}",
             self.name
         )
     }
@@ -122,18 +125,34 @@ impl Machine {
                     value: q,
                 });
             }
-            let value = for_people(a, q);
-            let [lo, hi] = a.limits;
-            if value < lo - LIMIT_TOLERANCE || value > hi + LIMIT_TOLERANCE {
-                return Err(PoseError::OutsideLimits(OutsideLimits {
-                    axis: i,
-                    name: a.name.clone(),
-                    kind: a.kind,
-                    value,
-                    limits: a.limits,
-                }));
-            }
+        }
+        if let Some(first) = self.outside_limits(commands).into_iter().next() {
+            return Err(PoseError::OutsideLimits(first));
         }
         Ok(())
+    }
+
+    /// Every axis of `commands` (one per axis: mm, rad) outside its stroke or range (inclusive,
+    /// with a margin of [`LIMIT_TOLERANCE`] mm or degrees), in axis order. Commands that are
+    /// not finite, and commands beyond the number of axes, are not reported here.
+    pub fn outside_limits(&self, commands: &[f64]) -> Vec<OutsideLimits> {
+        self.axes
+            .iter()
+            .zip(commands)
+            .enumerate()
+            .filter_map(|(i, (a, &q))| {
+                let value = for_people(a, q);
+                let [lo, hi] = a.limits;
+                (value < lo - LIMIT_TOLERANCE || value > hi + LIMIT_TOLERANCE).then(|| {
+                    OutsideLimits {
+                        axis: i,
+                        name: a.name.clone(),
+                        kind: a.kind,
+                        value,
+                        limits: a.limits,
+                    }
+                })
+            })
+            .collect()
     }
 }

@@ -41,25 +41,25 @@ fn within_and_at_the_limits() {
 fn outside() {
     assert_eq!(
         message([500.001, 0.0, 0.0, 0.0, 0.0]).unwrap(),
-        "axis X at 500.001 mm is outside its stroke -500 .. 500 mm"
+        "X = 500.001 mm outside its stroke -500 .. 500 mm"
     );
     assert_eq!(
         message([0.0, 121.0, 0.0, 0.0, 0.0]).unwrap(),
-        "axis A at 121 degrees is outside its range -120 .. 120 degrees"
+        "A = 121° outside its range -120 .. 120°"
     );
     assert_eq!(
         message([0.0, 0.0, 0.0, 0.0, -612.25]).unwrap(),
-        "axis Z at -612.25 mm is outside its stroke -500 .. 500 mm"
+        "Z = -612.25 mm outside its stroke -500 .. 500 mm"
     );
     // Just beyond the margin: every digit, so that the value is not shown as the limit.
     assert_eq!(
         message([0.0, 0.0, 0.0, 400.000_000_1, 0.0]).unwrap(),
-        "axis Y at 400.0000001 mm is outside its stroke -400 .. 400 mm"
+        "Y = 400.0000001 mm outside its stroke -400 .. 400 mm"
     );
     // The first axis outside, in axis order (X, A, C, Y, Z).
     assert_eq!(
         message([0.0, 130.0, 0.0, 401.0, 0.0]).unwrap(),
-        "axis A at 130 degrees is outside its range -120 .. 120 degrees"
+        "A = 130° outside its range -120 .. 120°"
     );
 }
 

@@ -339,4 +339,18 @@ proptest! {
     fn arbitrary_text_never_panics(text in "\\PC{0,200}") {
         check("arbitrary text", &text);
     }
+
+    /// Random bytes, decoded as a machine file is read (UTF-8, a byte-order mark dropped):
+    /// an error located at a line and column, or a description that parses or is refused
+    /// with a location.
+    #[test]
+    fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
+        match model_spec::text::decode_text("mut.toml", bytes.clone()) {
+            Ok(text) => check("arbitrary bytes", &text),
+            Err(e) => {
+                let s = e.to_string();
+                prop_assert!(s.starts_with("mut.toml:"), "{}", s);
+            }
+        }
+    }
 }

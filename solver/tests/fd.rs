@@ -125,33 +125,50 @@ fn seed_table2_boa_x_and_aoc_y_at_a_nontrivial_pose() {
     assert!((g[1][5] - a.sin()).abs() < 1e-9, "AOC K: {}", g[1][5]);
 }
 
-/// The step study behind [`FdSteps::default`]: prints the largest deviation from Table 2 for a
-/// range of angular steps, plain central differences and Richardson extrapolation
-/// (`cargo test -p solver --test fd -- --nocapture step_study`).
+/// The step study behind [`FdSteps::default`]: the largest deviation from Table 2 for a range
+/// of angular steps, plain central differences and Richardson extrapolation, and for a range of
+/// translational steps; it checks the conclusions the defaults rest on (the table is printed
+/// with `cargo test -p solver --test fd -- --nocapture step_study`).
 #[test]
 fn step_study() {
+    let angular = |h: f64, richardson: bool| {
+        table2_max_error(
+            FdSteps {
+                angular: h,
+                richardson,
+                ..FdSteps::default()
+            },
+            20,
+            true,
+        )
+    };
     println!("angular step  central        richardson");
-    for h in [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 1e-7] {
-        let plain = table2_max_error(
-            FdSteps {
-                angular: h,
-                richardson: false,
-                ..FdSteps::default()
-            },
-            20,
-            true,
+    let steps = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 1e-7];
+    let mut central = Vec::new();
+    let mut rich = Vec::new();
+    for h in steps {
+        central.push(angular(h, false));
+        rich.push(angular(h, true));
+        println!(
+            "{h:<12e}  {:<13.3e}  {:.3e}",
+            central.last().unwrap(),
+            rich.last().unwrap()
         );
-        let rich = table2_max_error(
-            FdSteps {
-                angular: h,
-                richardson: true,
-                ..FdSteps::default()
-            },
-            20,
-            true,
-        );
-        println!("{h:<12e}  {plain:<13.3e}  {rich:.3e}");
     }
+    let at = |h: f64| steps.iter().position(|&s| s == h).unwrap();
+    // Central differences: truncation error at large steps, rounding error at small ones, a
+    // minimum near 1e-5 rad of about 1e-8 mm/rad.
+    assert!(central[at(1e-5)] < 1e-7, "{central:?}");
+    assert!(central[at(1e-2)] > 10.0 * central[at(1e-5)], "{central:?}");
+    assert!(central[at(1e-7)] > central[at(1e-5)], "{central:?}");
+    // Richardson extrapolation removes the h² term: at the default 1e-3 rad it is far better
+    // than any central difference, about 1e-10 mm/rad.
+    let default = FdSteps::default();
+    assert_eq!((default.angular, default.richardson), (1e-3, true));
+    assert!(rich[at(1e-3)] < 1e-9, "{rich:?}");
+    assert!(rich[at(1e-3)] < central.iter().cloned().fold(f64::INFINITY, f64::min));
+    // Translational errors enter linearly: a larger step only lowers the rounding error.
+    let mut translational = Vec::new();
     for h in [1.0, 1e-2, 1e-3, 1e-4, 1e-6] {
         let e = table2_max_error(
             FdSteps {
@@ -162,5 +179,9 @@ fn step_study() {
             false,
         );
         println!("translational step {h:e} mm: {e:.3e}");
+        translational.push(e);
     }
+    assert_eq!(default.translational, 1e-2);
+    assert!(translational[1] < 1e-10, "{translational:?}");
+    assert!(translational[4] > translational[1], "{translational:?}");
 }

@@ -17,10 +17,12 @@
 //! 4. Refit the extended model (refined against the exact machine), and measure the residual
 //!    RMS before and after on the fitted record and on every held-out record.
 
+mod confounded;
 pub mod dictionary;
 pub mod figures;
 pub mod harmonic;
 pub mod hidden;
+mod options;
 pub mod select;
 pub mod structure;
 
@@ -29,103 +31,18 @@ use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
 use crate::fitting::refine::{RefineError, RefineOptions, identify_refined_with};
 use crate::fitting::validate::{ValidateError, ValidateOptions, validate_with};
 use crate::fitting::{
-    EstimateError, Identification, IdentifyOptions, Tolerances, measurement_vector, with_offsets,
+    EstimateError, Identification, IdentifyOptions, measurement_vector, with_offsets,
 };
 use crate::model::Model;
 use crate::record::Record;
-use dictionary::{DictionaryOptions, dictionary};
+use confounded::{confounded_with, same_span, scaled_size};
+use dictionary::dictionary;
 use model_spec::Machine;
 use model_spec::terms::Term;
-use nalgebra::{DMatrix, DVector};
+pub use options::DiagnoseOptions;
+
 use select::{Scored, Span, f_p_value, f_statistic, monte_carlo_p};
 use structure::Component;
-
-/// Options of [`diagnose`] (`DiagnoseOptions::default()`, then set the fields wanted).
-#[derive(Clone, Debug, PartialEq)]
-#[non_exhaustive]
-pub struct DiagnoseOptions {
-    /// The candidate dictionary's extent.
-    pub dictionary: DictionaryOptions,
-    /// Significance level α of each step, after the correction for the candidates tried.
-    pub alpha: f64,
-    /// Most findings.
-    pub max_findings: usize,
-    /// Monte-Carlo draws for the corrected p-value when Bonferroni is not decisive.
-    pub draws: usize,
-    /// Seed of the Monte-Carlo draws.
-    pub seed: u64,
-    /// The readings were zeroed at the first sample (the offsets dx0 dy0 dz0 join the base
-    /// model).
-    pub zeroed: bool,
-    /// Kinematic parameters (mm, symbol order); `None`: the machine's defaults.
-    pub params: Option<Vec<f64>>,
-    /// Rank and identifiability tolerances of the fits.
-    pub tolerances: Tolerances,
-}
-
-impl Default for DiagnoseOptions {
-    fn default() -> Self {
-        DiagnoseOptions {
-            dictionary: DictionaryOptions::default(),
-            alpha: 0.01,
-            max_findings: 8,
-            draws: 1000,
-            seed: 0x5eed,
-            zeroed: false,
-            params: None,
-            tolerances: Tolerances::default(),
-        }
-    }
-}
-
-impl DiagnoseOptions {
-    /// The defaults.
-    pub fn new() -> DiagnoseOptions {
-        DiagnoseOptions::default()
-    }
-
-    /// With the dictionary's extent.
-    pub fn dictionary(mut self, dictionary: DictionaryOptions) -> DiagnoseOptions {
-        self.dictionary = dictionary;
-        self
-    }
-
-    /// With the significance level of each step.
-    pub fn alpha(mut self, alpha: f64) -> DiagnoseOptions {
-        self.alpha = alpha;
-        self
-    }
-
-    /// With at most `n` findings.
-    pub fn max_findings(mut self, n: usize) -> DiagnoseOptions {
-        self.max_findings = n;
-        self
-    }
-
-    /// With `draws` Monte-Carlo draws.
-    pub fn draws(mut self, draws: usize) -> DiagnoseOptions {
-        self.draws = draws;
-        self
-    }
-
-    /// With the seed of the Monte-Carlo draws.
-    pub fn seed(mut self, seed: u64) -> DiagnoseOptions {
-        self.seed = seed;
-        self
-    }
-
-    /// With readings zeroed at the first sample (or not).
-    pub fn zeroed(mut self, zeroed: bool) -> DiagnoseOptions {
-        self.zeroed = zeroed;
-        self
-    }
-
-    /// With the kinematic parameters `params` (mm, symbol order).
-    pub fn params(mut self, params: Vec<f64>) -> DiagnoseOptions {
-        self.params = Some(params);
-        self
-    }
-}
 
 /// How the corrected p-value of a step was obtained.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -750,103 +667,4 @@ fn context_seed(seed: u64, chosen: &[Chosen], skip: Option<usize>) -> u64 {
     terms.iter().fold(seed, |h, &t| {
         (h ^ (t as u64 + 1)).wrapping_mul(0x9e37_79b9_7f4a_7c15)
     })
-}
-
-/// `true` when two scored candidates add the same directions to the model.
-fn same_span(a: &Scored, b: &Scored) -> bool {
-    let q = a.directions.ncols();
-    q == b.directions.ncols()
-        && (a.directions.tr_mul(&b.directions)).norm_squared() > q as f64 * (1.0 - 1e-9)
-}
-
-/// The norm of the least-squares coefficients (minimum norm) of `r` on the columns of `g`, each
-/// scaled to unit norm and with the model `q` projected out: how large a change of the
-/// candidate explains what it explains.
-fn scaled_size(q: &Span, g: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
-    let cols: Vec<DVector<f64>> = g
-        .column_iter()
-        .filter_map(|c| {
-            let norm = c.norm();
-            (norm > 0.0 && norm.is_finite()).then(|| q.project_out(&(c.into_owned() / norm)))
-        })
-        .collect();
-    if cols.is_empty() {
-        return f64::INFINITY;
-    }
-    let svd = DMatrix::from_columns(&cols).svd(true, true);
-    let eps = svd.singular_values.max() * select::SPAN_TOLERANCE;
-    svd.solve(r, eps).map_or(f64::INFINITY, |c| c.norm())
-}
-
-/// The candidates the final model spans, each with the model terms it is a combination of.
-#[allow(clippy::too_many_arguments)]
-fn confounded_with(
-    extended: &Model,
-    candidates: &[Term],
-    chosen: &[usize],
-    unexcited: &[Term],
-    q: &Span,
-    group: &dyn Fn(usize) -> DMatrix<f64>,
-    nb: usize,
-    h_all: &DMatrix<f64>,
-    starts: &[usize],
-    widths: &[usize],
-) -> Vec<Confounded> {
-    // The extended model's columns, scaled to unit norm, with their term indices in `extended`.
-    let mut cols: Vec<DVector<f64>> = Vec::new();
-    let mut owner: Vec<usize> = Vec::new();
-    for (ti, t) in extended.terms.iter().enumerate() {
-        let all_index = if ti < nb { ti } else { nb + chosen[ti - nb] };
-        debug_assert_eq!(widths[all_index], t.basis.width());
-        for k in 0..widths[all_index] {
-            let c = h_all.column(starts[all_index] + k).into_owned();
-            let norm = c.norm();
-            if norm > 0.0 {
-                cols.push(c / norm);
-                owner.push(ti);
-            }
-        }
-    }
-    if cols.is_empty() {
-        return Vec::new();
-    }
-    let hm = DMatrix::from_columns(&cols);
-    let svd = hm.clone().svd(true, true);
-    let eps = svd.singular_values.max() * 1e-10;
-    let mut out = Vec::new();
-    for (c, term) in candidates.iter().enumerate() {
-        if chosen.contains(&c) || unexcited.contains(term) {
-            continue;
-        }
-        let g = group(nb + c);
-        if q.new_directions(&g).ncols() > 0 {
-            continue;
-        }
-        let mut share = vec![0.0f64; extended.terms.len()];
-        for k in 0..g.ncols() {
-            let col = g.column(k).into_owned();
-            let norm = col.norm();
-            if norm == 0.0 {
-                continue;
-            }
-            if let Ok(beta) = svd.solve(&(col / norm), eps) {
-                for (j, b) in beta.iter().enumerate() {
-                    share[owner[j]] += b.abs();
-                }
-            }
-        }
-        let top = share.iter().cloned().fold(0.0, f64::max);
-        let mut with: Vec<(usize, f64)> = share
-            .iter()
-            .enumerate()
-            .filter(|(_, s)| **s >= 0.1 * top && **s > 0.0)
-            .map(|(j, s)| (j, *s))
-            .collect();
-        with.sort_by(|a, b| b.1.total_cmp(&a.1));
-        out.push(Confounded {
-            term: *term,
-            with: with.into_iter().map(|(j, _)| extended.terms[j]).collect(),
-        });
-    }
-    out
 }

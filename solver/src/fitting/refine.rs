@@ -43,6 +43,25 @@ pub struct RefineOptions {
     pub tolerance_mm: f64,
 }
 
+impl RefineOptions {
+    /// The defaults: at most 8 steps, down to 1e-12 mm.
+    pub fn new() -> RefineOptions {
+        RefineOptions::default()
+    }
+
+    /// With at most `n` Gauss–Newton steps.
+    pub fn max_iterations(mut self, n: usize) -> RefineOptions {
+        self.max_iterations = n;
+        self
+    }
+
+    /// Stopping when no correction moves the prediction by more than `mm`.
+    pub fn tolerance_mm(mut self, mm: f64) -> RefineOptions {
+        self.tolerance_mm = mm;
+        self
+    }
+}
+
 impl Default for RefineOptions {
     fn default() -> Self {
         RefineOptions {

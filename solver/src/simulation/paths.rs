@@ -154,7 +154,8 @@ pub fn load_path(m: &Machine, name_or_file: &str, opts: &ReadOptions) -> Result<
         return r;
     }
     let path = std::path::Path::new(name_or_file);
-    if !path.is_file() {
+    // Anything that exists and is not a directory is read (a file, a FIFO, a link to one).
+    if !path.exists() || path.is_dir() {
         return Err(PathError::NotFound(name_or_file.to_string()));
     }
     let f = std::fs::File::open(path).map_err(|source| CsvError::Io {

@@ -6,7 +6,7 @@
 //!    [`ReadOptions::on_ball_tolerance_mm`], at the machine's default kinematic parameters;
 //! 2. unless [`ReadOptions::allow_off_stroke`], every pose (linear axes filled) lies within the
 //!    machine's strokes (mm) and ranges (degrees), inclusive, with a rounding margin of
-//!    [`LIMIT_MARGIN`] in the axis unit;
+//!    [`model_spec::pose::LIMIT_TOLERANCE`] in the axis unit;
 //! 3. every reading lies within [`ReadOptions::max_reading_mm`] in each direction.
 //!
 //! The first check that fails refuses the batch with [`CsvError::Refused`]: how many samples or
@@ -14,11 +14,8 @@
 
 use crate::io::csv::{CsvError, MEASURED, ReadOptions, format_scaled};
 use crate::simulation::exact::VirtualMachine;
+use model_spec::Machine;
 use model_spec::units::short;
-use model_spec::{AxisKind, Machine};
-
-/// Rounding margin of the stroke and range check, in the axis unit (mm or degrees).
-pub const LIMIT_MARGIN: f64 = 1e-9;
 
 /// How many offending samples a refusal lists.
 pub const LISTED: usize = 5;
@@ -179,31 +176,15 @@ fn nominal_machine(m: &Machine) -> Machine {
     nominal
 }
 
-/// Whether `commands` (mm, rad; one per axis) lies within the strokes (mm) and ranges (degrees)
-/// of `m`, inclusive, with a margin of [`LIMIT_MARGIN`]; otherwise what lies outside
-/// (`X = 612.3 mm outside its stroke -500 .. 500 mm`, several joined by `, `).
+/// Whether `commands` (mm, rad; one per axis) lies within the strokes (mm) and ranges
+/// (degrees) of `m` ([`Machine::outside_limits`]); otherwise what lies outside, several axes
+/// joined by `, `.
 fn check_pose(m: &Machine, commands: &[f64]) -> Result<(), String> {
-    let mut out: Vec<String> = Vec::new();
-    for (a, &q) in m.axes.iter().zip(commands) {
-        let (v, unit, what) = match a.kind {
-            AxisKind::Linear => (q, " mm", "stroke"),
-            AxisKind::Rotary => (q.to_degrees(), "°", "range"),
-        };
-        let [lo, hi] = a.limits;
-        let inside = v >= lo - LIMIT_MARGIN && v <= hi + LIMIT_MARGIN;
-        if !inside {
-            let shown = match a.kind {
-                AxisKind::Linear => people(q),
-                AxisKind::Rotary => people(crate::io::csv::degrees_for(q)),
-            };
-            out.push(format!(
-                "{} = {shown}{unit} outside its {what} {} .. {}{unit}",
-                a.name,
-                people(lo),
-                people(hi)
-            ));
-        }
-    }
+    let out: Vec<String> = m
+        .outside_limits(commands)
+        .iter()
+        .map(ToString::to_string)
+        .collect();
     if out.is_empty() {
         Ok(())
     } else {
@@ -288,6 +269,7 @@ fn people(x: f64) -> String {
 mod tests {
     use super::*;
     use crate::simulation::rng::Rng;
+    use model_spec::AxisKind;
 
     #[test]
     fn the_nominal_machine_has_the_nominal_error_vector_of_the_machine() {

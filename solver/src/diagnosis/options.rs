@@ -1,0 +1,91 @@
+//! The options of a diagnosis.
+
+use super::dictionary::DictionaryOptions;
+use crate::fitting::Tolerances;
+
+/// Options of [`diagnose`] (`DiagnoseOptions::default()`, then set the fields wanted).
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct DiagnoseOptions {
+    /// The candidate dictionary's extent.
+    pub dictionary: DictionaryOptions,
+    /// Significance level α of each step, after the correction for the candidates tried.
+    pub alpha: f64,
+    /// Most findings.
+    pub max_findings: usize,
+    /// Monte-Carlo draws for the corrected p-value when Bonferroni is not decisive.
+    pub draws: usize,
+    /// Seed of the Monte-Carlo draws.
+    pub seed: u64,
+    /// The readings were zeroed at the first sample (the offsets dx0 dy0 dz0 join the base
+    /// model).
+    pub zeroed: bool,
+    /// Kinematic parameters (mm, symbol order); `None`: the machine's defaults.
+    pub params: Option<Vec<f64>>,
+    /// Rank and identifiability tolerances of the fits.
+    pub tolerances: Tolerances,
+}
+
+impl Default for DiagnoseOptions {
+    fn default() -> Self {
+        DiagnoseOptions {
+            dictionary: DictionaryOptions::default(),
+            alpha: 0.01,
+            max_findings: 8,
+            draws: 1000,
+            seed: 0x5eed,
+            zeroed: false,
+            params: None,
+            tolerances: Tolerances::default(),
+        }
+    }
+}
+
+impl DiagnoseOptions {
+    /// The defaults.
+    pub fn new() -> DiagnoseOptions {
+        DiagnoseOptions::default()
+    }
+
+    /// With the dictionary's extent.
+    pub fn dictionary(mut self, dictionary: DictionaryOptions) -> DiagnoseOptions {
+        self.dictionary = dictionary;
+        self
+    }
+
+    /// With the significance level of each step.
+    pub fn alpha(mut self, alpha: f64) -> DiagnoseOptions {
+        self.alpha = alpha;
+        self
+    }
+
+    /// With at most `n` findings.
+    pub fn max_findings(mut self, n: usize) -> DiagnoseOptions {
+        self.max_findings = n;
+        self
+    }
+
+    /// With `draws` Monte-Carlo draws.
+    pub fn draws(mut self, draws: usize) -> DiagnoseOptions {
+        self.draws = draws;
+        self
+    }
+
+    /// With the seed of the Monte-Carlo draws.
+    pub fn seed(mut self, seed: u64) -> DiagnoseOptions {
+        self.seed = seed;
+        self
+    }
+
+    /// With readings zeroed at the first sample (or not).
+    pub fn zeroed(mut self, zeroed: bool) -> DiagnoseOptions {
+        self.zeroed = zeroed;
+        self
+    }
+
+    /// With the kinematic parameters `params` (mm, symbol order).
+    pub fn params(mut self, params: Vec<f64>) -> DiagnoseOptions {
+        self.params = Some(params);
+        self
+    }
+}

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{TempDir, check_fails, fails, ok, run, stderr};
+use common::{TempDir, check_fails, fails, ok, run, stderr, words};
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::os::unix::fs::{MetadataExt, PermissionsExt};
@@ -56,17 +56,9 @@ fn snapshot(dir: &Path) -> BTreeMap<String, (String, u32, Vec<u8>)> {
 fn simulate(dir: &Path, path: &str, out: &str) {
     ok(
         dir,
-        &[
-            "simulate",
-            "--machine",
-            "seed-ac",
-            "--path",
-            path,
-            "--truth",
-            "seed-ac-reduced",
-            "-o",
-            out,
-        ],
+        &words(&format!(
+            "simulate --machine seed-ac --path {path} --truth seed-ac-reduced -o {out}"
+        )),
     );
 }
 
@@ -108,17 +100,9 @@ fn outputs_follow_symlinks_keep_modes_and_links_and_stream_to_fifos() {
     let sim = |out: &str| {
         ok(
             &dir,
-            &[
-                "simulate",
-                "--machine",
-                "seed-ac",
-                "--path",
-                "K4",
-                "--truth",
-                "seed-ac-reduced",
-                "-o",
-                out,
-            ],
+            &words(&format!(
+                "simulate --machine seed-ac --path K4 --truth seed-ac-reduced -o {out}"
+            )),
         )
     };
 
@@ -164,17 +148,7 @@ fn outputs_follow_symlinks_keep_modes_and_links_and_stream_to_fifos() {
     // `-o -`: the CSV on standard output, the summary on standard error.
     let o = run(
         Some(&dir),
-        &[
-            "simulate",
-            "--machine",
-            "seed-ac",
-            "--path",
-            "K4",
-            "--truth",
-            "seed-ac-reduced",
-            "-o",
-            "-",
-        ],
+        &words("simulate --machine seed-ac --path K4 --truth seed-ac-reduced -o -"),
     );
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(o.stdout, expected);
@@ -208,20 +182,10 @@ fn a_read_only_file_is_refused_as_a_shell_would_and_left_alone() {
     std::fs::set_permissions(dir.join("ro.csv"), std::fs::Permissions::from_mode(0o444)).unwrap();
     std::fs::set_permissions(&*dir, std::fs::Permissions::from_mode(0o777)).unwrap();
     let before = snapshot(&dir);
-    let args = [
-        "simulate",
-        "--machine",
-        "seed-ac",
-        "--path",
-        "K4",
-        "--truth",
-        "seed-ac-reduced",
-        "-o",
-        "ro.csv",
-    ];
+    let args = words("simulate --machine seed-ac --path K4 --truth seed-ac-reduced -o ro.csv");
     // As root a read-only file is writable (as it is to a shell): run as an ordinary user.
     let mut c = Command::new(env!("CARGO_BIN_EXE_rtest"));
-    c.args(args).current_dir(&*dir);
+    c.args(&args).current_dir(&*dir);
     if is_root() {
         std::os::unix::process::CommandExt::uid(&mut c, 65534);
         std::os::unix::process::CommandExt::gid(&mut c, 65534);
@@ -237,18 +201,9 @@ fn an_output_that_names_an_input_is_refused_before_any_work() {
     simulate(&dir, "K4", "k4.csv");
     ok(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "k4.csv",
-            "--first-order",
-            "--json",
-            "id.json",
-        ],
+        &words(
+            "identify --machine seed-ac --model reduced --data k4.csv --first-order --json id.json",
+        ),
     );
     std::fs::write(
         dir.join("m.toml"),
@@ -259,17 +214,9 @@ fn an_output_that_names_an_input_is_refused_before_any_work() {
     std::os::unix::fs::symlink("k4.csv", dir.join("k4-link.csv")).unwrap();
     std::fs::hard_link(dir.join("k4.csv"), dir.join("k4-hard.csv")).unwrap();
     let before = snapshot(&dir);
-    let id = [
-        "identify",
-        "--machine",
-        "seed-ac",
-        "--model",
-        "reduced",
-        "--data",
-        "k4.csv",
-    ];
+    let id = words("identify --machine seed-ac --model reduced --data k4.csv");
     for json in ["k4.csv", "./k4.csv", "k4-link.csv", "k4-hard.csv"] {
-        let mut args = id.to_vec();
+        let mut args = id.clone();
         args.extend(["--json", json]);
         fails(
             &dir,
@@ -280,63 +227,25 @@ fn an_output_that_names_an_input_is_refused_before_any_work() {
     }
     let cases: &[(&[&str], &str)] = &[
         (
-            &[
-                "validate",
-                "--machine",
-                "seed-ac",
-                "--params",
-                "id.json",
-                "--data",
-                "k4.csv",
-                "--json",
-                "id.json",
-            ],
+            &words("validate --machine seed-ac --params id.json --data k4.csv --json id.json"),
             "--json: `id.json` is also the input of --params",
         ),
         (
-            &["generate", "--machine", "m.toml", "-o", "m.toml"],
+            &words("generate --machine m.toml -o m.toml"),
             "-o: `m.toml` is also the input of --machine",
         ),
         (
-            &[
-                "diagnose",
-                "--machine",
-                "m.toml",
-                "--model",
-                "reduced",
-                "--data",
-                "k4.csv",
-                "--model-out",
-                "m.toml",
-            ],
+            &words("diagnose --machine m.toml --model reduced --data k4.csv --model-out m.toml"),
             "--model-out: `m.toml` is also the input of --machine",
         ),
         (
-            &[
-                "simulate",
-                "--machine",
-                "seed-ac",
-                "--path",
-                "path.csv",
-                "-o",
-                "path.csv",
-            ],
+            &words("simulate --machine seed-ac --path path.csv -o path.csv"),
             "-o: `path.csv` is also the input of --path",
         ),
         (
-            &[
-                "diagnose",
-                "--machine",
-                "seed-ac",
-                "--model",
-                "reduced",
-                "--data",
-                "k4.csv",
-                "--json",
-                "x.json",
-                "--model-out",
-                "x.json",
-            ],
+            &words(
+                "diagnose --machine seed-ac --model reduced --data k4.csv --json x.json --model-out x.json",
+            ),
             "is also the output of",
         ),
     ];
@@ -351,49 +260,61 @@ fn an_output_that_names_an_input_is_refused_before_any_work() {
 #[test]
 fn a_refinement_that_does_not_converge_is_an_error_and_writes_nothing() {
     let dir = temp_dir("diverge");
-    simulate(&dir, "K4", "k4.csv");
-    // The first five samples of K4: 15 readings for 11 parameters, which the first-order fit
-    // takes but which do not determine the exact machine.
-    let text = std::fs::read_to_string(dir.join("k4.csv")).unwrap();
-    let mut lines: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
-    lines.truncate(6);
-    std::fs::write(dir.join("few.csv"), lines.join("\n") + "\n").unwrap();
-    let before = snapshot(&dir);
-    let err = fails(
+    // K4 with the demo truth (0.5 µm of noise), and K4 without noise.
+    ok(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "few.csv",
-            "--json",
-            "few.json",
-        ],
-        3,
-        &["--data: "],
+        &words("simulate --machine seed-ac --path K4 -o noisy.csv"),
     );
-    assert!(
-        err.contains("did not converge") || err.contains("implausible"),
-        "{err}"
-    );
+    simulate(&dir, "K4", "exact.csv");
+    let first = |file: &str, n: usize| -> String {
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+        lines[..=n].join("\n") + "\n"
+    };
+    // The first five noisy samples: 15 readings for 11 parameters. The first-order fit takes
+    // them, but its values are far from any machine (the noise decides the ill-conditioned
+    // directions), the second-order terms there are not small, and Gauss-Newton diverges.
+    std::fs::write(dir.join("few.csv"), first("noisy.csv", 5)).unwrap();
+    // Eight: it crawls, and has not converged after eight steps.
+    std::fs::write(dir.join("eight.csv"), first("noisy.csv", 8)).unwrap();
+    let before = snapshot(&dir);
+    for data in ["few.csv", "eight.csv"] {
+        let json = format!("{data}.json");
+        fails(
+            &dir,
+            &words(&format!(
+                "identify --machine seed-ac --model reduced --data {data} --json {json}"
+            )),
+            3,
+            &[
+                "--data: the refinement against the exact machine did not converge: 8 Gauss-Newton steps",
+                "--first-order gives the first-order values",
+            ],
+        );
+        // Its first-order values are no result either: far beyond the plausibility bounds.
+        fails(
+            &dir,
+            &words(&format!(
+                "identify --machine seed-ac --model reduced --data {data} --first-order --json {json}"
+            )),
+            3,
+            &["--data: implausible result: values are beyond the plausibility bounds"],
+        );
+    }
     assert_eq!(snapshot(&dir), before, "no file written on exit code 3");
+    // The same five samples without noise: ill-conditioned (condition number 3e7), but the
+    // refinement converges to its rounding floor, and the values are the truth's.
+    std::fs::write(dir.join("five.csv"), first("exact.csv", 5)).unwrap();
+    let out = ok(
+        &dir,
+        &words("identify --machine seed-ac --model reduced --data five.csv"),
+    );
+    assert!(out.contains(", converged;"), "{out}");
     // Fewer readings than parameters plus one: an error before fitting, naming both numbers.
-    lines.truncate(4);
-    std::fs::write(dir.join("three.csv"), lines.join("\n") + "\n").unwrap();
+    std::fs::write(dir.join("three.csv"), first("exact.csv", 3)).unwrap();
     fails(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "three.csv",
-        ],
+        &words("identify --machine seed-ac --model reduced --data three.csv"),
         1,
         &["too few samples: 3 samples give 9 readings (3 per sample) for 11 parameters"],
     );
@@ -429,15 +350,7 @@ fn non_finite_and_implausible_inputs_are_refused_naming_the_cause() {
     let before = snapshot(&dir);
     fails(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "bad.csv",
-        ],
+        &words("identify --machine seed-ac --model reduced --data bad.csv"),
         1,
         &[
             "bad.csv: 2 readings beyond the plausibility bound of 1000 µm",
@@ -448,17 +361,7 @@ fn non_finite_and_implausible_inputs_are_refused_naming_the_cause() {
     // --noise-um beyond its range.
     fails(
         &dir,
-        &[
-            "simulate",
-            "--machine",
-            "seed-ac",
-            "--path",
-            "K4",
-            "--noise-um",
-            "1e308",
-            "-o",
-            "n.csv",
-        ],
+        &words("simulate --machine seed-ac --path K4 --noise-um 1e308 -o n.csv"),
         2,
         &["--noise-um: `1e308` must be a finite number from 0 to 1000 µm"],
     );
@@ -474,15 +377,9 @@ fn non_finite_and_implausible_inputs_are_refused_naming_the_cause() {
         std::fs::write(dir.join(name), text).unwrap();
         fails(
             &dir,
-            &[
-                "identify",
-                "--machine",
-                name,
-                "--model",
-                "reduced",
-                "--data",
-                "k4.csv",
-            ],
+            &words(&format!(
+                "identify --machine {name} --model reduced --data k4.csv"
+            )),
             1,
             &[&format!("--machine: {name}:"), "1e308"],
         );
@@ -491,19 +388,9 @@ fn non_finite_and_implausible_inputs_are_refused_naming_the_cause() {
     let snap = snapshot(&dir);
     fails(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "k4.csv",
-            "--max-error-um",
-            "1",
-            "--json",
-            "id.json",
-        ],
+        &words(
+            "identify --machine seed-ac --model reduced --data k4.csv --max-error-um 1 --json id.json",
+        ),
         3,
         &[
             "implausible result",
@@ -525,35 +412,18 @@ fn poses_off_stroke_or_off_the_ball_are_refused_unless_allowed() {
     std::fs::write(dir.join("path.csv"), "A,C\n0,0\n-60,10\n-125,20\n").unwrap();
     fails(
         &dir,
-        &[
-            "simulate",
-            "--machine",
-            "seed-ac",
-            "--path",
-            "path.csv",
-            "-o",
-            "p.csv",
-        ],
+        &words("simulate --machine seed-ac --path path.csv -o p.csv"),
         1,
         &["path.csv", "line 4", "A = -125"],
     );
     ok(
         &dir,
-        &[
-            "simulate",
-            "--machine",
-            "seed-ac",
-            "--path",
-            "path.csv",
-            "--allow-off-stroke",
-            "-o",
-            "p.csv",
-        ],
+        &words("simulate --machine seed-ac --path path.csv --allow-off-stroke -o p.csv"),
     );
     // gains --at checks the pose too.
     fails(
         &dir,
-        &["gains", "--machine", "seed-ac", "--at", "A=130,C=0"],
+        &words("gains --machine seed-ac --at A=130,C=0"),
         2,
         &["--at: ", "A", "--allow-off-stroke"],
     );
@@ -565,15 +435,7 @@ fn poses_off_stroke_or_off_the_ball_are_refused_unless_allowed() {
     std::fs::write(dir.join("grid.csv"), grid).unwrap();
     let err = fails(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-3axis",
-            "--model",
-            "full",
-            "--data",
-            "grid.csv",
-        ],
+        &words("identify --machine seed-3axis --model full --data grid.csv"),
         1,
         &["grid.csv", "line 3", "R-test"],
     );
@@ -586,17 +448,7 @@ fn values_of_another_machine_are_refused() {
     simulate(&dir, "K4", "k4.csv");
     ok(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "k4.csv",
-            "--json",
-            "id.json",
-        ],
+        &words("identify --machine seed-ac --model reduced --data k4.csv --json id.json"),
     );
     // The same machine with C turning the other way: another fingerprint.
     let seed = model_spec::write::source_text("seed-ac").unwrap();
@@ -610,15 +462,7 @@ fn values_of_another_machine_are_refused() {
     let before = snapshot(&dir);
     fails(
         &dir,
-        &[
-            "validate",
-            "--machine",
-            "reversed.toml",
-            "--params",
-            "id.json",
-            "--data",
-            "k4.csv",
-        ],
+        &words("validate --machine reversed.toml --params id.json --data k4.csv"),
         1,
         &["--params: id.json: field `fingerprint`", "another topology"],
     );
@@ -629,15 +473,7 @@ fn values_of_another_machine_are_refused() {
     std::fs::write(dir.join("short.json"), json.to_string()).unwrap();
     fails(
         &dir,
-        &[
-            "validate",
-            "--machine",
-            "seed-ac",
-            "--params",
-            "short.json",
-            "--data",
-            "k4.csv",
-        ],
+        &words("validate --machine seed-ac --params short.json --data k4.csv"),
         1,
         &[
             "--params: short.json: field `terms`",
@@ -697,17 +533,7 @@ fn simulate_never_writes_a_record_that_identify_would_refuse() {
     let before = snapshot(&dir);
     fails(
         &dir,
-        &[
-            "simulate",
-            "--machine",
-            "seed-ac",
-            "--path",
-            "K4",
-            "--truth",
-            "far.toml",
-            "-o",
-            "k4.csv",
-        ],
+        &words("simulate --machine seed-ac --path K4 --truth far.toml -o k4.csv"),
         3,
         &[
             "-o: the simulated record would not be accepted by identify, so it is not written",
@@ -718,49 +544,21 @@ fn simulate_never_writes_a_record_that_identify_would_refuse() {
     // With a bound that admits it, simulate and identify agree.
     ok(
         &dir,
-        &[
-            "simulate",
-            "--machine",
-            "seed-ac",
-            "--path",
-            "K4",
-            "--truth",
-            "far.toml",
-            "-o",
-            "k4.csv",
-            "--max-reading-um",
-            "10000",
-        ],
+        &words(
+            "simulate --machine seed-ac --path K4 --truth far.toml -o k4.csv --max-reading-um 10000",
+        ),
     );
     fails(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "k4.csv",
-        ],
+        &words("identify --machine seed-ac --model reduced --data k4.csv"),
         1,
         &["k4.csv: ", "beyond the plausibility bound of 1000 µm"],
     );
     let out = ok(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "k4.csv",
-            "--max-reading-um",
-            "10000",
-            "--max-error-um",
-            "10000",
-        ],
+        &words(
+            "identify --machine seed-ac --model reduced --data k4.csv --max-reading-um 10000 --max-error-um 10000",
+        ),
     );
     assert!(out.contains("XOW"), "{out}");
 }
@@ -772,18 +570,7 @@ fn messages_say_what_happened() {
     // Blocks of one sample: the first block reads ahead until every axis has moved, and says so.
     let out = ok(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "k4.csv",
-            "--stream",
-            "--block",
-            "1",
-        ],
+        &words("identify --machine seed-ac --model reduced --data k4.csv --stream --block 1"),
     );
     assert!(
         out.contains("Read in 240 blocks of up to 1 sample (the first read ahead to 2 samples, until every axis had moved)"),
@@ -791,18 +578,7 @@ fn messages_say_what_happened() {
     );
     fails(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "k4.csv",
-            "--stream",
-            "--block",
-            "0",
-        ],
+        &words("identify --machine seed-ac --model reduced --data k4.csv --stream --block 0"),
         2,
         &["--block"],
     );
@@ -815,15 +591,7 @@ fn messages_say_what_happened() {
     .unwrap();
     fails(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "empty.toml",
-            "--model",
-            "empty",
-            "--data",
-            "k4.csv",
-        ],
+        &words("identify --machine empty.toml --model empty --data k4.csv"),
         2,
         &["--model: model `empty` of machine seed-ac has no terms (its `errors` list is empty)"],
     );
@@ -831,17 +599,7 @@ fn messages_say_what_happened() {
     // refused with its line and column.
     ok(
         &dir,
-        &[
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "k4.csv",
-            "--json",
-            "id.json",
-        ],
+        &words("identify --machine seed-ac --model reduced --data k4.csv --json id.json"),
     );
     let json = std::fs::read(dir.join("id.json")).unwrap();
     let mut bom = b"\xef\xbb\xbf".to_vec();
@@ -849,15 +607,7 @@ fn messages_say_what_happened() {
     std::fs::write(dir.join("bom.json"), bom).unwrap();
     ok(
         &dir,
-        &[
-            "validate",
-            "--machine",
-            "seed-ac",
-            "--params",
-            "bom.json",
-            "--data",
-            "k4.csv",
-        ],
+        &words("validate --machine seed-ac --params bom.json --data k4.csv"),
     );
     let mut bad = json.clone();
     let at = bad.iter().position(|&b| b == b'\n').unwrap() + 3;
@@ -865,47 +615,19 @@ fn messages_say_what_happened() {
     std::fs::write(dir.join("bad.json"), bad).unwrap();
     fails(
         &dir,
-        &[
-            "validate",
-            "--machine",
-            "seed-ac",
-            "--params",
-            "bad.json",
-            "--data",
-            "k4.csv",
-        ],
+        &words("validate --machine seed-ac --params bad.json --data k4.csv"),
         1,
         &["--params: bad.json:2:3: not UTF-8 text (byte 0xff)"],
     );
     // The seed has one range everywhere.
     fails(
         &dir,
-        &[
-            "simulate",
-            "--machine",
-            "seed-ac",
-            "--path",
-            "K4",
-            "--seed",
-            "9223372036854775808",
-            "-o",
-            "s.csv",
-        ],
+        &words("simulate --machine seed-ac --path K4 --seed 9223372036854775808 -o s.csv"),
         2,
         &["--seed"],
     );
     ok(
         &dir,
-        &[
-            "simulate",
-            "--machine",
-            "seed-ac",
-            "--path",
-            "K4",
-            "--seed",
-            "9223372036854775807",
-            "-o",
-            "s.csv",
-        ],
+        &words("simulate --machine seed-ac --path K4 --seed 9223372036854775807 -o s.csv"),
     );
 }

@@ -88,4 +88,4 @@ pub use machine::{
     Axis, AxisId, AxisKind, Chain, FULL_MODEL, Link, Machine, Offset, Side, SubModel, Symbol,
     SymbolId, Value,
 };
-pub use validate::{parse_machine, reserved_names};
+pub use validate::{RUST_KEYWORDS, parse_machine, reserved_names};

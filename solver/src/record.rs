@@ -44,6 +44,21 @@ impl Record {
     }
 }
 
+/// The samples of commands (per sample, one per axis: mm, rad), times (s) and directions of
+/// motion, zipped (the shortest of the three sets the count).
+pub fn samples_from(commands: Vec<Vec<f64>>, times: Vec<f64>, motion: Vec<Vec<i8>>) -> Vec<Sample> {
+    commands
+        .into_iter()
+        .zip(times)
+        .zip(motion)
+        .map(|((commands, t), motion)| Sample {
+            commands,
+            t,
+            motion,
+        })
+        .collect()
+}
+
 /// The direction of motion of every axis at every sample of a sequence of commanded poses:
 /// the sign of the last non-zero move of the axis up to that sample; +1 before the first move.
 pub fn motion_directions(commands: &[Vec<f64>]) -> Vec<Vec<i8>> {

@@ -111,3 +111,9 @@ pub fn ok(dir: &Path, args: &[&str]) -> String {
 pub fn fails(dir: &Path, args: &[&str], code: i32, needles: &[&str]) -> String {
     check_fails(&run(Some(dir), args), args, code, needles)
 }
+
+/// The words of a command line written as one string (`"identify --machine seed-ac"`); for
+/// arguments without spaces.
+pub fn words(line: &str) -> Vec<&str> {
+    line.split_whitespace().collect()
+}

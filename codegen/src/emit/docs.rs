@@ -43,6 +43,19 @@ fn precondition() -> Vec<String> {
     .to_vec()
 }
 
+/// What the docs of `gains` and `position_gains` end with: the arguments, the precondition and
+/// the operation counts.
+fn common_tail(counts: OpCounts, reads_pose: bool, reads_params: bool) -> Vec<String> {
+    let mut lines = arguments(reads_pose, reads_params);
+    lines.push(String::new());
+    lines.extend(precondition());
+    lines.push(String::new());
+    lines.push(format!(
+        " Straight-line code, no allocation, no branches: {counts}."
+    ));
+    lines
+}
+
 /// The doc of a model's `gains`.
 pub fn gains(n: usize, counts: OpCounts, reads_pose: bool, reads_params: bool) -> Vec<String> {
     let mut lines = vec![
@@ -59,13 +72,7 @@ pub fn gains(n: usize, counts: OpCounts, reads_pose: bool, reads_params: bool) -
         " per mm of a translational error, per rad of an angular error.".to_string(),
         String::new(),
     ];
-    lines.extend(arguments(reads_pose, reads_params));
-    lines.push(String::new());
-    lines.extend(precondition());
-    lines.push(String::new());
-    lines.push(format!(
-        " Straight-line code, no allocation, no branches: {counts}."
-    ));
+    lines.extend(common_tail(counts, reads_pose, reads_params));
     lines
 }
 
@@ -81,13 +88,7 @@ pub fn position_gains(counts: OpCounts, reads_pose: bool, reads_params: bool) ->
         " orientation rows are not computed.".to_string(),
         String::new(),
     ];
-    lines.extend(arguments(reads_pose, reads_params));
-    lines.push(String::new());
-    lines.extend(precondition());
-    lines.push(String::new());
-    lines.push(format!(
-        " Straight-line code, no allocation, no branches: {counts}."
-    ));
+    lines.extend(common_tail(counts, reads_pose, reads_params));
     lines
 }
 

@@ -13,15 +13,6 @@ use crate::ir::{Input, Op, Program};
 use proc_macro2::{Ident, Span};
 use std::collections::HashSet;
 
-/// Rust's strict and reserved keywords (2024 edition): no local may be named one of these.
-const KEYWORDS: &[&str] = &[
-    "Self", "abstract", "as", "async", "await", "become", "box", "break", "const", "continue",
-    "crate", "do", "dyn", "else", "enum", "extern", "false", "final", "fn", "for", "gen", "if",
-    "impl", "in", "let", "loop", "macro", "match", "mod", "move", "mut", "override", "priv", "pub",
-    "ref", "return", "self", "static", "struct", "super", "trait", "true", "try", "type", "typeof",
-    "unsafe", "unsized", "use", "virtual", "where", "while", "yield",
-];
-
 /// The arguments of the generated functions, which a local must not shadow.
 const ARGUMENTS: &[&str] = &["pose", "params", "out"];
 
@@ -59,7 +50,7 @@ fn is_intermediate(name: &str) -> bool {
 
 /// `true` for a name no input may take as it is.
 fn is_reserved(name: &str) -> bool {
-    KEYWORDS.contains(&name) || ARGUMENTS.contains(&name) || is_intermediate(name)
+    model_spec::RUST_KEYWORDS.contains(&name) || ARGUMENTS.contains(&name) || is_intermediate(name)
 }
 
 /// The local name of every input, in order (see the module documentation for the rules).

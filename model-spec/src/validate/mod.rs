@@ -9,7 +9,7 @@ mod models;
 mod names;
 mod numbers;
 
-pub use names::reserved_names;
+pub use names::{RUST_KEYWORDS, reserved_names};
 
 use crate::catalogue::build_catalogue;
 use crate::error::SpecError;

@@ -28,8 +28,9 @@ fn is_identifier(s: &str) -> bool {
 }
 
 /// Rust's strict and reserved keywords (2024 edition): generated code uses symbol names as
-/// field names and model names as module names, so neither may be one of these.
-const RUST_KEYWORDS: &[&str] = &[
+/// field names and model names as module names, so neither may be one of these (and the code
+/// generator names no local one of these).
+pub const RUST_KEYWORDS: &[&str] = &[
     "Self", "abstract", "as", "async", "await", "become", "box", "break", "const", "continue",
     "crate", "do", "dyn", "else", "enum", "extern", "false", "final", "fn", "for", "gen", "if",
     "impl", "in", "let", "loop", "macro", "match", "mod", "move", "mut", "override", "priv", "pub",

@@ -3,7 +3,7 @@
 use super::dictionary::DictionaryOptions;
 use crate::fitting::Tolerances;
 
-/// Options of [`diagnose`] (`DiagnoseOptions::default()`, then set the fields wanted).
+/// Options of [`super::diagnose()`] (`DiagnoseOptions::default()`, then set the fields wanted).
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct DiagnoseOptions {

@@ -1,6 +1,6 @@
 //! Identification of a model on a record: the H matrix of the model (with the sensor zero
 //! offsets `dx0 dy0 dz0` when the readings were zeroed), the least-squares fit of
-//! [`super::least_squares`], and what the offsets swallow. First order; [`super::refine`]
+//! [`super::least_squares()`], and what the offsets swallow. First order; [`super::refine`]
 //! refines it against the exact machine.
 
 use super::hmatrix::{Backend, GainSource, h_matrix, parameter_names};

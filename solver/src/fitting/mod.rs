@@ -3,7 +3,7 @@
 //!
 //! - [`hmatrix`]: the design matrix of a model on a record, with gains from compiled code or
 //!   the in-process evaluator ([`hmatrix::GainSource`]);
-//! - [`least_squares`]: column-scaled least squares with a stated numerical rank,
+//! - [`mod@least_squares`]: column-scaled least squares with a stated numerical rank,
 //!   uncertainties, and no number for what the data cannot determine;
 //! - [`mod@identify`]: a model identified on a record (first order), with what the sensor
 //!   offsets swallow;

@@ -11,12 +11,22 @@
 //! repeat: r = y − exact(v);  Δ = H⁺ r  (same scaling, rank and constraint as the fit);  v ← v + Δ
 //! ```
 //!
-//! where `exact(v)` is the virtual machine ([`crate::simulation::readings`]) with the model's terms at the
-//! values `v`. `v` is the whole minimum-norm solution, undetermined parameters included (one
-//! representative of each confounded group, as in `H·v`); they get no reported value. The iteration contracts by the ratio of the
-//! second-order to the first-order terms (about 1e-4), so two or three steps reach rounding.
-//! With zeroed readings the sensor offsets are terms of the model like any other, so the
-//! prediction is `exact(v) + d0` exactly as the linear model has it.
+//! where `exact(v)` is the virtual machine ([`crate::simulation::readings`]) with the model's
+//! terms at the values `v`. `v` is the whole minimum-norm solution, undetermined parameters
+//! included (one representative of each confounded group, as in `H·v`); they get no reported
+//! value. The iteration contracts by the ratio of the second-order to the first-order terms
+//! (about 1e-4), so two or three steps reach rounding. With zeroed readings the sensor offsets
+//! are terms of the model like any other, so the prediction is `exact(v) + d0` exactly as the
+//! linear model has it.
+//!
+//! A step is measured by the largest change of the prediction it makes, `‖H·Δ‖∞` (mm), and the
+//! iteration has converged when a step is below [`RefineOptions::tolerance_mm`] (1e-12 mm), or
+//! below the rounding floor `64·ε·κ·‖y‖∞` of an ill-conditioned fit when that is larger (a
+//! least-squares solution is rounded by about ε·κ relative). Otherwise, after
+//! [`RefineOptions::max_iterations`] steps (8), it has not converged: a slow or diverging
+//! iteration (noisy readings of a few samples give first-order values far from any machine,
+//! where the second-order terms are no longer small), which is reported as such, never as a
+//! result.
 //!
 //! After convergence the fit's residual, σ̂, uncertainties and covariance are those of the exact
 //! residual; the identifiability analysis is unchanged (it depends on H only).
@@ -33,13 +43,19 @@ use crate::simulation::truth::Truth;
 use model_spec::Machine;
 use nalgebra::DVector;
 
+/// The rounding floor of a refinement step, in units of `ε·κ·‖y‖∞` (ε the machine epsilon, κ
+/// the condition number of the scaled H, `y` the readings): measured on ill-conditioned fits of
+/// a few samples, the steps settle at 5–20 of these units; 64 leaves a margin.
+pub const ROUNDING_FLOOR_FACTOR: f64 = 64.0;
+
 /// How far to refine (`RefineOptions::default()`, then set the fields wanted).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct RefineOptions {
     /// Most Gauss–Newton steps.
     pub max_iterations: usize,
-    /// Stop when no correction moves the prediction by more than this (mm).
+    /// Stop when no correction moves the prediction by more than this (mm), or by more than the
+    /// rounding floor ([`ROUNDING_FLOOR_FACTOR`]) when that is larger.
     pub tolerance_mm: f64,
 }
 
@@ -76,12 +92,14 @@ impl Default for RefineOptions {
 pub struct Refinement {
     /// Steps taken.
     pub iterations: usize,
-    /// Per step, the largest change of the prediction any correction makes: `max_j |Δ_j|·‖h_j‖∞`
-    /// (mm).
+    /// Per step, the largest change of the prediction at any reading: `‖H·Δ‖∞` (mm).
     pub steps_mm: Vec<f64>,
+    /// The tolerance the steps were compared with: [`RefineOptions::tolerance_mm`], or the
+    /// rounding floor of an ill-conditioned fit when that is larger (mm).
+    pub tolerance_mm: f64,
     /// `true` when the last step was below the tolerance. `false` when the iteration limit was
-    /// reached or a step grew (divergence): the values are then not an identification, and
-    /// callers must not report them as one.
+    /// reached first (a slow or diverging iteration): the values are then not an
+    /// identification, and callers must not report them as one.
     pub converged: bool,
     /// Residual RMS of the linear fit and of the refined one (mm, over 3N rows).
     pub rms_mm: (f64, f64),
@@ -146,7 +164,12 @@ pub fn refine(
     let rows = y.len().max(1) as f64;
     let linear_rms = (ident.fit.rss / rows).sqrt();
     let params = source.params().to_vec();
-    let influence: Vec<f64> = (0..h.ncols()).map(|j| h.column(j).amax()).collect();
+    // The rounding floor of a correction: relative rounding of the least-squares solution is
+    // about ε·κ, so its prediction cannot settle below a multiple of ε·κ·‖y‖∞. A step below
+    // the floor is rounding, not a correction.
+    let kappa = ident.fit.condition.unwrap_or(1.0);
+    let floor = ROUNDING_FLOOR_FACTOR * f64::EPSILON * kappa * y.amax();
+    let tolerance = opts.tolerance_mm.max(floor);
     // Iterate on the whole minimum-norm solution, undetermined parameters included: it is what
     // the linear model's prediction is made of. Which values are reported is decided at the end.
     let mut x = ident.fit.solution.clone();
@@ -161,25 +184,19 @@ pub fn refine(
         let r = residual(&x)?;
         let correction =
             least_squares(&h, &r, &ident.fit.names, &ident.fit.constraint, tolerances)?;
-        let mut step = 0.0f64;
-        for (j, (v, d)) in x.iter_mut().zip(&correction.solution).enumerate() {
+        for (v, d) in x.iter_mut().zip(&correction.solution) {
             *v += d;
-            step = step.max(d.abs() * influence[j]);
         }
+        // The largest change of the prediction at any reading.
+        let step = (&h * DVector::from_column_slice(&correction.solution)).amax();
         if !step.is_finite() || x.iter().any(|v| !v.is_finite()) {
             return Err(RefineError::NotFinite {
                 iterations: steps.len() + 1,
             });
         }
-        let growing = steps.last().is_some_and(|&last| step > last);
         steps.push(step);
-        if step <= opts.tolerance_mm {
+        if step <= tolerance {
             converged = true;
-            break;
-        }
-        if growing {
-            // Gauss–Newton contracts by the ratio of the second- to the first-order terms; a
-            // step larger than the one before means it is diverging.
             break;
         }
     }
@@ -198,6 +215,7 @@ pub fn refine(
     fit.solution = x;
     ident.fit = fit;
     Ok(Refinement {
+        tolerance_mm: tolerance,
         iterations: steps.len(),
         steps_mm: steps,
         converged,
@@ -205,7 +223,7 @@ pub fn refine(
     })
 }
 
-/// Identifies `model` on `record` ([`crate::fitting::identify`], with the gain source it
+/// Identifies `model` on `record` ([`crate::fitting::identify()`], with the gain source it
 /// needs built here) and refines the result against the exact machine ([`refine`], with the
 /// identification's tolerances). A refinement that did not converge is returned with
 /// [`Refinement::converged`] `false`.

@@ -71,7 +71,7 @@ impl StreamingQr {
         self.r.len() * std::mem::size_of::<f64>()
     }
 
-    /// The least-squares fit of all rows seen (see [`crate::fitting::least_squares`]).
+    /// The least-squares fit of all rows seen (see [`crate::fitting::least_squares()`]).
     pub fn solve(
         &self,
         names: &[String],
@@ -152,7 +152,7 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
 
 /// Identifies `model` of `m` from the measurement CSV at `path`, read in blocks of `block`
 /// samples with `read` (never the whole record, never the whole H): first-order least
-/// squares, with the options of [`crate::fitting::identify`] (zeroed readings add
+/// squares, with the options of [`crate::fitting::identify()`] (zeroed readings add
 /// `dx0 dy0 dz0`). A model with `time:K` terms costs one more pass over the file for the
 /// record's time span. Fewer readings than parameters plus one is an error, as in memory.
 pub fn identify_file(

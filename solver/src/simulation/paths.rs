@@ -23,7 +23,7 @@
 //! [`ReadOptions`]. The built-in paths lie within the strokes and ranges of `seed-ac`.
 
 use crate::io::csv::{CsvError, Need, ReadOptions, read_csv};
-use crate::record::{Record, Sample, motion_directions};
+use crate::record::{Record, motion_directions, samples_from};
 use crate::simulation::exact::{ExactError, VirtualMachine};
 use model_spec::Machine;
 
@@ -227,16 +227,7 @@ pub fn record_from_commands(commands: Vec<Vec<f64>>, times: Vec<f64>) -> Record 
     assert_eq!(commands.len(), times.len(), "one time per sample");
     let motion = motion_directions(&commands);
     Record {
-        samples: commands
-            .into_iter()
-            .zip(times)
-            .zip(motion)
-            .map(|((commands, t), motion)| Sample {
-                commands,
-                t,
-                motion,
-            })
-            .collect(),
+        samples: samples_from(commands, times, motion),
         measured: Vec::new(),
     }
 }

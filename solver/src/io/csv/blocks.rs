@@ -4,7 +4,7 @@ use crate::io::csv::checks::SampleChecks;
 use crate::io::csv::lines::Lines;
 use crate::io::csv::read::{Header, RowIk, header_only, is_data, read_header};
 use crate::io::csv::{CsvError, Ctx, Need, ReadOptions};
-use crate::record::{Record, Sample};
+use crate::record::{Record, samples_from};
 use model_spec::Machine;
 use std::io::Read;
 use std::path::Path;
@@ -162,16 +162,7 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
             commands.last().cloned().unwrap_or_default(),
             motion.last().cloned().unwrap_or_default(),
         ));
-        let samples = commands
-            .into_iter()
-            .zip(times)
-            .zip(motion)
-            .map(|((commands, t), motion)| Sample {
-                commands,
-                t,
-                motion,
-            })
-            .collect();
+        let samples = samples_from(commands, times, motion);
         Ok(Some(Record { samples, measured }))
     }
 }

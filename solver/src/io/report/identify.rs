@@ -66,8 +66,12 @@ pub struct RefinementReport {
     /// linear solution is exact). An identification that did not converge is not a result:
     /// `rtest identify` refuses it (exit code 3) and writes no file.
     pub converged: bool,
-    /// Per step, the largest change of the prediction any correction made, µm.
+    /// Per step, the largest change of the prediction at any reading, µm.
     pub steps_um: Vec<f64>,
+    /// The tolerance the steps were compared with, µm (1e-9 µm, or the rounding floor of an
+    /// ill-conditioned fit when larger); absent for `first-order`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance_um: Option<f64>,
     /// Residual RMS of the first-order fit, µm.
     pub first_order_rms_um: f64,
 }
@@ -208,6 +212,10 @@ impl IdentificationReport {
                     .enumerate()
                     .map(|(i, s)| finite(|| format!("refinement.steps_um[{i}]"), s * UM_PER_MM))
                     .collect::<Result<_, _>>()?,
+                tolerance_um: Some(finite(
+                    || "refinement.tolerance_um".into(),
+                    r.tolerance_mm * UM_PER_MM,
+                )?),
                 first_order_rms_um: finite(
                     || "refinement.first_order_rms_um".into(),
                     r.rms_mm.0 * UM_PER_MM,
@@ -218,6 +226,7 @@ impl IdentificationReport {
                 iterations: 0,
                 converged: true,
                 steps_um: Vec::new(),
+                tolerance_um: None,
                 first_order_rms_um: finite(
                     || "refinement.first_order_rms_um".into(),
                     fit.residual_rms() * UM_PER_MM,

@@ -61,7 +61,7 @@ use model_spec::{AxisKind, Machine};
 pub use numbers::{degrees_for, format_scaled, parse_scaled};
 use std::path::Path;
 pub use whole::{parse_csv, read_csv};
-pub use write::{format_record, write_atomically, write_record};
+pub use write::format_record;
 
 /// How the readers judge a file: the bounds of what they accept.
 ///

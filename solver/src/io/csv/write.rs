@@ -4,8 +4,6 @@
 use crate::io::csv::{CsvError, MEASURED, column_order, degrees_for, format_scaled};
 use crate::record::Record;
 use model_spec::{AxisKind, Machine};
-use std::io::Write;
-use std::path::Path;
 
 /// The CSV text of `record` of machine `m`: `comments` as `# ` lines, then the header
 /// (axes as in [`column_order`], `dx_um,dy_um,dz_um` when the record is measured, `t_s`), then
@@ -78,54 +76,4 @@ pub fn format_record(
         out.push('\n');
     }
     Ok(out)
-}
-
-/// Writes `record` of machine `m` to `path` atomically (see [`format_record`]).
-///
-/// # Errors
-/// See [`format_record`]; [`CsvError::Io`] when the file cannot be written (then nothing is
-/// left behind).
-pub fn write_record(
-    path: &Path,
-    m: &Machine,
-    record: &Record,
-    comments: &[String],
-) -> Result<(), CsvError> {
-    let text = format_record(m, record, comments)?;
-    write_atomically(path, text.as_bytes()).map_err(|source| CsvError::Io {
-        file: path.display().to_string(),
-        source,
-    })
-}
-
-/// Writes `bytes` to `path` atomically: to a temporary file in the same directory, flushed to
-/// disk, then renamed over `path`. On failure the temporary file is removed and `path` is
-/// untouched.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let name = path
-        .file_name()
-        .ok_or_else(|| std::io::Error::other("the path names no file"))?
-        .to_string_lossy();
-    let tmp = dir.join(format!(
-        ".{name}.tmp-{}-{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }

@@ -2,7 +2,7 @@
 //! paths for any machine from a CSV file, and the nominal tool-centre-point inverse kinematics
 //! that fills the linear commands.
 //!
-//! Built-in paths (DESIGN.md; the seed's sample counts, ISO 10791-6 style), sample `i`:
+//! Built-in paths (docs/conventions.md; the seed's sample counts, ISO 10791-6 style), sample `i`:
 //! - `K1`: `C = i°`, `A = 0°`, `i = 0…360` (361 samples);
 //! - `K2`: `A = (−90 + i)°`, `C = 0°`, `i = 0…120` (121 samples);
 //! - `K4`: `C = 1.5·i°`, `A = −45·(1 − cos C)°`, `i = 0…240` (241 samples; all five axes move).

@@ -1,4 +1,4 @@
-//! The R-test measurement CSV (DESIGN.md): read and written.
+//! The R-test measurement CSV (docs/conventions.md): read and written.
 //!
 //! One row a sample; the header names the columns, in any order:
 //! - one column per axis of the machine, named after it (`X,Y,Z,A,C` for `seed-ac`): linear

@@ -23,14 +23,12 @@ struct Staged {
     ino: u64,
 }
 
-/// A file replaced by its temporary.
+/// A file replaced by its temporary (the undo of the rename is registered with it in
+/// [`temp`], where a signal finds it too).
 struct Replaced {
-    path: PathBuf,
     /// A hard link to the file that was replaced (none if the file was new, or if the link
     /// could not be made).
     backup: Option<PathBuf>,
-    existed: bool,
-    ino: u64,
 }
 
 /// A file written in place, with its old contents if they could be read.
@@ -42,6 +40,8 @@ struct Rewritten {
 /// What has been done so far, to undo it.
 #[derive(Default)]
 struct Transaction {
+    /// Its number in the registry of renames to undo ([`temp::transaction`]).
+    id: u64,
     created_dirs: Vec<PathBuf>,
     staged: Vec<Staged>,
     replaced: Vec<Replaced>,
@@ -50,7 +50,10 @@ struct Transaction {
 
 /// Writes `contents[i]` to `planned[i]` for every `i`, all or none (see the crate docs).
 pub(crate) fn write(planned: &[Planned], contents: &[&[u8]]) -> Result<(), WriteError> {
-    let mut tx = Transaction::default();
+    let mut tx = Transaction {
+        id: temp::transaction(),
+        ..Transaction::default()
+    };
     if let Err(e) = tx.files(planned, contents) {
         tx.roll_back();
         return Err(e);
@@ -152,7 +155,14 @@ impl Transaction {
                 (true, Some(name)) => temp::backup(&s.path, &dir, name).ok(),
                 _ => None,
             };
-            if let Err(e) = temp::rename(&s.temp, &s.path) {
+            if let Err(e) = temp::replace(
+                self.id,
+                &s.temp,
+                &s.path,
+                backup.as_deref(),
+                s.existed,
+                s.ino,
+            ) {
                 if let Some(b) = &backup {
                     temp::remove(b);
                 }
@@ -160,12 +170,8 @@ impl Transaction {
                 self.staged.insert(0, s);
                 return Err((index, e));
             }
-            self.replaced.push(Replaced {
-                path: s.path,
-                backup,
-                existed: s.existed,
-                ino: s.ino,
-            });
+            self.replaced.push(Replaced { backup });
+            testing::after_rename();
             dirs.insert(dir);
         }
         // Makes the renames durable (best effort: not every file system syncs directories).
@@ -193,11 +199,12 @@ impl Transaction {
 
     /// Every file is in place: the backups go.
     fn commit(self) {
-        for r in &self.replaced {
-            if let Some(b) = &r.backup {
-                temp::remove(b);
-            }
-        }
+        let backups: Vec<PathBuf> = self
+            .replaced
+            .iter()
+            .filter_map(|r| r.backup.clone())
+            .collect();
+        temp::commit_renames(self.id, &backups);
         for d in &self.created_dirs {
             temp::keep_dir(d);
         }
@@ -217,20 +224,9 @@ impl Transaction {
                     });
             }
         }
-        for r in self.replaced.iter().rev() {
-            if let Some(b) = &r.backup {
-                // If it cannot be put back, the backup is the old contents: it stays.
-                if temp::rename(b, &r.path).is_err() {
-                    temp::forget(b);
-                }
-            } else if !r.existed {
-                // Only the file this call created, not one that appeared since.
-                let ours = fs::symlink_metadata(&r.path).is_ok_and(|m| m.ino() == r.ino);
-                if ours {
-                    let _ = fs::remove_file(&r.path);
-                }
-            }
-        }
+        // The renames, newest first: backups put back, new files removed (only the file this
+        // call created, not one that appeared since).
+        temp::undo_renames(self.id);
         for s in &self.staged {
             temp::remove(&s.temp);
         }

@@ -63,20 +63,24 @@
 //! writes midway may refuse it too; a backup that cannot be put back is left beside its file,
 //! holding the old contents, rather than removed); a backup link cannot be made on a file
 //! system without hard links, and then that file cannot be put back; a crash or `SIGKILL` in
-//! steps 3–4 leaves what was done so far; the checks and the writes are not one atomic step
+//! steps 3–4 leaves what was done so far (SIGINT and SIGTERM undo it: see below); the checks and the writes are not one atomic step
 //! against other processes changing the same files; and a stream, once written, cannot be
 //! taken back — which is why streams come last and an error writing one leaves the files
 //! written.
 //!
 //! # Signals
 //!
-//! Every temporary and backup, and every directory created for the outputs, is registered
-//! process-wide until it is kept or removed. When the first one is created, SIGINT and SIGTERM
-//! get a watcher (unless they are ignored or handled already): on either signal it removes
-//! every registered temporary (and each registered directory left empty) and then ends the
-//! process by the signal's default action, so the parent still sees death by that signal. No file work is
-//! done inside a signal handler. `SIGKILL` cannot be caught: it may leave a temporary behind
-//! (a hidden `.*.rtest-*.tmp` file that is safe to delete).
+//! Every temporary and backup, every directory created for the outputs, and the undo of every
+//! rename not yet final, is registered process-wide. When the first temporary is created,
+//! SIGINT and SIGTERM get a watcher (unless they are ignored or handled already): on either
+//! signal it first undoes the renames of step 3 not yet final (the replaced files get their old
+//! contents back from their backups, the files that did not exist are removed), then removes
+//! every registered temporary (and each registered directory left empty), and then ends the
+//! process by the signal's default action, so the parent still sees death by that signal. So
+//! an interrupted command leaves its regular files all old, not some new and some old. An
+//! in-place write of a hard-linked file (step 4) interrupted by a signal is not undone, nor is
+//! a stream. No file work is done inside a signal handler. `SIGKILL` cannot be caught: it may
+//! leave a temporary behind (a hidden `.*.rtest-*.tmp` file that is safe to delete).
 //!
 //! # Example
 //!

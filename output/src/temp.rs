@@ -20,6 +20,7 @@ use std::fs::{self, File, OpenOptions};
 use std::hash::{BuildHasher, Hasher};
 use std::io;
 use std::os::unix::ffi::{OsStrExt, OsStringExt};
+use std::os::unix::fs::MetadataExt;
 use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -36,18 +37,68 @@ const ATTEMPTS: usize = 100;
 /// name stays within the 255 bytes a directory entry allows.
 const NAME_BYTES: usize = 200;
 
+/// How to undo one rename of a temporary over its file.
+enum Step {
+    /// Put the backup link of the file's old contents back.
+    Restore { backup: PathBuf, target: PathBuf },
+    /// Remove the file, which did not exist before (if it is still the one made, inode `ino`).
+    Created { target: PathBuf, ino: u64 },
+}
+
+/// The undo of one rename, with the transaction it belongs to (several `write_all` may run at
+/// once in one process, on several threads).
+struct Undo {
+    transaction: u64,
+    step: Step,
+}
+
+/// A fresh transaction number for [`replace`], [`undo_renames`] and [`commit_renames`].
+pub(crate) fn transaction() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
+
 /// What this process has created and not yet kept or removed, as absolute paths.
 pub(crate) struct Live {
     /// Temporaries and backups.
     files: Vec<PathBuf>,
     /// Directories created for outputs (removed only if empty).
     dirs: Vec<PathBuf>,
+    /// The renames of a transaction not yet committed, oldest first.
+    undo: Vec<Undo>,
 }
 
 impl Live {
-    /// Removes every registered temporary, then every registered directory that is empty,
-    /// newest first; the caller keeps the lock so that nothing new can be created after.
+    /// Undoes the renames not yet committed of `transaction` (every one for `None`), newest
+    /// first (a backup that cannot be put back is the only copy of the old contents: it stays,
+    /// forgotten).
+    fn undo_renames(&mut self, transaction: Option<u64>) {
+        let mut i = self.undo.len();
+        while i > 0 {
+            i -= 1;
+            if transaction.is_some_and(|t| self.undo[i].transaction != t) {
+                continue;
+            }
+            match self.undo.remove(i).step {
+                Step::Restore { backup, target } => {
+                    // Put back, or left where it is if that fails: forgotten either way.
+                    let _ = fs::rename(&backup, &target);
+                    self.files.retain(|p| *p != backup);
+                }
+                Step::Created { target, ino } => {
+                    if fs::symlink_metadata(&target).is_ok_and(|m| m.ino() == ino) {
+                        let _ = fs::remove_file(&target);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Undoes the renames not yet committed, then removes every registered temporary and every
+    /// registered directory that is empty, newest first; the caller keeps the lock so that
+    /// nothing new can be created after.
     pub(crate) fn remove_all(&mut self) {
+        self.undo_renames(None);
         for path in self.files.drain(..) {
             let _ = fs::remove_file(path);
         }
@@ -60,6 +111,7 @@ impl Live {
 static LIVE: Mutex<Live> = Mutex::new(Live {
     files: Vec::new(),
     dirs: Vec::new(),
+    undo: Vec::new(),
 });
 
 /// The registry, locked; a panic elsewhere while holding it does not make it unusable.
@@ -149,12 +201,48 @@ pub(crate) fn backup(file: &Path, dir: &Path, name: &OsStr) -> io::Result<PathBu
     create_with(dir, name, "bak", |path| fs::hard_link(file, path))
 }
 
-/// Renames the registered `temp` to `to` and forgets it.
-pub(crate) fn rename(temp: &Path, to: &Path) -> io::Result<()> {
+/// Renames the registered `temp` over its file `to`, forgets it, and records how to undo it in
+/// `transaction`: put `backup` (a registered link to the old contents) back, or, for a file
+/// that did not exist before (`existed` false), remove the new one (inode `ino`). A file that
+/// existed and has no backup cannot be undone.
+pub(crate) fn replace(
+    transaction: u64,
+    temp: &Path,
+    to: &Path,
+    backup: Option<&Path>,
+    existed: bool,
+    ino: u64,
+) -> io::Result<()> {
     let mut live = lock();
     fs::rename(temp, to)?;
     live.files.retain(|p| p != temp);
+    let target = to.to_path_buf();
+    let step = match (backup, existed) {
+        (Some(b), _) => Step::Restore {
+            backup: b.to_path_buf(),
+            target,
+        },
+        (None, false) => Step::Created { target, ino },
+        (None, true) => return Ok(()),
+    };
+    live.undo.push(Undo { transaction, step });
     Ok(())
+}
+
+/// Undoes every rename of `transaction` not yet committed, newest first (the roll-back of a
+/// failed write; a signal undoes those of every transaction).
+pub(crate) fn undo_renames(transaction: u64) {
+    lock().undo_renames(Some(transaction));
+}
+
+/// The renames of `transaction` are final: forgets how to undo them and removes the `backups`.
+pub(crate) fn commit_renames(transaction: u64, backups: &[PathBuf]) {
+    let mut live = lock();
+    live.undo.retain(|u| u.transaction != transaction);
+    for b in backups {
+        let _ = fs::remove_file(b);
+        live.files.retain(|p| p != b);
+    }
 }
 
 /// Removes the registered `temp` (best effort) and forgets it.
@@ -162,12 +250,6 @@ pub(crate) fn remove(temp: &Path) {
     let mut live = lock();
     let _ = fs::remove_file(temp);
     live.files.retain(|p| p != temp);
-}
-
-/// Forgets the registered `path` without removing it (a backup that could not be put back,
-/// which holds the only copy of a file's old contents).
-pub(crate) fn forget(path: &Path) {
-    lock().files.retain(|p| p != path);
 }
 
 /// Creates the directory `dir` and registers it; `Ok(None)` if it exists already.

@@ -1,5 +1,5 @@
-//! Hooks for this crate's own tests; not part of the API. Both are per thread, so tests running
-//! in parallel threads do not see each other's hooks, and both are off unless a test sets them.
+//! Hooks for this crate's own tests; not part of the API. They are per thread, so tests running
+//! in parallel threads do not see each other's hooks, and they are off unless a test sets them.
 
 use std::cell::RefCell;
 use std::ffi::{OsStr, OsString};
@@ -10,6 +10,7 @@ type Hook = Box<dyn Fn()>;
 thread_local! {
     static NAME_SOURCE: RefCell<Option<NameSource>> = const { RefCell::new(None) };
     static AFTER_STAGING: RefCell<Option<Hook>> = const { RefCell::new(None) };
+    static AFTER_RENAME: RefCell<Option<Hook>> = const { RefCell::new(None) };
 }
 
 /// Makes this thread's temporary and backup names use the bits `source` returns instead of
@@ -22,6 +23,12 @@ pub fn set_name_source(source: Option<NameSource>) {
 /// rename (`None`: no hook), so that a test can change the file system or send a signal there.
 pub fn set_after_staging(hook: Option<Hook>) {
     AFTER_STAGING.with(|h| *h.borrow_mut() = hook);
+}
+
+/// Runs `hook` on this thread after every rename of a temporary over its file (`None`: no
+/// hook), so that a test can send a signal between two renames.
+pub fn set_after_rename(hook: Option<Hook>) {
+    AFTER_RENAME.with(|h| *h.borrow_mut() = hook);
 }
 
 /// The name of the temporary for a file `name` whose unpredictable part is `bits`.
@@ -40,6 +47,14 @@ pub(crate) fn next_name_bits() -> Option<u64> {
 
 pub(crate) fn after_staging() {
     AFTER_STAGING.with(|h| {
+        if let Some(hook) = h.borrow().as_ref() {
+            hook();
+        }
+    });
+}
+
+pub(crate) fn after_rename() {
+    AFTER_RENAME.with(|h| {
         if let Some(hook) = h.borrow().as_ref() {
             hook();
         }

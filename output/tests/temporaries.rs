@@ -178,3 +178,73 @@ fn sigint_while_staged_leaves_no_temporary() {
     }
     killed_while_staged(TEST, libc::SIGINT);
 }
+
+/// The child's part of the rename test: replace `a.csv` and `b.csv` and create `new.json`;
+/// after the first rename, tell the parent and wait to be killed.
+fn rename_and_wait() {
+    let dir = child_dir();
+    let marker = dir.join("renamed");
+    testing::set_after_rename(Some(Box::new(move || {
+        fs::write(&marker, "").unwrap();
+        loop {
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    })));
+    let mut o = Outputs::new();
+    o.add("-o", Target::Path(dir.join("a.csv")), "new a");
+    o.add("--json", Target::Path(dir.join("new.json")), "{}");
+    o.add("--other", Target::Path(dir.join("b.csv")), "new b");
+    let _ = o.write_all();
+    std::process::exit(3); // never reached: the hook waits for the signal
+}
+
+/// A signal between two renames undoes the renames already done: all outputs or none.
+#[test]
+fn sigterm_between_renames_puts_the_old_files_back() {
+    const TEST: &str = "sigterm_between_renames_puts_the_old_files_back";
+    if is_child(TEST) {
+        rename_and_wait();
+    }
+    let dir = TestDir::new(TEST);
+    dir.file("a.csv", "old a");
+    dir.file("b.csv", "old b");
+    let original = snapshot(&dir.path);
+    let exe = std::env::current_exe().unwrap();
+    let mut child = child_command(&exe, TEST, &dir.path)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    if !wait_until(Duration::from_secs(20), || dir.join("renamed").exists()) {
+        let _ = child.kill();
+        let _ = child.wait();
+        panic!("the child never renamed an output");
+    }
+    // One file is replaced already.
+    assert_eq!(read(&dir.join("a.csv")), "new a");
+    let pid = child.id() as libc::pid_t;
+    // SAFETY: sends a signal to the child this test started.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
+    let mut status = None;
+    wait_until(Duration::from_secs(20), || {
+        status = child.try_wait().unwrap();
+        status.is_some()
+    });
+    let Some(status) = status else {
+        let _ = child.kill();
+        let _ = child.wait();
+        panic!("the child did not end on the signal");
+    };
+    assert_eq!(status.signal(), Some(libc::SIGTERM), "{status}");
+    assert_eq!(read(&dir.join("a.csv")), "old a");
+    assert_eq!(read(&dir.join("b.csv")), "old b");
+    assert!(!dir.join("new.json").exists());
+    assert!(
+        leftovers(&dir.path).is_empty(),
+        "{:?}",
+        leftovers(&dir.path)
+    );
+    let mut after = snapshot(&dir.path);
+    after.remove(std::path::Path::new("renamed"));
+    assert_only_changed(&original, &after, &[]);
+}

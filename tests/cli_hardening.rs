@@ -420,6 +420,24 @@ fn poses_off_stroke_or_off_the_ball_are_refused_unless_allowed() {
         &dir,
         &words("simulate --machine seed-ac --path path.csv --allow-off-stroke -o p.csv"),
     );
+    // gains --at: a pose off the ball is evaluated, with a note that the numbers are the gain
+    // functions there; a kinematic parameter beyond any machine is refused.
+    let out = ok(
+        &dir,
+        &words("gains --machine seed-ac --at X=0,Y=0,Z=0,A=30,C=45"),
+    );
+    assert!(
+        out.contains("Note: this pose puts the nominal tool point 301.493833 mm from the nominal workpiece point"),
+        "{out}"
+    );
+    let out = ok(&dir, &words("gains --machine seed-ac --at A=30,C=45"));
+    assert!(!out.contains("Note:"), "{out}");
+    fails(
+        &dir,
+        &words("gains --machine seed-ac --at A=30,C=45 --param Zp=1e200"),
+        2,
+        &["--param: `Zp` = 1e200 mm is beyond the largest length a machine may have, 100000 mm"],
+    );
     // gains --at checks the pose too.
     fails(
         &dir,
@@ -480,8 +498,22 @@ fn values_of_another_machine_are_refused() {
             "a parameter is missing or extra",
         ],
     );
+    // Only three of the eleven parameters, with `terms` cut to match: the base model says what
+    // is missing.
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("id.json")).unwrap()).unwrap();
+    json["parameters"].as_array_mut().unwrap().truncate(3);
+    json["terms"].as_array_mut().unwrap().truncate(3);
+    std::fs::write(dir.join("partial.json"), json.to_string()).unwrap();
+    fails(
+        &dir,
+        &words("validate --machine seed-ac --params partial.json --data k4.csv"),
+        1,
+        &["--params: partial.json: field `parameters`: the base model `reduced` has YOA, ZOA"],
+    );
     let mut now = snapshot(&dir);
     now.remove("short.json");
+    now.remove("partial.json");
     assert_eq!(now, before);
 }
 
@@ -630,4 +662,31 @@ fn messages_say_what_happened() {
         &dir,
         &words("simulate --machine seed-ac --path K4 --seed 9223372036854775807 -o s.csv"),
     );
+}
+
+#[test]
+fn a_closed_standard_output_is_an_error_not_a_panic() {
+    let dir = temp_dir("closed-stdout");
+    for args in [
+        words("gains --machine seed-ac --format latex"),
+        words("machines"),
+        words("simulate --machine seed-ac --path K4 -o -"),
+    ] {
+        // A pipe whose reading end is closed before rtest starts: every write fails.
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let o = Command::new(env!("CARGO_BIN_EXE_rtest"))
+            .args(&args)
+            .current_dir(&*dir)
+            .stdout(writer)
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(
+            err.starts_with("rtest: error: ") && err.contains("standard output"),
+            "{args:?}: {err}"
+        );
+    }
 }

@@ -64,26 +64,9 @@ pub const ALLOWED_LINTS: &[&str] = &["non_snake_case"];
 /// The longest line of the header comment, `// ` included.
 const HEADER_WIDTH: usize = 100;
 
-/// `text` wrapped at word boundaries into lines of at most `width` characters; lines after the
-/// first start with `indent`. A word longer than a line stays whole.
+/// `text` wrapped at word boundaries ([`model_spec::text::wrap`]).
 fn wrap(text: &str, width: usize, indent: &str) -> Vec<String> {
-    let mut lines: Vec<String> = Vec::new();
-    let mut line = String::new();
-    for word in text.split_whitespace() {
-        if !line.is_empty() && line.chars().count() + 1 + word.chars().count() > width {
-            lines.push(std::mem::take(&mut line));
-        }
-        if line.is_empty() {
-            if !lines.is_empty() {
-                line.push_str(indent);
-            }
-        } else {
-            line.push(' ');
-        }
-        line.push_str(word);
-    }
-    lines.push(line);
-    lines
+    model_spec::text::wrap(text.split_whitespace(), width, indent)
 }
 
 /// The header comment of a machine's file, one line per element, each at most

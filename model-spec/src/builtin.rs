@@ -40,11 +40,19 @@ pub fn all_builtin() -> Vec<Machine> {
 /// [`crate::text::read_text`], at most [`MAX_FILE_BYTES`] bytes, and named in messages as
 /// given.
 pub fn load_machine(name_or_path: &str) -> Result<Machine, LoadError> {
-    if let Some(m) = builtin(name_or_path) {
-        return m.map_err(LoadError::Spec);
+    load_machine_and_text(name_or_path).map(|(m, _)| m)
+}
+
+/// A machine given by built-in name or by the path of a TOML file, with the text it was read
+/// from (a file is read once: a FIFO or a file changed meanwhile cannot give two texts).
+pub fn load_machine_and_text(name_or_path: &str) -> Result<(Machine, String), LoadError> {
+    if let Some((n, text)) = BUILTIN.iter().find(|(n, _)| *n == name_or_path) {
+        let m = parse_machine(&format!("<built-in {n}>"), text).map_err(LoadError::Spec)?;
+        return Ok((m, text.to_string()));
     }
     let text = file_text(name_or_path)?;
-    parse_machine(name_or_path, &text).map_err(LoadError::Spec)
+    let m = parse_machine(name_or_path, &text).map_err(LoadError::Spec)?;
+    Ok((m, text))
 }
 
 /// The text of the machine description file `path`: at most [`MAX_FILE_BYTES`] bytes of UTF-8.

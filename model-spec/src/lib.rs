@@ -79,7 +79,7 @@ pub mod units;
 mod validate;
 pub mod write;
 
-pub use builtin::{BUILTIN, LoadError, all_builtin, builtin, load_machine};
+pub use builtin::{BUILTIN, LoadError, all_builtin, builtin, load_machine, load_machine_and_text};
 pub use catalogue::{ErrorId, ErrorKind, ErrorTerm, Motion, canonical_name};
 pub use catalogue::{build_catalogue, default_squareness_order};
 pub use error::SpecError;

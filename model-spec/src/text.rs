@@ -1,4 +1,5 @@
-//! Reading a text file for people: bounded in size, UTF-8, with located errors.
+//! Text for people: reading a file bounded in size, UTF-8, with located errors; and the one
+//! way lines are wrapped ([`wrap`]).
 //!
 //! [`read_text`] reads at most one byte more than its limit, so that a huge file, a device
 //! that never ends or a pipe fed without end is refused quickly and with bounded memory.
@@ -111,4 +112,47 @@ pub fn decode_text(file_name: &str, mut bytes: Vec<u8>) -> Result<String, TextEr
             byte: bytes[bad],
         }
     })
+}
+/// `pieces` joined by single spaces into lines of at most `width` characters, greedily; lines
+/// after the first start with `indent` (counted in the width). A piece longer than a line stays
+/// whole on a line of its own. No piece gives one empty line.
+pub fn wrap<S: AsRef<str>>(
+    pieces: impl IntoIterator<Item = S>,
+    width: usize,
+    indent: &str,
+) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    for piece in pieces {
+        let piece = piece.as_ref();
+        if !line.is_empty() && line.chars().count() + 1 + piece.chars().count() > width {
+            lines.push(std::mem::take(&mut line));
+        }
+        if line.is_empty() {
+            if !lines.is_empty() {
+                line.push_str(indent);
+            }
+        } else {
+            line.push(' ');
+        }
+        line.push_str(piece);
+    }
+    lines.push(line);
+    lines
+}
+
+/// `items` as pieces of a list: each but the last followed by `separator` (`a,` `b,` `c`).
+pub fn list_pieces(items: &[String], separator: &str) -> Vec<String> {
+    let n = items.len();
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| {
+            if i + 1 < n {
+                format!("{item}{separator}")
+            } else {
+                item.clone()
+            }
+        })
+        .collect()
 }

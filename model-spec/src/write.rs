@@ -93,27 +93,13 @@ fn free_name(m: &Machine) -> String {
 
 /// The items of a TOML array, four spaces in, wrapped to lines shorter than [`LINE`].
 fn wrapped(items: &[String]) -> String {
-    let mut out = String::new();
-    let mut line = String::new();
-    for (i, item) in items.iter().enumerate() {
-        let piece = if i + 1 < items.len() {
-            format!("{item},")
-        } else {
-            item.clone()
-        };
-        if !line.is_empty() && 4 + line.chars().count() + 1 + piece.chars().count() >= LINE {
-            out.push_str(&format!("    {line}\n"));
-            line.clear();
-        }
-        if !line.is_empty() {
-            line.push(' ');
-        }
-        line.push_str(&piece);
+    if items.is_empty() {
+        return String::new();
     }
-    if !line.is_empty() {
-        out.push_str(&format!("    {line}\n"));
-    }
-    out
+    crate::text::wrap(crate::text::list_pieces(items, ","), LINE - 5, "")
+        .into_iter()
+        .map(|l| format!("    {l}\n"))
+        .collect()
 }
 
 /// The machine description `text` of `m` with a sub-model of `terms` appended, described by

@@ -829,6 +829,18 @@ fn model_name_rust_keyword() {
 }
 
 #[test]
+fn model_name_of_a_generated_item() {
+    for name in ["Pose", "Params", "POSE_INPUTS", "PARAMETERS"] {
+        check(
+            &edit("[models.reduced]", &format!("[models.{name}]")),
+            &format!(
+                "m.toml:52:9: model name `{name}` is the name of an item of the generated code (Pose, Params, POSE_INPUTS, PARAMETERS), which uses model names as module names: choose another name"
+            ),
+        );
+    }
+}
+
+#[test]
 fn model_without_errors() {
     check(
         &edit(r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#, ""),

@@ -214,8 +214,8 @@ fn missing_linear_columns_are_filled_by_inverse_kinematics() {
     for s in &k4.samples {
         text += &format!(
             "{},{},1,2,3,{}\n",
-            solver::io::csv::degrees_for(s.commands[a]),
-            solver::io::csv::degrees_for(s.commands[c]),
+            model_spec::units::degrees_for(s.commands[a]),
+            model_spec::units::degrees_for(s.commands[c]),
             s.t
         );
     }

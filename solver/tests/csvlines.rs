@@ -105,24 +105,28 @@ fn text_that_is_not_utf8_is_located_by_line_and_character() {
     let one = bytes.iter().rposition(|&b| b == 1).unwrap();
     bytes[one] = 0xff;
     bytes.extend_from_slice(&text.as_bytes()[end..]);
-    let want = format!("k4.csv:3: column {column}: not UTF-8 text (byte 0xff)");
+    let want = format!("k4.csv:3:{column}: not UTF-8 text (byte 0xff)");
     assert_eq!(whole_error(&bytes, &opts()), want);
     assert_eq!(blocks_error(&bytes, &opts()).unwrap(), want);
     let e = read_path("k4.csv", &bytes[..], &m, &opts()).unwrap_err();
     assert_eq!(e.to_string(), want);
     match read_csv("k4.csv", &bytes[..], &m, Need::Measured, &opts()).unwrap_err() {
-        CsvError::Format { line, column, .. } => assert_eq!((line, column), (3, None)),
+        CsvError::Text(model_spec::text::TextError::NotUtf8 {
+            line, column: c, ..
+        }) => {
+            assert_eq!((line, c), (3, column))
+        }
         other => panic!("{other:?}"),
     }
     // In the header, in a comment, a lone continuation byte, a truncated sequence at the end.
     let e = whole_error(b"X,Y,Z,A,\xc3\x28C\n", &opts());
-    assert_eq!(e, "k4.csv:1: column 9: not UTF-8 text (byte 0xc3)");
+    assert_eq!(e, "k4.csv:1:9: not UTF-8 text (byte 0xc3)");
     let e = whole_error(b"# r\xe9sum\xe9\nA,C,dx_um,dy_um,dz_um\n", &opts());
-    assert_eq!(e, "k4.csv:1: column 4: not UTF-8 text (byte 0xe9)");
+    assert_eq!(e, "k4.csv:1:4: not UTF-8 text (byte 0xe9)");
     let e = blocks_error(b"# ok\n\x80\n", &opts()).unwrap();
-    assert_eq!(e, "k4.csv:2: column 1: not UTF-8 text (byte 0x80)");
+    assert_eq!(e, "k4.csv:2:1: not UTF-8 text (byte 0x80)");
     let e = whole_error(b"A,C,dx_um,dy_um,dz_um\n0,0,0,0,0\xe2\x82", &opts());
-    assert_eq!(e, "k4.csv:2: column 10: not UTF-8 text (byte 0xe2)");
+    assert_eq!(e, "k4.csv:2:10: not UTF-8 text (byte 0xe2)");
 }
 
 #[test]

@@ -128,8 +128,8 @@ fn a_path_file_without_linear_columns_is_filled_by_inverse_kinematics() {
         let c = s.commands[m.axis_by_name("C").unwrap()];
         text += &format!(
             "{},{}\n",
-            solver::io::csv::degrees_for(c),
-            solver::io::csv::degrees_for(a)
+            model_spec::units::degrees_for(c),
+            model_spec::units::degrees_for(a)
         );
     }
     let dir = std::env::temp_dir().join(format!("rtest-paths-{}", std::process::id()));

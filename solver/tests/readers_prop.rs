@@ -211,9 +211,19 @@ fn check_report(m: &Machine, bytes: &[u8]) {
             assert_eq!(file, "id.json");
             assert!(!field.is_empty() && !message.is_empty());
         }
-        Err(ReportError::Json { file, source }) => {
+        Err(ReportError::Json {
+            file,
+            line,
+            column,
+            message,
+        }) => {
             assert_eq!(file, "id.json");
-            assert!(source.line() >= 1, "{source}");
+            let lines = bytes.split(|&b| b == b'\n').count();
+            assert!(
+                line >= 1 && line <= lines,
+                "line {line} of {lines}: {message}"
+            );
+            assert!(column >= 1, "{message}");
         }
         Err(ReportError::Text(e)) => {
             let s = e.to_string();

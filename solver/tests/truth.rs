@@ -356,6 +356,10 @@ fn every_invalid_entry_names_file_line_and_column() {
             "t.toml:1:8: `seed` must be a whole number from 0 to 9223372036854775807, not `-1`",
         ),
         (
+            "seed = 18446744073709551615\n",
+            "t.toml:1:8: `seed` must be a whole number from 0 to 9223372036854775807, not `18446744073709551615`",
+        ),
+        (
             "seed = 1.5\n",
             "t.toml:1:8: `seed` must be a whole number from 0 to 9223372036854775807, not float",
         ),

@@ -368,18 +368,52 @@ fn bad_identify_json_names_the_file_and_the_field() {
             "id.json: field `terms`: [XOC, ECC@harmonic:1, YOC] are not the terms of the parameters [XOC, ECC@harmonic:1]: a parameter is missing or extra",
         ),
         (
+            ok.replace("\"base_model\": null", "\"base_model\": \"reduced\""),
+            "id.json: field `parameters`: the base model `reduced` has XOW, YOW, ZOW, YOA, ZOA, BOA, COA, YOC, AOC, BOC that the parameters lack",
+        ),
+        (
+            ok.replace("\"terms\": [\"XOC\", \"ECC@harmonic:1\"],", ""),
+            "id.json: field `terms`: missing: the report must list the terms it identified (XOC, ECC@harmonic:1)",
+        ),
+        (
+            ok.replace(
+                "\"model\": \"m\",",
+                "\"model\": \"m\", \"refinement\": {\"converged\": false},",
+            ),
+            "id.json: field `refinement.converged`: false: the refinement against the exact machine did not converge, so these values are not an identification",
+        ),
+        (
             ok.replace("1.5", "1e999"),
-            "id.json: not valid JSON: number out of range at line 3 column 57",
+            "id.json:3:57: not valid JSON: number out of range",
         ),
     ];
     for (text, message) in cases {
         assert_eq!(field_error(&text, &m), message, "{text}");
     }
+    // A poly:K value belongs to the stroke it was normalised over.
+    let poly = ok
+        .replace("[\"XOC\", \"ECC@harmonic:1\"]", "[\"XOC\", \"ECC@harmonic:1\", \"EXX@poly:2\"]")
+        .replace(
+            "\"unit\": \"urad\"}]}",
+            "\"unit\": \"urad\"},\n{\"error\": \"EXX\", \"basis\": \"poly:2\", \"value\": 0.5, \"unit\": \"um\", \"over_mm\": [-500, 500]}]}",
+        );
+    parse_identification("id.json", &poly, &m).unwrap();
+    assert_eq!(
+        field_error(&poly.replace("[-500, 500]", "[-800, 800]"), &m),
+        "id.json: field `parameters[3].over_mm`: EXX@poly:2 was normalised over the stroke -800 .. 800 mm, but axis X of this machine has -500 .. 500 mm: the value would mean another error"
+    );
+    assert_eq!(
+        field_error(&poly.replace(", \"over_mm\": [-500, 500]", ""), &m),
+        "id.json: field `parameters[3].over_mm`: missing or not [min, max]: a poly:K value means something only with the stroke (mm) it was normalised over"
+    );
+    // Columns count characters, as every reader's do (the parser counts bytes).
+    let e = field_error("{\"machine\": \"sé\" x", &m);
+    assert_eq!(e, "id.json:1:18: not valid JSON: expected `,` or `}`");
     // A byte-order mark is accepted, as in CSV and TOML files.
     assert!(parse_identification("id.json", &format!("\u{feff}{ok}"), &m).is_ok());
     let e = field_error("{\"machine\": ", &m);
     assert!(
-        e.starts_with("id.json: not valid JSON: EOF while parsing a value at line 1 column 12"),
+        e.starts_with("id.json:1:12: not valid JSON: EOF while parsing a value"),
         "{e}"
     );
     let missing = std::env::temp_dir().join(format!("rtest-no-such-{}.json", std::process::id()));

@@ -3,41 +3,50 @@
 //! is a usage error (exit code 2).
 
 use super::{CliError, CliResult};
+use model_spec::units::{UM_PER_MM, compact};
 use model_spec::{AxisId, ErrorId, Machine};
 use solver::fitting::{Constraint, ValueLimits};
 use solver::io::csv::ReadOptions;
 use solver::model::{Effect, Model, Term};
 use std::path::PathBuf;
 
-/// The plausibility bounds and the stroke check, shared by the verbs that read records or
-/// identify values.
+/// What a record read must be: plausible readings, poses within the strokes. For the verbs
+/// that read or write records.
 #[derive(Debug, Clone, clap::Args)]
-pub struct Limits {
+pub struct RecordLimits {
     /// Largest plausible reading, µm: a record with a larger |dx|, |dy| or |dz| is refused,
     /// naming its lines.
     #[arg(long, value_name = "UM", default_value = "1000", value_parser = positive)]
     pub max_reading_um: f64,
-    /// Largest plausible identified translational value (errors and sensor offsets), µm.
-    #[arg(long, value_name = "UM", default_value = "1000", value_parser = positive)]
-    pub max_error_um: f64,
-    /// Largest plausible identified angular value, µrad.
-    #[arg(long, value_name = "URAD", default_value = "10000", value_parser = positive)]
-    pub max_error_urad: f64,
     /// Accept poses outside the machine's strokes and ranges (refused by default, naming the
     /// first offending lines).
     #[arg(long)]
     pub allow_off_stroke: bool,
 }
 
-impl Limits {
+impl RecordLimits {
     /// The options of the record readers.
     pub fn read_options(&self) -> ReadOptions {
         let mut o = ReadOptions::default();
-        o.max_reading_mm = self.max_reading_um / 1e3;
+        o.max_reading_mm = self.max_reading_um / UM_PER_MM;
         o.allow_off_stroke = self.allow_off_stroke;
         o
     }
+}
 
+/// The plausibility bounds of identified values. For the verbs that identify values or read
+/// them.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ValueBounds {
+    /// Largest plausible identified translational value (errors and sensor offsets), µm.
+    #[arg(long, value_name = "UM", default_value = "1000", value_parser = positive)]
+    pub max_error_um: f64,
+    /// Largest plausible identified angular value, µrad.
+    #[arg(long, value_name = "URAD", default_value = "10000", value_parser = positive)]
+    pub max_error_urad: f64,
+}
+
+impl ValueBounds {
     /// The bounds of identified values.
     pub fn values(&self) -> ValueLimits {
         ValueLimits::from_display(self.max_error_um, self.max_error_urad)
@@ -286,6 +295,13 @@ pub fn params(m: &Machine, text: Option<&str>) -> CliResult<Vec<f64>> {
                 }
             )));
         };
+        if x.abs() > model_spec::limits::MAX_LENGTH_MM {
+            return Err(CliError::usage(format!(
+                "--param: `{name}` = {} mm is beyond the largest length a machine may have, {} mm",
+                compact(x),
+                model_spec::limits::MAX_LENGTH_MM
+            )));
+        }
         params[s] = x;
     }
     Ok(params)

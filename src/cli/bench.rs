@@ -40,9 +40,9 @@ pub fn run(args: &BenchArgs) -> CliResult {
     if args.json {
         let json = serde_json::to_string_pretty(&report)
             .map_err(|e| CliError::computation(format!("--json: {e}")))?;
-        println!("{json}");
+        super::print(&(json + "\n"))?;
     } else {
-        print!("{}", perf::report::text(&report));
+        super::print(&perf::report::text(&report))?;
     }
     Ok(())
 }

@@ -80,6 +80,5 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         "\nDone in {:.2} s. The same steps one by one: rtest simulate, rtest identify, rtest validate, rtest diagnose (see --help).\n",
         start.elapsed().as_secs_f64()
     ));
-    print!("{text}");
-    Ok(())
+    super::print(&text)
 }

@@ -2,7 +2,7 @@
 //! an engineer reads it, the extended model (as a machine description `identify` and `generate`
 //! accept) and its gain on the fitted and the held-out data.
 
-use super::args::{self, Limits};
+use super::args::{self, RecordLimits, ValueBounds};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
 use solver::diagnosis::dictionary::DictionaryOptions;
@@ -104,7 +104,9 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "DIR")]
     plot: Option<PathBuf>,
     #[command(flatten)]
-    limits: Limits,
+    records: RecordLimits,
+    #[command(flatten)]
+    bounds: ValueBounds,
 }
 
 /// `--alpha`: a number strictly between 0 and 1.
@@ -117,7 +119,7 @@ fn parse_alpha(s: &str) -> Result<f64, String> {
 
 /// Runs `rtest diagnose`.
 pub fn run(args: &DiagnoseArgs) -> CliResult {
-    let m = super::load_machine(&args.machine)?;
+    let (m, machine_text) = super::load_machine_and_text(&args.machine)?;
     let (label, model) = args::model(&m, Some(&args.model), None)?;
     let held_files = match &args.validate {
         Some(list) => args::files("--validate", list)?,
@@ -130,15 +132,8 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     outputs.extend(args.model_out.iter().map(|t| ("--model-out", t)));
     let dirs: Vec<(&str, &Path)> = args.plot.iter().map(|d| ("--plot", d.as_path())).collect();
     check_outputs(&inputs, &outputs, &dirs)?;
-    let machine_text = match &args.model_out {
-        Some(_) => Some(
-            model_spec::write::source_text(&args.machine)
-                .map_err(|e| CliError::input(format!("--machine: {e}")))?,
-        ),
-        None => None,
-    };
 
-    let read = args.limits.read_options();
+    let read = args.records.read_options();
     let record = super::read_record("--data", &m, &args.data, &read)?;
     let mut held = Vec::new();
     for f in &held_files {
@@ -159,9 +154,9 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         other => CliError::computation(format!("--data: cannot diagnose: {other}")),
     })?;
     for fit in [&d.base_fit, &d.extended_fit] {
-        check_values(&m, fit, &args.limits.values()).map_err(|e| {
+        check_values(&m, fit, &args.bounds.values()).map_err(|e| {
             CliError::computation(format!(
-                "--data: {e} (--max-error-um, --max-error-urad change the bounds)"
+                "--data: implausible result: {e}; the fit does not describe this machine (--max-error-um, --max-error-urad change the bounds)"
             ))
         })?;
     }
@@ -169,18 +164,14 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     // Everything is computed before anything is written.
     let mut files = Outputs::new();
     let mut model_out = None;
-    if let (Some(target), Some(text)) = (&args.model_out, &machine_text) {
-        let terms: Vec<String> = d
-            .extended_terms()
-            .terms
-            .iter()
-            .map(|t| t.spelling(&m))
-            .collect();
-        let description = format!(
-            "{} (rtest diagnose on {data})",
-            d.extended_label(&m, &label)
-        );
-        let (name, contents) = model_spec::write::append_model(&m, text, &terms, &description)
+    if let Some(target) = &args.model_out {
+        let (name, contents) = d
+            .extended_machine(
+                &m,
+                &machine_text,
+                &label,
+                &format!("rtest diagnose on {data}"),
+            )
             .map_err(|e| CliError::computation(format!("--model-out: {e}")))?;
         files.add("--model-out", target.clone(), contents);
         model_out = Some((name, target.to_string()));
@@ -218,6 +209,5 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     }
     let stdout_taken = outputs.iter().any(|(_, t)| matches!(t, Target::Stdout));
     text.push_str(&wrote(&write(files)?));
-    print_text(&text, stdout_taken);
-    Ok(())
+    print_text(&text, stdout_taken)
 }

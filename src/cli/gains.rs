@@ -100,8 +100,7 @@ pub fn run(args: &GainsArgs) -> CliResult {
             None => to_json(&GainTableReport::new(&m, model_name.as_deref(), &model))
                 .map_err(|e| CliError::computation(format!("--format: {e}")))?,
         };
-        print!("{out}");
-        return Ok(());
+        return super::print(&out);
     };
     let params = args::params(&m, args.param.as_deref())?;
     let pose =
@@ -126,6 +125,10 @@ pub fn run(args: &GainsArgs) -> CliResult {
         .iter()
         .map(|&e| m.catalogue[e].is_angular())
         .collect();
+    if let (None, Some(note)) = (table_format, pose.off_ball_note()) {
+        // The JSON stays what tools read; the note goes to standard error.
+        super::print_text(&format!("{note}\n"), true)?;
+    }
     let out = match table_format {
         Some(f) => pose_gains(&m, &title, &pose, &names, &angular, &gains, f),
         None => to_json(
@@ -134,6 +137,5 @@ pub fn run(args: &GainsArgs) -> CliResult {
         )
         .map_err(|e| CliError::computation(format!("--format: {e}")))?,
     };
-    print!("{out}");
-    Ok(())
+    super::print(&out)
 }

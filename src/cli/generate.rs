@@ -54,10 +54,6 @@ pub fn run(args: &GenerateArgs) -> CliResult {
         .map_err(|e| CliError::computation(format!("generate: machine {}: {e}", m.name)))?;
     let mut files = Outputs::new();
     files.add("-o", target.clone(), code);
-    for w in write(files)? {
-        if !matches!(w.target, Target::Stdout) {
-            eprintln!("wrote {w}");
-        }
-    }
-    Ok(())
+    // The code may be on standard output: what was written is said on standard error.
+    super::print_text(&super::wrote(&write(files)?), true)
 }

@@ -1,8 +1,9 @@
 //! `rtest identify`: the errors of a model from an R-test measurement, with uncertainties and
 //! what the data cannot separate.
 
-use super::args::{self, Limits};
+use super::args::{self, RecordLimits, ValueBounds};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use model_spec::units::plural;
 use output::{Outputs, Target};
 use solver::fitting::streaming::{StreamingError, identify_file};
 use solver::fitting::{
@@ -11,7 +12,6 @@ use solver::fitting::{
 };
 use solver::io::report::{IdentificationReport, IdentificationSource, to_json};
 use solver::io::text::identify::identification;
-use solver::io::text::plural;
 use solver::io::text::validate::LOOKS_ZEROED;
 use std::path::PathBuf;
 
@@ -97,7 +97,9 @@ pub struct IdentifyArgs {
           value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
     block: u64,
     #[command(flatten)]
-    limits: Limits,
+    records: RecordLimits,
+    #[command(flatten)]
+    bounds: ValueBounds,
 }
 
 /// Runs `rtest identify`.
@@ -111,12 +113,13 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
-    let read = args.limits.read_options();
+    let read = args.records.read_options();
     let data = args.data.display().to_string();
     let (ident, refinement, notes) = if args.stream {
         let (ident, run) = identify_file(&m, &model, &args.data, &opts, args.block as usize, &read)
             .map_err(|e| match e {
                 StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
+                e @ StreamingError::ReadTwice(_) => CliError::input(format!("--data: {e}")),
                 StreamingError::Estimate(e) => estimate_error(e),
                 other => CliError::computation(format!("--data: cannot identify: {other}")),
             })?;
@@ -152,6 +155,9 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
                 identify_refined(&m, &model, &record, &opts, &RefineOptions::default())
                     .map_err(|e| match e {
                         RefineError::Estimate(e) => estimate_error(e),
+                        e @ RefineError::NotConverged { .. } => CliError::computation(format!(
+                            "--data: {e}: the data do not determine the model well enough for the exact machine (--first-order gives the first-order values)"
+                        )),
                         other => CliError::computation(format!(
                             "--data: the refinement against the exact machine failed: {other} (--first-order skips it)"
                         )),
@@ -159,18 +165,9 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             (ident, Some(r), note)
         }
     };
-    if let Some(r) = &refinement
-        && !r.converged
-    {
-        return Err(CliError::computation(format!(
-            "--data: the refinement against the exact machine did not converge: {} Gauss-Newton steps, the last moved the prediction by {:.3e} µm (the data do not determine the model well enough for the exact machine; --first-order gives the first-order values)",
-            r.iterations,
-            r.steps_mm.last().copied().unwrap_or(0.0) * 1e3
-        )));
-    }
-    check_values(&m, &ident, &args.limits.values()).map_err(|e| {
+    check_values(&m, &ident, &args.bounds.values()).map_err(|e| {
         CliError::computation(format!(
-            "--data: {e} (--max-error-um, --max-error-urad change the bounds)"
+            "--data: implausible result: {e}; the fit does not describe this machine (too few or unsuitable data, or a model the data cannot determine; --max-error-um, --max-error-urad change the bounds)"
         ))
     })?;
     let source = IdentificationSource {
@@ -189,8 +186,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     }
     let stdout_taken = matches!(args.json, Some(Target::Stdout));
     text.push_str(&wrote(&write(files)?));
-    print_text(&text, stdout_taken);
-    Ok(())
+    print_text(&text, stdout_taken)
 }
 
 /// An estimation error as a verb's error: an unknown constraint name is a usage error, too few

@@ -30,6 +30,5 @@ pub fn run(args: &MachinesArgs) -> CliResult {
         .iter()
         .map(model_spec::describe::describe)
         .collect();
-    print!("{}", text.join("\n"));
-    Ok(())
+    super::print(&text.join("\n"))
 }

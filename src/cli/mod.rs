@@ -19,6 +19,7 @@ use output::{Outputs, Target, WriteError, Written};
 use solver::io::csv::ReadOptions;
 use solver::record::Record;
 use std::fmt;
+use std::io::Write as _;
 use std::path::Path;
 
 /// Exit code of a bad input: a file that cannot be read, is malformed, implausible, or does
@@ -33,8 +34,8 @@ pub const EXIT_COMPUTATION: u8 = 3;
 /// The exit-code rule, shown after every verb's help.
 pub const EXIT_CODES: &str = "\
 Exit codes: 0 success; 1 bad input (a machine, truth, measurement CSV or JSON file that cannot \
-be read, is malformed, holds implausible readings or poses, or belongs to another machine; an \
-output that cannot be written); 2 the command line is wrong (missing or unknown flag; unknown \
+be read, is malformed, holds implausible readings, poses or values, or belongs to another \
+machine; an output that cannot be written); 2 the command line is wrong (missing or unknown flag; unknown \
 machine, model, path, truth, axis, symbol, error or term name; a malformed or out-of-range \
 value; an output that names an input); 3 a computation failed (a refinement that does not \
 converge, a non-finite result, identified values beyond the plausibility bounds). Errors are \
@@ -88,7 +89,12 @@ pub type CliResult<T = ()> = Result<T, CliError>;
 /// Loads the machine of `--machine` (a built-in name or a TOML file). An unknown name is a
 /// usage error; a file that cannot be read or does not validate is a bad input.
 pub fn load_machine(name_or_path: &str) -> CliResult<Machine> {
-    model_spec::load_machine(name_or_path).map_err(|e| match e {
+    load_machine_and_text(name_or_path).map(|(m, _)| m)
+}
+
+/// [`load_machine`], with the text it was read from (read once).
+pub fn load_machine_and_text(name_or_path: &str) -> CliResult<(Machine, String)> {
+    model_spec::load_machine_and_text(name_or_path).map_err(|e| match e {
         LoadError::NotFound(_) => CliError::usage(format!("--machine: {e}")),
         _ => CliError::input(format!("--machine: {e}")),
     })
@@ -143,13 +149,27 @@ pub fn write(outputs: Outputs) -> CliResult<Vec<Written>> {
 }
 
 /// Prints the text for people: on standard output, or on standard error when an output goes to
-/// standard output (`-o -`), so that the two never mix.
-pub fn print_text(text: &str, stdout_taken: bool) {
-    if stdout_taken {
-        eprint!("{text}");
+/// standard output (`-o -`), so that the two never mix. A stream that cannot be written (a
+/// closed pipe) is an output that cannot be written: exit code 1, never a panic.
+pub fn print_text(text: &str, stdout_taken: bool) -> CliResult {
+    let (result, name) = if stdout_taken {
+        (
+            std::io::stderr().lock().write_all(text.as_bytes()),
+            "standard error",
+        )
     } else {
-        print!("{text}");
-    }
+        let mut out = std::io::stdout().lock();
+        (
+            out.write_all(text.as_bytes()).and_then(|()| out.flush()),
+            "standard output",
+        )
+    };
+    result.map_err(|e| CliError::input(format!("cannot write to {name}: {e}")))
+}
+
+/// Prints `text` on standard output (see [`print_text`]).
+pub fn print(text: &str) -> CliResult {
+    print_text(text, false)
 }
 
 /// One `Wrote FILE` line per file written (standard output is not listed).

@@ -1,13 +1,14 @@
 //! `rtest simulate`: R-test readings of the exact virtual machine along a test path, written as
 //! a measurement CSV that `identify` reads back.
 
-use super::args::Limits;
+use super::args::RecordLimits;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write};
+use model_spec::units::parse_scaled;
 use output::{Outputs, Target};
-use solver::io::csv::{format_record, parse_measurement, parse_scaled};
+use solver::io::csv::{format_record, parse_measurement};
 use solver::io::text::simulation;
 use solver::simulation::paths::PathError;
-use solver::simulation::truth::{MAX_NOISE_UM, Truth, TruthError};
+use solver::simulation::truth::{MAX_NOISE_UM, MAX_SEED, Truth, TruthError};
 use solver::simulation::{load_path, provenance, simulate};
 use std::path::Path;
 
@@ -58,7 +59,7 @@ pub struct SimulateArgs {
     noise_um: Option<String>,
     /// Seed of the noise generator, 0 to 9223372036854775807 (overrides the truth's).
     #[arg(long, value_name = "N",
-          value_parser = clap::value_parser!(u64).range(0..=i64::MAX as u64))]
+          value_parser = clap::value_parser!(u64).range(0..=MAX_SEED))]
     seed: Option<u64>,
     /// Zero the readings at the first sample, as R-test software does (overrides the truth).
     #[arg(long)]
@@ -67,7 +68,7 @@ pub struct SimulateArgs {
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Target,
     #[command(flatten)]
-    limits: Limits,
+    records: RecordLimits,
 }
 
 /// Parses `--noise-um` (µm, finite, 0 to [`MAX_NOISE_UM`]) into mm, without double rounding.
@@ -112,7 +113,7 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     }
     check_outputs(&inputs, &[("-o", &args.output)], &[])?;
     let mut truth = truth(&m, args.truth.as_deref())?;
-    let read = args.limits.read_options();
+    let read = args.records.read_options();
     let path = load_path(&m, &args.path, &read).map_err(|e| match e {
         PathError::NotFound(_) | PathError::NotAC { .. } => CliError::usage(format!("--path: {e}")),
         other => CliError::input(format!("--path: {other}")),
@@ -143,6 +144,5 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     if let Target::Path(p) = &args.output {
         text.insert_str(text.len() - 1, &format!("; wrote {}", p.display()));
     }
-    print_text(&text, matches!(args.output, Target::Stdout));
-    Ok(())
+    print_text(&text, matches!(args.output, Target::Stdout))
 }

@@ -1,7 +1,7 @@
 //! `rtest validate`: identified values (an `identify` JSON) predict another measurement;
 //! residuals before (nominal machine) and after (identified model), per direction.
 
-use super::args::Limits;
+use super::args::{RecordLimits, ValueBounds};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
 use solver::fitting::hmatrix::parameter_names;
@@ -66,7 +66,9 @@ pub struct ValidateArgs {
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
     #[command(flatten)]
-    limits: Limits,
+    records: RecordLimits,
+    #[command(flatten)]
+    bounds: ValueBounds,
 }
 
 /// Runs `rtest validate`.
@@ -87,10 +89,15 @@ pub fn run(args: &ValidateArgs) -> CliResult {
         &params.model,
         &names,
         &params.values,
-        &args.limits.values(),
+        &args.bounds.values(),
     )
-    .map_err(|e| CliError::input(format!("--params: {e}")))?;
-    let record = super::read_record("--data", &m, &args.data, &args.limits.read_options())?;
+    .map_err(|e| {
+        CliError::input(format!(
+            "--params: {}: {e}: these cannot be the errors of a machine tool (--max-error-um, --max-error-urad change the bounds)",
+            args.params.display()
+        ))
+    })?;
+    let record = super::read_record("--data", &m, &args.data, &args.records.read_options())?;
     let mut opts = ValidateOptions::default();
     opts.zeroed = args.zeroed;
     opts.exact = !args.first_order;
@@ -128,6 +135,5 @@ pub fn run(args: &ValidateArgs) -> CliResult {
         files.add("--json", target.clone(), json);
     }
     text.push_str(&wrote(&write(files)?));
-    print_text(&text, matches!(args.json, Some(Target::Stdout)));
-    Ok(())
+    print_text(&text, matches!(args.json, Some(Target::Stdout)))
 }

@@ -27,6 +27,10 @@ fn is_identifier(s: &str) -> bool {
         && c.all(|ch| ch.is_ascii_alphanumeric() || ch == '_')
 }
 
+/// The items the generated code of a machine defines beside its model modules; a model may not
+/// be named like one of them.
+pub const GENERATED_ITEMS: &[&str] = &["Pose", "Params", "POSE_INPUTS", "PARAMETERS"];
+
 /// Rust's strict and reserved keywords (2024 edition): generated code uses symbol names as
 /// field names and model names as module names, so neither may be one of these (and the code
 /// generator names no local one of these).
@@ -173,6 +177,15 @@ impl Validator<'_> {
                 name.span(),
                 format!(
                     "model name `{n}` is a Rust keyword (generated code uses model names as module names): choose another name"
+                ),
+            );
+        }
+        if GENERATED_ITEMS.contains(&n.as_str()) {
+            return self.err(
+                name.span(),
+                format!(
+                    "model name `{n}` is the name of an item of the generated code ({}), which uses model names as module names: choose another name",
+                    GENERATED_ITEMS.join(", ")
                 ),
             );
         }

@@ -141,11 +141,6 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
         &RefineOptions::default(),
     )
     .map_err(failed("identification"))?;
-    if !refinement.converged {
-        return Err(failed("identification")(
-            "the refinement against the exact machine did not converge",
-        ));
-    }
     check_values(&m, &ident, &ValueLimits::default()).map_err(failed("identification"))?;
     let k4_file = path_of(&k4.file);
     let identification = IdentificationReport::new(
@@ -207,23 +202,15 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
         .map(|r| (path_of(&r.file), r.record.clone()))
         .collect();
     let diagnosis = diagnose(&m, &model, &k4.record, &held, &opts).map_err(failed("diagnosis"))?;
-    let (ext_name, ext_text) = model_spec::write::append_model(
-        &m,
-        model_spec::write::source_text(MACHINE)
-            .map_err(failed("extended model"))?
-            .as_str(),
-        &diagnosis
-            .extended_terms()
-            .terms
-            .iter()
-            .map(|t| t.spelling(&m))
-            .collect::<Vec<_>>(),
-        &format!(
-            "{} (rtest demo: the diagnosis of the reduced model on K4)",
-            diagnosis.extended_label(&m, REDUCED)
-        ),
-    )
-    .map_err(failed("extended model"))?;
+    let machine_text = model_spec::write::source_text(MACHINE).map_err(failed("extended model"))?;
+    let (ext_name, ext_text) = diagnosis
+        .extended_machine(
+            &m,
+            &machine_text,
+            REDUCED,
+            "rtest demo: the diagnosis of the reduced model on K4",
+        )
+        .map_err(failed("extended model"))?;
     let source = DiagnosisSource {
         machine_source: MACHINE,
         label: REDUCED,

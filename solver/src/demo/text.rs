@@ -10,9 +10,10 @@ use crate::io::report::{DiagnosisReport, IdentificationReport, ValidationReport}
 use crate::io::text::diagnose as diag_text;
 use crate::io::text::identify::value;
 use crate::io::text::validate::{defaulted_note, residual_table};
-use crate::io::text::{header, plural, table};
+use crate::io::text::{header, table};
 use crate::simulation::truth::Truth;
 use model_spec::Machine;
+use model_spec::units::plural;
 use model_spec::units::{fixed, short, symbol};
 
 /// Everything the summary is written from.

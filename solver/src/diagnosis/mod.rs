@@ -149,19 +149,6 @@ pub enum DiagnoseError {
     /// A validation failed.
     #[error(transparent)]
     Validate(#[from] ValidateError),
-    /// The refinement of a fit against the exact machine did not converge.
-    #[error(
-        "the refinement against the exact machine did not converge for the model [{model}] ({iterations} Gauss-Newton steps, the last moved the prediction by {:.3e} µm)",
-        last_step_mm * 1e3
-    )]
-    NotConverged {
-        /// The parameters of the model fitted.
-        model: String,
-        /// Steps taken.
-        iterations: usize,
-        /// The last step's largest change of the prediction, mm.
-        last_step_mm: f64,
-    },
 }
 
 /// A step of the selection, before the extended fit gives its values.
@@ -188,15 +175,8 @@ fn fit(
         tolerances: o.tolerances,
         params: None,
     };
-    let (mut ident, refinement) =
+    let (mut ident, _) =
         identify_refined_with(m, model, record, source, &opts, &RefineOptions::default())?;
-    if !refinement.converged {
-        return Err(DiagnoseError::NotConverged {
-            model: ident.fit.names.join(", "),
-            iterations: refinement.iterations,
-            last_step_mm: refinement.steps_mm.last().copied().unwrap_or(0.0),
-        });
-    }
     ident.zeroed = o.zeroed;
     Ok(ident)
 }
@@ -636,6 +616,30 @@ impl Diagnosis {
             .chain(self.findings.iter().map(|f| f.term.spelling(m)))
             .collect::<Vec<_>>()
             .join(" + ")
+    }
+
+    /// The machine description `text` of `m` with the extended model appended as a sub-model
+    /// ([`model_spec::write::append_model`]), described by its label and `context` (`rtest
+    /// diagnose on k4.csv`): the model's name and the new text.
+    ///
+    /// # Errors
+    /// [`model_spec::write::AppendError`] when the text does not read back as the same machine
+    /// with that model.
+    pub fn extended_machine(
+        &self,
+        m: &Machine,
+        text: &str,
+        label: &str,
+        context: &str,
+    ) -> Result<(String, String), model_spec::write::AppendError> {
+        let terms: Vec<String> = self
+            .extended_terms()
+            .terms
+            .iter()
+            .map(|t| t.spelling(m))
+            .collect();
+        let description = format!("{} ({context})", self.extended_label(m, label));
+        model_spec::write::append_model(m, text, &terms, &description)
     }
 
     /// The held-out records the extended model predicts worse than the base model: name and

@@ -117,6 +117,20 @@ pub enum RefineError {
     /// The exact prediction failed.
     #[error(transparent)]
     Simulate(#[from] SimulateError),
+    /// The refinement did not converge in the steps allowed: the values are no identification.
+    #[error(
+        "the refinement against the exact machine did not converge: {iterations} Gauss-Newton steps, the last moved the prediction by {:.3e} µm (tolerance {:.1e} µm)",
+        last_step_mm * 1e3,
+        tolerance_mm * 1e3
+    )]
+    NotConverged {
+        /// Steps taken.
+        iterations: usize,
+        /// The last step's largest change of the prediction, mm.
+        last_step_mm: f64,
+        /// The tolerance, mm.
+        tolerance_mm: f64,
+    },
     /// A step produced a non-finite value: the iteration diverged.
     #[error(
         "the refinement against the exact machine diverged to non-finite values at step {iterations}"
@@ -225,11 +239,11 @@ pub fn refine(
 
 /// Identifies `model` on `record` ([`crate::fitting::identify()`], with the gain source it
 /// needs built here) and refines the result against the exact machine ([`refine`], with the
-/// identification's tolerances). A refinement that did not converge is returned with
-/// [`Refinement::converged`] `false`.
+/// identification's tolerances).
 ///
 /// # Errors
-/// As [`crate::fitting::identify_with`] and [`refine`].
+/// As [`crate::fitting::identify_with`] and [`refine`]; [`RefineError::NotConverged`] when
+/// the refinement did not converge (its values are no identification).
 pub fn identify_refined(
     m: &Machine,
     model: &Model,
@@ -256,5 +270,12 @@ pub fn identify_refined_with(
 ) -> Result<(Identification, Refinement), RefineError> {
     let mut ident = identify_with(m, model, record, source, opts)?;
     let r = refine(m, record, &mut ident, source, &opts.tolerances, refine_opts)?;
+    if !r.converged {
+        return Err(RefineError::NotConverged {
+            iterations: r.iterations,
+            last_step_mm: r.steps_mm.last().copied().unwrap_or(0.0),
+            tolerance_mm: r.tolerance_mm,
+        });
+    }
     Ok((ident, r))
 }

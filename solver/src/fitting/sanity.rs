@@ -51,7 +51,7 @@ impl ValueLimits {
 /// Identified values beyond the bounds.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error(
-    "implausible result: {} beyond the plausibility bounds ({} µm, {} µrad): {}; the fit does not describe this machine (too few or unsuitable data, or a model the data cannot determine)",
+    "{} beyond the plausibility bounds ({} µm, {} µrad): {}",
     if .values.len() == 1 { "a value is" } else { "values are" },
     short(.limits.translation_mm * UM_PER_MM),
     short(.limits.angle_rad * URAD_PER_RAD),

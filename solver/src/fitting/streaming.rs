@@ -98,6 +98,12 @@ pub enum StreamingError<E: std::error::Error + 'static> {
     /// A block's measurements, or the final solve, failed.
     #[error(transparent)]
     Estimate(#[from] EstimateError),
+    /// The record must be read twice (a model with `time:K` terms needs its time span first)
+    /// but is not a regular file (a pipe or a device can be read once only).
+    #[error(
+        "`{0}`: a model with time:K terms reads the record twice (its time span first), so it must be a regular file, not a pipe or a device"
+    )]
+    ReadTwice(String),
 }
 
 /// A streaming identification.
@@ -140,6 +146,7 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
         largest = largest.max(block.samples.len());
         count += 1;
     }
+    check_readings(samples, model.width())?;
     let fit = qr.solve(&parameter_names(m, model), constraint, tol)?;
     Ok(StreamingIdentification {
         fit,
@@ -170,6 +177,9 @@ pub fn identify_file(
         .iter()
         .any(|t| matches!(t.basis, Basis::Time(_)));
     let span = if has_time {
+        if !std::fs::metadata(path).is_ok_and(|f| f.is_file()) {
+            return Err(StreamingError::ReadTwice(path.display().to_string()));
+        }
         Some(time_span(path, m, read).map_err(StreamingError::Read)?)
     } else {
         None
@@ -184,7 +194,6 @@ pub fn identify_file(
         &opts.constraint,
         &opts.tolerances,
     )?;
-    check_readings(run.samples, fitted.width())?;
     let ident = Identification::new(
         m,
         fitted,

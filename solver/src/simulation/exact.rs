@@ -351,7 +351,10 @@ impl<'m> VirtualMachine<'m> {
         if det.abs() < IK_MIN_DETERMINANT || !det.is_finite() {
             let pose = m
                 .rotary_axes()
-                .map(|i| format!("{} = {}°", m.axes[i].name, commands[i].to_degrees()))
+                .map(|i| {
+                    let deg = model_spec::units::degrees_for(commands[i]);
+                    format!("{} = {}°", m.axes[i].name, model_spec::units::short(deg))
+                })
                 .collect::<Vec<_>>()
                 .join(", ");
             return Err(ExactError::Singular {

@@ -3,7 +3,7 @@
 //! tool point is on the workpiece point, as at every R-test sample), and the pose checked
 //! against the machine's strokes and ranges.
 
-use super::exact::{ExactError, tool_centre_point_ik};
+use super::exact::{ExactError, nominal_error_vector, tool_centre_point_ik};
 use model_spec::{AxisId, AxisKind, Machine};
 
 /// A pose ready for evaluation.
@@ -17,7 +17,30 @@ pub struct Pose {
     pub from_ik: Vec<bool>,
     /// Per kinematic symbol, mm.
     pub params: Vec<f64>,
+    /// The distance between the nominal tool point and the nominal workpiece point, mm: 0 to
+    /// rounding when the inverse kinematics filled the linear axes. Beyond
+    /// [`ON_BALL_TOLERANCE_MM`] the gain functions evaluated here are not the first-order gains
+    /// of the chain (those are taken where the two points coincide).
+    pub gap_mm: f64,
 }
+
+impl Pose {
+    /// A note for people when the pose is off the workpiece point by more than
+    /// [`ON_BALL_TOLERANCE_MM`], else `None`.
+    pub fn off_ball_note(&self) -> Option<String> {
+        (self.gap_mm > ON_BALL_TOLERANCE_MM).then(|| {
+            format!(
+                "Note: this pose puts the nominal tool point {} mm from the nominal workpiece point: the numbers are the gain functions evaluated here, which are the first-order gains of the chain only where the two points coincide (leave the linear axes out to have them filled by the inverse kinematics).",
+                model_spec::units::short(self.gap_mm)
+            )
+        })
+    }
+}
+
+/// The largest distance between the nominal tool point and the nominal workpiece point at a
+/// pose where gains are evaluated or a sample is taken, mm: the gains are the first-order
+/// gains where the two coincide (the sensor nest on the ball).
+pub const ON_BALL_TOLERANCE_MM: f64 = 0.5;
 
 /// Why a pose cannot be made.
 #[derive(Debug, thiserror::Error)]
@@ -75,10 +98,12 @@ pub fn complete(
     if !allow_off_stroke {
         m.check_pose(&commands).map_err(PoseError::OffStroke)?;
     }
+    let gap_mm = nominal_error_vector(m, &commands, &params).position.norm();
     Ok(Pose {
         commands,
         shown,
         from_ik,
         params,
+        gap_mm,
     })
 }

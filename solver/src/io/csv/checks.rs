@@ -12,10 +12,10 @@
 //! The first check that fails refuses the batch with [`CsvError::Refused`]: how many samples or
 //! readings offend, and the first [`LISTED`] of them by line.
 
-use crate::io::csv::{CsvError, MEASURED, ReadOptions, format_scaled};
+use crate::io::csv::{CsvError, MEASURED, ReadOptions};
 use crate::simulation::exact::VirtualMachine;
 use model_spec::Machine;
-use model_spec::units::short;
+use model_spec::units::{compact, format_scaled, plural};
 
 /// How many offending samples a refusal lists.
 pub const LISTED: usize = 5;
@@ -84,7 +84,7 @@ impl<'m> SampleChecks<'m> {
             if !at_most(d, tol) {
                 off.add(line, || {
                     if d.is_finite() {
-                        format!("line {line}: {} mm", people(d))
+                        format!("line {line}: {} mm", compact(d))
                     } else {
                         format!("line {line}: beyond any number (the commands overflow)")
                     }
@@ -94,8 +94,8 @@ impl<'m> SampleChecks<'m> {
         let what = |n| {
             format!(
                 "{n} pose{} put the nominal tool point off the nominal workpiece point by more than {} mm (machine {}, default kinematic parameters)",
-                plural(n),
-                people(tol),
+                plural(n, "s"),
+                compact(tol),
                 self.m.name
             )
         };
@@ -125,7 +125,7 @@ impl<'m> SampleChecks<'m> {
             |n| {
                 format!(
                     "{n} pose{} outside the strokes and ranges of machine {}{filled}",
-                    plural(n),
+                    plural(n, "s"),
                     self.m.name
                 )
             },
@@ -156,7 +156,7 @@ impl<'m> SampleChecks<'m> {
             |n| {
                 format!(
                     "{n} reading{} beyond the plausibility bound of {} µm",
-                    plural(n),
+                    plural(n, "s"),
                     format_scaled(bound, 3)
                 )
             },
@@ -245,24 +245,6 @@ impl Offenders {
 /// `x <= bound`; `false` when either is NaN (a NaN offends).
 fn at_most(x: f64, bound: f64) -> bool {
     x <= bound
-}
-
-fn plural(n: usize) -> &'static str {
-    if n == 1 { "" } else { "s" }
-}
-
-/// A number for people: the shortest decimal that reads back to it when that is short, else
-/// six decimals at most; scientific notation for huge values.
-fn people(x: f64) -> String {
-    let shortest = format_scaled(x, 0);
-    let digits = shortest.bytes().filter(u8::is_ascii_digit).count();
-    if digits <= 12 || !x.is_finite() {
-        shortest
-    } else if x.abs() < 1e12 {
-        short(x)
-    } else {
-        format!("{x:.6e}")
-    }
 }
 
 #[cfg(test)]

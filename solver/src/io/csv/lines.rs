@@ -157,16 +157,14 @@ fn too_long(cx: &Ctx, line: usize, max: usize) -> CsvError {
     )
 }
 
-/// The error for line `line` whose bytes `bytes` are UTF-8 up to `valid`: the column is counted
-/// in characters.
+/// The error for line `line` whose bytes `bytes` are UTF-8 up to `valid`: located like every
+/// text reader's (`file:line:column`, the column counted in characters).
 fn not_utf8(cx: &Ctx, line: usize, bytes: &[u8], valid: usize) -> CsvError {
     let column = std::str::from_utf8(&bytes[..valid]).map_or(valid, |s| s.chars().count()) + 1;
-    cx.err(
+    CsvError::Text(model_spec::text::TextError::NotUtf8 {
+        file: cx.file.to_string(),
         line,
-        None,
-        format!(
-            "column {column}: not UTF-8 text (byte {:#04x})",
-            bytes[valid]
-        ),
-    )
+        column,
+        byte: bytes[valid],
+    })
 }

@@ -42,12 +42,12 @@
 //! Files are written atomically: to a temporary file in the same directory, then renamed.
 //!
 //! Files: `lines` (the bounded line reader), `read` (header and rows), `whole` and `blocks`
-//! (the two readers), `checks` (what samples must satisfy), `write`, `numbers`.
+//! (the two readers), `checks` (what samples must satisfy), `write`; the exact number conversions are
+//! [`model_spec::units::exact`].
 
 mod blocks;
 mod checks;
 mod lines;
-mod numbers;
 mod read;
 mod whole;
 mod write;
@@ -58,7 +58,6 @@ pub use checks::LISTED;
 pub use lines::READ_BUFFER_BYTES;
 use model_spec::catalogue::iso_rank;
 use model_spec::{AxisKind, Machine};
-pub use numbers::{degrees_for, format_scaled, parse_scaled};
 use std::path::Path;
 pub use whole::{parse_csv, read_csv};
 pub use write::format_record;
@@ -90,7 +89,7 @@ impl Default for ReadOptions {
         ReadOptions {
             max_reading_mm: 1.0,
             allow_off_stroke: false,
-            on_ball_tolerance_mm: 0.5,
+            on_ball_tolerance_mm: crate::simulation::pose::ON_BALL_TOLERANCE_MM,
             max_line_bytes: 65_536,
         }
     }
@@ -135,6 +134,9 @@ pub enum CsvError {
     /// A record that cannot be written (not a file problem: a programming error reported).
     #[error("cannot write the record: {0}")]
     Record(String),
+    /// A line that is not UTF-8 text, located at its first byte that is not.
+    #[error(transparent)]
+    Text(model_spec::text::TextError),
     /// The file could not be read.
     #[error("cannot read `{file}`: {source}")]
     Io {

@@ -7,10 +7,10 @@ use crate::io::csv::checks::SampleChecks;
 use crate::io::csv::lines::Lines;
 use crate::io::csv::{
     Col, CsvError, Ctx, MEASURED, Need, ReadOptions, classify, clean_name, expected_columns,
-    parse_scaled,
 };
 use crate::simulation::exact::{ExactError, VirtualMachine};
 use crate::simulation::paths::fill_linear_ik;
+use model_spec::units::parse_scaled;
 use model_spec::{AxisKind, Machine};
 use std::io::Read;
 

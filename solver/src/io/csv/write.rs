@@ -1,8 +1,9 @@
 //! Writing a record as a measurement or path CSV: the text, then the file, atomically. Every
 //! number is the shortest decimal that reads back to the same value ([`crate::io::csv`]).
 
-use crate::io::csv::{CsvError, MEASURED, column_order, degrees_for, format_scaled};
+use crate::io::csv::{CsvError, MEASURED, column_order};
 use crate::record::Record;
+use model_spec::units::{degrees_for, format_scaled};
 use model_spec::{AxisKind, Machine};
 
 /// The CSV text of `record` of machine `m`: `comments` as `# ` lines, then the header

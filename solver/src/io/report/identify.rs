@@ -44,6 +44,10 @@ pub struct ParameterReport {
     pub determined: bool,
     /// Fixed to 0 by the constraint.
     pub fixed: bool,
+    /// For a `poly:K` column: the stroke of its axis the polynomial is normalised over, mm
+    /// (the value means something only over the same stroke); absent for other bases.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub over_mm: Option<[f64; 2]>,
 }
 
 /// A pair of determined parameters with a high correlation.
@@ -140,6 +144,15 @@ pub struct IdentificationReport {
     pub notes: Vec<String>,
 }
 
+/// The stroke (mm) a `poly:K` term's polynomial is normalised over: its axis's; `None` for
+/// other bases.
+pub fn poly_stroke(m: &Machine, term: &crate::model::Term) -> Option<[f64; 2]> {
+    match (term.basis, term.effect.carrier(m)) {
+        (crate::model::Basis::Poly(_), crate::model::Carrier::Axis(a)) => Some(m.axes[a].limits),
+        _ => None,
+    }
+}
+
 /// The text of a constraint, as the report writes it.
 pub fn constraint_text(c: &Constraint) -> String {
     match c {
@@ -198,6 +211,7 @@ impl IdentificationReport {
                 unit: term.effect.unit(m).to_string(),
                 determined: id.determined[j],
                 fixed: fit.fixed[j],
+                over_mm: poly_stroke(m, &term),
             });
         }
         let name = |j: usize| fit.names[j].clone();

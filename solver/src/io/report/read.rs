@@ -9,11 +9,17 @@
 //! - every parameter has `error` (an effect of the machine), `basis` (a column of the
 //!   vocabulary; a harmonic's `cos` column followed by its `sin` column), `value` (a finite
 //!   number, or `null`: undetermined) and `unit` (the effect's);
-//! - `terms`, when given, lists exactly the terms of the parameters, in order.
+//! - `terms` lists exactly the terms of the parameters, in order, and holds every term of the
+//!   base model (and the sensor offsets when the readings were zeroed): no parameter is missing;
+//! - a `poly:K` parameter was normalised over the stroke this machine has for its axis;
+//! - the refinement, when the report has one, converged (an identification that did not is no
+//!   result).
 
+use super::identify::poly_stroke;
 use crate::model::{Basis, Effect, Model, Term};
 use model_spec::Machine;
 use model_spec::text::{TextError, decode_text};
+use model_spec::units::short;
 use serde_json::Value;
 
 /// The largest identification report read (bytes): far above any real one.
@@ -25,13 +31,17 @@ pub enum ReportError {
     /// The file cannot be read, is too large or is not UTF-8 text.
     #[error(transparent)]
     Text(#[from] TextError),
-    /// Not JSON.
-    #[error("{file}: not valid JSON: {source}")]
+    /// Not JSON, located by line and column (in characters, as every reader counts them).
+    #[error("{file}:{line}:{column}: not valid JSON: {message}")]
     Json {
         /// The file.
         file: String,
-        /// The cause (with line and column).
-        source: serde_json::Error,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column, in characters.
+        column: usize,
+        /// What the JSON parser said.
+        message: String,
     },
     /// A field that is missing or wrong.
     #[error("{file}: field `{field}`: {message}")]
@@ -95,10 +105,7 @@ pub fn parse_identification(
     m: &Machine,
 ) -> Result<IdentifiedValues, ReportError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let root: Value = serde_json::from_str(text).map_err(|source| ReportError::Json {
-        file: file.to_string(),
-        source,
-    })?;
+    let root: Value = serde_json::from_str(text).map_err(|e| json_error(file, text, &e))?;
     let r = Reader { file, m };
     if !root.is_object() {
         return Err(r.bad("(top level)", "expected a JSON object".into()));
@@ -129,51 +136,96 @@ pub fn parse_identification(
             ),
         ));
     }
-    if let Some(base) = root.get("base_model").filter(|v| !v.is_null()) {
-        let Value::String(base) = base else {
-            return Err(r.bad(
-                "base_model",
-                format!("expected a string or null, found {base}"),
-            ));
-        };
-        if m.model_errors(base).is_none() {
-            return Err(r.bad(
-                "base_model",
-                format!(
-                    "machine {} has no model `{base}` (models: {})",
-                    m.name,
-                    m.model_names().join(", ")
-                ),
-            ));
+    let base = match root.get("base_model") {
+        None | Some(Value::Null) => None,
+        Some(Value::String(base)) => match Model::of(m, base) {
+            Some(model) => Some((base.clone(), model)),
+            None => {
+                return Err(r.bad(
+                    "base_model",
+                    format!(
+                        "machine {} has no model `{base}` (models: {})",
+                        m.name,
+                        m.model_names().join(", ")
+                    ),
+                ));
+            }
+        },
+        Some(other) => {
+            return Err(r.bad("base_model", format!("expected a string, found {other}")));
         }
+    };
+    if let Some(Value::Object(refinement)) = root.get("refinement")
+        && refinement.get("converged") == Some(&Value::Bool(false))
+    {
+        return Err(r.bad(
+            "refinement.converged",
+            "false: the refinement against the exact machine did not converge, so these values are not an identification".into(),
+        ));
     }
     let model_name = r.string(&root, "model", "model")?;
     let (model, values) = r.parameters(&root)?;
-    if let Some(terms) = root.get("terms") {
-        let Value::Array(items) = terms else {
-            return Err(r.bad("terms", format!("expected an array, found {terms}")));
-        };
-        let spelled: Vec<String> = model.terms.iter().map(|t| t.spelling(m)).collect();
-        let listed: Vec<String> = items
-            .iter()
-            .map(|v| {
-                v.as_str()
-                    .map(str::to_string)
-                    .unwrap_or_else(|| v.to_string())
-            })
-            .collect();
-        let parsed: Vec<Option<Term>> = listed.iter().map(|t| Term::parse(m, t).ok()).collect();
-        if parsed
-            .iter()
-            .map(Option::as_ref)
-            .ne(model.terms.iter().map(Some))
-        {
+    let spelled: Vec<String> = model.terms.iter().map(|t| t.spelling(m)).collect();
+    let items = match root.get("terms") {
+        Some(Value::Array(items)) => items,
+        Some(other) => return Err(r.bad("terms", format!("expected an array, found {other}"))),
+        None => {
             return Err(r.bad(
                 "terms",
                 format!(
-                    "[{}] are not the terms of the parameters [{}]: a parameter is missing or extra",
-                    listed.join(", "),
+                    "missing: the report must list the terms it identified ({})",
                     spelled.join(", ")
+                ),
+            ));
+        }
+    };
+    let listed: Vec<String> = items
+        .iter()
+        .map(|v| {
+            v.as_str()
+                .map(str::to_string)
+                .unwrap_or_else(|| v.to_string())
+        })
+        .collect();
+    let parsed: Vec<Option<Term>> = listed.iter().map(|t| Term::parse(m, t).ok()).collect();
+    if parsed
+        .iter()
+        .map(Option::as_ref)
+        .ne(model.terms.iter().map(Some))
+    {
+        return Err(r.bad(
+            "terms",
+            format!(
+                "[{}] are not the terms of the parameters [{}]: a parameter is missing or extra",
+                listed.join(", "),
+                spelled.join(", ")
+            ),
+        ));
+    }
+    if let Some((name, base)) = &base {
+        let zeroed = root.get("zeroed") == Some(&Value::Bool(true));
+        let wanted = if zeroed {
+            crate::fitting::with_offsets(base)
+        } else {
+            base.clone()
+        };
+        let missing: Vec<String> = wanted
+            .terms
+            .iter()
+            .filter(|t| !model.terms.contains(t))
+            .map(|t| t.spelling(m))
+            .collect();
+        if !missing.is_empty() {
+            return Err(r.bad(
+                "parameters",
+                format!(
+                    "the base model `{name}`{} has {} that the parameters lack",
+                    if zeroed {
+                        " with the offsets of zeroed readings"
+                    } else {
+                        ""
+                    },
+                    missing.join(", ")
                 ),
             ));
         }
@@ -184,6 +236,27 @@ pub fn parse_identification(
         model,
         values,
     })
+}
+
+/// A JSON syntax error located in characters: the parser counts columns in bytes.
+fn json_error(file: &str, text: &str, e: &serde_json::Error) -> ReportError {
+    let line = e.line().max(1);
+    let line_text = text.split('\n').nth(line - 1).unwrap_or("");
+    let mut byte = e.column().saturating_sub(1).min(line_text.len());
+    while !line_text.is_char_boundary(byte) {
+        byte -= 1;
+    }
+    let full = e.to_string();
+    let message = match full.rfind(" at line ") {
+        Some(i) => full[..i].to_string(),
+        None => full,
+    };
+    ReportError::Json {
+        file: file.to_string(),
+        line,
+        column: line_text[..byte].chars().count() + 1,
+        message,
+    }
 }
 
 /// Reads fields of one report, naming its file in errors.
@@ -208,6 +281,47 @@ impl Reader<'_> {
             Some(other) => Err(self.bad(field, format!("expected a string, found {other}"))),
             None => Err(self.bad(field, "missing".into())),
         }
+    }
+
+    /// Checks that the `poly:K` parameter `q` was normalised over `stroke` (mm), the stroke of
+    /// its axis on this machine.
+    fn check_stroke(
+        &self,
+        q: &Value,
+        field: &str,
+        term: &Term,
+        stroke: [f64; 2],
+    ) -> Result<(), ReportError> {
+        let given = q.get("over_mm").and_then(Value::as_array).and_then(|a| {
+            let lo = a.first()?.as_f64()?;
+            let hi = a.get(1)?.as_f64()?;
+            (a.len() == 2).then_some([lo, hi])
+        });
+        let Some(given) = given else {
+            return Err(self.bad(
+                field,
+                "missing or not [min, max]: a poly:K value means something only with the stroke (mm) it was normalised over".into(),
+            ));
+        };
+        let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * (1.0 + a.abs());
+        if !(same(given[0], stroke[0]) && same(given[1], stroke[1])) {
+            let axis = match term.effect.carrier(self.m) {
+                crate::model::Carrier::Axis(a) => self.m.axes[a].name.clone(),
+                crate::model::Carrier::None => "?".into(),
+            };
+            return Err(self.bad(
+                field,
+                format!(
+                    "{} was normalised over the stroke {} .. {} mm, but axis {axis} of this machine has {} .. {} mm: the value would mean another error",
+                    term.spelling(self.m),
+                    short(given[0]),
+                    short(given[1]),
+                    short(stroke[0]),
+                    short(stroke[1])
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The model and values of `parameters`.
@@ -282,6 +396,9 @@ impl Reader<'_> {
                             ),
                         ));
                     }
+                }
+                if let Some(stroke) = poly_stroke(m, &term) {
+                    self.check_stroke(q, &field("over_mm"), &term, stroke)?;
                 }
                 let unit = self.string(q, "unit", &field("unit"))?;
                 if unit != effect.unit(m) {

@@ -51,7 +51,7 @@ pub fn pose_gains(
         .map(|(s, v)| format!("{} = {}", s.name, short(*v)))
         .collect::<Vec<_>>()
         .join(", ");
-    let notes = [
+    let mut notes = vec![
         format!("At {}.", describe_pose(m, pose)),
         format!(
             "Kinematic parameters (mm): {}.",
@@ -60,6 +60,7 @@ pub fn pose_gains(
         "Error vector = tool point minus workpiece point, in the tool frame (first order).".into(),
         "gx gy gz: mm/mm for translational errors, mm/rad for angular errors (1 mm/rad = 1 µm per mrad).".into(),
     ];
+    notes.extend(pose.off_ball_note());
     let head = header(&["error", "unit", "gx", "gy", "gz"]);
     let rows: Vec<Vec<String>> = names
         .iter()

@@ -2,8 +2,9 @@
 //! µm or µrad, or why there is none), then rank, condition number, residual RMS, σ̂, the
 //! confounded groups, the nearly confounded pairs and what the zero offsets swallow.
 
-use super::{plural, zeroed_text};
+use super::zeroed_text;
 use crate::io::report::identify::IdentificationReport;
+use model_spec::units::plural;
 use model_spec::units::{fixed, readable, symbol};
 
 /// A value in µm or µrad for people: four decimals, or two significant digits below 5e-5.

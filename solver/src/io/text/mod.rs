@@ -53,30 +53,17 @@ pub fn indent(text: &str, pad: &str) -> String {
     text.lines().map(|l| format!("{pad}{l}\n")).collect()
 }
 
-/// `items` joined by `sep` in lines of at most `width` characters, each starting with `pad`.
+/// `items` joined by `sep` in lines of at most `width` characters, each starting with `pad`
+/// ([`model_spec::text::wrap`]).
 pub fn wrap(items: &[String], sep: &str, pad: &str, width: usize) -> String {
-    let mut out = String::new();
-    let mut line = String::new();
-    for (i, item) in items.iter().enumerate() {
-        let piece = if i + 1 < items.len() {
-            format!("{item}{}", sep.trim_end())
-        } else {
-            item.clone()
-        };
-        if !line.is_empty() && pad.len() + line.chars().count() + 1 + piece.chars().count() > width
-        {
-            out.push_str(&format!("{pad}{line}\n"));
-            line.clear();
-        }
-        if !line.is_empty() {
-            line.push(' ');
-        }
-        line.push_str(&piece);
+    if items.is_empty() {
+        return String::new();
     }
-    if !line.is_empty() {
-        out.push_str(&format!("{pad}{line}\n"));
-    }
-    out
+    let pieces = model_spec::text::list_pieces(items, sep.trim_end());
+    model_spec::text::wrap(pieces, width.saturating_sub(pad.len()), "")
+        .into_iter()
+        .map(|l| format!("{pad}{l}\n"))
+        .collect()
 }
 
 /// A path or argument for a shell command line, quoted when needed.
@@ -89,11 +76,6 @@ pub fn shell(s: &str) -> String {
     } else {
         format!("'{}'", s.replace('\'', r"'\''"))
     }
-}
-
-/// `s` when `n` is not 1 (`plural(3, "s")`), for counts in sentences.
-pub fn plural(n: usize, s: &str) -> &str {
-    if n == 1 { "" } else { s }
 }
 
 /// "zeroed at the first sample" or "not zeroed".

@@ -28,11 +28,11 @@
 //! (the documented default of `rtest demo`) and `seed-ac-reduced` (the 11 errors of the reduced
 //! model only, constants, no noise).
 
-use crate::io::csv::{format_scaled, parse_scaled};
 use crate::model::Basis;
 use crate::model::{Effect, Model, Term};
 use crate::record::Sample;
 use model_spec::Machine;
+use model_spec::units::{format_scaled, parse_scaled};
 
 mod parse;
 
@@ -51,6 +51,10 @@ pub const BUILTIN_TRUTHS: &[(&str, &str)] = &[
         include_str!("../../../truths/seed-ac-budget.toml"),
     ),
 ];
+
+/// The largest seed of the noise generator: a TOML integer is at most `i64::MAX`, so truth
+/// files and the command line share this range.
+pub const MAX_SEED: u64 = i64::MAX as u64;
 
 /// The largest standard deviation of the reading noise a truth may have, µm: larger noise
 /// would give readings beyond any plausible R-test reading.

@@ -1,10 +1,10 @@
 //! The validation of a truth file: every entry checked against the machine, every problem
 //! located by line and column.
 
-use super::{MAX_NOISE_UM, MAX_VALUE, Truth, TruthError, places};
-use crate::io::csv::parse_scaled;
+use super::{MAX_NOISE_UM, MAX_SEED, MAX_VALUE, Truth, TruthError, places};
 use crate::model::{Basis, Carrier, Effect, Term};
 use model_spec::Machine;
+use model_spec::units::parse_scaled;
 use std::ops::Range;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
@@ -184,10 +184,12 @@ impl Parser<'_> {
     }
 
     fn seed(&self, v: &Val<'_>) -> Res<u64> {
-        let msg = "`seed` must be a whole number from 0 to 9223372036854775807";
+        let msg = format!("`seed` must be a whole number from 0 to {MAX_SEED}");
         match v.get_ref() {
             DeValue::Integer(i) => u64::from_str_radix(i.as_str(), i.radix())
-                .map_err(|_| self.err(v.span(), format!("{msg}, not `{i}`"))),
+                .ok()
+                .filter(|&s| s <= MAX_SEED)
+                .ok_or_else(|| self.err(v.span(), format!("{msg}, not `{i}`"))),
             other => Err(self.err(v.span(), format!("{msg}, not {}", other.type_str()))),
         }
     }

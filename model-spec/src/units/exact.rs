@@ -150,9 +150,17 @@ mod tests {
         // Longer than the stack buffer.
         let long = format!("{}.{}", "1".repeat(70), "2".repeat(30));
         assert_eq!(parse_scaled(&long, -3), format!("{long}e-3").parse().ok());
-        let mut r = crate::simulation::rng::Rng::new(3);
+        // SplitMix64: numbers with every exponent from 1e-20 to 1e20 and random digits.
+        let mut state = 3u64;
+        let mut next = || {
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
         for _ in 0..20_000 {
-            let x = r.normal() * 10f64.powi((r.uniform() * 40.0) as i32 - 20);
+            let x = (2.0 * next() - 1.0) * 10f64.powi((next() * 40.0) as i32 - 20);
             for k in [0, 3, 6, -3] {
                 let s = format_scaled(x, k);
                 assert_eq!(

@@ -15,8 +15,17 @@
 //! None of them prints a negative zero. Non-finite numbers are written as Rust writes them
 //! (`NaN`, `inf`); the reports check for them before they format anything.
 //!
-//! Numbers written to files that are read back (CSV readings, JSON values, Rust literals) do
-//! not use these: they use the shortest decimal that reads back to the same `f64`.
+//! - [`compact`]: a value as it would be written back, for echoing inputs in messages
+//!   (`1e308`, `-2400`, `217.504`).
+//!
+//! Numbers written to files that are read back use [`exact`]: the shortest decimal that reads
+//! back to the same `f64`, µm moved to mm in the decimal text ([`format_scaled`],
+//! [`parse_scaled`]), degrees that convert back to the radian command exactly
+//! ([`degrees_for`]).
+
+pub mod exact;
+
+pub use exact::{degrees_for, format_scaled, parse_scaled};
 
 /// µm per mm.
 pub const UM_PER_MM: f64 = 1e3;
@@ -70,6 +79,12 @@ pub fn short(x: f64) -> String {
     }
 }
 
+/// `suffix` when `n` is not 1 (`format!("{n} reading{}", plural(n, "s"))`), for counts in
+/// sentences.
+pub fn plural(n: usize, suffix: &str) -> &str {
+    if n == 1 { "" } else { suffix }
+}
+
 /// A probability for people: three decimals from 0.001 up, two significant digits in
 /// scientific notation below, `< 1e-300` for an underflow to zero.
 pub fn p_value(p: f64) -> String {
@@ -79,6 +94,21 @@ pub fn p_value(p: f64) -> String {
         format!("{p:.1e}")
     } else {
         format!("{p:.3}")
+    }
+}
+
+/// A value as it would be written back: the shortest decimal that reads back to `x` when it
+/// has at most twelve digits (`1e308`, `-2400`, `1.5e-12`), else six decimals at most
+/// ([`short`]: `0.30000000000000004` is `0.3`), and scientific notation for huge values.
+pub fn compact(x: f64) -> String {
+    let shortest = format_scaled(x, 0);
+    let digits = shortest.bytes().filter(u8::is_ascii_digit).count();
+    if digits <= 12 || !x.is_finite() {
+        shortest
+    } else if x.abs() < 1e12 {
+        short(x)
+    } else {
+        format!("{x:.6e}")
     }
 }
 
@@ -107,5 +137,9 @@ mod tests {
         assert_eq!(symbol("um"), "µm");
         assert_eq!(symbol("urad"), "µrad");
         assert_eq!(symbol("mm"), "mm");
+        assert_eq!(compact(1e308), "1e308");
+        assert_eq!(compact(-2400.0), "-2400");
+        assert_eq!(compact(0.1 + 0.2), "0.3");
+        assert_eq!(compact(217.504), "217.504");
     }
 }

@@ -151,7 +151,7 @@ pub fn generate_machine_with(
             })?;
         let model = GainModel::derive(m, errors);
         let parts = compile_parts(m, &model, max_instructions);
-        built.push((name.replace('-', "_"), model, parts));
+        built.push((name.to_string(), model, parts));
     }
     let header = header(m, &built);
     let refs: Vec<(&str, &GainModel, Vec<Part>)> = built

@@ -20,8 +20,8 @@
 //!
 //! The digest is FNV-1a (64 bits) of a canonical encoding (strings with their length, numbers
 //! by their IEEE 754 bits, little-endian), written as 16 lower-case hex digits. It does not
-//! depend on the platform or the Rust version; a change of the encoding changes the version
-//! string it starts with.
+//! depend on the platform or the Rust version. The encoding starts with a version string, so a
+//! change of the encoding changes every fingerprint.
 
 use crate::machine::{AxisKind, Link, Machine, Offset, Side, SymbolId, Value};
 

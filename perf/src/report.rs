@@ -14,7 +14,7 @@ pub struct StreamingReport {
     pub seconds: f64,
     /// Generating the synthetic record alone, s.
     pub data_generation_seconds: f64,
-    /// Peak resident memory, MB; `null` where the system does not say.
+    /// Peak resident memory, MB; `null` where the system does not say (undetermined).
     pub peak_rss_mb: Option<f64>,
     /// Largest estimate error against the values used, in standard uncertainties.
     pub worst_z: f64,
@@ -107,6 +107,46 @@ fn fill_report(f: &FillBandwidth) -> FillReport {
         plain_write_gb_per_s: f.bytes / f.write_seconds / 1e9,
         fraction: f.fraction(),
     }
+}
+
+/// The first number of the report that is not finite (a failed measurement: a zero time, an
+/// empty run), named by its place; `None` when every number is finite.
+pub fn non_finite(r: &BenchReport) -> Option<String> {
+    let s = &r.streaming_identify;
+    let mut numbers: Vec<(String, f64)> = vec![
+        ("streaming_identify.seconds".into(), s.seconds),
+        (
+            "streaming_identify.data_generation_seconds".into(),
+            s.data_generation_seconds,
+        ),
+        ("streaming_identify.worst_z".into(), s.worst_z),
+    ];
+    numbers.extend(
+        s.peak_rss_mb
+            .map(|x| ("streaming_identify.peak_rss_mb".into(), x)),
+    );
+    for m in &r.gains_per_pose {
+        numbers.push((format!("gains_per_pose[{}].ns", m.method), m.ns));
+        numbers.push((
+            format!("gains_per_pose[{}].ratio_to_generated", m.method),
+            m.ratio_to_generated,
+        ));
+    }
+    for (i, f) in r.h_fill.iter().enumerate() {
+        numbers.push((format!("h_fill[{i}].fill_gb_per_s"), f.fill_gb_per_s));
+        numbers.push((
+            format!("h_fill[{i}].plain_write_gb_per_s"),
+            f.plain_write_gb_per_s,
+        ));
+        numbers.push((format!("h_fill[{i}].fraction"), f.fraction));
+    }
+    for (m, ms) in &r.codegen_ms {
+        numbers.push((format!("codegen_ms[{m}]"), *ms));
+    }
+    numbers
+        .into_iter()
+        .find(|(_, x)| !x.is_finite())
+        .map(|(name, x)| format!("`{name}` is {x}"))
 }
 
 /// The report for people.

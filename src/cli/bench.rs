@@ -37,6 +37,11 @@ pub struct BenchArgs {
 /// Runs `rtest bench`.
 pub fn run(args: &BenchArgs) -> CliResult {
     let report = perf::report::run(args.quick);
+    if let Some(what) = perf::report::non_finite(&report) {
+        return Err(CliError::computation(format!(
+            "bench: a measurement failed: {what}"
+        )));
+    }
     if args.json {
         let json = serde_json::to_string_pretty(&report)
             .map_err(|e| CliError::computation(format!("--json: {e}")))?;

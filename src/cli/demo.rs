@@ -61,24 +61,11 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         files.add_in_dir("demo", dir, &f.name, f.contents.clone());
         listed.push((f.name.clone(), f.what.clone()));
     }
-    for (name, svg) in super::figures::svgs(&result.figures)? {
-        let what = if name.ends_with("-path.svg") {
-            "figure: measured and predicted error along the path (base and extended model), x, y, z"
-        } else {
-            "figure: residual components before and after the extension"
-        };
+    for (name, what, svg) in super::figures::svgs(&result.figures)? {
         files.add_in_dir("demo", dir, &name, svg);
-        listed.push((name, what.to_string()));
+        listed.push((name, what));
     }
     write(files)?;
-    let mut text = result.text;
-    text.push_str(&format!("\nWrote {OUT_DIR}/:\n"));
-    for (name, what) in &listed {
-        text.push_str(&format!("  {OUT_DIR}/{name}  ({what})\n"));
-    }
-    text.push_str(&format!(
-        "\nDone in {:.2} s. The same steps one by one: rtest simulate, rtest identify, rtest validate, rtest diagnose (see --help).\n",
-        start.elapsed().as_secs_f64()
-    ));
-    super::print(&text)
+    let seconds = start.elapsed().as_secs_f64();
+    super::print(&(result.text + &demo::written(OUT_DIR, &listed, seconds)))
 }

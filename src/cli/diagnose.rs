@@ -199,7 +199,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         records.extend(held.iter().map(|(n, r)| (n.clone(), r, false)));
         let figs = figures(&m, &d, &label, &opts, &records)
             .map_err(|e| CliError::computation(format!("--plot: {e}")))?;
-        for (name, svg) in super::figures::svgs(&figs)? {
+        for (name, _, svg) in super::figures::svgs(&figs)? {
             files.add_in_dir("--plot", dir, &name, svg);
         }
     }

@@ -8,8 +8,8 @@ fn series(s: &Series) -> plots::Series {
     plots::Series::new(s.label.clone(), s.values.clone())
 }
 
-/// Every figure as (file name, SVG text).
-pub fn svgs(figures: &Figures) -> CliResult<Vec<(String, String)>> {
+/// Every figure as (file name, what it shows, SVG text).
+pub fn svgs(figures: &Figures) -> CliResult<Vec<(String, String, String)>> {
     let failed = |e: plots::PlotError| CliError::computation(format!("--plot: {e}"));
     let mut out = Vec::new();
     for f in &figures.paths {
@@ -23,12 +23,12 @@ pub fn svgs(figures: &Figures) -> CliResult<Vec<(String, String)>> {
             })
             .collect();
         let svg = plots::path_comparison(&f.title, &f.x_label, &f.x, &panels).map_err(failed)?;
-        out.push((f.file_name.clone(), svg));
+        out.push((f.file_name.clone(), f.what.clone(), svg));
     }
     for s in &figures.spectra {
         let svg =
             plots::spectrum(&s.title, &s.before_label, &s.after_label, &s.rows).map_err(failed)?;
-        out.push((s.file_name.clone(), svg));
+        out.push((s.file_name.clone(), s.what.clone(), svg));
     }
     Ok(out)
 }

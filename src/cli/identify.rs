@@ -3,13 +3,13 @@
 
 use super::args::{self, RecordLimits, ValueBounds};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
-use model_spec::units::plural;
 use output::{Outputs, Target};
 use solver::fitting::streaming::{StreamingError, identify_file};
 use solver::fitting::{
     EstimateError, IdentifyOptions, RefineError, RefineOptions, check_values, identify,
     identify_refined,
 };
+use solver::io::report::identify::StreamingReport;
 use solver::io::report::{IdentificationReport, IdentificationSource, to_json};
 use solver::io::text::identify::identification;
 use solver::io::text::validate::LOOKS_ZEROED;
@@ -115,7 +115,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     check_outputs(&inputs, &outputs, &[])?;
     let read = args.records.read_options();
     let data = args.data.display().to_string();
-    let (ident, refinement, notes) = if args.stream {
+    let (ident, refinement, streaming, notes) = if args.stream {
         let (ident, run) = identify_file(&m, &model, &args.data, &opts, args.block as usize, &read)
             .map_err(|e| match e {
                 StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
@@ -123,23 +123,12 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
                 StreamingError::Estimate(e) => estimate_error(e),
                 other => CliError::computation(format!("--data: cannot identify: {other}")),
             })?;
-        let ahead = if run.first_block > args.block as usize {
-            format!(
-                " (the first read ahead to {} samples, until every axis had moved)",
-                run.first_block
-            )
-        } else {
-            String::new()
+        let streaming = StreamingReport {
+            blocks: run.blocks,
+            block: args.block as usize,
+            first_block: run.first_block,
         };
-        let note = format!(
-            "Read in {} block{} of up to {} sample{}{ahead}, folded into an incremental QR (first order; state {} numbers).\n",
-            run.blocks,
-            plural(run.blocks, "s"),
-            args.block,
-            plural(args.block as usize, "s"),
-            (ident.fit.names.len() + 1).pow(2)
-        );
-        (ident, None, note)
+        (ident, None, Some(streaming), String::new())
     } else {
         let record = super::read_record("--data", &m, &args.data, &read)?;
         let note = if record.looks_zeroed() && !args.zeroed {
@@ -149,7 +138,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         };
         if args.first_order {
             let ident = identify(&m, &model, &record, &opts).map_err(estimate_error)?;
-            (ident, None, note)
+            (ident, None, None, note)
         } else {
             let (ident, r) =
                 identify_refined(&m, &model, &record, &opts, &RefineOptions::default())
@@ -162,7 +151,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
                             "--data: the refinement against the exact machine failed: {other} (--first-order skips it)"
                         )),
                     })?;
-            (ident, Some(r), note)
+            (ident, Some(r), None, note)
         }
     };
     check_values(&m, &ident, &args.bounds.values()).map_err(|e| {
@@ -175,8 +164,9 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         label: &label,
         base_model: args.model.as_deref(),
     };
-    let report = IdentificationReport::new(&m, source, &ident, refinement.as_ref())
+    let mut report = IdentificationReport::new(&m, source, &ident, refinement.as_ref())
         .map_err(|e| CliError::computation(format!("--data: {e}")))?;
+    report.streaming = streaming;
     let mut text = identification(&report);
     text.push_str(&notes);
     let mut files = Outputs::new();

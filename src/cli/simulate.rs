@@ -139,10 +139,7 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     let mut files = Outputs::new();
     files.add("-o", args.output.clone(), csv);
     write(files)?;
-    // One line: the summary, and the file written.
-    let mut text = simulation(&m, &args.path, &truth, &record);
-    if let Target::Path(p) = &args.output {
-        text.insert_str(text.len() - 1, &format!("; wrote {}", p.display()));
-    }
+    let written = args.output.path().map(|p| p.display().to_string());
+    let text = simulation(&m, &args.path, &truth, &record, written.as_deref());
     print_text(&text, matches!(args.output, Target::Stdout))
 }

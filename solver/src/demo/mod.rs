@@ -61,6 +61,18 @@ pub struct Demo {
     pub text: String,
 }
 
+/// The list of the files written to `dir` (name, what it is), and the time taken, for people.
+pub fn written(dir: &str, files: &[(String, String)], seconds: f64) -> String {
+    let mut text = format!("\nWrote {dir}/:\n");
+    for (name, what) in files {
+        text.push_str(&format!("  {dir}/{name}  ({what})\n"));
+    }
+    text.push_str(&format!(
+        "\nDone in {seconds:.2} s. The same steps one by one: rtest simulate, rtest identify, rtest validate, rtest diagnose (see --help).\n"
+    ));
+    text
+}
+
 /// A step of the demo that failed.
 #[derive(Debug, thiserror::Error)]
 #[error("demo: {step}: {message}")]

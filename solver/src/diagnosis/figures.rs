@@ -37,6 +37,8 @@ pub struct Panel {
 pub struct PathFigure {
     /// The file name it is written to (`k4-path.svg`).
     pub file_name: String,
+    /// What it shows, for a list of files.
+    pub what: String,
     /// Its title.
     pub title: String,
     /// What the abscissa is (`C (deg)` or `sample index`).
@@ -52,6 +54,8 @@ pub struct PathFigure {
 pub struct SpectrumFigure {
     /// The file name it is written to (`k4-spectrum.svg`).
     pub file_name: String,
+    /// What it shows, for a list of files.
+    pub what: String,
     /// Its title.
     pub title: String,
     /// The legend of the bars before (base model).
@@ -217,6 +221,7 @@ pub fn figures(
         let s = stem(name, &mut taken);
         out.paths.push(PathFigure {
             file_name: format!("{s}-path.svg"),
+            what: "figure: measured and predicted error along the path (base and extended model), x, y, z".into(),
             title: format!("{name} ({role}): measured and predicted error, µm"),
             x_label,
             x,
@@ -235,6 +240,7 @@ pub fn figures(
         if !rows.is_empty() {
             out.spectra.push(SpectrumFigure {
                 file_name: format!("{s}-spectrum.svg"),
+                what: "figure: residual components before and after the extension".into(),
                 title: format!("{name} ({role}): residual components, µm"),
                 before_label: format!("base model ({label})"),
                 after_label: format!("extended model ({ext_label})"),

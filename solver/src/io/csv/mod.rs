@@ -34,12 +34,13 @@
 //! - every reading lies within ±[`ReadOptions::max_reading_mm`] (1000 µm) in each direction.
 //!
 //! Numbers are converted without double rounding: a µm value is read by moving the decimal
-//! point of its text three places ([`parse_scaled`]), and written as the shortest decimal of the
-//! mm value with the point moved back ([`format_scaled`]), so write → read gives the same bits.
+//! point of its text three places ([`model_spec::units::parse_scaled`]), and written as the shortest decimal of the
+//! mm value with the point moved back ([`model_spec::units::format_scaled`]), so write → read gives the same bits.
 //! Degrees are written as the shortest decimal whose `to_radians()` is the command; every
 //! command that was itself read from degrees (files, built-in paths) round-trips bit for bit.
 //!
-//! Files are written atomically: to a temporary file in the same directory, then renamed.
+//! This module formats the text ([`format_record`]); the command line writes files through its
+//! `output` crate.
 //!
 //! Files: `lines` (the bounded line reader), `read` (header and rows), `whole` and `blocks`
 //! (the two readers), `checks` (what samples must satisfy), `write`; the exact number conversions are

@@ -1,5 +1,5 @@
-//! Writing a record as a measurement or path CSV: the text, then the file, atomically. Every
-//! number is the shortest decimal that reads back to the same value ([`crate::io::csv`]).
+//! A record as the text of a measurement or path CSV. Every number is the shortest decimal that
+//! reads back to the same value ([`model_spec::units::exact`]).
 
 use crate::io::csv::{CsvError, MEASURED, column_order};
 use crate::record::Record;

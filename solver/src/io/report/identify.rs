@@ -1,7 +1,7 @@
 //! The identification report (`rtest identify --json`).
 //!
 //! ```json
-//! {"machine": "seed-ac", "fingerprint": "fnv1a64:…", "model": "reduced", "base_model": "reduced",
+//! {"machine": "seed-ac", "fingerprint": "fa038fe9e24c960a", "model": "reduced", "base_model": "reduced",
 //!  "terms": ["XOW", …, "BOC"],
 //!  "parameters": [{"name": "XOC", "error": "XOC", "basis": "const", "value": 12.3, "std": 0.05,
 //!                  "unit": "um", "determined": true, "fixed": false}, …],
@@ -80,6 +80,17 @@ pub struct RefinementReport {
     pub first_order_rms_um: f64,
 }
 
+/// How a record was read in blocks and folded into an incremental QR decomposition.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StreamingReport {
+    /// Blocks read.
+    pub blocks: usize,
+    /// Samples per block asked for.
+    pub block: usize,
+    /// Samples of the first block (it reads ahead until every axis has moved).
+    pub first_block: usize,
+}
+
 /// A group of sensor offsets and the errors they cannot be told from (zeroed readings).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SwallowedReport {
@@ -140,6 +151,9 @@ pub struct IdentificationReport {
     pub gains: String,
     /// The refinement against the exact machine.
     pub refinement: RefinementReport,
+    /// How a long record was read in blocks (`--stream`); absent when it was read whole.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub streaming: Option<StreamingReport>,
     /// Statements for people (what was swallowed, what has no value and why, non-convergence).
     pub notes: Vec<String>,
 }
@@ -294,6 +308,7 @@ impl IdentificationReport {
             gains: backend_name(ident.backend).into(),
             notes: notes(ident, &refinement),
             refinement,
+            streaming: None,
         })
     }
 }

@@ -25,6 +25,24 @@ pub fn identification(r: &IdentificationReport) -> String {
         plural(n, "s"),
     );
     out.push_str(&method(r));
+    if let Some(s) = &r.streaming {
+        let ahead = if s.first_block > s.block {
+            format!(
+                " (the first read ahead to {} samples, until every axis had moved)",
+                s.first_block
+            )
+        } else {
+            String::new()
+        };
+        out.push_str(&format!(
+            "Read in {} block{} of up to {} sample{}{ahead}, folded into an incremental QR (first order; state {} numbers).\n",
+            s.blocks,
+            plural(s.blocks, "s"),
+            s.block,
+            plural(s.block, "s"),
+            (n + 1).pow(2)
+        ));
+    }
     if r.zeroed {
         out.push_str(
             "Zeroed readings: the R-test zero offsets dx0 dy0 dz0 (constant, µm) are fitted with the model.\n",

@@ -6,19 +6,25 @@ use crate::fitting::validate::statistics;
 use crate::record::Record;
 use crate::simulation::truth::Truth;
 use model_spec::Machine;
-use model_spec::units::{fixed, short};
+use model_spec::units::{UM_PER_MM, fixed, short};
 
 /// `simulated K4 on seed-ac (truth …, noise 0.5 µm, seed 1, not zeroed): 241 samples, RMS of
-/// the readings … µm (x …, y …, z …)`.
-pub fn simulation(m: &Machine, path: &str, truth: &Truth, record: &Record) -> String {
+/// the readings … µm (x …, y …, z …); wrote k4.csv`, one line (`written`: the file, if any).
+pub fn simulation(
+    m: &Machine,
+    path: &str,
+    truth: &Truth,
+    record: &Record,
+    written: Option<&str>,
+) -> String {
     let zeros = vec![[0.0; 3]; record.measured.len()];
     let (per, all) = statistics(&record.measured, &zeros);
-    let um = |mm: f64| fixed(mm * 1e3, 3);
+    let um = |mm: f64| fixed(mm * UM_PER_MM, 3);
     format!(
-        "simulated {path} on {} (truth {}, noise {} µm, seed {}, {}): {} samples, RMS of the readings {} µm (x {}, y {}, z {})\n",
+        "simulated {path} on {} (truth {}, noise {} µm, seed {}, {}): {} samples, RMS of the readings {} µm (x {}, y {}, z {}){}\n",
         m.name,
         truth.source,
-        short(truth.noise_mm * 1e3),
+        short(truth.noise_mm * UM_PER_MM),
         truth.seed,
         zeroed_text(truth.zeroed),
         record.samples.len(),
@@ -26,5 +32,6 @@ pub fn simulation(m: &Machine, path: &str, truth: &Truth, record: &Record) -> St
         um(per[0].measured_rms),
         um(per[1].measured_rms),
         um(per[2].measured_rms),
+        written.map_or(String::new(), |f| format!("; wrote {f}")),
     )
 }

@@ -1,7 +1,7 @@
 //! `rtest gains`: the error-gain functions of a machine's model, as a symbolic table or as
 //! numbers at one pose.
 
-use super::{CliError, CliResult, EXIT_CODES, args};
+use super::{CliError, CliResult, EXIT_CODES, args, pose_args};
 use codegen::GainModel;
 use codegen::table::{self, render};
 use solver::fitting::GainSource;
@@ -102,15 +102,16 @@ pub fn run(args: &GainsArgs) -> CliResult {
         };
         return super::print(&out);
     };
-    let params = args::params(&m, args.param.as_deref())?;
-    let pose =
-        complete(&m, &args::at(&m, at)?, params, args.allow_off_stroke).map_err(|e| match e {
+    let params = pose_args::params(&m, args.param.as_deref())?;
+    let pose = complete(&m, &pose_args::at(&m, at)?, params, args.allow_off_stroke).map_err(
+        |e| match e {
             PoseError::Ik(_) => CliError::input(format!("--at: {e}")),
             PoseError::OffStroke(_) => {
                 CliError::usage(format!("--at: {e} (--allow-off-stroke accepts it)"))
             }
             PoseError::MissingRotary(_) => CliError::usage(format!("--at: {e}")),
-        })?;
+        },
+    )?;
     let mut source = GainSource::new(&m, &errors, &pose.params)
         .map_err(|e| CliError::usage(format!("--param: {e}")))?;
     let mut gains = vec![[0.0; 3]; source.errors().len()];

@@ -88,45 +88,35 @@ fn no_free_temporary_name_is_an_error_that_changes_nothing() {
     assert_only_changed(&before, &snapshot(&dir.path), &[]);
 }
 
-/// The child's part of the signal tests: stage a large output and a small one, tell the parent
-/// (by creating `staged`), and wait to be killed.
-fn stage_and_wait() {
-    let dir = child_dir();
-    let marker = dir.join("staged");
-    testing::set_after_staging(Some(Box::new(move || {
+/// A child's hook: tell the parent (by creating `marker`), then wait to be killed.
+fn mark_and_wait(marker: std::path::PathBuf) -> Box<dyn Fn()> {
+    Box::new(move || {
         fs::write(&marker, "").unwrap();
         loop {
             std::thread::sleep(Duration::from_millis(10));
         }
-    })));
-    let mut o = Outputs::new();
-    o.add("-o", Target::Path(dir.join("big.csv")), vec![b'x'; 4 << 20]);
-    o.add_in_dir("--plot", dir.join("plots"), "p.svg", "<svg/>");
-    o.add("--json", Target::Path(dir.join("new.json")), "{}");
-    let _ = o.write_all();
-    std::process::exit(3); // never reached: the hook waits for the signal
+    })
 }
 
-/// Runs the child, sends it `signal` once its temporaries exist, and checks that it died of
-/// that signal leaving no temporary and no directory it created.
-fn killed_while_staged(test: &str, signal: i32) {
-    let dir = TestDir::new(test);
-    dir.file("big.csv", "old");
+/// Runs the child of `test` in `dir` and waits until it has created `marker` (`what` says what
+/// that means, for the panic if it never does).
+fn spawn_until(test: &str, dir: &TestDir, marker: &str, what: &str) -> std::process::Child {
     let exe = std::env::current_exe().unwrap();
     let mut child = child_command(&exe, test, &dir.path)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    let staged = wait_until(Duration::from_secs(20), || dir.join("staged").exists());
-    if !staged {
+    if !wait_until(Duration::from_secs(20), || dir.join(marker).exists()) {
         let _ = child.kill();
         let _ = child.wait();
-        panic!("the child never staged its outputs");
+        panic!("the child never {what}");
     }
-    // Its temporaries exist now (the plots directory holds one too).
-    assert!(!leftovers(&dir.path).is_empty());
-    let before = snapshot(&dir.path);
+    child
+}
+
+/// Sends `signal` to `child` and checks that it died of it.
+fn signal_and_wait(mut child: std::process::Child, signal: i32) {
     let pid = child.id() as libc::pid_t;
     // SAFETY: sends a signal to the child this test started.
     assert_eq!(unsafe { libc::kill(pid, signal) }, 0);
@@ -141,6 +131,31 @@ fn killed_while_staged(test: &str, signal: i32) {
         panic!("the child did not end on the signal");
     };
     assert_eq!(status.signal(), Some(signal), "{status}");
+}
+
+/// The child's part of the signal tests: stage a large output and a small one, tell the parent
+/// (by creating `staged`), and wait to be killed.
+fn stage_and_wait() {
+    let dir = child_dir();
+    testing::set_after_staging(Some(mark_and_wait(dir.join("staged"))));
+    let mut o = Outputs::new();
+    o.add("-o", Target::Path(dir.join("big.csv")), vec![b'x'; 4 << 20]);
+    o.add_in_dir("--plot", dir.join("plots"), "p.svg", "<svg/>");
+    o.add("--json", Target::Path(dir.join("new.json")), "{}");
+    let _ = o.write_all();
+    std::process::exit(3); // never reached: the hook waits for the signal
+}
+
+/// Runs the child, sends it `signal` once its temporaries exist, and checks that it died of
+/// that signal leaving no temporary and no directory it created.
+fn killed_while_staged(test: &str, signal: i32) {
+    let dir = TestDir::new(test);
+    dir.file("big.csv", "old");
+    let child = spawn_until(test, &dir, "staged", "staged its outputs");
+    // Its temporaries exist now (the plots directory holds one too).
+    assert!(!leftovers(&dir.path).is_empty());
+    let before = snapshot(&dir.path);
+    signal_and_wait(child, signal);
     assert!(
         leftovers(&dir.path).is_empty(),
         "{:?}",
@@ -183,13 +198,7 @@ fn sigint_while_staged_leaves_no_temporary() {
 /// after the first rename, tell the parent and wait to be killed.
 fn rename_and_wait() {
     let dir = child_dir();
-    let marker = dir.join("renamed");
-    testing::set_after_rename(Some(Box::new(move || {
-        fs::write(&marker, "").unwrap();
-        loop {
-            std::thread::sleep(Duration::from_millis(10));
-        }
-    })));
+    testing::set_after_rename(Some(mark_and_wait(dir.join("renamed"))));
     let mut o = Outputs::new();
     o.add("-o", Target::Path(dir.join("a.csv")), "new a");
     o.add("--json", Target::Path(dir.join("new.json")), "{}");
@@ -209,33 +218,10 @@ fn sigterm_between_renames_puts_the_old_files_back() {
     dir.file("a.csv", "old a");
     dir.file("b.csv", "old b");
     let original = snapshot(&dir.path);
-    let exe = std::env::current_exe().unwrap();
-    let mut child = child_command(&exe, TEST, &dir.path)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    if !wait_until(Duration::from_secs(20), || dir.join("renamed").exists()) {
-        let _ = child.kill();
-        let _ = child.wait();
-        panic!("the child never renamed an output");
-    }
+    let child = spawn_until(TEST, &dir, "renamed", "renamed an output");
     // One file is replaced already.
     assert_eq!(read(&dir.join("a.csv")), "new a");
-    let pid = child.id() as libc::pid_t;
-    // SAFETY: sends a signal to the child this test started.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
-    let mut status = None;
-    wait_until(Duration::from_secs(20), || {
-        status = child.try_wait().unwrap();
-        status.is_some()
-    });
-    let Some(status) = status else {
-        let _ = child.kill();
-        let _ = child.wait();
-        panic!("the child did not end on the signal");
-    };
-    assert_eq!(status.signal(), Some(libc::SIGTERM), "{status}");
+    signal_and_wait(child, libc::SIGTERM);
     assert_eq!(read(&dir.join("a.csv")), "old a");
     assert_eq!(read(&dir.join("b.csv")), "old b");
     assert!(!dir.join("new.json").exists());

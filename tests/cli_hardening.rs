@@ -535,15 +535,7 @@ fn an_endless_stream_without_line_ends_ends_quickly_with_an_error() {
                 }
             }
         });
-        let mut args = vec![
-            "identify",
-            "--machine",
-            "seed-ac",
-            "--model",
-            "reduced",
-            "--data",
-            "zeros",
-        ];
+        let mut args = words("identify --machine seed-ac --model reduced --data zeros");
         if stream {
             args.push("--stream");
         }

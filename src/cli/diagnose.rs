@@ -11,7 +11,7 @@ use solver::diagnosis::{DiagnoseError, DiagnoseOptions, diagnose};
 use solver::fitting::check_values;
 use solver::io::report::{DiagnosisReport, DiagnosisSource, to_json};
 use solver::io::text::diagnose::diagnosis;
-use solver::io::text::validate::LOOKS_ZEROED;
+use solver::io::text::validate::zeroed_note;
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
@@ -204,9 +204,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         }
     }
     let mut text = diagnosis(&report);
-    if record.looks_zeroed() && !args.zeroed {
-        text.push_str(LOOKS_ZEROED);
-    }
+    text.push_str(zeroed_note(&record, args.zeroed));
     let stdout_taken = outputs.iter().any(|(_, t)| matches!(t, Target::Stdout));
     text.push_str(&wrote(&write(files)?));
     print_text(&text, stdout_taken)

@@ -12,7 +12,7 @@ use solver::fitting::{
 use solver::io::report::identify::StreamingReport;
 use solver::io::report::{IdentificationReport, IdentificationSource, to_json};
 use solver::io::text::identify::identification;
-use solver::io::text::validate::LOOKS_ZEROED;
+use solver::io::text::validate::zeroed_note;
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -131,11 +131,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         (ident, None, Some(streaming), String::new())
     } else {
         let record = super::read_record("--data", &m, &args.data, &read)?;
-        let note = if record.looks_zeroed() && !args.zeroed {
-            LOOKS_ZEROED.to_string()
-        } else {
-            String::new()
-        };
+        let note = zeroed_note(&record, args.zeroed).to_string();
         if args.first_order {
             let ident = identify(&m, &model, &record, &opts).map_err(estimate_error)?;
             (ident, None, None, note)

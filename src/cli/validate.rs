@@ -9,7 +9,7 @@ use solver::fitting::sanity::check_model_values;
 use solver::fitting::validate::Unidentified;
 use solver::fitting::{ValidateError, ValidateOptions, validate};
 use solver::io::report::{ValidationReport, ValidationSource, read_identification, to_json};
-use solver::io::text::validate::{LOOKS_ZEROED, validation};
+use solver::io::text::validate::{validation, zeroed_note};
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -126,9 +126,7 @@ pub fn run(args: &ValidateArgs) -> CliResult {
     let report = ValidationReport::new(source, &v)
         .map_err(|e| CliError::computation(format!("--data: {e}")))?;
     let mut text = validation(&report);
-    if record.looks_zeroed() && !args.zeroed {
-        text.push_str(LOOKS_ZEROED);
-    }
+    text.push_str(zeroed_note(&record, args.zeroed));
     let mut files = Outputs::new();
     if let Some(target) = &args.json {
         let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;

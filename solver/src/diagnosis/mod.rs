@@ -641,19 +641,6 @@ impl Diagnosis {
         let description = format!("{} ({context})", self.extended_label(m, label));
         model_spec::write::append_model(m, text, &terms, &description)
     }
-
-    /// The held-out records the extended model predicts worse than the base model: name and
-    /// relative change of the residual RMS.
-    pub fn worse_held_out(&self) -> Vec<(String, f64)> {
-        if self.findings.is_empty() {
-            return Vec::new();
-        }
-        self.validation
-            .iter()
-            .filter(|(_, b, a)| a > b && *b > 0.0)
-            .map(|(n, b, a)| (n.clone(), (a - b) / b))
-            .collect()
-    }
 }
 
 /// The seed of the Monte-Carlo draws of a step: a function of the model the step starts from

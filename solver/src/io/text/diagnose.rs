@@ -2,14 +2,9 @@
 //! significance, what the data cannot see, the gain on the fitted and held-out records, and the
 //! commands that use the extended model.
 
-use super::{header, indent, shell, table, wrap, zeroed_text};
+use super::{header, indent, shell, table, value, wrap, zeroed_text};
 use crate::io::report::diagnose::{ComponentReport, DiagnosisReport, FindingReport, GainRow};
-use model_spec::units::{fixed, p_value, readable, symbol};
-
-/// A value in µm or µrad for people.
-fn value(x: f64) -> String {
-    readable(x, 4)
-}
+use model_spec::units::{fixed, p_value, symbol};
 
 /// `ECC harmonic:2` from `ECC@harmonic:2` (a constant term is its name).
 fn words(spelling: &str) -> String {

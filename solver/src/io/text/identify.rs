@@ -2,15 +2,10 @@
 //! µm or µrad, or why there is none), then rank, condition number, residual RMS, σ̂, the
 //! confounded groups, the nearly confounded pairs and what the zero offsets swallow.
 
-use super::zeroed_text;
+use super::{value, zeroed_text};
 use crate::io::report::identify::IdentificationReport;
 use model_spec::units::plural;
-use model_spec::units::{fixed, readable, symbol};
-
-/// A value in µm or µrad for people: four decimals, or two significant digits below 5e-5.
-pub fn value(x: f64) -> String {
-    readable(x, 4)
-}
+use model_spec::units::{fixed, symbol};
 
 /// The whole identification text.
 pub fn identification(r: &IdentificationReport) -> String {

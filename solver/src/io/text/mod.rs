@@ -10,6 +10,12 @@ pub mod validate;
 
 pub use simulate::simulation;
 
+/// A value in µm or µrad for people: four decimals, or two significant digits in scientific
+/// notation when it would print as zero.
+pub fn value(x: f64) -> String {
+    model_spec::units::readable(x, 4)
+}
+
 /// An aligned text table: the first two columns left-aligned, the others right-aligned; every
 /// row has the header's number of cells.
 pub fn table<R: AsRef<[String]>>(header: &[String], rows: &[R]) -> String {

@@ -3,11 +3,18 @@
 
 use super::{header, table, zeroed_text};
 use crate::io::report::validate::ValidationReport;
+use crate::record::Record;
 use model_spec::units::{fixed, readable};
 
-/// The note printed when the first reading is exactly zero but the readings were not declared
-/// zeroed.
-pub const LOOKS_ZEROED: &str = "Note: the first reading is exactly 0: if the readings were zeroed at the first sample, give --zeroed.\n";
+/// The note printed when the first reading of `record` is exactly zero but the readings were not
+/// declared `zeroed`; empty otherwise.
+pub fn zeroed_note(record: &Record, zeroed: bool) -> &'static str {
+    if record.looks_zeroed() && !zeroed {
+        "Note: the first reading is exactly 0: if the readings were zeroed at the first sample, give --zeroed.\n"
+    } else {
+        ""
+    }
+}
 
 /// The whole validation text.
 pub fn validation(r: &ValidationReport) -> String {

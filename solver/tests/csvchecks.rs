@@ -3,9 +3,11 @@
 //! ball when the file gives the linear axes; the same in the block reader and for path files;
 //! the built-in paths within the strokes of seed-ac.
 
+mod common;
 mod csvfiles;
 
-use csvfiles::{drop_columns, k4_record, k4_text, machine, set_field};
+use common::builtin;
+use csvfiles::{drop_columns, k4_record, k4_text, set_field};
 use model_spec::Machine;
 use solver::io::csv::{
     CsvError, LISTED, MeasurementBlocks, ReadOptions, format_record, parse_measurement,
@@ -34,7 +36,7 @@ fn blocks(text: &str, m: &Machine, block: usize, o: &ReadOptions) -> String {
 
 #[test]
 fn implausible_readings_are_refused_with_count_bound_and_first_lines() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     let text = k4_text(&m);
     let bad = set_field(&text, 14, "dx_um", "1e308");
     let bad = set_field(&bad, 15, "dz_um", "-2.4e3");
@@ -113,7 +115,7 @@ fn poses_outside_the_strokes_and_ranges_are_refused_naming_axis_value_and_limits
         "k4.csv: 1 pose outside the strokes and ranges of machine seed-3axis: line 4: X = 612.3 mm outside its stroke -400 .. 400 mm"
     );
     // Rotary axes in degrees; linear axes filled by the inverse kinematics are checked too.
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     let rotary = drop_columns(&k4_text(&m), &["X", "Y", "Z"]);
     let bad = set_field(&rotary, 7, "A", "-130");
     let bad = set_field(&bad, 9, "A", "120.000001");
@@ -131,7 +133,7 @@ fn poses_outside_the_strokes_and_ranges_are_refused_naming_axis_value_and_limits
     )
     .unwrap();
     // Narrower limits of X and A: several axes on one line.
-    let mut narrow = machine("seed-ac");
+    let mut narrow = builtin("seed-ac");
     let x = narrow.axis_by_name("X").unwrap();
     narrow.axes[x].limits = [-200.0, 200.0];
     let a = narrow.axis_by_name("A").unwrap();
@@ -166,7 +168,7 @@ fn poses_outside_the_strokes_and_ranges_are_refused_naming_axis_value_and_limits
 #[test]
 fn linear_axes_given_must_keep_the_nest_on_the_ball() {
     // A three-axis grid whose readings are the commanded motion in mm: not an R-test record.
-    let m = machine("seed-3axis");
+    let m = builtin("seed-3axis");
     let mut text = String::from("# a grid\nX,Y,Z,dx_um,dy_um,dz_um\n");
     for x in [0, 100, 200] {
         for y in [0, 50] {
@@ -204,7 +206,7 @@ fn linear_axes_given_must_keep_the_nest_on_the_ball() {
     );
     // seed-ac with the linear axes written for the wrong side of the ball; within the
     // tolerance; the tolerance of one's own.
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     let text = k4_text(&m);
     let wrong = set_field(&text, 2, "X", "-217.504");
     assert!(
@@ -228,7 +230,7 @@ fn linear_axes_given_must_keep_the_nest_on_the_ball() {
 
 #[test]
 fn path_files_are_checked_as_measurements_are() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     let k4 = builtin_path(&m, "K4").unwrap().unwrap();
     let path = format_record(&m, &k4, &[]).unwrap();
     let rotary = drop_columns(&path, &["X", "Y", "Z"]);
@@ -262,7 +264,7 @@ fn path_files_are_checked_as_measurements_are() {
 
 #[test]
 fn the_builtin_paths_lie_within_the_strokes_and_ranges_of_seed_ac() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     for name in BUILTIN_PATHS {
         let p = builtin_path(&m, name).unwrap().unwrap();
         // Read back as a path file and as a measurement: every check passes.

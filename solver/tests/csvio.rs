@@ -5,14 +5,13 @@
 
 mod common;
 
-use common::builtin;
+use common::{Scratch, builtin};
 use model_spec::Machine;
 use solver::io::csv::{CsvError, ReadOptions, format_record, parse_measurement, read_measurement};
 use solver::record::Record;
 use solver::simulation::paths::builtin_path;
 use solver::simulation::readings::{provenance, simulate};
 use solver::simulation::truth::seed_ac_demo_truth;
-use std::path::PathBuf;
 
 fn seed_ac() -> Machine {
     builtin("seed-ac")
@@ -22,24 +21,6 @@ fn message(text: &str) -> String {
     match parse_measurement("m.csv", text, &seed_ac(), &ReadOptions::default()) {
         Ok(r) => panic!("accepted: {r:?}"),
         Err(e) => e.to_string(),
-    }
-}
-
-/// A scratch directory removed on drop.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Scratch {
-        let d = std::env::temp_dir().join(format!("rtest-csvio-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        Scratch(d)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
     }
 }
 

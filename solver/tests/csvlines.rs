@@ -2,9 +2,11 @@
 //! byte-order mark, Windows line ends; endless input ends with an error after at most about
 //! `max_line_bytes` and one buffer, from a reader and from a FIFO.
 
+mod common;
 mod csvfiles;
 
-use csvfiles::{Scratch, counting, k4_text, machine, set_field};
+use common::{Scratch, builtin};
+use csvfiles::{counting, k4_text, set_field};
 use solver::io::csv::{
     CsvError, MeasurementBlocks, Need, READ_BUFFER_BYTES, ReadOptions, parse_measurement, read_csv,
     read_measurement,
@@ -18,7 +20,7 @@ fn opts() -> ReadOptions {
 
 /// The first error of the block reader on `bytes`, or `None` when every block reads.
 fn blocks_error(bytes: &[u8], o: &ReadOptions) -> Option<String> {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     match MeasurementBlocks::new("k4.csv".into(), Cursor::new(bytes), &m, 50, o) {
         Err(e) => Some(e.to_string()),
         Ok(mut blocks) => blocks.find_map(|b| b.err()).map(|e| e.to_string()),
@@ -26,7 +28,7 @@ fn blocks_error(bytes: &[u8], o: &ReadOptions) -> Option<String> {
 }
 
 fn whole_error(bytes: &[u8], o: &ReadOptions) -> String {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     read_csv("k4.csv", bytes, &m, Need::Measured, o)
         .unwrap_err()
         .to_string()
@@ -34,7 +36,7 @@ fn whole_error(bytes: &[u8], o: &ReadOptions) -> String {
 
 #[test]
 fn a_line_longer_than_the_bound_is_refused_at_its_line() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     let text = k4_text(&m);
     let long = format!("# {}", "x".repeat(70_000));
     let with = |line: usize| -> String {
@@ -89,7 +91,7 @@ fn a_line_longer_than_the_bound_is_refused_at_its_line() {
 
 #[test]
 fn text_that_is_not_utf8_is_located_by_line_and_character() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     let text = k4_text(&m);
     // Line 3, the reading dy_um: `é` then the byte 0xff.
     let line3 = set_field(&text, 3, "dy_um", "é")
@@ -131,7 +133,7 @@ fn text_that_is_not_utf8_is_located_by_line_and_character() {
 
 #[test]
 fn a_byte_order_mark_and_windows_line_ends_are_accepted() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     let text = k4_text(&m);
     let plain = parse_measurement("k4.csv", &text, &m, &opts()).unwrap();
     let bom = format!("\u{feff}{}", text.replace('\n', "\r\n"));
@@ -175,7 +177,7 @@ fn bound(o: &ReadOptions) -> usize {
 
 #[test]
 fn an_endless_line_is_refused_after_a_bounded_number_of_bytes() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     for max in [100, 65_536, 200_000] {
         let mut o = opts();
         o.max_line_bytes = max;
@@ -242,7 +244,7 @@ fn zeros_fifo(dir: &Scratch, name: &str) -> (std::path::PathBuf, std::thread::Jo
 
 #[test]
 fn an_endless_stream_of_zeros_from_a_fifo_ends_with_the_line_error() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     let dir = Scratch::new("fifo");
     let want = "line longer than 65536 bytes: not a measurement CSV";
     let (fifo, writer) = zeros_fifo(&dir, "whole.csv");

@@ -11,9 +11,11 @@
 //! of cases (96 random inputs, 160 damaged files) keep the test to a few seconds in a debug
 //! build.
 
+mod common;
 mod csvfiles;
 
-use csvfiles::{drop_columns, k4_text, located, machine};
+use common::builtin;
+use csvfiles::{drop_columns, k4_text, located};
 use model_spec::Machine;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
@@ -97,7 +99,7 @@ fn options(short_lines: bool) -> ReadOptions {
 
 #[test]
 fn random_bytes_never_panic_and_errors_are_located() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     // Bytes of any value, and bytes from the alphabet of the format (more of them get past the
     // header), with a header in front or not.
     let alphabet: Vec<u8> = b"0123456789,.-+eE\n\r# XYZACdxyz_umts\"".to_vec();
@@ -235,7 +237,7 @@ fn apply(bytes: &mut Vec<u8>, d: &Damage) {
 
 #[test]
 fn damaged_files_never_panic_and_errors_are_located() {
-    let m = machine("seed-ac");
+    let m = builtin("seed-ac");
     // Valid files: the first 40 samples of simulated K4, with every column and with the rotary
     // columns only (linear axes filled by the inverse kinematics), and a short path file.
     let k4: String = k4_text(&m)

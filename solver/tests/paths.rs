@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::builtin;
+use common::{Scratch, builtin};
 use model_spec::Machine;
 use solver::io::csv::ReadOptions;
 use solver::record::Record;
@@ -132,12 +132,10 @@ fn a_path_file_without_linear_columns_is_filled_by_inverse_kinematics() {
             model_spec::units::degrees_for(a)
         );
     }
-    let dir = std::env::temp_dir().join(format!("rtest-paths-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let f = dir.join("k4-rotary.csv");
+    let dir = Scratch::new("paths");
+    let f = dir.0.join("k4-rotary.csv");
     std::fs::write(&f, &text).unwrap();
     let r = load_path(&m, f.to_str().unwrap(), &ReadOptions::default()).unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(r, k4, "same commands bit for bit, t = i s, same motion");
     assert_closed(&m, &r);
 }

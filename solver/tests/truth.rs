@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{builtin, commands, id};
+use common::{Scratch, builtin, commands, id};
 use model_spec::{Dir, Machine};
 use solver::model::Basis;
 use solver::model::{Effect, Term};
@@ -232,14 +232,12 @@ fn load_truth_by_name_or_file() {
         e.to_string(),
         "no built-in truth and no file called `no-such-truth.toml` (built-in: seed-ac-demo, seed-ac-reduced, seed-ac-budget)"
     );
-    let dir = std::env::temp_dir().join(format!("rtest-truth-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let f = dir.join("t.toml");
+    let dir = Scratch::new("truth");
+    let f = dir.0.join("t.toml");
     std::fs::write(&f, "[errors]\nXOW = 1\n").unwrap();
     let t = load_truth(f.to_str().unwrap(), &m).unwrap();
     assert_eq!(t.source, f.display().to_string());
     assert_eq!(t.coefficients, vec![0.001]);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

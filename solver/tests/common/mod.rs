@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use model_spec::{AxisKind, Machine};
+use std::path::PathBuf;
 
 /// A small deterministic generator (xorshift64*), so the tests need no extra crate.
 pub struct Rng(u64);
@@ -66,4 +67,23 @@ pub fn id(m: &Machine, name: &str) -> usize {
 /// The value of kinematic symbol `name` in `params`.
 pub fn sym(m: &Machine, params: &[f64], name: &str) -> f64 {
     params[m.symbol_by_name(name).expect("symbol exists")]
+}
+
+/// A fresh scratch directory under the system's temporary directory, removed on drop.
+pub struct Scratch(pub PathBuf);
+
+impl Scratch {
+    /// The directory `rtest-solver-{tag}-{pid}`, emptied if it was left by an earlier run.
+    pub fn new(tag: &str) -> Scratch {
+        let d = std::env::temp_dir().join(format!("rtest-solver-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        Scratch(d)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
 }

@@ -1,5 +1,5 @@
 //! Helpers of the CSV reader tests: valid files to start from, field edits, a reader that
-//! counts what it hands out, scratch directories.
+//! counts what it hands out.
 #![allow(dead_code)]
 
 use model_spec::Machine;
@@ -10,13 +10,7 @@ use solver::simulation::readings::simulate;
 use solver::simulation::truth::seed_ac_demo_truth;
 use std::cell::Cell;
 use std::io::Read;
-use std::path::PathBuf;
 use std::rc::Rc;
-
-/// A built-in machine.
-pub fn machine(name: &str) -> Machine {
-    model_spec::builtin(name).unwrap().unwrap()
-}
 
 /// The simulated K4 record of seed-ac (demo truth: readings of tens of µm).
 pub fn k4_record(m: &Machine) -> Record {
@@ -83,24 +77,6 @@ pub fn counting<R: Read>(inner: R) -> (Counting<R>, Rc<Cell<usize>>) {
         },
         count,
     )
-}
-
-/// A fresh scratch directory under the system's temporary directory, removed on drop.
-pub struct Scratch(pub PathBuf);
-
-impl Scratch {
-    pub fn new(tag: &str) -> Scratch {
-        let d = std::env::temp_dir().join(format!("rtest-csv-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        Scratch(d)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 /// Whether an error message is located: `file:line:` at its start, or `file: ` followed by the

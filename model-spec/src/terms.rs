@@ -116,6 +116,21 @@ impl Term {
     }
 }
 
+/// The machine errors `terms` use, ascending (catalogue order), each once; sensor offsets are
+/// not machine errors.
+pub fn errors_of(terms: &[Term]) -> Vec<ErrorId> {
+    let mut errors: Vec<ErrorId> = terms
+        .iter()
+        .filter_map(|t| match t.effect {
+            Effect::Error(e) => Some(e),
+            Effect::SensorOffset(_) => None,
+        })
+        .collect();
+    errors.sort_unstable();
+    errors.dedup();
+    errors
+}
+
 /// What an effect is, in a machine-tool engineer's words (`angular positioning error of C`,
 /// `straightness of X in y`, `squareness of X to the reference`, `ball set-up error in x`).
 pub fn describe_effect(m: &Machine, effect: Effect) -> String {

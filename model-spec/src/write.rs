@@ -6,7 +6,7 @@
 //! original stay as they were. The result is read back and checked before it is returned.
 
 use crate::builtin::{BUILTIN, LoadError, file_text};
-use crate::terms::{Effect, Term};
+use crate::terms::{Effect, Term, errors_of};
 use crate::{Machine, SpecError, SubModel, parse_machine};
 
 /// Lines of the appended term list are shorter than this (in characters).
@@ -163,21 +163,9 @@ pub fn append_model(
         })?;
     let mut without = back;
     let model = without.models.remove(&name);
-    let expected_errors = {
-        let mut e: Vec<_> = parsed
-            .iter()
-            .filter_map(|t| match t.effect {
-                Effect::Error(id) => Some(id),
-                Effect::SensorOffset(_) => None,
-            })
-            .collect();
-        e.sort_unstable();
-        e.dedup();
-        e
-    };
     let expected = SubModel {
         description: description.to_string(),
-        errors: expected_errors,
+        errors: errors_of(&parsed),
         terms: parsed,
     };
     if without != *m || model.as_ref() != Some(&expected) {

@@ -53,16 +53,6 @@ impl Model {
 
     /// The machine errors the model uses, ascending, without repeats.
     pub fn errors(&self) -> Vec<ErrorId> {
-        let mut v: Vec<ErrorId> = self
-            .terms
-            .iter()
-            .filter_map(|t| match t.effect {
-                Effect::Error(e) => Some(e),
-                Effect::SensorOffset(_) => None,
-            })
-            .collect();
-        v.sort_unstable();
-        v.dedup();
-        v
+        model_spec::terms::errors_of(&self.terms)
     }
 }

@@ -6,7 +6,7 @@ use crate::catalogue::{ErrorId, ErrorKind, default_squareness_order};
 use crate::limits::MAX_TERMS;
 use crate::machine::{Axis, AxisId, AxisKind, Machine, SubModel};
 use crate::raw::{RawErrors, RawModel};
-use crate::terms::{Effect, Term};
+use crate::terms::{Effect, Term, errors_of};
 use std::collections::BTreeMap;
 use toml::Spanned;
 
@@ -234,16 +234,7 @@ impl Validator<'_> {
             terms.push((term, item.span()));
         }
         let terms: Vec<Term> = terms.into_iter().map(|(t, _)| t).collect();
-        let mut errors: Vec<ErrorId> = terms
-            .iter()
-            .filter_map(|t| match t.effect {
-                Effect::Error(e) => Some(e),
-                Effect::SensorOffset(_) => None,
-            })
-            .collect();
-        errors.sort_unstable();
-        errors.dedup();
-        Ok((errors, terms))
+        Ok((errors_of(&terms), terms))
     }
 
     pub(super) fn model_errors(&self, raw: &RawErrors, m: &Machine) -> Res<Vec<ErrorId>> {

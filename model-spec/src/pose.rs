@@ -10,7 +10,7 @@
 //! 119.99999999999999 or 120.00000000000001 degrees) is within it.
 
 use crate::machine::{Axis, AxisId, AxisKind, Machine};
-use crate::units::short;
+use crate::units::{compact, short};
 use std::fmt;
 
 /// How far (mm for a linear axis, degrees for a rotary axis) a command may lie beyond a limit
@@ -61,23 +61,16 @@ pub struct OutsideLimits {
     pub limits: [f64; 2],
 }
 
-impl OutsideLimits {
-    /// `mm` or `degrees`.
-    pub fn unit(&self) -> &'static str {
-        match self.kind {
-            AxisKind::Linear => "mm",
-            AxisKind::Rotary => "degrees",
-        }
-    }
-}
-
 impl fmt::Display for OutsideLimits {
     /// `A = 121° outside its range -120 .. 120°`, `X = 612.3 mm outside its stroke -500 .. 500
-    /// mm`. The value is written with every digit when six decimals would show it at the limit.
+    /// mm`, `X = 1e300 mm outside …`. The value is written compactly
+    /// ([`crate::units::compact`]: a huge value in scientific notation, not with hundreds of
+    /// digits), and with every digit when that would show it at the limit.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let [lo, hi] = self.limits;
         let (lo_s, hi_s) = (short(lo), short(hi));
-        let mut value = short(self.value);
+        // `+ 0.0` turns a -0 into 0: no negative zero, as `short` writes it.
+        let mut value = compact(self.value + 0.0);
         if value == lo_s || value == hi_s {
             value = format!("{}", self.value);
         }

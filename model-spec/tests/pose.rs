@@ -64,6 +64,24 @@ fn outside() {
 }
 
 #[test]
+fn a_huge_value_is_written_compactly() {
+    // Not the three hundred digits of 1e300: the shortest decimal that reads back.
+    assert_eq!(
+        message([1e300, 0.0, 0.0, 0.0, 0.0]).unwrap(),
+        "X = 1e300 mm outside its stroke -500 .. 500 mm"
+    );
+    // More than twelve digits near a limit: every digit, not the limit's six decimals.
+    assert_eq!(
+        message([500.000_000_002_1, 0.0, 0.0, 0.0, 0.0]).unwrap(),
+        "X = 500.0000000021 mm outside its stroke -500 .. 500 mm"
+    );
+    assert_eq!(
+        message([0.0, 0.0, 0.0, 0.0, -2.5e12]).unwrap(),
+        "Z = -2.500000e12 mm outside its stroke -500 .. 500 mm"
+    );
+}
+
+#[test]
 fn typed() {
     let m = seed_ac();
     let e = m

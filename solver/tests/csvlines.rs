@@ -261,3 +261,23 @@ fn an_endless_stream_of_zeros_from_a_fifo_ends_with_the_line_error() {
     assert_eq!(e.to_string(), format!("{}:1: {want}", fifo.display()));
     writer.join().unwrap();
 }
+
+#[test]
+fn the_largest_line_bound_is_no_bound() {
+    let m = builtin("seed-ac");
+    let mut o = opts();
+    o.max_line_bytes = usize::MAX;
+    // A line that spans refills of the read buffer, and a last line without a line end.
+    let text = k4_text(&m);
+    let long = format!(
+        "# {}\n{}",
+        "x".repeat(2 * READ_BUFFER_BYTES),
+        text.trim_end()
+    );
+    let want = parse_measurement("k4.csv", &text, &m, &opts()).unwrap();
+    assert_eq!(
+        read_csv("k4.csv", long.as_bytes(), &m, Need::Measured, &o).unwrap(),
+        want
+    );
+    assert_eq!(blocks_error(long.as_bytes(), &o), None);
+}

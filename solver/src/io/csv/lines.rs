@@ -114,10 +114,11 @@ impl<R: Read> Lines<R> {
     }
 
     /// Appends `buf[from..to]` to the pending line, refusing it when it grows past the bound
-    /// (one byte more is held for a `\r` before the line end).
+    /// (one byte more is held for a `\r` before the line end, and the byte-order mark of the
+    /// first line; the sum saturates, so `usize::MAX` is no bound).
     fn take(&mut self, cx: &Ctx, from: usize, to: usize) -> Result<(), CsvError> {
         if to > from {
-            if self.pending.len() + (to - from) > self.max.saturating_add(1) + BOM.len() {
+            if self.pending.len() + (to - from) > self.max.saturating_add(1 + BOM.len()) {
                 return Err(too_long(cx, self.number + 1, self.max));
             }
             self.pending.extend_from_slice(&self.buf[from..to]);

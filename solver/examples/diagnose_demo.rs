@@ -63,20 +63,24 @@ fn main() {
             .values
             .iter()
             .zip(&f.stds)
-            .map(|(v, s)| format!("{:.2} ± {:.2}", v * scale, s.unwrap_or(f64::NAN) * scale))
+            .map(|(v, s)| match (v, s) {
+                (Some(v), Some(s)) => format!("{:.2} ± {:.2}", v * scale, s * scale),
+                (Some(v), None) => format!("{:.2}", v * scale),
+                _ => "not determined".into(),
+            })
             .collect();
         println!(
             "{}. {}: {} {unit}{}",
             k + 1,
             f.description,
             v.join(", "),
-            if f.values.len() == 2 {
-                format!(
-                    " (amplitude {:.2} {unit})",
-                    f.values[0].hypot(f.values[1]) * scale
-                )
-            } else {
-                String::new()
+            match (f.values.len(), f.plausible) {
+                (2, true) => format!(" (amplitude {:.2} {unit})", f.size),
+                (_, true) => String::new(),
+                (_, false) => format!(
+                    " (fits, but implausible: {:.2} {unit} beyond the budget of {:.2})",
+                    f.size, f.limit
+                ),
             }
         );
         println!(
@@ -139,9 +143,23 @@ fn main() {
         d.fit_rms.0 * 1e3,
         d.fit_rms.1 * 1e3
     );
-    for (n, b, a) in &d.validation {
-        println!("   {n:7} {:6.3}  {:6.3}", b * 1e3, a * 1e3);
+    for h in &d.validation {
+        println!(
+            "   {:7} {:6.3}  {:6.3}",
+            h.name,
+            h.before_rms * 1e3,
+            h.after_rms * 1e3
+        );
     }
+    println!(
+        "{}: {}",
+        if d.recommendation.recommended {
+            "Recommended"
+        } else {
+            "Not recommended"
+        },
+        d.recommendation.reasons.join("; ")
+    );
     println!("\nResidual structure after the extension (largest amplitudes, µm):");
     structure(&d.structure_after);
 

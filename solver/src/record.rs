@@ -14,16 +14,54 @@ pub struct Sample {
 }
 
 /// A record: samples and, when measured, the error vector at each (tool minus workpiece, tool
-/// frame, mm).
-#[derive(Clone, Debug, PartialEq, Default)]
+/// frame, mm). Two records are equal when their samples and readings are: the lines they were
+/// read from do not count.
+#[derive(Clone, Debug, Default)]
 pub struct Record {
     /// The samples, in the order they were taken.
     pub samples: Vec<Sample>,
     /// The measured error vector per sample (mm); empty for a bare path.
     pub measured: Vec<[f64; 3]>,
+    /// The 1-based line of its file each sample was read from; empty when the record was not
+    /// read from a file (simulated, or built in memory).
+    pub lines: Vec<usize>,
+}
+
+impl PartialEq for Record {
+    fn eq(&self, other: &Record) -> bool {
+        self.samples == other.samples && self.measured == other.measured
+    }
 }
 
 impl Record {
+    /// Where sample `i` came from, for messages: `line L` when the record was read from a
+    /// file, else `sample i+1` (1-based).
+    pub fn place(&self, i: usize) -> String {
+        match self.lines.get(i) {
+            Some(l) => format!("line {l}"),
+            None => format!("sample {}", i + 1),
+        }
+    }
+
+    /// The record without the samples `drop` (indices, any order): samples, readings and lines
+    /// of the others, in order.
+    pub fn without(&self, drop: &[usize]) -> Record {
+        let keep = |i: &usize| !drop.contains(i);
+        let pick =
+            |v: &[[f64; 3]]| -> Vec<[f64; 3]> { (0..v.len()).filter(keep).map(|i| v[i]).collect() };
+        Record {
+            samples: (0..self.samples.len())
+                .filter(keep)
+                .map(|i| self.samples[i].clone())
+                .collect(),
+            measured: pick(&self.measured),
+            lines: (0..self.lines.len())
+                .filter(keep)
+                .map(|i| self.lines[i])
+                .collect(),
+        }
+    }
+
     /// `true` when the first reading is exactly zero and there are others, as R-test software
     /// leaves readings zeroed at the first sample.
     pub fn looks_zeroed(&self) -> bool {

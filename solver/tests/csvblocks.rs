@@ -27,6 +27,7 @@ fn concatenated(text: &str, m: &model_spec::Machine, block: usize) -> Record {
         );
         out.samples.extend(b.samples);
         out.measured.extend(b.measured);
+        out.lines.extend(b.lines);
     }
     out
 }

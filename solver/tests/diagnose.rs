@@ -506,8 +506,8 @@ fn visibility() {
         println!(
             "{spec:24} signature on K4 {sig:.2} µm, left by the base fit {left:.3} µm ({:.1} % absorbed); base mispredicts K1 {:.2} µm, K2 {:.2} µm",
             100.0 * (1.0 - (left / sig).powi(2)),
-            d.validation[0].1 * 1e3,
-            d.validation[1].1 * 1e3
+            d.validation[0].before_rms * 1e3,
+            d.validation[1].before_rms * 1e3
         );
     }
 }

@@ -50,6 +50,7 @@ fn path(m: &Machine, poses: impl Iterator<Item = (f64, f64)>) -> Record {
             })
             .collect(),
         measured: vec![],
+        lines: vec![],
     }
 }
 

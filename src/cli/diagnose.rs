@@ -93,6 +93,16 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "T", default_value = "2",
           value_parser = clap::value_parser!(u32).range(0..=12))]
     time: u32,
+    /// Largest plausible size of a finding, per unit (`um=100,urad=200,ms=20,1=0.05`; any
+    /// subset, the others keep these defaults): a larger finding fits, but is not named as a
+    /// cause and is left out of the extended model.
+    #[arg(long, value_name = "UNIT=SIZE,…")]
+    budget: Option<String>,
+    /// What the fits do with parameters the data cannot determine: `none` (no value),
+    /// `min-norm`, or `zero:NAME,NAME` (as `identify`). Held-out predictions that need them are
+    /// flagged and not counted either way.
+    #[arg(long, value_name = "none|min-norm|zero:NAME,…")]
+    constraint: Option<String>,
     /// Also write the diagnosis as JSON to FILE (values in µm and µrad; `-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
@@ -146,10 +156,16 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     opts.dictionary = DictionaryOptions::new(args.harmonics, args.poly, args.time);
     opts.alpha = args.alpha;
     opts.zeroed = args.zeroed;
+    opts.constraint = args::constraint(args.constraint.as_deref())?;
+    if let Some(b) = &args.budget {
+        opts.budget = solver::diagnosis::plausible::Budget::parse(b)
+            .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
+    }
     let data = args.data.display().to_string();
     let d = diagnose(&m, &model, &record, &held, &opts).map_err(|e| match e {
-        DiagnoseError::Estimate(e @ solver::fitting::EstimateError::TooFewReadings { .. }) => {
-            CliError::input(format!("--data: {e}"))
+        DiagnoseError::Estimate(e)
+        | DiagnoseError::Refine(solver::fitting::RefineError::Estimate(e)) => {
+            super::identify::estimate_error(e)
         }
         other => CliError::computation(format!("--data: cannot diagnose: {other}")),
     })?;

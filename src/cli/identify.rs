@@ -177,7 +177,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
 
 /// An estimation error as a verb's error: an unknown constraint name is a usage error, too few
 /// samples a bad input, anything else a failed computation.
-fn estimate_error(e: EstimateError) -> CliError {
+pub(super) fn estimate_error(e: EstimateError) -> CliError {
     match e {
         EstimateError::UnknownParameter(name, names) => CliError::usage(format!(
             "--constraint: `{name}` is not a parameter of the model (parameters: {names})"

@@ -265,7 +265,7 @@ fn diagnosis_text(m: &Machine, s: &Summary) -> String {
         r.extended_model.label
     ));
     out.push_str(&diag_text::gain(r));
-    out.push_str(&diag_text::worse(r));
+    out.push_str(&diag_text::recommendation(r));
     out.push_str(&diag_text::next_steps(r));
 
     // The check against the truth.
@@ -289,8 +289,10 @@ fn diagnosis_text(m: &Machine, s: &Summary) -> String {
                     .iter()
                     .zip(&x.stds)
                     .zip(&want)
-                    .map(|((v, sd), w)| match sd {
-                        Some(sd) if *sd > 0.0 => format!("{:+.2}", (v * f - w) / (sd * f)),
+                    .map(|((v, sd), w)| match (v, sd) {
+                        (Some(v), Some(sd)) if *sd > 0.0 => {
+                            format!("{:+.2}", (v * f - w) / (sd * f))
+                        }
                         _ => "-".into(),
                     })
                     .collect();

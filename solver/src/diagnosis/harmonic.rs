@@ -42,10 +42,7 @@ pub fn harmonic(m: &Machine, d: &Diagnosis, f: &Finding) -> Option<Harmonic> {
         return None;
     }
     let k = f.term.effect.display_factor(m);
-    let (c, s) = (f.values[0] * k, f.values[1] * k);
-    if !c.is_finite() || !s.is_finite() {
-        return None;
-    }
+    let (c, s) = (f.values[0]? * k, f.values[1]? * k);
     let a = c.hypot(s);
     let cols = columns_of(d, &f.term);
     let cov = &d.extended_fit.fit.covariance;

@@ -65,6 +65,7 @@ pub fn hidden_terms(
         let alone = Record {
             samples: fitted.samples.clone(),
             measured,
+            lines: fitted.lines.clone(),
         };
         Some(
             identify(m, model, &alone, &IdentifyOptions::default())?

@@ -1,7 +1,8 @@
 //! The options of a diagnosis.
 
 use super::dictionary::DictionaryOptions;
-use crate::fitting::Tolerances;
+use super::plausible::Budget;
+use crate::fitting::{Constraint, Tolerances};
 
 /// Options of [`super::diagnose()`] (`DiagnoseOptions::default()`, then set the fields wanted).
 #[derive(Clone, Debug, PartialEq)]
@@ -24,6 +25,11 @@ pub struct DiagnoseOptions {
     pub params: Option<Vec<f64>>,
     /// Rank and identifiability tolerances of the fits.
     pub tolerances: Tolerances,
+    /// What the fits do with parameters the data cannot determine (as `identify
+    /// --constraint`); held-out predictions that depend on them are flagged all the same.
+    pub constraint: Constraint,
+    /// The largest plausible size of a finding, per unit.
+    pub budget: Budget,
 }
 
 impl Default for DiagnoseOptions {
@@ -37,6 +43,8 @@ impl Default for DiagnoseOptions {
             zeroed: false,
             params: None,
             tolerances: Tolerances::default(),
+            constraint: Constraint::None,
+            budget: Budget::default(),
         }
     }
 }

@@ -229,5 +229,6 @@ pub fn record_from_commands(commands: Vec<Vec<f64>>, times: Vec<f64>) -> Record 
     Record {
         samples: samples_from(commands, times, motion),
         measured: Vec::new(),
+        lines: Vec::new(),
     }
 }

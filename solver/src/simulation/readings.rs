@@ -97,6 +97,7 @@ pub fn simulate(m: &Machine, truth: &Truth, path: &Record) -> Result<Record, Sim
     Ok(Record {
         samples: path.samples.clone(),
         measured,
+        lines: path.lines.clone(),
     })
 }
 

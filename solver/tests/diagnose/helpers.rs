@@ -184,10 +184,10 @@ pub fn run(m: &Machine, base: &Model, recs: &[(String, Record)], o: &DiagnoseOpt
 /// sample-weighted mean of the per-record mean squares.
 pub fn held_out_rms(d: &Diagnosis, recs: &[(String, Record)]) -> (f64, f64) {
     let mut s = (0.0, 0.0, 0.0);
-    for ((_, before, after), (_, r)) in d.validation.iter().zip(&recs[1..]) {
+    for (h, (_, r)) in d.validation.iter().zip(&recs[1..]) {
         let n = r.samples.len() as f64;
-        s.0 += n * before * before;
-        s.1 += n * after * after;
+        s.0 += n * h.before_rms * h.before_rms;
+        s.1 += n * h.after_rms * h.after_rms;
         s.2 += n;
     }
     ((s.0 / s.2).sqrt() * 1e3, (s.1 / s.2).sqrt() * 1e3)
@@ -234,7 +234,14 @@ pub fn summary(m: &Machine, d: &Diagnosis, recs: &[(String, Record)]) -> String 
     let per: Vec<String> = d
         .validation
         .iter()
-        .map(|(n, b, a)| format!("{n} {:.2}→{:.2}", b * 1e3, a * 1e3))
+        .map(|h| {
+            format!(
+                "{} {:.2}→{:.2}",
+                h.name,
+                h.before_rms * 1e3,
+                h.after_rms * 1e3
+            )
+        })
         .collect();
     format!(
         "found [{}]; fit {:.2}→{:.2} µm; held out {hb:.2}→{ha:.2} µm ({})",

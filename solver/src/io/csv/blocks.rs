@@ -139,6 +139,7 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
         }
         self.checks
             .check(&self.file, &commands, Some(&measured), &row_lines)?;
+        let lines = row_lines;
         self.samples += commands.len();
         // Directions of motion, continuing from the previous block.
         let motion = match self.previous.take() {
@@ -163,7 +164,11 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
             motion.last().cloned().unwrap_or_default(),
         ));
         let samples = samples_from(commands, times, motion);
-        Ok(Some(Record { samples, measured }))
+        Ok(Some(Record {
+            samples,
+            measured,
+            lines,
+        }))
     }
 }
 

@@ -70,5 +70,6 @@ pub fn read_csv<R: Read>(
     if header.measured {
         record.measured = measured;
     }
+    record.lines = row_lines;
     Ok(record)
 }

@@ -21,6 +21,9 @@ pub struct BaseFitReport {
     pub terms: Vec<String>,
     /// Residual RMS over all readings, µm.
     pub residual_rms_um: f64,
+    /// Residual RMS with the outliers' samples in the fit, µm (equal to `residual_rms_um`
+    /// when there are none).
+    pub residual_rms_um_with_outliers: f64,
     /// σ̂, µm; `null` without degrees of freedom.
     pub sigma_um: Option<f64>,
     /// Degrees of freedom.
@@ -38,6 +41,10 @@ pub struct ComponentReport {
     pub direction: String,
     /// RMS of what the shape alone explains, µm.
     pub explained_rms_um: f64,
+    /// In `before`: what the same shape explains of the extended fit's residual, µm (absent
+    /// in `after`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extended_rms_um: Option<f64>,
 }
 
 /// The residual structure before and after the extension.
@@ -87,6 +94,57 @@ pub struct FindingReport {
     pub candidates_tried: usize,
     /// Candidates the data cannot tell from it (`NAME@BASIS`).
     pub alternatives: Vec<String>,
+    /// Its size (`|value|`, or the amplitude of a pair), in `unit`.
+    pub size: f64,
+    /// The budget of its unit it was compared with (`--budget`), in `unit`.
+    pub limit: f64,
+    /// `size ≤ limit`: named as a cause and in the extended model. `false`: it fits, but is
+    /// implausible, and is left out of the extended model.
+    pub plausible: bool,
+}
+
+/// An isolated reading far outside the residual's robust local scale, left out of the fits
+/// and of the RMS.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OutlierReport {
+    /// The record's file.
+    pub data: String,
+    /// The 1-based line of the sample in that file; absent when not read from a file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub line: Option<usize>,
+    /// The 1-based sample number in the record.
+    pub sample: usize,
+    /// `x`, `y` or `z`.
+    pub direction: String,
+    /// The residual of the base model at that reading, µm.
+    pub residual_um: f64,
+    /// Its deviation from the running median of the residual, µm.
+    pub deviation_um: f64,
+    /// The threshold it exceeded, µm.
+    pub threshold_um: f64,
+}
+
+/// Whether the extended model is recommended.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecommendationReport {
+    /// `true`: use the extended model.
+    pub recommended: bool,
+    /// Why (not), one sentence each.
+    pub reasons: Vec<String>,
+}
+
+/// The size budget findings are compared with.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BudgetReport {
+    /// Translational errors and offsets, µm.
+    pub um: f64,
+    /// Angular errors, µrad.
+    pub urad: f64,
+    /// Servo lag, ms.
+    pub ms: f64,
+    /// Instrument gain and cross-talk, a fraction.
+    #[serde(rename = "1")]
+    pub fraction: f64,
 }
 
 /// The amplitude and phase of a harmonic finding.
@@ -132,7 +190,7 @@ pub struct ExtendedModelReport {
     pub label: String,
     /// Its terms, as a sub-model lists them.
     pub terms: Vec<String>,
-    /// The terms added.
+    /// The terms added (the plausible findings).
     pub added: Vec<String>,
     /// The model's name in the machine description written (`--model-out`); absent when none
     /// was written.
@@ -152,6 +210,12 @@ pub struct GainRow {
     pub residual_rms_um_before: f64,
     /// With the extended model, µm.
     pub residual_rms_um_after: f64,
+    /// `false` when a prediction needs a combination of parameters the fit does not
+    /// determine: then the RMS is not the model's error and does not count.
+    pub estimable: bool,
+    /// The confounded groups (parameter names) the predictions need; empty when estimable.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub undetermined: Vec<Vec<String>>,
 }
 
 /// The gain of the extension.
@@ -204,6 +268,14 @@ pub struct DiagnosisReport {
     pub extended_model: ExtendedModelReport,
     /// The gain.
     pub gain: GainReport,
+    /// Outliers of the fitted and the held-out records.
+    pub outliers: Vec<OutlierReport>,
+    /// The size budget of the findings.
+    pub budget: BudgetReport,
+    /// Whether the extended model is recommended.
+    pub recommended: bool,
+    /// Why (not).
+    pub recommendation: Vec<String>,
 }
 
 /// What the report says besides the diagnosis: where things come from and go.
@@ -229,12 +301,25 @@ fn spell(m: &Machine, ts: &[Term]) -> Vec<String> {
     ts.iter().map(|t| t.spelling(m)).collect()
 }
 
-fn components(field: &str, c: &[Component]) -> Result<Vec<ComponentReport>, NonFinite> {
+/// The largest components of `c`; with `after`, each with what the same shape explains there.
+fn components(
+    field: &str,
+    c: &[Component],
+    after: Option<&[Component]>,
+) -> Result<Vec<ComponentReport>, NonFinite> {
     c.iter()
         .take(COMPONENTS_LISTED)
         .enumerate()
         .map(|(i, c)| {
+            let same = |x: &&Component| {
+                x.source == c.source && x.shape == c.shape && x.direction == c.direction
+            };
+            let extended = after.map(|a| a.iter().find(same).map_or(0.0, |x| x.explained_rms_um));
             Ok(ComponentReport {
+                extended_rms_um: finite_opt(
+                    || format!("structure.{field}[{i}].extended_rms_um"),
+                    extended,
+                )?,
                 source: c.source.clone(),
                 shape: c.shape.clone(),
                 direction: ["x", "y", "z"][c.direction].into(),
@@ -247,8 +332,16 @@ fn components(field: &str, c: &[Component]) -> Result<Vec<ComponentReport>, NonF
         .collect()
 }
 
-fn gain_row(field: &str, data: &str, before: f64, after: f64) -> Result<GainRow, NonFinite> {
+fn gain_row(
+    field: &str,
+    data: &str,
+    before: f64,
+    after: f64,
+    undetermined: Vec<Vec<String>>,
+) -> Result<GainRow, NonFinite> {
     Ok(GainRow {
+        estimable: undetermined.is_empty(),
+        undetermined,
         data: data.into(),
         residual_rms_um_before: finite(
             || format!("{field}.residual_rms_um_before"),
@@ -259,6 +352,29 @@ fn gain_row(field: &str, data: &str, before: f64, after: f64) -> Result<GainRow,
             after * UM_PER_MM,
         )?,
     })
+}
+
+/// The outliers of the fitted record (`data`) and of every held-out record.
+fn outliers(data: &str, d: &Diagnosis) -> Result<Vec<OutlierReport>, NonFinite> {
+    let all = d.outliers.iter().map(|o| (data, o)).chain(
+        d.validation
+            .iter()
+            .flat_map(|h| h.outliers.iter().map(move |o| (h.name.as_str(), o))),
+    );
+    all.enumerate()
+        .map(|(i, (file, o))| {
+            let um = |what: &str, v: f64| finite(|| format!("outliers[{i}].{what}"), v * UM_PER_MM);
+            Ok(OutlierReport {
+                data: file.into(),
+                line: o.line,
+                sample: o.sample + 1,
+                direction: ["x", "y", "z"][o.direction].into(),
+                residual_um: um("residual_um", o.residual_mm)?,
+                deviation_um: um("deviation_um", o.deviation_mm)?,
+                threshold_um: um("threshold_um", o.threshold_mm)?,
+            })
+        })
+        .collect()
 }
 
 impl DiagnosisReport {
@@ -285,12 +401,11 @@ impl DiagnosisReport {
                     Carrier::Axis(a) => Some(m.axes[a].name.clone()),
                     Carrier::None => None,
                 },
-                // A value the extended fit cannot determine is NaN in the finding: undetermined.
                 values: f
                     .values
                     .iter()
-                    .map(|v| v.is_finite().then_some(v * k))
-                    .collect(),
+                    .map(|v| finite_opt(|| field("values"), v.map(|v| v * k)))
+                    .collect::<Result<_, _>>()?,
                 stds: f
                     .stds
                     .iter()
@@ -317,6 +432,9 @@ impl DiagnosisReport {
                 .into(),
                 candidates_tried: f.candidates_tried,
                 alternatives: spell(m, &f.alternatives),
+                size: finite(|| field("size"), f.size)?,
+                limit: f.limit,
+                plausible: f.plausible,
             });
         }
         let (name, file) = match &source.model_out {
@@ -345,11 +463,15 @@ impl DiagnosisReport {
                     || "base_fit.sigma_um".into(),
                     fit.sigma.map(|s| s * UM_PER_MM),
                 )?,
+                residual_rms_um_with_outliers: finite(
+                    || "base_fit.residual_rms_um_with_outliers".into(),
+                    d.fit_rms_with_outliers * UM_PER_MM,
+                )?,
                 dof: fit.dof,
             },
             structure: StructureReport {
-                before: components("before", &d.structure_before)?,
-                after: components("after", &d.structure_after)?,
+                before: components("before", &d.structure_before, Some(&d.structure_after))?,
+                after: components("after", &d.structure_after, None)?,
             },
             dictionary_size: d.dictionary_size,
             unexcited: spell(m, &d.unexcited),
@@ -371,19 +493,53 @@ impl DiagnosisReport {
             extended_model: ExtendedModelReport {
                 label: d.extended_label(m, source.label),
                 terms: spell(m, &d.extended_terms().terms),
-                added: d.findings.iter().map(|f| f.term.spelling(m)).collect(),
+                added: d
+                    .findings
+                    .iter()
+                    .filter(|f| f.plausible)
+                    .map(|f| f.term.spelling(m))
+                    .collect(),
                 name,
                 file,
             },
             gain: GainReport {
-                fit: gain_row("gain.fit", source.data, d.fit_rms.0, d.fit_rms.1)?,
+                fit: gain_row(
+                    "gain.fit",
+                    source.data,
+                    d.fit_rms.0,
+                    d.fit_rms.1,
+                    Vec::new(),
+                )?,
                 validation: d
                     .validation
                     .iter()
                     .enumerate()
-                    .map(|(i, (n, b, a))| gain_row(&format!("gain.validation[{i}]"), n, *b, *a))
+                    .map(|(i, h)| {
+                        let mut groups = h.undetermined_before.clone();
+                        for g in &h.undetermined_after {
+                            if !groups.contains(g) {
+                                groups.push(g.clone());
+                            }
+                        }
+                        gain_row(
+                            &format!("gain.validation[{i}]"),
+                            &h.name,
+                            h.before_rms,
+                            h.after_rms,
+                            groups,
+                        )
+                    })
                     .collect::<Result<_, _>>()?,
             },
+            outliers: outliers(source.data, d)?,
+            budget: BudgetReport {
+                um: o.budget.um,
+                urad: o.budget.urad,
+                ms: o.budget.ms,
+                fraction: o.budget.fraction,
+            },
+            recommended: d.recommendation.recommended,
+            recommendation: d.recommendation.reasons.clone(),
         })
     }
 }

@@ -3,7 +3,7 @@
 //! commands that use the extended model.
 
 use super::{header, indent, shell, table, value, wrap, zeroed_text};
-use crate::io::report::diagnose::{ComponentReport, DiagnosisReport, FindingReport, GainRow};
+use crate::io::report::diagnose::{DiagnosisReport, FindingReport, GainRow};
 use model_spec::units::{fixed, p_value, symbol};
 
 /// `ECC harmonic:2` from `ECC@harmonic:2` (a constant term is its name).
@@ -55,6 +55,13 @@ pub fn findings(r: &DiagnosisReport) -> String {
     for (i, f) in r.findings.iter().enumerate() {
         let unit = symbol(&f.unit);
         out.push_str(&format!("  {}. {}: {}\n", i + 1, f.description, values(f)));
+        if !f.plausible {
+            out.push_str(&format!(
+                "     fits, but implausible: size {} {unit} beyond the budget of {} {unit}; not a cause, left out of the extended model\n",
+                value(f.size),
+                value(f.limit)
+            ));
+        }
         if let (Some(h), Some(k)) = (&f.harmonic, f.basis.strip_prefix("harmonic:")) {
             let pm = |s: Option<f64>, digits: usize| {
                 s.map_or(String::new(), |s| format!(" ± {}", fixed(s, digits)))
@@ -94,7 +101,9 @@ pub fn gain(r: &DiagnosisReport) -> String {
             name,
             value(b),
             value(a),
-            if b > 0.0 {
+            if !g.estimable {
+                "not counted: needs undetermined parameters".into()
+            } else if b > 0.0 {
                 format!("{:+.1} %", 100.0 * (a - b) / b)
             } else {
                 "-".into()
@@ -111,28 +120,54 @@ pub fn gain(r: &DiagnosisReport) -> String {
     )
 }
 
-/// A warning for every held-out record the extended model predicts worse than the base model.
-pub fn worse(r: &DiagnosisReport) -> String {
+/// The verdict on the extended model: recommended or not, and why.
+pub fn recommendation(r: &DiagnosisReport) -> String {
+    let mut out = String::new();
+    for g in r.gain.validation.iter().filter(|g| !g.estimable) {
+        let groups: Vec<String> = g.undetermined.iter().map(|x| x.join(" ≡ ")).collect();
+        out.push_str(&format!(
+            "{}: the predictions need combinations the fit does not determine ({}); its RMS is not the model's error.\n",
+            g.data,
+            groups.join("; ")
+        ));
+    }
     if r.findings.is_empty() {
+        return out;
+    }
+    if r.recommended {
+        out.push_str(&format!("Recommended: {}.\n", r.recommendation.join("; ")));
+    } else {
+        out.push_str(&format!(
+            "Not recommended: {}. A finding may stand for one of the candidates the data cannot tell it from, or the fitted path does not separate the cause; try those alternatives (identify --terms) on the held-out data.\n",
+            r.recommendation.join("; ")
+        ));
+    }
+    out
+}
+
+/// The outliers found and left out, one line each.
+pub fn outliers(r: &DiagnosisReport) -> String {
+    if r.outliers.is_empty() {
         return String::new();
     }
-    let worse: Vec<String> = r
-        .gain
-        .validation
-        .iter()
-        .filter(|g| g.residual_rms_um_after > g.residual_rms_um_before)
-        .map(|g| {
-            let (b, a) = (g.residual_rms_um_before, g.residual_rms_um_after);
-            format!("{} ({:+.1} %)", g.data, 100.0 * (a - b) / b)
-        })
-        .collect();
-    if worse.is_empty() {
-        return String::new();
+    let mut out = format!(
+        "Outliers ({}: isolated readings beyond {} robust scales of the residual's local deviation; left out of every fit, test and RMS):\n",
+        r.outliers.len(),
+        crate::diagnosis::outliers::THRESHOLD
+    );
+    for o in &r.outliers {
+        let place = o
+            .line
+            .map_or(format!("sample {}", o.sample), |l| format!("line {l}"));
+        out.push_str(&format!(
+            "  {}:{place} {}: residual {} µm (threshold {} µm)\n",
+            o.data,
+            o.direction,
+            value(o.residual_um),
+            value(o.threshold_um)
+        ));
     }
-    format!(
-        "Warning: the extended model predicts {} worse than the base model: a finding may stand for one of the candidates the data cannot tell it from, or the fitted path does not separate the cause; try those alternatives (identify --terms) on the held-out data.\n",
-        worse.join(", ")
-    )
+    out
 }
 
 /// What to do with the result: the commands that use the extended model, or that nothing was
@@ -140,6 +175,7 @@ pub fn worse(r: &DiagnosisReport) -> String {
 pub fn next_steps(r: &DiagnosisReport) -> String {
     let zeroed = if r.zeroed { " --zeroed" } else { "" };
     let mut out = String::new();
+    let plausible: Vec<&FindingReport> = r.findings.iter().filter(|f| f.plausible).collect();
     if r.findings.is_empty() {
         out.push_str(&format!(
             "Nothing to add: no candidate of the dictionary is significant at α = {} after the correction for the candidates tried. This does not show that the residual of model {} on {} ({} µm RMS) is measurement noise: what remains is not explained by any candidate.\n",
@@ -148,9 +184,8 @@ pub fn next_steps(r: &DiagnosisReport) -> String {
             r.data,
             value(r.base_fit.residual_rms_um)
         ));
-    } else {
-        let terms: Vec<String> = r
-            .findings
+    } else if r.recommended {
+        let terms: Vec<String> = plausible
             .iter()
             .map(|f| {
                 if f.basis == "const" {
@@ -189,13 +224,6 @@ pub fn stop(r: &DiagnosisReport) -> String {
 
 /// The residual components of the base fit, each with its size after the extension.
 fn structure(r: &DiagnosisReport) -> String {
-    let after = |c: &ComponentReport| {
-        r.structure
-            .after
-            .iter()
-            .find(|x| x.source == c.source && x.shape == c.shape && x.direction == c.direction)
-            .map_or(0.0, |x| x.explained_rms_um)
-    };
     let rows: Vec<Vec<String>> = r
         .structure
         .before
@@ -207,7 +235,7 @@ fn structure(r: &DiagnosisReport) -> String {
                 c.shape.clone(),
                 c.direction.clone(),
                 fixed(c.explained_rms_um, 4),
-                fixed(after(c), 4),
+                c.extended_rms_um.map_or("-".into(), |a| fixed(a, 4)),
             ]
         })
         .collect();
@@ -244,6 +272,7 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
             .collect();
         out.push_str(&format!("Held out (not fitted): {}\n", h.join(", ")));
     }
+    out.push_str(&outliers(r));
     out.push_str(&format!(
         "\nBase fit: model {} on {}, refined against the exact machine: residual RMS {} µm, σ̂ {} ({} degrees of freedom)\n",
         r.base_model,
@@ -294,7 +323,7 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
         r.base_model, r.extended_model.label
     ));
     out.push_str(&gain(r));
-    out.push_str(&worse(r));
+    out.push_str(&recommendation(r));
     out.push('\n');
     out.push_str(&next_steps(r));
     out

@@ -1,0 +1,109 @@
+//! Plausibility: a finding is named as a cause only when its size is one a machine can have.
+//!
+//! A term's **size** is the magnitude of its coefficient: `|v|` for one column, `√(c² + s²)`
+//! (the amplitude) for a pair. Every basis of the vocabulary is at most 1 in magnitude over the
+//! stroke or the revolution, so the size bounds what the term adds anywhere on the machine.
+//! It is compared with the [`Budget`] of its unit; a larger term fits the data but is not
+//! reported as a cause ("fits, but implausible"): a 3756 µrad cubic pitch error of X that
+//! explains a step of the C axis is a look-alike, not a finding.
+
+use crate::model::Term;
+use model_spec::Machine;
+
+/// The largest plausible size of a term, per unit (configurable: `rtest diagnose --budget`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Budget {
+    /// Translational errors, sensor offsets and their drifts, µm (default 100).
+    pub um: f64,
+    /// Angular errors, µrad (default 200).
+    pub urad: f64,
+    /// Servo lag τ of a velocity term, ms (default 20).
+    pub ms: f64,
+    /// Instrument gain and cross-talk, a fraction (default 0.05: 5 %).
+    pub fraction: f64,
+}
+
+impl Default for Budget {
+    fn default() -> Self {
+        Budget {
+            um: 100.0,
+            urad: 200.0,
+            ms: 20.0,
+            fraction: 0.05,
+        }
+    }
+}
+
+impl Budget {
+    /// Parses `um=100,urad=200,ms=20,1=0.05` (any subset; the others keep their defaults).
+    ///
+    /// # Errors
+    /// A message naming the entry that is not `KEY=VALUE` with a known key and a positive
+    /// finite value, or a key given twice.
+    pub fn parse(s: &str) -> Result<Budget, String> {
+        let mut b = Budget::default();
+        let mut seen = Vec::new();
+        for item in s.split(',').map(str::trim).filter(|i| !i.is_empty()) {
+            let Some((k, v)) = item.split_once('=') else {
+                return Err(format!(
+                    "`{item}`: expected KEY=VALUE with KEY one of um, urad, ms, 1"
+                ));
+            };
+            let k = k.trim();
+            let v: f64 = match v.trim().parse() {
+                Ok(v) if f64::is_finite(v) && v > 0.0 => v,
+                _ => {
+                    return Err(format!("`{item}`: the value must be a positive number"));
+                }
+            };
+            if seen.contains(&k.to_string()) {
+                return Err(format!("`{k}` is given twice"));
+            }
+            seen.push(k.to_string());
+            match k {
+                "um" => b.um = v,
+                "urad" => b.urad = v,
+                "ms" => b.ms = v,
+                "1" => b.fraction = v,
+                _ => {
+                    return Err(format!("`{k}`: unknown unit (expected um, urad, ms or 1)"));
+                }
+            }
+        }
+        Ok(b)
+    }
+
+    /// The limit for a term of unit `unit` (`um`, `urad`, `ms`, `1`), in that unit.
+    pub fn limit(&self, unit: &str) -> f64 {
+        match unit {
+            "urad" => self.urad,
+            "ms" => self.ms,
+            "1" => self.fraction,
+            _ => self.um,
+        }
+    }
+}
+
+/// Size of a term with `values` (internal units), in the unit people see, and its limit.
+pub fn size_and_limit(m: &Machine, term: &Term, values: &[f64], budget: &Budget) -> (f64, f64) {
+    let size = values.iter().map(|v| v * v).sum::<f64>().sqrt() * term.effect.display_factor(m);
+    (size, budget.limit(term.effect.unit(m)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parse_budgets() {
+        assert_eq!(Budget::parse("").unwrap(), Budget::default());
+        let b = Budget::parse("um=50, urad=100,1=0.1").unwrap();
+        assert_eq!((b.um, b.urad, b.ms, b.fraction), (50.0, 100.0, 20.0, 0.1));
+        assert_eq!(b.limit("urad"), 100.0);
+        assert!(Budget::parse("mm=1").unwrap_err().contains("unknown unit"));
+        assert!(Budget::parse("um=-1").unwrap_err().contains("positive"));
+        assert!(Budget::parse("um=inf").unwrap_err().contains("positive"));
+        assert!(Budget::parse("um").unwrap_err().contains("KEY=VALUE"));
+        assert!(Budget::parse("um=1,um=2").unwrap_err().contains("twice"));
+    }
+}

@@ -1,0 +1,110 @@
+//! Whether the extended model is recommended, and why (not).
+//!
+//! The extended model (the base model plus the plausible findings) is recommended only when
+//! all of these hold:
+//! 1. there is at least one plausible finding;
+//! 2. there is at least one held-out record whose predictions use only what the fits
+//!    determined ([`super::heldout`]): without one the gain cannot be checked;
+//! 3. no such held-out record is predicted worse than by the base model;
+//! 4. the residual moves toward the noise: the RMS pooled over those records (weighted by
+//!    their readings) falls.
+//!
+//! Otherwise the reasons say which condition failed, with the records and sizes involved.
+
+use super::Finding;
+use super::heldout::HeldOut;
+use model_spec::units::UM_PER_MM;
+
+/// The verdict on the extended model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Recommendation {
+    /// `true`: use the extended model.
+    pub recommended: bool,
+    /// Why (not), for people, one sentence each.
+    pub reasons: Vec<String>,
+}
+
+fn um(v: f64) -> String {
+    format!("{:.3} µm", v * UM_PER_MM)
+}
+
+/// The verdict on the extension of `findings`, from the held-out gain `held`.
+pub fn recommend(findings: &[Finding], held: &[HeldOut]) -> Recommendation {
+    let mut reasons = Vec::new();
+    let implausible = findings.iter().filter(|f| !f.plausible).count();
+    if !findings.iter().any(|f| f.plausible) {
+        reasons.push(if findings.is_empty() {
+            "there is no finding to add".into()
+        } else {
+            format!(
+                "no finding is plausible ({} fit, but beyond the size budget)",
+                implausible
+            )
+        });
+        return Recommendation {
+            recommended: false,
+            reasons,
+        };
+    }
+    if held.is_empty() {
+        reasons.push(
+            "no held-out record: the gain of the extension cannot be checked (give held-out records)"
+                .into(),
+        );
+    }
+    let estimable: Vec<&HeldOut> = held.iter().filter(|h| h.estimable()).collect();
+    for h in held.iter().filter(|h| !h.estimable()) {
+        let groups: Vec<String> = h
+            .undetermined_before
+            .iter()
+            .chain(&h.undetermined_after)
+            .map(|g| g.join(" ≡ "))
+            .collect();
+        reasons.push(format!(
+            "{}: its prediction needs what the fit does not determine ({}); its RMS is not counted",
+            h.name,
+            groups.join("; ")
+        ));
+    }
+    if !held.is_empty() && estimable.is_empty() {
+        reasons.push("no held-out record can check the extension".into());
+    }
+    for h in &estimable {
+        if h.after_rms > h.before_rms {
+            reasons.push(format!(
+                "{} is predicted worse: {} → {}",
+                h.name,
+                um(h.before_rms),
+                um(h.after_rms)
+            ));
+        }
+    }
+    let pooled = |f: fn(&HeldOut) -> f64| -> f64 {
+        let s: f64 = estimable
+            .iter()
+            .map(|h| h.readings as f64 * f(h).powi(2))
+            .sum();
+        let n: usize = estimable.iter().map(|h| h.readings).sum();
+        (s / n.max(1) as f64).sqrt()
+    };
+    let (before, after) = (pooled(|h| h.before_rms), pooled(|h| h.after_rms));
+    if !estimable.is_empty() && after >= before {
+        reasons.push(format!(
+            "the held-out residual does not fall ({} → {} RMS)",
+            um(before),
+            um(after)
+        ));
+    }
+    let recommended = reasons.is_empty();
+    if recommended {
+        reasons.push(format!(
+            "every held-out record is predicted at least as well; pooled RMS {} → {}",
+            um(before),
+            um(after)
+        ));
+    }
+    Recommendation {
+        recommended,
+        reasons,
+    }
+}

@@ -29,6 +29,7 @@ pub mod plausible;
 mod search;
 pub mod select;
 pub mod structure;
+pub mod unexplained;
 pub mod verdict;
 
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};

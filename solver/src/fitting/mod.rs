@@ -8,6 +8,8 @@
 //! - [`mod@identify`]: a model identified on a record (first order), with what the sensor
 //!   offsets swallow;
 //! - [`identifiability`]: what the data can and cannot tell apart;
+//! - [`noise`]: the reading noise (white or AR(1) per direction: declared, from a static
+//!   record, or estimated without trusting the model) and the prewhitening that makes it white;
 //! - [`refine`]: Gauss–Newton against the exact machine, removing the second-order bias;
 //! - [`streaming`]: identification of long records in blocks, memory bounded by the model;
 //! - [`mod@validate`]: the identified model's prediction against another record;
@@ -18,6 +20,7 @@ pub mod hmatrix;
 pub mod identifiability;
 pub mod identify;
 pub mod least_squares;
+pub mod noise;
 pub mod refine;
 pub mod sanity;
 pub mod streaming;

@@ -18,7 +18,9 @@
 use super::outliers::{self, Outlier};
 use crate::fitting::Identification;
 use crate::fitting::hmatrix::{GainSource, h_matrix};
-use crate::fitting::validate::{ValidateError, ValidateOptions, statistics, validate_with};
+use crate::fitting::validate::{
+    ValidateError, ValidateOptions, Validation, statistics, validate_with,
+};
 use crate::record::Record;
 use model_spec::Machine;
 
@@ -128,19 +130,33 @@ fn rms_without(residual: &[[f64; 3]], outliers: &[Outlier]) -> f64 {
         .measured_rms
 }
 
-/// The gain on every held-out record: base and extended predictions (exact machine, estimable
-/// values), outliers left out, undetermined needs named.
+/// The prediction of `fit` on every held-out record (exact machine, estimable values).
+pub fn predict(
+    m: &Machine,
+    fit: &Identification,
+    held_out: &[(String, Record)],
+    source: &mut GainSource,
+    opts: &ValidateOptions,
+) -> Result<Vec<Validation>, ValidateError> {
+    held_out
+        .iter()
+        .map(|(_, rec)| validate_with(m, &fit.model, &estimable_values(fit), rec, source, opts))
+        .collect()
+}
+
+/// The gain on every held-out record: the base predictions `before` ([`predict`]) and the
+/// extended ones, outliers left out, undetermined needs named.
 pub fn held_out_gain(
     m: &Machine,
     base: &Identification,
+    before: &[Validation],
     extended: &Identification,
     held_out: &[(String, Record)],
     source: &mut GainSource,
     opts: &ValidateOptions,
 ) -> Result<Vec<HeldOut>, ValidateError> {
     let mut out = Vec::new();
-    for (name, rec) in held_out {
-        let before = validate_with(m, &base.model, &estimable_values(base), rec, source, opts)?;
+    for ((name, rec), before) in held_out.iter().zip(before) {
         let after = validate_with(
             m,
             &extended.model,

@@ -17,6 +17,7 @@
 //! 4. Refit the extended model (refined against the exact machine), and measure the residual
 //!    RMS before and after on the fitted record and on every held-out record.
 
+pub mod adequacy;
 mod confounded;
 pub mod dictionary;
 pub mod figures;
@@ -33,6 +34,7 @@ pub mod unexplained;
 pub mod verdict;
 
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::noise::{self, NoiseChoice, NoiseError, NoiseModel, NoiseSource};
 use crate::fitting::refine::{RefineError, RefineOptions, identify_refined_with};
 use crate::fitting::validate::{ValidateError, ValidateOptions};
 use crate::fitting::{
@@ -155,6 +157,14 @@ pub struct Diagnosis {
     pub validation: Vec<heldout::HeldOut>,
     /// Whether the extended model is recommended, and why (not).
     pub recommendation: verdict::Recommendation,
+    /// The noise model every test assumes (the readings and columns are whitened by it).
+    pub noise: NoiseModel,
+    /// The lack-of-fit test of the extended model's residual against the noise; `Err(why)`
+    /// when there is no noise model independent of the fit (noise-free data, or ordinary least
+    /// squares asked for).
+    pub adequacy: Result<adequacy::Adequacy, String>,
+    /// What remains in each direction the adequacy test finds inconsistent with the noise.
+    pub unexplained: Vec<unexplained::Unexplained>,
 }
 
 /// Why a diagnosis could not be made.
@@ -172,6 +182,9 @@ pub enum DiagnoseError {
     /// A validation failed.
     #[error(transparent)]
     Validate(#[from] ValidateError),
+    /// The noise model cannot whiten the readings.
+    #[error("noise model: {0}")]
+    Noise(#[from] NoiseError),
 }
 
 fn fit(
@@ -251,8 +264,21 @@ pub fn diagnose(
         (&cleaned, f)
     };
 
-    let h_all = h_matrix(m, &all, record, &mut source)?;
-    let y = measurement_vector(record)?;
+    // The noise model, and the readings and columns whitened by it: every test after is the
+    // textbook one on white noise of unit variance.
+    let vopts = ValidateOptions {
+        zeroed: o.zeroed,
+        exact: true,
+        params: Some(params.clone()),
+        ..Default::default()
+    };
+    let before = heldout::predict(m, &base_fit, held_out, &mut source, &vopts)?;
+    let (noise, estimated) = noise_model(&o.noise, &base_fit, held_out, &before);
+    let layout = [record.samples.len()];
+    let h_raw = h_matrix(m, &all, record, &mut source)?;
+    let mut h_all = h_raw.clone();
+    let mut y = measurement_vector(record)?;
+    noise.whiten(&layout, &mut h_all, &mut y)?;
     let n = y.len();
 
     // Column ranges: base terms first, then one group per candidate.
@@ -275,7 +301,12 @@ pub fn diagnose(
     }
     let rss_base = q_base.project_out(&y).norm_squared();
     let unexcited: Vec<Term> = (0..candidates.len())
-        .filter(|&c| group(nb + c).iter().all(|v| v.abs() < 1e-15))
+        .filter(|&c| {
+            h_raw
+                .columns(starts[nb + c], widths[nb + c])
+                .iter()
+                .all(|v| v.abs() < 1e-15)
+        })
         .map(|c| candidates[c])
         .collect();
     let candidates_live: Vec<usize> = (0..candidates.len())
@@ -360,14 +391,46 @@ pub fn diagnose(
         &widths,
     );
 
-    let vopts = ValidateOptions {
-        zeroed: o.zeroed,
-        exact: true,
-        params: Some(params.clone()),
-        ..Default::default()
+    let validation = heldout::held_out_gain(
+        m,
+        &base_fit,
+        &before,
+        &extended_fit,
+        held_out,
+        &mut source,
+        &vopts,
+    )?;
+    // Lack of fit of the extended model against the noise, and what remains, described.
+    let adequacy = match &noise.source {
+        NoiseSource::Residual { why } => Err(why.clone()),
+        _ => {
+            let cols: Vec<usize> = (0..nb)
+                .chain(
+                    extended.terms[nb..]
+                        .iter()
+                        .filter_map(|t| candidates.iter().position(|c| c == t).map(|c| nb + c)),
+                )
+                .flat_map(|g| starts[g]..starts[g] + widths[g])
+                .collect();
+            let h_ext = h_raw.select_columns(&cols);
+            adequacy::adequacy(
+                &noise,
+                estimated,
+                &h_ext,
+                &extended_fit.fit.residual,
+                o.alpha,
+                o.seed,
+            )
+            .map_err(|e| e.to_string())
+        }
     };
-    let validation =
-        heldout::held_out_gain(m, &base_fit, &extended_fit, held_out, &mut source, &vopts)?;
+    let unexplained = match &adequacy {
+        Ok(a) if !a.consistent_with_noise => (0..3)
+            .filter(|&d| 3.0 * a.p_values[d] < o.alpha)
+            .map(|d| unexplained::describe(m, record, &residual_rows(&extended_fit), d))
+            .collect(),
+        _ => Vec::new(),
+    };
     let rows = n.max(1) as f64;
     let fit_rms = (
         (base_fit.fit.rss / rows).sqrt(),
@@ -393,7 +456,48 @@ pub fn diagnose(
         extended_fit,
         validation,
         recommendation,
+        noise,
+        adequacy,
+        unexplained,
     })
+}
+
+/// The noise model of a diagnosis, and whether it was estimated from the records: declared or
+/// from a static record as given; estimated from the base model's residual on the fitted record
+/// and its prediction residual on every held-out record without outliers (independent
+/// realisations of the same instrument); white with the base fit's σ̂ when it cannot be
+/// estimated (noise-free data) or ordinary least squares was asked for.
+fn noise_model(
+    choice: &NoiseChoice,
+    base_fit: &Identification,
+    held_out: &[(String, Record)],
+    before: &[crate::fitting::Validation],
+) -> (NoiseModel, bool) {
+    let sigma = base_fit
+        .fit
+        .sigma
+        .filter(|s| *s > 0.0)
+        .unwrap_or(noise::NOISE_FLOOR_MM);
+    match choice {
+        NoiseChoice::Model(model) => (model.clone(), false),
+        NoiseChoice::Ordinary => (NoiseModel::residual(sigma, "ordinary least squares"), false),
+        NoiseChoice::Estimate => {
+            let fitted = residual_rows(base_fit);
+            let mut series: Vec<&[[f64; 3]]> = vec![&fitted];
+            for ((_, rec), v) in held_out.iter().zip(before) {
+                if outliers::find_in(rec, &v.residual).is_empty() {
+                    series.push(&v.residual);
+                }
+            }
+            match NoiseModel::estimate(&series) {
+                Ok(model) => (model, true),
+                Err(e) => (
+                    NoiseModel::residual(sigma, format!("the noise cannot be estimated: {e}")),
+                    false,
+                ),
+            }
+        }
+    }
 }
 
 /// The orthonormal basis of the columns of `model` (the base terms, then candidates).

@@ -2,6 +2,7 @@
 
 use super::dictionary::DictionaryOptions;
 use super::plausible::Budget;
+use crate::fitting::noise::NoiseChoice;
 use crate::fitting::{Constraint, Tolerances};
 
 /// Options of [`super::diagnose()`] (`DiagnoseOptions::default()`, then set the fields wanted).
@@ -30,6 +31,10 @@ pub struct DiagnoseOptions {
     pub constraint: Constraint,
     /// The largest plausible size of a finding, per unit.
     pub budget: Budget,
+    /// The noise model of the tests: estimated from the records (the default), declared, from
+    /// a static record, or ordinary least squares (white, σ from the residual: no lack-of-fit
+    /// test is then possible).
+    pub noise: NoiseChoice,
 }
 
 impl Default for DiagnoseOptions {
@@ -45,6 +50,7 @@ impl Default for DiagnoseOptions {
             tolerances: Tolerances::default(),
             constraint: Constraint::None,
             budget: Budget::default(),
+            noise: NoiseChoice::Estimate,
         }
     }
 }

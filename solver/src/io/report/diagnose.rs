@@ -3,8 +3,10 @@
 //! on the fitted and the held-out records. Values in µm and µrad.
 
 use super::{NonFinite, finite, finite_opt};
+use crate::diagnosis::adequacy::Adequacy;
 use crate::diagnosis::harmonic::harmonic;
 use crate::diagnosis::structure::Component;
+use crate::diagnosis::unexplained::{Shape, Unexplained};
 use crate::diagnosis::{Correction, DiagnoseOptions, Diagnosis};
 use crate::model::{Carrier, Term};
 use model_spec::Machine;
@@ -227,6 +229,56 @@ pub struct GainReport {
     pub validation: Vec<GainRow>,
 }
 
+/// The lack-of-fit test of the extended model's residual against the noise model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AdequacyReport {
+    /// The test, for people.
+    pub test: String,
+    /// The noise's σ per direction x, y, z the test used, µm.
+    pub noise_sigma_um: [f64; 3],
+    /// The residual's RMS per direction, µm.
+    pub residual_sigma_um: [f64; 3],
+    /// Per direction, the residual's mean square over the noise variance.
+    pub statistic: [f64; 3],
+    /// Per direction, the bootstrap p-value.
+    pub p_values: [f64; 3],
+    /// The smallest times 3 (Bonferroni over the directions), at most 1.
+    pub p_value: f64,
+    /// Bootstrap draws.
+    pub draws: usize,
+    /// `p_value ≥ alpha`: what remains is consistent with the noise.
+    pub consistent_with_noise: bool,
+}
+
+/// What remains in a direction the noise does not account for, described.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct UnexplainedReport {
+    /// `x`, `y` or `z`.
+    pub direction: String,
+    /// RMS of the residual in that direction, µm.
+    pub rms_um: f64,
+    /// What it follows (`C`, `X`, `time`, `velocity of A`, `direction of motion of C`,
+    /// `sample`); absent when it follows nothing simple.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub follows: Option<String>,
+    /// The unit of what it follows (`deg`, `mm`, `s`, `deg/s`, `mm/s`, `±1`; empty for
+    /// `sample`).
+    pub unit: String,
+    /// `smooth`, `periodic`, `step`, `local` or `irregular`.
+    pub shape: String,
+    /// The period of a periodic shape, in `unit`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
+    /// Where a step is, in `unit`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at: Option<f64>,
+    /// The first and last sample (1-based) of a local deviation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<[usize; 2]>,
+    /// RMS of what the shape explains, µm.
+    pub explained_rms_um: f64,
+}
+
 /// The diagnosis report.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DiagnosisReport {
@@ -276,6 +328,16 @@ pub struct DiagnosisReport {
     pub recommended: bool,
     /// Why (not).
     pub recommendation: Vec<String>,
+    /// The noise model every test and p-value assumes, for people.
+    pub noise_model: String,
+    /// The lack-of-fit test; `null` when no noise model independent of the fit exists
+    /// (`adequacy_unavailable` says why).
+    pub adequacy: Option<AdequacyReport>,
+    /// Why there is no lack-of-fit test; absent when there is one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adequacy_unavailable: Option<String>,
+    /// What remains unexplained, per direction the test finds inconsistent with the noise.
+    pub unexplained: Vec<UnexplainedReport>,
 }
 
 /// What the report says besides the diagnosis: where things come from and go.
@@ -351,6 +413,50 @@ fn gain_row(
             || format!("{field}.residual_rms_um_after"),
             after * UM_PER_MM,
         )?,
+    })
+}
+
+fn adequacy(a: &Adequacy) -> Result<AdequacyReport, NonFinite> {
+    let three = |what: &str, v: [f64; 3], k: f64| -> Result<[f64; 3], NonFinite> {
+        for x in v {
+            finite(|| format!("adequacy.{what}"), x * k)?;
+        }
+        Ok(v.map(|x| x * k))
+    };
+    Ok(AdequacyReport {
+        test: format!(
+            "residual mean square over the noise variance per direction, against a parametric bootstrap of the fit under the noise model ({} draws); Bonferroni over the three directions",
+            a.draws
+        ),
+        noise_sigma_um: three("noise_sigma_um", a.noise_sigma_mm, UM_PER_MM)?,
+        residual_sigma_um: three("residual_sigma_um", a.residual_sigma_mm, UM_PER_MM)?,
+        statistic: three("statistic", a.statistic, 1.0)?,
+        p_values: a.p_values,
+        p_value: a.p_value,
+        draws: a.draws,
+        consistent_with_noise: a.consistent_with_noise,
+    })
+}
+
+fn unexplained(i: usize, u: &Unexplained) -> Result<UnexplainedReport, NonFinite> {
+    let um = |what: &str, v: f64| finite(|| format!("unexplained[{i}].{what}"), v * UM_PER_MM);
+    let (shape, period, at, samples) = match u.shape {
+        Shape::Smooth => ("smooth", None, None, None),
+        Shape::Periodic { period } => ("periodic", Some(period), None, None),
+        Shape::Step { at } => ("step", None, Some(at), None),
+        Shape::Local { first, last } => ("local", None, None, Some([first + 1, last + 1])),
+        Shape::Irregular => ("irregular", None, None, None),
+    };
+    Ok(UnexplainedReport {
+        direction: ["x", "y", "z"][u.direction].into(),
+        rms_um: um("rms_um", u.rms_mm)?,
+        follows: u.follows.clone(),
+        unit: u.unit.clone(),
+        shape: shape.into(),
+        period,
+        at,
+        samples,
+        explained_rms_um: um("explained_rms_um", u.explained_rms_mm)?,
     })
 }
 
@@ -540,6 +646,18 @@ impl DiagnosisReport {
             },
             recommended: d.recommendation.recommended,
             recommendation: d.recommendation.reasons.clone(),
+            noise_model: d.noise.to_string(),
+            adequacy: match &d.adequacy {
+                Ok(a) => Some(adequacy(a)?),
+                Err(_) => None,
+            },
+            adequacy_unavailable: d.adequacy.as_ref().err().cloned(),
+            unexplained: d
+                .unexplained
+                .iter()
+                .enumerate()
+                .map(|(i, u)| unexplained(i, u))
+                .collect::<Result<_, _>>()?,
         })
     }
 }

@@ -145,6 +145,73 @@ pub fn recommendation(r: &DiagnosisReport) -> String {
     out
 }
 
+/// The lack-of-fit test, and what remains where it fails.
+pub fn adequacy(r: &DiagnosisReport) -> String {
+    let Some(a) = &r.adequacy else {
+        return format!(
+            "Noise: no lack-of-fit test ({}); whether what remains is noise is not known.\n",
+            r.adequacy_unavailable
+                .as_deref()
+                .unwrap_or("no noise model")
+        );
+    };
+    let per: Vec<String> = (0..3)
+        .map(|d| {
+            format!(
+                "{} residual {} µm against noise {} µm (p = {})",
+                ["x", "y", "z"][d],
+                fixed(a.residual_sigma_um[d], 3),
+                fixed(a.noise_sigma_um[d], 3),
+                p_value(a.p_values[d])
+            )
+        })
+        .collect();
+    let mut out = format!(
+        "Residual of the extended model against the noise: {}.\n",
+        per.join("; ")
+    );
+    if a.consistent_with_noise {
+        out.push_str(&format!(
+            "  Consistent with the noise (p = {} ≥ α = {}): the model explains the data down to the noise.\n",
+            p_value(a.p_value),
+            r.alpha
+        ));
+        return out;
+    }
+    out.push_str(&format!(
+        "  NOT consistent with the noise (p = {} < α = {}). Unexplained:\n",
+        p_value(a.p_value),
+        r.alpha
+    ));
+    for u in &r.unexplained {
+        let what = match (u.follows.as_deref(), u.shape.as_str()) {
+            (None, _) | (_, "irregular") => "follows nothing simple (no shape of an axis position, velocity, direction of motion or time beats the noise)".to_string(),
+            (Some(_), "local") => {
+                let [a, b] = u.samples.unwrap_or([0, 0]);
+                format!("a local deviation over samples {a}–{b}")
+            }
+            (Some(f), "periodic") => format!(
+                "follows {f}: periodic, period {} {}",
+                fixed(u.period.unwrap_or(f64::NAN), 3),
+                u.unit
+            ),
+            (Some(f), "step") => format!(
+                "follows {f}: a step near {} {}",
+                fixed(u.at.unwrap_or(f64::NAN), 3),
+                u.unit
+            ),
+            (Some(f), shape) => format!("follows {f}: {shape}"),
+        };
+        out.push_str(&format!(
+            "  {}: {} µm RMS; {what} (explains {} µm RMS)\n",
+            u.direction,
+            fixed(u.rms_um, 3),
+            fixed(u.explained_rms_um, 3)
+        ));
+    }
+    out
+}
+
 /// The outliers found and left out, one line each.
 pub fn outliers(r: &DiagnosisReport) -> String {
     if r.outliers.is_empty() {
@@ -178,11 +245,28 @@ pub fn next_steps(r: &DiagnosisReport) -> String {
     let plausible: Vec<&FindingReport> = r.findings.iter().filter(|f| f.plausible).collect();
     if r.findings.is_empty() {
         out.push_str(&format!(
-            "Nothing to add: no candidate of the dictionary is significant at α = {} after the correction for the candidates tried. This does not show that the residual of model {} on {} ({} µm RMS) is measurement noise: what remains is not explained by any candidate.\n",
+            "Nothing to add: no candidate of the dictionary is significant at α = {} after the correction for the candidates tried. {}\n",
             r.alpha,
-            r.base_model,
-            r.data,
-            value(r.base_fit.residual_rms_um)
+            match &r.adequacy {
+                Some(a) if a.consistent_with_noise => format!(
+                    "The residual of model {} on {} ({} µm RMS) is consistent with the noise.",
+                    r.base_model,
+                    r.data,
+                    value(r.base_fit.residual_rms_um)
+                ),
+                Some(_) => format!(
+                    "The residual of model {} on {} ({} µm RMS) is not the noise: what remains is described above, and no candidate explains it.",
+                    r.base_model,
+                    r.data,
+                    value(r.base_fit.residual_rms_um)
+                ),
+                None => format!(
+                    "Whether the residual of model {} on {} ({} µm RMS) is noise is not known.",
+                    r.base_model,
+                    r.data,
+                    value(r.base_fit.residual_rms_um)
+                ),
+            }
         ));
     } else if r.recommended {
         let terms: Vec<String> = plausible
@@ -273,6 +357,7 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
         out.push_str(&format!("Held out (not fitted): {}\n", h.join(", ")));
     }
     out.push_str(&outliers(r));
+    out.push_str(&format!("Noise model of every test: {}\n", r.noise_model));
     out.push_str(&format!(
         "\nBase fit: model {} on {}, refined against the exact machine: residual RMS {} µm, σ̂ {} ({} degrees of freedom)\n",
         r.base_model,
@@ -323,6 +408,7 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
         r.base_model, r.extended_model.label
     ));
     out.push_str(&gain(r));
+    out.push_str(&adequacy(r));
     out.push_str(&recommendation(r));
     out.push('\n');
     out.push_str(&next_steps(r));

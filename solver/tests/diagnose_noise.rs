@@ -119,8 +119,8 @@ fn add(recs: &mut [(String, Record)], f: impl Fn(&Record, usize) -> [f64; 3]) {
     for (_, r) in recs.iter_mut() {
         for i in 0..r.measured.len() {
             let e = f(r, i);
-            for d in 0..3 {
-                r.measured[i][d] += e[d];
+            for (v, x) in r.measured[i].iter_mut().zip(e) {
+                *v += x;
             }
         }
     }

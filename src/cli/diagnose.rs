@@ -162,6 +162,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
             .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
     }
     let data = args.data.display().to_string();
+    opts.data_name = data.clone();
     let d = diagnose(&m, &model, &record, &held, &opts).map_err(|e| match e {
         DiagnoseError::Estimate(e)
         | DiagnoseError::Refine(solver::fitting::RefineError::Estimate(e)) => {

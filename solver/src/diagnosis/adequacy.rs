@@ -6,19 +6,33 @@
 //! the statistic is
 //!
 //! ```text
-//! T_d = (mean of r_d²) / σ̂_d²
+//! T_kd = (mean of r_kd²) / σ̂_d²
 //! ```
 //!
-//! the residual's mean square over the noise variance, with σ̂_d the declared or static σ, or,
-//! for an estimated model, the σ estimated from that residual alone. Its null distribution is
+//! the mean square of record k's residual over the noise variance, with σ̂_d the declared or
+//! static σ, or, for an estimated model, the σ estimated from all the residuals together;
+//! where the records' own estimates of a direction differ by more than a factor
+//! [`HOMOGENEITY`], the smallest of them. A misfit faster than the sampling (a ballscrew
+//! period of a few samples) looks like noise to any estimator from one record, but not on
+//! every record alike: on a path where the axis barely moves it is absent, and that record's
+//! σ̂ is the noise's. Its null distribution is
 //! drawn by a parametric bootstrap of the whole procedure: AR(1) noise of the model's σ and φ
 //! on the record's samples, fitted by the same generalized least squares (the model's columns,
 //! whitened), its residual's noise estimated again when the model was estimated, and `T_d`
 //! computed the same way. So the test accounts for the serial correlation, for what the fit
-//! absorbs, and for the uncertainty of an estimated σ. The p-value of a direction is
-//! `(1 + #{draws with T_d at least as large}) / (D + 1)`; the overall p-value is the smallest of
-//! the three times 3 (Bonferroni over the directions), and the residual is
-//! `consistent_with_noise` when it is at least α.
+//! absorbs, and for the uncertainty of an estimated σ (each draw estimates it again by the
+//! same rule). The p-value of a direction is `(1 + #{draws with T at least as large}) /
+//! (D + 1)`; when fewer than [`TAIL_DRAWS`] draws reach the statistic, the rank cannot resolve
+//! it, and the p-value is the Gaussian tail of `ln T` beyond the draws' mean and standard
+//! deviation (never more than the rank p-value).
+//!
+//! The test is made on the fitted record and on every held-out record (the extended model's
+//! prediction there; the draws are noise alone, since nothing was fitted to those readings, and
+//! a prediction zeroed at the first sample is compared with noise zeroed the same way): a model
+//! that fits the fitted path to the noise with look-alike terms shows its misfit on the paths
+//! it did not see. The overall p-value is the smallest of all times their number (Bonferroni
+//! over records and directions), and what remains is `consistent_with_noise` when it is at
+//! least α.
 
 use crate::fitting::noise::{NoiseError, NoiseModel};
 use crate::simulation::rng::Rng;
@@ -27,13 +41,20 @@ use nalgebra::{DMatrix, DVector};
 /// Draws of the bootstrap null.
 pub const DRAWS: usize = 400;
 
-/// The lack-of-fit test of a residual.
+/// Below this many draws at least as large, the p-value is the Gaussian tail of `ln T`.
+pub const TAIL_DRAWS: usize = 5;
+
+use crate::fitting::distributions::normal_upper_tail as normal_tail;
+
+/// The test on one record.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Adequacy {
-    /// The noise model tested against.
-    pub noise: NoiseModel,
-    /// The noise's σ per direction the statistic used, mm (for an estimated model: estimated
-    /// from this residual).
+pub struct RecordAdequacy {
+    /// The record's name.
+    pub name: String,
+    /// `true` for the fitted record, `false` for a held-out one.
+    pub fitted: bool,
+    /// The noise's σ per direction the statistic used, mm (for an estimated model: the smallest
+    /// of the records' own estimates).
     pub noise_sigma_mm: [f64; 3],
     /// RMS of the residual per direction, mm.
     pub residual_sigma_mm: [f64; 3],
@@ -41,7 +62,16 @@ pub struct Adequacy {
     pub statistic: [f64; 3],
     /// The bootstrap p-value per direction.
     pub p_values: [f64; 3],
-    /// The smallest of them times 3, at most 1.
+}
+
+/// The lack-of-fit test of the extended model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Adequacy {
+    /// The noise model tested against.
+    pub noise: NoiseModel,
+    /// Per record: the fitted one first, then the held-out ones.
+    pub records: Vec<RecordAdequacy>,
+    /// The smallest p-value times the number of tests, at most 1.
     pub p_value: f64,
     /// Bootstrap draws.
     pub draws: usize,
@@ -49,24 +79,60 @@ pub struct Adequacy {
     pub consistent_with_noise: bool,
 }
 
+/// What to test: a residual and, for the fitted record, the columns that were fitted.
+pub struct Residual<'a> {
+    /// The record's name.
+    pub name: &'a str,
+    /// `y − prediction`, mm, 3 rows per sample.
+    pub residual: &'a DVector<f64>,
+    /// The columns fitted to this record (mm per unit); `None` for a held-out record.
+    pub fitted: Option<&'a DMatrix<f64>>,
+    /// The prediction was zeroed at the first sample.
+    pub zeroed: bool,
+}
+
 /// Rows `[x, y, z]` of a vector of 3 rows per sample.
 fn rows(v: &[f64]) -> Vec<[f64; 3]> {
     v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
 }
 
-/// Mean square per direction of `r` (3 rows per sample).
+/// Mean square per direction of `r`.
 fn mean_squares(r: &[[f64; 3]]) -> [f64; 3] {
     let n = r.len().max(1) as f64;
     std::array::from_fn(|d| r.iter().map(|v| v[d] * v[d]).sum::<f64>() / n)
 }
 
-/// The σ the statistic divides by: the model's, or estimated from `r` when the model was.
-fn sigma_of(noise: &NoiseModel, estimated: bool, r: &[[f64; 3]]) -> Result<[f64; 3], NoiseError> {
-    if estimated {
-        Ok(NoiseModel::estimate(&[r])?.sigma_mm)
-    } else {
-        Ok(noise.sigma_mm)
+/// Records whose σ estimates of one direction differ by more than this factor are not
+/// measuring the same noise.
+pub const HOMOGENEITY: f64 = 1.5;
+
+/// The σ per direction the statistics divide by: the model's; or, when it was estimated, the
+/// estimate from all residuals together, except in a direction where the records' own
+/// estimates differ by more than [`HOMOGENEITY`]: then the smallest of them.
+fn reference_sigma(
+    noise: &NoiseModel,
+    estimated: bool,
+    residuals: &[Vec<[f64; 3]>],
+) -> Result<[f64; 3], NoiseError> {
+    if !estimated {
+        return Ok(noise.sigma_mm);
     }
+    let all: Vec<&[[f64; 3]]> = residuals.iter().map(Vec::as_slice).collect();
+    let mut out = NoiseModel::estimate(&all)?.sigma_mm;
+    let own: Vec<[f64; 3]> = residuals
+        .iter()
+        .filter_map(|r| NoiseModel::estimate(&[r]).ok().map(|m| m.sigma_mm))
+        .collect();
+    for d in 0..3 {
+        let (lo, hi) = own
+            .iter()
+            .map(|s| s[d])
+            .fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        if own.len() > 1 && hi > HOMOGENEITY * lo {
+            out[d] = lo;
+        }
+    }
+    Ok(out)
 }
 
 /// AR(1) noise of `noise` on `samples` samples: 3 rows per sample.
@@ -85,65 +151,132 @@ fn draw(noise: &NoiseModel, samples: usize, rng: &mut Rng) -> DVector<f64> {
     e
 }
 
-/// Tests the residual `residual` (mm, 3 rows per sample, one record) of a fit of the columns
-/// `h` (mm per unit of each parameter, same rows) against `noise`; `estimated`: the noise model
-/// was estimated from the records (so each draw estimates it again); level `alpha`.
+/// The fit of a draw on a fitted record: its columns and the pseudo-inverse of the whitened
+/// columns (β = (whitened H)⁺ · (whitened e)).
+fn draw_fit(noise: &NoiseModel, h: &DMatrix<f64>) -> Result<DMatrix<f64>, NoiseError> {
+    let mut hw = h.clone();
+    noise.whiten_matrix(&[h.nrows() / 3], &mut hw)?;
+    let svd = hw.svd(true, true);
+    let tol = svd.singular_values.max() * 1e-10 * (h.nrows().max(h.ncols()) as f64);
+    svd.pseudo_inverse(tol)
+        .map_err(|e| NoiseError::Whitening(e.to_string()))
+}
+
+/// One draw of every residual under the null.
+fn draw_residuals(
+    noise: &NoiseModel,
+    residuals: &[Residual],
+    fits: &[Option<DMatrix<f64>>],
+    rng: &mut Rng,
+) -> Result<Vec<Vec<[f64; 3]>>, NoiseError> {
+    residuals
+        .iter()
+        .zip(fits)
+        .map(|(r, pinv)| {
+            let samples = r.residual.len() / 3;
+            let mut e = draw(noise, samples, rng);
+            if r.zeroed {
+                let first = e.rows(0, 3).into_owned();
+                for i in 0..samples {
+                    let mut row = e.rows_mut(3 * i, 3);
+                    row -= &first;
+                }
+            }
+            Ok(match (r.fitted, pinv) {
+                (Some(h), Some(pinv)) => {
+                    let mut ew = e.clone();
+                    noise.whiten_vector(&[samples], &mut ew)?;
+                    let beta = pinv * ew;
+                    rows((e - h * beta).as_slice())
+                }
+                _ => rows(e.as_slice()),
+            })
+        })
+        .collect()
+}
+
+/// Tests the residuals against `noise`; `estimated`: the noise model was estimated from the
+/// records (so each draw estimates it again); level `alpha`.
 ///
 /// # Errors
-/// [`NoiseError`] when the noise model cannot whiten, or σ cannot be estimated from the
+/// [`NoiseError`] when the noise model cannot whiten, or σ cannot be estimated from a
 /// residual (noise-free data).
 pub fn adequacy(
     noise: &NoiseModel,
     estimated: bool,
-    h: &DMatrix<f64>,
-    residual: &DVector<f64>,
+    residuals: &[Residual],
     alpha: f64,
     seed: u64,
 ) -> Result<Adequacy, NoiseError> {
-    let samples = residual.len() / 3;
-    let layout = [samples];
-    let r = rows(residual.as_slice());
-    let noise_sigma_mm = sigma_of(noise, estimated, &r)?;
-    let ms = mean_squares(&r);
-    let statistic: [f64; 3] = std::array::from_fn(|d| ms[d] / noise_sigma_mm[d].powi(2));
-
-    // The generalized least-squares fit of a draw: β = (whitened H)⁺ · (whitened e).
-    let mut hw = h.clone();
-    noise.whiten_matrix(&layout, &mut hw)?;
-    let svd = hw.svd(true, true);
-    let tol = svd.singular_values.max() * 1e-10 * (h.nrows().max(h.ncols()) as f64);
-    let pinv = svd
-        .pseudo_inverse(tol)
-        .map_err(|e| NoiseError::Whitening(e.to_string()))?;
+    let observed: Vec<Vec<[f64; 3]>> = residuals
+        .iter()
+        .map(|r| rows(r.residual.as_slice()))
+        .collect();
+    let sigma = reference_sigma(noise, estimated, &observed)?;
+    let statistic = |r: &[[f64; 3]], sigma: &[f64; 3]| -> [f64; 3] {
+        let ms = mean_squares(r);
+        std::array::from_fn(|d| ms[d] / sigma[d].powi(2))
+    };
+    let stats: Vec<[f64; 3]> = observed.iter().map(|r| statistic(r, &sigma)).collect();
+    let fits = residuals
+        .iter()
+        .map(|r| r.fitted.map(|h| draw_fit(noise, h)).transpose())
+        .collect::<Result<Vec<_>, _>>()?;
     let mut rng = Rng::new(seed);
-    let mut exceed = [0usize; 3];
+    let mut exceed = vec![[0usize; 3]; residuals.len()];
+    let mut logs = vec![[(0.0f64, 0.0f64); 3]; residuals.len()];
     for _ in 0..DRAWS {
-        let e = draw(noise, samples, &mut rng);
-        let mut ew = e.clone();
-        noise.whiten_vector(&layout, &mut ew)?;
-        let beta = &pinv * ew;
-        let rd = rows((e - h * beta).as_slice());
+        let drawn = draw_residuals(noise, residuals, &fits, &mut rng)?;
         // A draw whose σ cannot be estimated counts as exceeding: conservative, it can only
-        // make the residual look more consistent with the noise.
-        let Ok(sigma) = sigma_of(noise, estimated, &rd) else {
-            exceed.iter_mut().for_each(|x| *x += 1);
+        // make the residuals look more consistent with the noise.
+        let Ok(s) = reference_sigma(noise, estimated, &drawn) else {
+            exceed.iter_mut().flatten().for_each(|x| *x += 1);
             continue;
         };
-        let msd = mean_squares(&rd);
-        for d in 0..3 {
-            if msd[d] / sigma[d].powi(2) >= statistic[d] {
-                exceed[d] += 1;
+        for (k, r) in drawn.iter().enumerate() {
+            let t = statistic(r, &s);
+            for d in 0..3 {
+                if t[d] >= stats[k][d] {
+                    exceed[k][d] += 1;
+                }
+                let l = t[d].max(f64::MIN_POSITIVE).ln();
+                logs[k][d].0 += l;
+                logs[k][d].1 += l * l;
             }
         }
     }
-    let p_values: [f64; 3] = std::array::from_fn(|d| (1 + exceed[d]) as f64 / (DRAWS + 1) as f64);
-    let p_value = (3.0 * p_values.iter().copied().fold(1.0, f64::min)).min(1.0);
+    let records: Vec<RecordAdequacy> = residuals
+        .iter()
+        .enumerate()
+        .map(|(k, r)| RecordAdequacy {
+            name: r.name.to_string(),
+            fitted: r.fitted.is_some(),
+            noise_sigma_mm: sigma,
+            residual_sigma_mm: mean_squares(&observed[k]).map(f64::sqrt),
+            statistic: stats[k],
+            p_values: std::array::from_fn(|d| {
+                let rank = (1 + exceed[k][d]) as f64 / (DRAWS + 1) as f64;
+                if exceed[k][d] >= TAIL_DRAWS {
+                    return rank;
+                }
+                let n = DRAWS as f64;
+                let mean = logs[k][d].0 / n;
+                let sd = (logs[k][d].1 / n - mean * mean).max(0.0).sqrt();
+                let z = (stats[k][d].max(f64::MIN_POSITIVE).ln() - mean) / sd;
+                if sd > 0.0 && z.is_finite() {
+                    normal_tail(z).min(rank)
+                } else {
+                    rank
+                }
+            }),
+        })
+        .collect();
+    let tests = 3 * records.len().max(1);
+    let smallest = records.iter().flat_map(|r| r.p_values).fold(1.0, f64::min);
+    let p_value = (tests as f64 * smallest).min(1.0);
     Ok(Adequacy {
         noise: noise.clone(),
-        noise_sigma_mm,
-        residual_sigma_mm: ms.map(f64::sqrt),
-        statistic,
-        p_values,
+        records,
         p_value,
         draws: DRAWS,
         consistent_with_noise: p_value >= alpha,

@@ -45,6 +45,8 @@ pub struct HeldOut {
     pub undetermined_before: Vec<Vec<String>>,
     /// The same for the extended fit.
     pub undetermined_after: Vec<Vec<String>>,
+    /// The extended model's residual per sample, mm (outliers included).
+    pub residual_after: Vec<[f64; 3]>,
 }
 
 impl HeldOut {
@@ -171,6 +173,7 @@ pub fn held_out_gain(
             readings: 3 * (rec.samples.len() - outliers::samples(&outliers).len()),
             before_rms: rms_without(&before.residual, &outliers),
             after_rms: rms_without(&after.residual, &outliers),
+            residual_after: after.residual,
             outliers,
             undetermined_before: needed_groups(m, base, rec, source, opts.zeroed)?,
             undetermined_after: needed_groups(m, extended, rec, source, opts.zeroed)?,

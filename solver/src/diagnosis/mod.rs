@@ -46,6 +46,7 @@ use confounded::confounded_with;
 use dictionary::dictionary;
 use model_spec::Machine;
 use model_spec::terms::Term;
+use nalgebra::DVector;
 pub use options::DiagnoseOptions;
 
 use select::Span;
@@ -278,7 +279,12 @@ pub fn diagnose(
     let h_raw = h_matrix(m, &all, record, &mut source)?;
     let mut h_all = h_raw.clone();
     let mut y = measurement_vector(record)?;
-    noise.whiten(&layout, &mut h_all, &mut y)?;
+    let whitening = if estimated {
+        conservative(&noise)
+    } else {
+        noise.clone()
+    };
+    whitening.whiten(&layout, &mut h_all, &mut y)?;
     let n = y.len();
 
     // Column ranges: base terms first, then one group per candidate.
@@ -400,7 +406,8 @@ pub fn diagnose(
         &mut source,
         &vopts,
     )?;
-    // Lack of fit of the extended model against the noise, and what remains, described.
+    // Lack of fit of the extended model against the noise on every record, and what remains
+    // where it fails, described.
     let adequacy = match &noise.source {
         NoiseSource::Residual { why } => Err(why.clone()),
         _ => {
@@ -413,22 +420,61 @@ pub fn diagnose(
                 .flat_map(|g| starts[g]..starts[g] + widths[g])
                 .collect();
             let h_ext = h_raw.select_columns(&cols);
-            adequacy::adequacy(
-                &noise,
-                estimated,
-                &h_ext,
-                &extended_fit.fit.residual,
-                o.alpha,
-                o.seed,
-            )
-            .map_err(|e| e.to_string())
+            let held: Vec<DVector<f64>> = validation
+                .iter()
+                .map(|h| {
+                    let drop = outliers::samples(&h.outliers);
+                    DVector::from_iterator(
+                        3 * (h.residual_after.len() - drop.len()),
+                        (0..h.residual_after.len())
+                            .filter(|i| !drop.contains(i))
+                            .flat_map(|i| h.residual_after[i]),
+                    )
+                })
+                .collect();
+            let data = o.data_name.as_str();
+            let mut residuals = vec![adequacy::Residual {
+                name: data,
+                residual: &extended_fit.fit.residual,
+                fitted: Some(&h_ext),
+                zeroed: false,
+            }];
+            residuals.extend(
+                validation
+                    .iter()
+                    .zip(&held)
+                    .map(|(h, r)| adequacy::Residual {
+                        name: &h.name,
+                        residual: r,
+                        fitted: None,
+                        zeroed: o.zeroed,
+                    }),
+            );
+            adequacy::adequacy(&noise, estimated, &residuals, o.alpha, o.seed)
+                .map_err(|e| e.to_string())
         }
     };
     let unexplained = match &adequacy {
-        Ok(a) if !a.consistent_with_noise => (0..3)
-            .filter(|&d| 3.0 * a.p_values[d] < o.alpha)
-            .map(|d| unexplained::describe(m, record, &residual_rows(&extended_fit), d))
-            .collect(),
+        Ok(a) if !a.consistent_with_noise => {
+            let tests = 3.0 * a.records.len() as f64;
+            let mut out = Vec::new();
+            for (k, r) in a.records.iter().enumerate() {
+                let (name, rec, res) = if k == 0 {
+                    (o.data_name.as_str(), record, residual_rows(&extended_fit))
+                } else {
+                    let h = &validation[k - 1];
+                    (
+                        h.name.as_str(),
+                        &held_out[k - 1].1,
+                        h.residual_after.clone(),
+                    )
+                };
+                for d in (0..3).filter(|&d| tests * r.p_values[d] < o.alpha) {
+                    out.push(unexplained::describe(m, (name, rec), &res, d));
+                }
+            }
+            out
+        }
         _ => Vec::new(),
     };
     let rows = n.max(1) as f64;
@@ -460,6 +506,26 @@ pub fn diagnose(
         adequacy,
         unexplained,
     })
+}
+
+/// The noise model the selection whitens with when the noise was estimated: φ raised by two
+/// standard errors of its estimate, `2·√((1 − φ²)/N)` with N the samples pooled (twice the
+/// Yule–Walker standard error: the variogram estimate's spread, measured on AR(1) records of
+/// the built-in paths' lengths), the raise shrunk in proportion below φ = 0.3. A φ estimated
+/// too low leaves correlated noise that the F-tests and the Monte-Carlo null take for
+/// structure, and that matters where the correlation is strong; one too high only makes them
+/// conservative for the slowly varying candidates, which costs power where the noise is white.
+fn conservative(noise: &NoiseModel) -> NoiseModel {
+    let samples = match noise.source {
+        NoiseSource::Estimated { samples, .. } => samples.max(1) as f64,
+        _ => return noise.clone(),
+    };
+    let mut out = noise.clone();
+    for p in &mut out.phi {
+        let se = 2.0 * ((1.0 - *p * *p) / samples).sqrt();
+        *p = (*p + 2.0 * se * (*p / 0.3).min(1.0)).min(noise::MAX_ESTIMATED_PHI);
+    }
+    out
 }
 
 /// The noise model of a diagnosis, and whether it was estimated from the records: declared or

@@ -35,6 +35,8 @@ pub struct DiagnoseOptions {
     /// a static record, or ordinary least squares (white, σ from the residual: no lack-of-fit
     /// test is then possible).
     pub noise: NoiseChoice,
+    /// The fitted record's name in reports (default `fitted`).
+    pub data_name: String,
 }
 
 impl Default for DiagnoseOptions {
@@ -51,6 +53,7 @@ impl Default for DiagnoseOptions {
             constraint: Constraint::None,
             budget: Budget::default(),
             noise: NoiseChoice::Estimate,
+            data_name: "fitted".into(),
         }
     }
 }

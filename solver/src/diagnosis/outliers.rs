@@ -138,7 +138,11 @@ pub fn find(residual: &[[f64; 3]]) -> Vec<Outlier> {
                 (Some(a), Some(c)) => (a - c).abs() <= threshold,
                 _ => true,
             };
-            if grows || last - first + 1 > MAX_RUN || !sides_agree || !(first..=last).all(|k| beyond(r[k], b)) {
+            if grows
+                || last - first + 1 > MAX_RUN
+                || !sides_agree
+                || !(first..=last).all(|k| beyond(r[k], b))
+            {
                 continue;
             }
             for k in first..=last {

@@ -62,6 +62,8 @@ pub enum Shape {
 /// What remains in one direction, described.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Unexplained {
+    /// The record's name (fitted or held out).
+    pub data: String,
     /// 0, 1, 2 for x, y, z.
     pub direction: usize,
     /// RMS of the residual in that direction, mm.
@@ -359,7 +361,7 @@ fn local(y: &[f64]) -> Option<Tried> {
 /// order).
 pub fn describe(
     m: &Machine,
-    record: &Record,
+    (data, record): (&str, &Record),
     residual: &[[f64; 3]],
     direction: usize,
 ) -> Unexplained {
@@ -393,6 +395,7 @@ pub fn describe(
         Some((b, name, unit, x, t)) if b < bic(rss0, 1) - 2.0 * (tried.max(1) as f64).ln() => {
             let explained = ((rss0 - rss(&y, &t.fitted)).max(0.0) / n).sqrt();
             Unexplained {
+                data: data.to_string(),
                 direction,
                 rms_mm,
                 follows: Some(name),
@@ -404,6 +407,7 @@ pub fn describe(
             }
         }
         _ => Unexplained {
+            data: data.to_string(),
             direction,
             rms_mm,
             follows: None,
@@ -468,7 +472,7 @@ mod tests {
         let c = m.axis_by_name("C").unwrap();
         for seed in 1..=5 {
             let res = residual(&m, &r, seed, |_, q| if q[c] >= 90.0 { 5e-3 } else { 0.0 });
-            let u = describe(&m, &r, &res, 1);
+            let u = describe(&m, ("K4", &r), &res, 1);
             assert_eq!(u.follows.as_deref(), Some("C"), "seed {seed}: {u:?}");
             match u.shape {
                 Shape::Step { at } => assert!((at - 90.0).abs() < 2.0, "seed {seed}: at {at}"),
@@ -494,7 +498,7 @@ mod tests {
             let res = residual(&m, &r, seed, |_, q| {
                 2e-3 * (std::f64::consts::TAU * q[x] / 10.0).sin()
             });
-            let u = describe(&m, &r, &res, 1);
+            let u = describe(&m, ("K4", &r), &res, 1);
             assert_eq!(u.follows.as_deref(), Some("X"), "seed {seed}: {u:?}");
             match u.shape {
                 Shape::Periodic { period } => {
@@ -512,7 +516,7 @@ mod tests {
             let res = residual(&m, &r, seed, |i, _| {
                 if (100..106).contains(&i) { 1e-2 } else { 0.0 }
             });
-            let u = describe(&m, &r, &res, 1);
+            let u = describe(&m, ("K4", &r), &res, 1);
             match u.shape {
                 Shape::Local { first, last } => {
                     assert_eq!((first, last), (100, 105), "seed {seed}")
@@ -529,7 +533,7 @@ mod tests {
         let mut irregular = 0;
         for seed in 1..=20 {
             let res = residual(&m, &r, seed, |_, _| 0.0);
-            let u = describe(&m, &r, &res, 1);
+            let u = describe(&m, ("K4", &r), &res, 1);
             irregular += usize::from(u.shape == Shape::Irregular);
         }
         // The best of some 3000 shapes must beat the intercept by 2·ln N on top of the BIC.

@@ -229,11 +229,13 @@ pub struct GainReport {
     pub validation: Vec<GainRow>,
 }
 
-/// The lack-of-fit test of the extended model's residual against the noise model.
+/// The lack-of-fit test on one record.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct AdequacyReport {
-    /// The test, for people.
-    pub test: String,
+pub struct RecordAdequacyReport {
+    /// The record's file.
+    pub data: String,
+    /// `true` for the fitted record.
+    pub fitted: bool,
     /// The noise's σ per direction x, y, z the test used, µm.
     pub noise_sigma_um: [f64; 3],
     /// The residual's RMS per direction, µm.
@@ -242,9 +244,19 @@ pub struct AdequacyReport {
     pub statistic: [f64; 3],
     /// Per direction, the bootstrap p-value.
     pub p_values: [f64; 3],
-    /// The smallest times 3 (Bonferroni over the directions), at most 1.
+}
+
+/// The lack-of-fit test of the extended model's residuals against the noise model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AdequacyReport {
+    /// The test, for people.
+    pub test: String,
+    /// Per record: the fitted one, then the held-out ones.
+    pub records: Vec<RecordAdequacyReport>,
+    /// The smallest p-value times the number of tests (Bonferroni over records and
+    /// directions), at most 1.
     pub p_value: f64,
-    /// Bootstrap draws.
+    /// Bootstrap draws per record.
     pub draws: usize,
     /// `p_value ≥ alpha`: what remains is consistent with the noise.
     pub consistent_with_noise: bool,
@@ -253,6 +265,8 @@ pub struct AdequacyReport {
 /// What remains in a direction the noise does not account for, described.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct UnexplainedReport {
+    /// The record's file.
+    pub data: String,
     /// `x`, `y` or `z`.
     pub direction: String,
     /// RMS of the residual in that direction, µm.
@@ -417,21 +431,33 @@ fn gain_row(
 }
 
 fn adequacy(a: &Adequacy) -> Result<AdequacyReport, NonFinite> {
-    let three = |what: &str, v: [f64; 3], k: f64| -> Result<[f64; 3], NonFinite> {
-        for x in v {
-            finite(|| format!("adequacy.{what}"), x * k)?;
-        }
-        Ok(v.map(|x| x * k))
-    };
+    let records = a
+        .records
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let three = |what: &str, v: [f64; 3], k: f64| -> Result<[f64; 3], NonFinite> {
+                for x in v {
+                    finite(|| format!("adequacy.records[{i}].{what}"), x * k)?;
+                }
+                Ok(v.map(|x| x * k))
+            };
+            Ok(RecordAdequacyReport {
+                data: r.name.clone(),
+                fitted: r.fitted,
+                noise_sigma_um: three("noise_sigma_um", r.noise_sigma_mm, UM_PER_MM)?,
+                residual_sigma_um: three("residual_sigma_um", r.residual_sigma_mm, UM_PER_MM)?,
+                statistic: three("statistic", r.statistic, 1.0)?,
+                p_values: r.p_values,
+            })
+        })
+        .collect::<Result<_, NonFinite>>()?;
     Ok(AdequacyReport {
         test: format!(
-            "residual mean square over the noise variance per direction, against a parametric bootstrap of the fit under the noise model ({} draws); Bonferroni over the three directions",
+            "per record and direction, the residual's mean square over the noise variance, against a parametric bootstrap of the fit (or, held out, of the noise alone) under the noise model ({} draws); Bonferroni over records and directions",
             a.draws
         ),
-        noise_sigma_um: three("noise_sigma_um", a.noise_sigma_mm, UM_PER_MM)?,
-        residual_sigma_um: three("residual_sigma_um", a.residual_sigma_mm, UM_PER_MM)?,
-        statistic: three("statistic", a.statistic, 1.0)?,
-        p_values: a.p_values,
+        records,
         p_value: a.p_value,
         draws: a.draws,
         consistent_with_noise: a.consistent_with_noise,
@@ -448,6 +474,7 @@ fn unexplained(i: usize, u: &Unexplained) -> Result<UnexplainedReport, NonFinite
         Shape::Irregular => ("irregular", None, None, None),
     };
     Ok(UnexplainedReport {
+        data: u.data.clone(),
         direction: ["x", "y", "z"][u.direction].into(),
         rms_um: um("rms_um", u.rms_mm)?,
         follows: u.follows.clone(),

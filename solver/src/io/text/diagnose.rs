@@ -155,21 +155,24 @@ pub fn adequacy(r: &DiagnosisReport) -> String {
                 .unwrap_or("no noise model")
         );
     };
-    let per: Vec<String> = (0..3)
-        .map(|d| {
-            format!(
-                "{} residual {} µm against noise {} µm (p = {})",
-                ["x", "y", "z"][d],
-                fixed(a.residual_sigma_um[d], 3),
-                fixed(a.noise_sigma_um[d], 3),
-                p_value(a.p_values[d])
-            )
-        })
-        .collect();
-    let mut out = format!(
-        "Residual of the extended model against the noise: {}.\n",
-        per.join("; ")
+    let mut out = String::from(
+        "Residual of the extended model against the noise (RMS, µm; bootstrap p-value):\n",
     );
+    for rec in &a.records {
+        let per: Vec<String> = (0..3)
+            .map(|d| {
+                format!(
+                    "{} {} vs {} (p = {})",
+                    ["x", "y", "z"][d],
+                    fixed(rec.residual_sigma_um[d], 3),
+                    fixed(rec.noise_sigma_um[d], 3),
+                    p_value(rec.p_values[d])
+                )
+            })
+            .collect();
+        let role = if rec.fitted { "fitted" } else { "held out" };
+        out.push_str(&format!("  {} ({role}): {}\n", rec.data, per.join("; ")));
+    }
     if a.consistent_with_noise {
         out.push_str(&format!(
             "  Consistent with the noise (p = {} ≥ α = {}): the model explains the data down to the noise.\n",
@@ -203,7 +206,8 @@ pub fn adequacy(r: &DiagnosisReport) -> String {
             (Some(f), shape) => format!("follows {f}: {shape}"),
         };
         out.push_str(&format!(
-            "  {}: {} µm RMS; {what} (explains {} µm RMS)\n",
+            "  {} {}: {} µm RMS; {what} (explains {} µm RMS)\n",
+            u.data,
             u.direction,
             fixed(u.rms_um, 3),
             fixed(u.explained_rms_um, 3)

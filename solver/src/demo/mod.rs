@@ -208,8 +208,10 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
         hidden_terms(&m, &truth, &model, &k4.record, &records).map_err(failed("hidden terms"))?;
 
     // 5. The diagnosis of the reduced model on K4, K1 and K2 held out, from the data alone.
-    let mut opts = DiagnoseOptions::default();
-    opts.data_name = path_of(&k4.file);
+    let opts = DiagnoseOptions {
+        data_name: path_of(&k4.file),
+        ..Default::default()
+    };
     let held: Vec<(String, Record)> = runs[1..]
         .iter()
         .map(|r| (path_of(&r.file), r.record.clone()))

@@ -201,6 +201,9 @@ fn finds_the_demo_truths_ecc_twice_per_revolution_and_halves_the_held_out_residu
             "extended",
             "--data",
             "k4.csv",
+            // Ordinary least squares, as the diagnosis fits.
+            "--noise",
+            "white",
             "--json",
             "ext.json",
         ],

@@ -934,7 +934,8 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
         assert!(after < before / 5.0 && after < 3.0, "{name}: {v}");
         assert!(after > 0.4, "{name}: the noise and ECC remain: {v}");
     }
-    // The demo's identification is what `rtest identify` gives on its file.
+    // The demo's identification is what `rtest identify` gives on its file by ordinary least
+    // squares (the demo does not estimate the noise).
     ok(
         &dir,
         &[
@@ -945,6 +946,8 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
             "reduced",
             "--data",
             "rtest-demo/k4.csv",
+            "--noise",
+            "white",
             "--json",
             "again.json",
         ],

@@ -45,6 +45,7 @@ fn a_full_example_in_people_units_is_held_in_mm_and_rad() {
 machine = "seed-ac"
 description = "example"
 noise_um = 0.25
+noise_phi = 0.8
 seed = 42
 zeroed = true
 
@@ -63,6 +64,12 @@ dz0 = { const = 1.0, "time:1" = 0.5 }
     .unwrap();
     assert_eq!(t.description, "example");
     assert_eq!(t.noise_mm, 0.00025);
+    assert_eq!(t.noise_phi, 0.8);
+    assert!(
+        t.summary(&m).contains("noise 0.25 um AR(1) phi 0.8"),
+        "{}",
+        t.summary(&m)
+    );
     assert_eq!(t.seed, 42);
     assert!(t.zeroed);
     let zp = m.symbol_by_name("Zp").unwrap();
@@ -137,6 +144,7 @@ fn to_toml_reads_back_bit_for_bit() {
         r#"
 description = "with \"quotes\""
 noise_um = 0.3
+noise_phi = 0.35
 seed = 9
 [parameters]
 Zc = 30.1
@@ -258,11 +266,11 @@ fn every_invalid_entry_names_file_line_and_column() {
         // Unknown keys.
         (
             "noise = 0.5\n",
-            "t.toml:1:1: unknown key `noise` (expected machine, description, noise_um, seed, zeroed, [parameters], [errors])",
+            "t.toml:1:1: unknown key `noise` (expected machine, description, noise_um, noise_phi, seed, zeroed, [parameters], [errors])",
         ),
         (
             "[offsets]\ndx0 = 1\n",
-            "t.toml:1:2: unknown key `offsets` (expected machine, description, noise_um, seed, zeroed, [parameters], [errors])",
+            "t.toml:1:2: unknown key `offsets` (expected machine, description, noise_um, noise_phi, seed, zeroed, [parameters], [errors])",
         ),
         // Unknown error.
         (
@@ -332,6 +340,18 @@ fn every_invalid_entry_names_file_line_and_column() {
         (
             "noise_um = -0.5\n",
             "t.toml:1:12: `noise_um` (standard deviation of the reading noise, µm) must be from 0 to 1000 µm, not -0.5",
+        ),
+        (
+            "noise_phi = 0.99\n",
+            "t.toml:1:13: `noise_phi` (lag-1 autocorrelation of the reading noise) must be at least 0 and below 0.99, not 0.99",
+        ),
+        (
+            "noise_phi = -0.1\n",
+            "t.toml:1:13: `noise_phi` (lag-1 autocorrelation of the reading noise) must be at least 0 and below 0.99, not -0.1",
+        ),
+        (
+            "noise_phi = \"high\"\n",
+            "t.toml:1:13: `noise_phi` (lag-1 autocorrelation of the reading noise) must be a number, not string",
         ),
         (
             "noise_um = 1e308\n",

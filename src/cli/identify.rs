@@ -4,10 +4,11 @@
 use super::args::{self, RecordLimits, ValueBounds};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
+use solver::fitting::noise::{NoiseChoice, NoiseModel};
 use solver::fitting::streaming::{StreamingError, identify_file};
 use solver::fitting::{
-    EstimateError, IdentifyOptions, RefineError, RefineOptions, check_values, identify,
-    identify_refined,
+    EstimateError, IdentifyOptions, RefineError, RefineOptions, check_values, identify_noise,
+    identify_refined_noise,
 };
 use solver::io::report::identify::StreamingReport;
 use solver::io::report::{IdentificationReport, IdentificationSource, to_json};
@@ -40,6 +41,19 @@ H as Jacobian, two or three steps): that removes the second-order terms of a rea
 (products of two errors with a lever arm, about 1e-3 µm for errors of tens of µm and µrad). A \
 refinement that does not converge is an error (exit code 3); --first-order skips it.
 
+Noise: the uncertainties assume a noise model per direction x, y, z (the marginal σ of a reading \
+and the lag-1 autocorrelation φ of an AR(1) process; equally spaced samples), and the fit is \
+generalized least squares: the rows are whitened by the model (Prais-Winsten), so correlated \
+noise (thermal drift, vibration, electronics) gets honest uncertainties. The model is, in this \
+order: --noise white:sigma=S or ar1:phi=F,sigma=S (declared; S in µm, 0 ≤ F < 0.99); \
+--noise-record FILE (a record of the machine standing still: σ and φ by Yule-Walker, at least \
+100 samples); else estimated from the residual of an ordinary fit by the variogram of second \
+differences, which a smooth misfit of the model does not fool (white with the residual's σ̂ \
+when the data are noise-free). --noise white is ordinary least squares (white noise, one σ from \
+the residual). The report says which model was used (noise_model). --stream fits by ordinary \
+least squares (the estimate needs the whole record) and refuses --noise models and \
+--noise-record.
+
 Plausibility: readings beyond --max-reading-um and poses outside the strokes are refused with \
 their lines; identified values beyond --max-error-um / --max-error-urad are an error (exit code \
 3), not a result.
@@ -47,7 +61,8 @@ their lines; identified values beyond --max-error-um / --max-error-urad are an e
 --json writes the report (docs/identification.md): {machine, fingerprint, data, model, \
 base_model, terms, parameters: [{name, error, basis, value, std, unit, determined, fixed}], \
 residual_rms_um, rank, condition, confounded, samples, sigma_um, near_confounded, refinement: \
-{method, iterations, converged, …}, notes, …}; `rtest validate --params` reads it. `--json -` \
+{method, iterations, converged, …}, noise_model: {source, sigma_um, phi, whitened_sigma, text}, \
+notes, …}; `rtest validate --params` reads it. `--json -` \
 writes it to standard output (the text then goes to standard error).";
 
 /// Flags of `rtest identify`.
@@ -92,6 +107,15 @@ pub struct IdentifyArgs {
     /// refinement needs the whole record).
     #[arg(long)]
     stream: bool,
+    /// The noise the uncertainties assume: `white:sigma=S` or `ar1:phi=F,sigma=S` (S the
+    /// marginal standard deviation of a reading in µm, 0 ≤ F < 0.99), or `white` (ordinary
+    /// least squares). Default: estimated from the residual.
+    #[arg(long, value_name = "SPEC", conflicts_with = "noise_record")]
+    noise: Option<String>,
+    /// A record of the machine standing still (a measurement CSV, at least 100 samples): the
+    /// noise model's σ and φ per direction, by Yule-Walker.
+    #[arg(long, value_name = "FILE")]
+    noise_record: Option<PathBuf>,
     /// Samples per block with --stream (at least 1).
     #[arg(long, value_name = "N", default_value_t = 4096, requires = "stream",
           value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
@@ -109,11 +133,29 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let opts = IdentifyOptions::new()
         .zeroed(args.zeroed)
         .constraint(args::constraint(args.constraint.as_deref())?);
+    let mut noise = match args.noise.as_deref() {
+        Some(spec) => {
+            NoiseChoice::parse(spec).map_err(|e| CliError::usage(format!("--noise: {e}")))?
+        }
+        None => NoiseChoice::Estimate,
+    };
+    if args.stream && (args.noise_record.is_some() || matches!(noise, NoiseChoice::Model(_))) {
+        return Err(CliError::usage(
+            "--stream fits by ordinary least squares in one pass; --noise models and --noise-record need the whole record (drop --stream, or use --noise white)",
+        ));
+    }
     let mut inputs = vec![("--data", args.data.as_path())];
+    inputs.extend(args.noise_record.as_deref().map(|p| ("--noise-record", p)));
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
     let read = args.records.read_options();
+    if let Some(path) = &args.noise_record {
+        let still = super::read_record("--noise-record", &m, path, &read)?;
+        let model = NoiseModel::from_static_record(&still)
+            .map_err(|e| CliError::input(format!("--noise-record: {}: {e}", path.display())))?;
+        noise = NoiseChoice::Model(model);
+    }
     let data = args.data.display().to_string();
     let (ident, refinement, streaming, notes) = if args.stream {
         let (ident, run) = identify_file(&m, &model, &args.data, &opts, args.block as usize, &read)
@@ -133,11 +175,12 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         let record = super::read_record("--data", &m, &args.data, &read)?;
         let note = zeroed_note(&record, args.zeroed).to_string();
         if args.first_order {
-            let ident = identify(&m, &model, &record, &opts).map_err(estimate_error)?;
+            let ident =
+                identify_noise(&m, &model, &record, &opts, &noise).map_err(estimate_error)?;
             (ident, None, None, note)
         } else {
             let (ident, r) =
-                identify_refined(&m, &model, &record, &opts, &RefineOptions::default())
+                identify_refined_noise(&m, &model, &record, &opts, &RefineOptions::default(), &noise)
                     .map_err(|e| match e {
                         RefineError::Estimate(e) => estimate_error(e),
                         e @ RefineError::NotConverged { .. } => CliError::computation(format!(

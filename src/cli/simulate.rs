@@ -8,7 +8,7 @@ use output::{Outputs, Target};
 use solver::io::csv::{format_record, parse_measurement};
 use solver::io::text::simulation;
 use solver::simulation::paths::PathError;
-use solver::simulation::truth::{MAX_NOISE_UM, MAX_SEED, Truth, TruthError};
+use solver::simulation::truth::{MAX_NOISE_PHI, MAX_NOISE_UM, MAX_SEED, Truth, TruthError};
 use solver::simulation::{load_path, provenance, simulate};
 use std::path::Path;
 
@@ -25,7 +25,9 @@ within the strokes and keep the nest on the ball). The truth (docs/truth.md) say
 machine: error values (translational in µm, angular in µrad, constants or position-dependent), \
 R-test zero offsets dx0 dy0 dz0 (µm), noise (µm) and its seed, zeroing at the first sample. \
 Default truth: the machine's built-in demo truth if it has one (seed-ac-demo for seed-ac), else \
-the nominal machine. --noise-um, --seed and --zeroed override the truth's.
+the nominal machine. --noise-um, --noise-phi, --seed and --zeroed override the truth's. The \
+noise is Gaussian, per direction: white, or AR(1) with lag-1 autocorrelation --noise-phi \
+(stationary from the first sample; --noise-um stays the standard deviation of one reading).
 
 The CSV (docs/conventions.md) has a comment header saying what produced it, then the columns of \
 the machine's axes (linear mm, rotary degrees), dx_um,dy_um,dz_um (tool minus workpiece, tool \
@@ -57,6 +59,10 @@ pub struct SimulateArgs {
     /// (overrides the truth's).
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     noise_um: Option<String>,
+    /// Lag-1 autocorrelation φ of the reading noise, 0 ≤ F < 0.99: AR(1) noise per direction,
+    /// e_t = φ·e_{t−1} + σ·√(1−φ²)·n_t (0: white; overrides the truth's `noise_phi`).
+    #[arg(long, value_name = "F")]
+    noise_phi: Option<String>,
     /// Seed of the noise generator, 0 to 9223372036854775807 (overrides the truth's).
     #[arg(long, value_name = "N",
           value_parser = clap::value_parser!(u64).range(0..=MAX_SEED))]
@@ -86,6 +92,21 @@ fn noise_mm(text: &str) -> CliResult<f64> {
     parse_scaled(text, -3).ok_or_else(|| bad("is not a plain decimal number (µm)"))
 }
 
+/// Parses `--noise-phi` (finite, 0 ≤ φ < [`MAX_NOISE_PHI`]).
+fn noise_phi(text: &str) -> CliResult<f64> {
+    let x: f64 = text.trim().parse().map_err(|_| {
+        CliError::usage(format!(
+            "--noise-phi: `{text}` is not a number (the lag-1 autocorrelation)"
+        ))
+    })?;
+    if !(x.is_finite() && (0.0..MAX_NOISE_PHI).contains(&x)) {
+        return Err(CliError::usage(format!(
+            "--noise-phi: `{text}` must be at least 0 and below {MAX_NOISE_PHI}"
+        )));
+    }
+    Ok(x)
+}
+
 /// The truth of `--truth`, else the machine's demo truth, else the nominal machine.
 fn truth(m: &model_spec::Machine, name: Option<&str>) -> CliResult<Truth> {
     let found = match name {
@@ -102,6 +123,7 @@ fn truth(m: &model_spec::Machine, name: Option<&str>) -> CliResult<Truth> {
 pub fn run(args: &SimulateArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     let noise = args.noise_um.as_deref().map(noise_mm).transpose()?;
+    let phi = args.noise_phi.as_deref().map(noise_phi).transpose()?;
     let mut inputs: Vec<(&str, &Path)> = Vec::new();
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let path_file = Path::new(&args.path);
@@ -120,6 +142,9 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     })?;
     if let Some(n) = noise {
         truth.noise_mm = n;
+    }
+    if let Some(p) = phi {
+        truth.noise_phi = p;
     }
     if let Some(s) = args.seed {
         truth.seed = s;

@@ -2,10 +2,18 @@
 //! offsets `dx0 dy0 dz0` when the readings were zeroed), the least-squares fit of
 //! [`super::least_squares()`], and what the offsets swallow. First order; [`super::refine`]
 //! refines it against the exact machine.
+//!
+//! Under a noise model ([`identify_with_noise`]): first an ordinary fit, then the noise model
+//! ([`choose_noise`]: declared, from a static record, or estimated from the ordinary fit's
+//! residual), then the generalized least-squares fit of the whitened rows
+//! ([`super::least_squares_whitened`]), whose uncertainties are honest under correlated noise.
 
 use super::hmatrix::{Backend, GainSource, h_matrix, parameter_names};
 use super::identifiability::{Swallowed, swallowed_by_offsets};
-use super::least_squares::{Constraint, EstimateError, Fit, Tolerances, least_squares};
+use super::least_squares::{
+    Constraint, EstimateError, Fit, Tolerances, least_squares, least_squares_whitened,
+};
+use super::noise::{NoiseChoice, NoiseModel};
 use crate::model::{Basis, Effect, Model, Term};
 use crate::record::Record;
 use model_spec::{Dir, Machine};
@@ -144,6 +152,13 @@ pub struct Identification {
     pub swallowed: Vec<Swallowed>,
     /// Which code computed the gains.
     pub backend: Backend,
+    /// The noise model the uncertainties assume: white with the residual's σ̂ for an ordinary
+    /// fit ([`crate::fitting::noise::NoiseSource::Residual`]), else the model the rows were
+    /// whitened by.
+    pub noise: NoiseModel,
+    /// σ̂ of the whitened residual (unitless; about 1 when the noise model's σ is right), for a
+    /// fit whitened by a noise model; `None` for an ordinary fit.
+    pub whitened_sigma: Option<f64>,
 }
 
 /// Identifies `model` of `m` from the measured `record` (first order), with the best gain
@@ -175,6 +190,91 @@ pub fn gain_source(
     let fitted = opts.fitted_model(model);
     crate::fitting::hmatrix::check_model(m, &fitted)?;
     Ok(GainSource::new(m, &fitted.errors(), &opts.parameters(m))?)
+}
+
+/// As [`identify`], under the noise model `noise` (see the module documentation).
+///
+/// # Errors
+/// See [`identify_with_noise`].
+pub fn identify_noise(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    opts: &IdentifyOptions,
+    noise: &NoiseChoice,
+) -> Result<Identification, EstimateError> {
+    let mut source = gain_source(m, model, opts)?;
+    identify_with_noise(m, model, record, &mut source, opts, noise)
+}
+
+/// The noise model of `choice` for an ordinary fit with `residual` (mm, 3 rows per sample, one
+/// record) and σ̂ `sigma` (mm): [`NoiseChoice::Ordinary`] is white with σ̂;
+/// [`NoiseChoice::Model`] the model; [`NoiseChoice::Estimate`] the estimate from the residual
+/// ([`NoiseModel::estimate`]), or, when the residual cannot give one (too short, or at
+/// rounding level on noise-free data), white with σ̂, the source saying why.
+pub fn choose_noise(choice: &NoiseChoice, residual: &[f64], sigma: Option<f64>) -> NoiseModel {
+    let sigma = sigma.unwrap_or(0.0);
+    match choice {
+        NoiseChoice::Ordinary => NoiseModel::residual(sigma, "ordinary least squares"),
+        NoiseChoice::Model(m) => m.clone(),
+        NoiseChoice::Estimate => {
+            let rows: Vec<[f64; 3]> = residual
+                .chunks_exact(3)
+                .map(|r| [r[0], r[1], r[2]])
+                .collect();
+            NoiseModel::estimate(&[&rows]).unwrap_or_else(|e| {
+                NoiseModel::residual(sigma, format!("ordinary least squares: {e}"))
+            })
+        }
+    }
+}
+
+/// As [`identify_with`], under the noise model `noise`: an ordinary fit, the noise model of
+/// [`choose_noise`] from its residual, then generalized least squares
+/// ([`super::least_squares_whitened`]) unless the choice is [`NoiseChoice::Ordinary`].
+///
+/// # Errors
+/// As [`identify_with`]; [`EstimateError::Noise`] when the model cannot whiten or whitening
+/// changes the rank.
+pub fn identify_with_noise(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    source: &mut GainSource,
+    opts: &IdentifyOptions,
+    noise: &NoiseChoice,
+) -> Result<Identification, EstimateError> {
+    let fitted = opts.fitted_model(model);
+    check_readings(record.samples.len(), fitted.width())?;
+    let y = measurement_vector(record)?;
+    let h = h_matrix(m, &fitted, record, source)?;
+    let names = parameter_names(m, &fitted);
+    let ordinary = least_squares(&h, &y, &names, &opts.constraint, &opts.tolerances)?;
+    let samples = record.samples.len();
+    if *noise == NoiseChoice::Ordinary {
+        return Ok(Identification::new(
+            m,
+            fitted,
+            ordinary,
+            samples,
+            opts.zeroed,
+            source.backend(),
+        ));
+    }
+    let model_of_noise = choose_noise(noise, ordinary.residual.as_slice(), ordinary.sigma);
+    let w = least_squares_whitened(
+        &h,
+        &y,
+        &names,
+        &opts.constraint,
+        &opts.tolerances,
+        &model_of_noise,
+        &[samples],
+    )?;
+    let mut ident = Identification::new(m, fitted, w.fit, samples, opts.zeroed, source.backend());
+    ident.noise = model_of_noise;
+    ident.whitened_sigma = w.whitened_sigma;
+    Ok(ident)
 }
 
 /// As [`identify`], with gains from `source` (which must cover the model's errors; its
@@ -209,7 +309,8 @@ pub fn identify_with(
 
 impl Identification {
     /// An identification of `model` (the model fitted, offsets included) by `fit`, with what
-    /// the sensor offsets swallow derived from the fit's confounded groups.
+    /// the sensor offsets swallow derived from the fit's confounded groups; an ordinary fit
+    /// (noise model: white with the fit's σ̂).
     pub fn new(
         m: &Machine,
         model: Model,
@@ -225,6 +326,7 @@ impl Identification {
             .collect();
         let swallowed =
             swallowed_by_offsets(&fit.names, &fit.identifiability.confounded, &is_offset);
+        let noise = NoiseModel::residual(fit.sigma.unwrap_or(0.0), "ordinary least squares");
         Identification {
             machine: m.name.clone(),
             model,
@@ -233,6 +335,8 @@ impl Identification {
             zeroed,
             swallowed,
             backend,
+            noise,
+            whitened_sigma: None,
         }
     }
 }

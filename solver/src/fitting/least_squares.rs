@@ -24,6 +24,7 @@ use crate::fitting::identifiability::{
     CORRELATION_LIMIT, DETERMINED_TOLERANCE, Identifiability, LINK_TOLERANCE, near_confounded,
     null_space_groups,
 };
+use crate::fitting::noise::{NoiseError, NoiseModel};
 use nalgebra::{DMatrix, DVector, SVD};
 
 /// Default `ρ`: singular values of the scaled H below `ρ·σ_max` count as zero (condition
@@ -106,6 +107,9 @@ pub enum EstimateError {
     /// The SVD did not converge.
     #[error("the singular value decomposition of the {0}×{1} scaled H matrix did not converge")]
     Svd(usize, usize),
+    /// The noise model cannot whiten these rows, or whitening changed the rank.
+    #[error(transparent)]
+    Noise(#[from] NoiseError),
 }
 
 /// The result of a least-squares fit. Internal units: parameters in mm or rad, residuals mm.
@@ -194,6 +198,84 @@ pub fn least_squares(
     tol: &Tolerances,
 ) -> Result<Fit, EstimateError> {
     solve(h, y, names, constraint, tol, h.nrows(), 0.0)
+}
+
+/// A generalized least-squares fit ([`least_squares_whitened`]): the fit, and the σ̂ of the
+/// whitened residual.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WhitenedFit {
+    /// The fit: values, uncertainties, covariance and correlation of the whitened system; rank,
+    /// singular values, condition number and identifiability of the ordinary H; residual, RSS
+    /// and σ̂ of the readings themselves (mm).
+    pub fit: Fit,
+    /// σ̂ of the whitened residual, `√(RSS_w / dof)` (unitless): 1 when the noise model's σ is
+    /// right, the factor its σ is off otherwise (the uncertainties use it, so they do not
+    /// depend on the model's overall scale); `None` when dof = 0.
+    pub whitened_sigma: Option<f64>,
+}
+
+/// Generalized least squares under `noise`: `y` and `H` whitened by
+/// [`NoiseModel::whiten`] (`layout`: samples per record, in row order), then fitted by
+/// [`least_squares`]. The estimates, standard uncertainties, covariance, correlation and
+/// near-confounded pairs are those of the whitened system (its σ̂ sets the scale). The rank,
+/// singular values, condition number, column norms and what the data determine are the
+/// ordinary H's (the path's geometry, as without a noise model): the whitened fit must find the
+/// same rank and the same undetermined parameters. The residual, RSS and σ̂ are those of the
+/// readings, `y − H·p̂` (mm). A uniform white model (one σ, φ = 0) whitens by one factor: the
+/// fit is then the ordinary one, bit for bit.
+///
+/// # Errors
+/// As [`least_squares`]; [`EstimateError::Noise`] when the layout does not fit the rows, the
+/// model cannot whiten, or the whitened fit has another rank or other undetermined parameters.
+pub fn least_squares_whitened(
+    h: &DMatrix<f64>,
+    y: &DVector<f64>,
+    names: &[String],
+    constraint: &Constraint,
+    tol: &Tolerances,
+    noise: &NoiseModel,
+    layout: &[usize],
+) -> Result<WhitenedFit, EstimateError> {
+    let ordinary = least_squares(h, y, names, constraint, tol)?;
+    if noise.is_uniform_white() {
+        let s = noise.sigma_mm[0];
+        return Ok(WhitenedFit {
+            whitened_sigma: ordinary.sigma.filter(|_| s > 0.0).map(|x| x / s),
+            fit: ordinary,
+        });
+    }
+    let (mut wh, mut wy) = (h.clone(), y.clone());
+    noise.whiten(layout, &mut wh, &mut wy)?;
+    let w = least_squares(&wh, &wy, names, constraint, tol)?;
+    if w.rank != ordinary.rank
+        || w.identifiability.determined != ordinary.identifiability.determined
+    {
+        return Err(NoiseError::RankChanged {
+            ordinary: ordinary.rank,
+            whitened: w.rank,
+        }
+        .into());
+    }
+    let residual = y - h * DVector::from_column_slice(&w.solution);
+    let rss = residual.norm_squared();
+    let sigma = (ordinary.dof > 0).then(|| (rss / ordinary.dof as f64).sqrt());
+    let mut identifiability = ordinary.identifiability;
+    identifiability.near_confounded = w.identifiability.near_confounded;
+    Ok(WhitenedFit {
+        whitened_sigma: w.sigma,
+        fit: Fit {
+            values: w.values,
+            solution: w.solution,
+            std: w.std,
+            covariance: w.covariance,
+            correlation: w.correlation,
+            identifiability,
+            residual,
+            rss,
+            sigma,
+            ..ordinary
+        },
+    })
 }
 
 /// [`least_squares`] on a reduced system: `r` (p × p or (p+1) × p) and `z` with `rᵀr = HᵀH`

@@ -30,11 +30,18 @@
 //!
 //! After convergence the fit's residual, σ̂, uncertainties and covariance are those of the exact
 //! residual; the identifiability analysis is unchanged (it depends on H only).
+//!
+//! Under a noise model ([`identify_refined_with_noise`]) the ordinary refinement comes first;
+//! the noise model is chosen from its exact residual ([`crate::fitting::choose_noise`]), then
+//! the iteration continues from its solution with every correction the generalized
+//! least-squares one (`Δ = (W·H)⁺·W·r`, [`crate::fitting::least_squares_whitened`]), and the
+//! uncertainties are the whitened fit's.
 
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::noise::{NoiseChoice, NoiseModel};
 use crate::fitting::{
-    EstimateError, Identification, IdentifyOptions, Tolerances, gain_source, identify_with,
-    least_squares, measurement_vector,
+    EstimateError, Fit, Identification, IdentifyOptions, Tolerances, choose_noise, gain_source,
+    identify_with, least_squares, least_squares_whitened, measurement_vector,
 };
 use crate::model::Model;
 use crate::record::Record;
@@ -158,6 +165,7 @@ pub fn exact_prediction(
         model: model.clone(),
         coefficients: values.iter().map(|v| v.unwrap_or(0.0)).collect(),
         noise_mm: 0.0,
+        noise_phi: 0.0,
         seed: 0,
         zeroed: false,
     };
@@ -173,6 +181,48 @@ pub fn refine(
     tolerances: &Tolerances,
     opts: &RefineOptions,
 ) -> Result<Refinement, RefineError> {
+    refine_under(m, record, ident, source, tolerances, opts, None)
+}
+
+/// As [`refine`], every correction and the final fit by generalized least squares under
+/// `noise` (the record one layout of its samples); `ident.whitened_sigma` is set. From
+/// `ident`'s solution as it is (an ordinary refinement's, usually).
+pub fn refine_whitened(
+    m: &Machine,
+    record: &Record,
+    ident: &mut Identification,
+    source: &mut GainSource,
+    tolerances: &Tolerances,
+    opts: &RefineOptions,
+    noise: &NoiseModel,
+) -> Result<Refinement, RefineError> {
+    refine_under(m, record, ident, source, tolerances, opts, Some(noise))
+}
+
+fn refine_under(
+    m: &Machine,
+    record: &Record,
+    ident: &mut Identification,
+    source: &mut GainSource,
+    tolerances: &Tolerances,
+    opts: &RefineOptions,
+    noise: Option<&NoiseModel>,
+) -> Result<Refinement, RefineError> {
+    let layout = [record.samples.len()];
+    // The fit of a residual: ordinary, or generalized under the noise model.
+    let fit_of = |h: &nalgebra::DMatrix<f64>,
+                  r: &DVector<f64>,
+                  names: &[String],
+                  constraint: &crate::fitting::Constraint|
+     -> Result<(Fit, Option<f64>), EstimateError> {
+        match noise {
+            None => Ok((least_squares(h, r, names, constraint, tolerances)?, None)),
+            Some(n) => {
+                let w = least_squares_whitened(h, r, names, constraint, tolerances, n, &layout)?;
+                Ok((w.fit, w.whitened_sigma))
+            }
+        }
+    };
     let h = h_matrix(m, &ident.model, record, source)?;
     let y = measurement_vector(record)?;
     let rows = y.len().max(1) as f64;
@@ -196,8 +246,7 @@ pub fn refine(
     };
     for _ in 0..opts.max_iterations {
         let r = residual(&x)?;
-        let correction =
-            least_squares(&h, &r, &ident.fit.names, &ident.fit.constraint, tolerances)?;
+        let (correction, _) = fit_of(&h, &r, &ident.fit.names, &ident.fit.constraint)?;
         for (v, d) in x.iter_mut().zip(&correction.solution) {
             *v += d;
         }
@@ -219,7 +268,7 @@ pub fn refine(
     // exact model. Its own correction is below the tolerance and is not added.
     let r = residual(&x)?;
     let refined_rms = (r.norm_squared() / rows).sqrt();
-    let mut fit = least_squares(&h, &r, &ident.fit.names, &ident.fit.constraint, tolerances)?;
+    let (mut fit, whitened_sigma) = fit_of(&h, &r, &ident.fit.names, &ident.fit.constraint)?;
     fit.values = fit
         .values
         .iter()
@@ -228,6 +277,9 @@ pub fn refine(
         .collect();
     fit.solution = x;
     ident.fit = fit;
+    if noise.is_some() {
+        ident.whitened_sigma = whitened_sigma;
+    }
     Ok(Refinement {
         tolerance_mm: tolerance,
         iterations: steps.len(),
@@ -278,4 +330,75 @@ pub fn identify_refined_with(
         });
     }
     Ok((ident, r))
+}
+
+/// [`identify_refined`] under the noise model `noise`, with the gain source it needs built
+/// here.
+///
+/// # Errors
+/// As [`identify_refined_with_noise`].
+pub fn identify_refined_noise(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    opts: &IdentifyOptions,
+    refine_opts: &RefineOptions,
+    noise: &NoiseChoice,
+) -> Result<(Identification, Refinement), RefineError> {
+    let mut source = gain_source(m, model, opts)?;
+    identify_refined_with_noise(m, model, record, &mut source, opts, refine_opts, noise)
+}
+
+/// [`identify_refined_with`] under the noise model `noise` (see the module documentation):
+/// the ordinary refinement, the noise model from its exact residual, then the refinement by
+/// generalized least squares from its solution. The [`Refinement`] counts the steps of both;
+/// its first-order RMS is the ordinary linear fit's. [`NoiseChoice::Ordinary`] is
+/// [`identify_refined_with`].
+///
+/// # Errors
+/// As [`identify_refined`]; [`RefineError::NotConverged`] when either refinement does not
+/// converge.
+pub fn identify_refined_with_noise(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    source: &mut GainSource,
+    opts: &IdentifyOptions,
+    refine_opts: &RefineOptions,
+    noise: &NoiseChoice,
+) -> Result<(Identification, Refinement), RefineError> {
+    let (mut ident, ordinary) = identify_refined_with(m, model, record, source, opts, refine_opts)?;
+    if *noise == NoiseChoice::Ordinary {
+        return Ok((ident, ordinary));
+    }
+    let chosen = choose_noise(noise, ident.fit.residual.as_slice(), ident.fit.sigma);
+    let r = refine_whitened(
+        m,
+        record,
+        &mut ident,
+        source,
+        &opts.tolerances,
+        refine_opts,
+        &chosen,
+    )?;
+    ident.noise = chosen;
+    if !r.converged {
+        return Err(RefineError::NotConverged {
+            iterations: r.iterations,
+            last_step_mm: r.steps_mm.last().copied().unwrap_or(0.0),
+            tolerance_mm: r.tolerance_mm,
+        });
+    }
+    let mut steps_mm = ordinary.steps_mm;
+    steps_mm.extend(&r.steps_mm);
+    Ok((
+        ident,
+        Refinement {
+            iterations: steps_mm.len(),
+            steps_mm,
+            tolerance_mm: r.tolerance_mm,
+            converged: true,
+            rms_mm: (ordinary.rms_mm.0, r.rms_mm.1),
+        },
+    ))
 }

@@ -9,9 +9,12 @@
 //!    workpiece; [`crate::simulation::exact::ErrorVector::position`]); it includes any nominal mismatch the
 //!    path leaves, e.g. when the truth's kinematic parameters differ from the defaults the path
 //!    was planned with;
-//! 3. the offsets `dx0 dy0 dz0` are added, then Gaussian noise of standard deviation
-//!    `truth.noise_mm` per direction, drawn from [`Rng::new`]`(truth.seed)` in sample order,
-//!    x, y, z (no draws when the noise is zero);
+//! 3. the offsets `dx0 dy0 dz0` are added, then Gaussian noise of marginal standard deviation
+//!    σ = `truth.noise_mm` per direction, from standard normal draws `n_t` of
+//!    [`Rng::new`]`(truth.seed)` in sample order, x, y, z (no draws when the noise is zero): an
+//!    AR(1) process of lag-1 autocorrelation φ = `truth.noise_phi` per direction, stationary
+//!    from the first sample, `e_0 = σ·n_0`, `e_t = φ·e_{t−1} + σ·√(1−φ²)·n_t`; with φ = 0 it
+//!    is white, `e_t = σ·n_t`, the same draws as before AR(1) noise existed;
 //! 4. when `truth.zeroed`, the first reading is subtracted from every reading (the first is
 //!    then exactly zero), as R-test software does.
 
@@ -68,6 +71,9 @@ pub fn simulate(m: &Machine, truth: &Truth, path: &Record) -> Result<Record, Sim
     let mut offsets = [0.0; 3];
     let mut rng = Rng::new(truth.seed);
     let noise = truth.noise_mm;
+    let phi = truth.noise_phi;
+    let innovation = noise * (1.0 - phi * phi).sqrt();
+    let mut previous = [0.0; 3];
     let mut measured = Vec::with_capacity(path.samples.len());
     for (i, s) in path.samples.iter().enumerate() {
         let tau = path.tau(i);
@@ -79,8 +85,13 @@ pub fn simulate(m: &Machine, truth: &Truth, path: &Record) -> Result<Record, Sim
         let p = tool.rotation.inverse_transform_vector(&gap);
         let mut r = [p.x + offsets[0], p.y + offsets[1], p.z + offsets[2]];
         if noise > 0.0 {
-            for v in &mut r {
-                *v += noise * rng.normal();
+            for (v, e) in r.iter_mut().zip(&mut previous) {
+                *e = if i == 0 || phi == 0.0 {
+                    noise * rng.normal()
+                } else {
+                    phi * *e + innovation * rng.normal()
+                };
+                *v += *e;
             }
         }
         measured.push(r);
@@ -119,6 +130,18 @@ fn check(m: &Machine, truth: &Truth, path: &Record) -> Result<(), SimulateError>
         machine: m.name.clone(),
         why,
     };
+    let phi_range = 0.0..crate::simulation::truth::MAX_NOISE_PHI;
+    if !(truth.noise_mm.is_finite()
+        && truth.noise_mm >= 0.0
+        && phi_range.contains(&truth.noise_phi))
+    {
+        return Err(bad(format!(
+            "its noise (σ = {} mm, φ = {}) is not a standard deviation ≥ 0 and a lag-1 autocorrelation in [0, {})",
+            truth.noise_mm,
+            truth.noise_phi,
+            crate::simulation::truth::MAX_NOISE_PHI
+        )));
+    }
     if truth.params.len() != m.symbols.len() {
         return Err(bad(format!(
             "it has {} kinematic parameters, the machine {}",

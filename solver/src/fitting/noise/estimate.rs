@@ -34,6 +34,8 @@ pub const VARIOGRAM_MIN_LAGS: usize = 8;
 /// differences at it.
 pub const VARIOGRAM_MIN_PAIRS: usize = 20;
 
+const PASSES: usize = 2;
+
 /// The step of the grid of φ of the variogram fit.
 pub const PHI_GRID_STEP: f64 = 0.01;
 
@@ -165,10 +167,12 @@ fn fit_direction(lags: &[usize], pairs: &[usize], v: &[f64]) -> (f64, f64) {
         }
         (best.0, best.1, best.2)
     };
-    let first = search(&weights(&|i| v[i]));
-    let (a, phi, c) = first;
-    let model = |i: usize| a * shape(phi, lags[i]) + c * (lags[i] as f64).powi(4);
-    let (a, phi, _) = search(&weights(&model));
+    let mean = v.iter().sum::<f64>() / v.len() as f64;
+    let (mut a, mut phi, mut c) = search(&weights(&|_| mean));
+    for _ in 0..PASSES {
+        let model = |i: usize| a * shape(phi, lags[i]) + c * (lags[i] as f64).powi(4);
+        (a, phi, c) = search(&weights(&model));
+    }
     (a, phi)
 }
 

@@ -8,6 +8,10 @@
 //!  "residual_rms_um": 0.49, "rank": 11, "condition": 4.2, "confounded": [["XOC", "dx0"]], …,
 //!  "refinement": {"method": "exact", "iterations": 3, "converged": true, …}, "notes": […]}
 //! ```
+//! `noise_model` says which noise the uncertainties assume: `{"source": "estimated",
+//! "sigma_um": [0.3, 0.3, 0.3], "phi": [0.8, 0.8, 0.8], "whitened_sigma": 1.02, "text": …}`
+//! (`source`: `declared`, `static-record`, `estimated`, or `residual`, white with the σ̂ of an
+//! ordinary fit).
 //! `value` and `std` are `null` where the data do not determine the parameter; `basis` is
 //! `const`, `harmonic:K:cos`, `harmonic:K:sin`, `poly:K`, `reversal` or `time:K`; `unit` is
 //! `um` (translational errors, sensor offsets) or `urad` (angular errors). Readers of the values
@@ -78,6 +82,23 @@ pub struct RefinementReport {
     pub tolerance_um: Option<f64>,
     /// Residual RMS of the first-order fit, µm.
     pub first_order_rms_um: f64,
+}
+
+/// The noise model the uncertainties assume ([`crate::fitting::noise::NoiseModel`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NoiseModelReport {
+    /// `declared`, `static-record`, `estimated`, or `residual` (white with the σ̂ of an
+    /// ordinary fit: ordinary least squares).
+    pub source: String,
+    /// Marginal standard deviation of a reading per direction x, y, z, µm.
+    pub sigma_um: [f64; 3],
+    /// Lag-1 autocorrelation per direction x, y, z (0: white).
+    pub phi: [f64; 3],
+    /// σ̂ of the whitened residual (unitless, about 1 when the model's σ is right); `null` for
+    /// an ordinary fit or without degrees of freedom.
+    pub whitened_sigma: Option<f64>,
+    /// The model for people, with where it came from.
+    pub text: String,
 }
 
 /// How a record was read in blocks and folded into an incremental QR decomposition.
@@ -151,6 +172,10 @@ pub struct IdentificationReport {
     pub gains: String,
     /// The refinement against the exact machine.
     pub refinement: RefinementReport,
+    /// The noise model the uncertainties assume; absent in reports written before noise models
+    /// existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_model: Option<NoiseModelReport>,
     /// How a long record was read in blocks (`--stream`); absent when it was read whole.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub streaming: Option<StreamingReport>,
@@ -308,9 +333,29 @@ impl IdentificationReport {
             gains: backend_name(ident.backend).into(),
             notes: notes(ident, &refinement),
             refinement,
+            noise_model: Some(noise_report(ident)?),
             streaming: None,
         })
     }
+}
+
+/// The noise model of `ident` in µm.
+fn noise_report(ident: &Identification) -> Result<NoiseModelReport, NonFinite> {
+    let n = &ident.noise;
+    let mut sigma_um = [0.0; 3];
+    for (d, s) in sigma_um.iter_mut().enumerate() {
+        *s = finite(
+            || format!("noise_model.sigma_um[{d}]"),
+            n.sigma_mm[d] * UM_PER_MM,
+        )?;
+    }
+    Ok(NoiseModelReport {
+        source: n.source.keyword().into(),
+        sigma_um,
+        phi: n.phi,
+        whitened_sigma: finite_opt(|| "noise_model.whitened_sigma".into(), ident.whitened_sigma)?,
+        text: n.to_string(),
+    })
 }
 
 /// The statements for people: what the offsets swallow, what has no value, no uncertainty,

@@ -20,6 +20,16 @@ pub fn identification(r: &IdentificationReport) -> String {
         plural(n, "s"),
     );
     out.push_str(&method(r));
+    if let Some(n) = &r.noise_model {
+        out.push_str(&format!(
+            "Noise model (the uncertainties assume it): {}{}.\n",
+            n.text,
+            n.whitened_sigma.map_or(String::new(), |w| format!(
+                "; σ̂ of the whitened residual {}",
+                fixed(w, 2)
+            ))
+        ));
+    }
     if let Some(s) = &r.streaming {
         let ahead = if s.first_block > s.block {
             format!(
@@ -58,13 +68,19 @@ fn method(r: &IdentificationReport) -> String {
         _ => "the compiled code and the evaluator",
     };
     let f = &r.refinement;
+    let ls = match &r.noise_model {
+        Some(n) if n.source != "residual" => {
+            "Generalized least squares (rows whitened by the noise model)"
+        }
+        _ => "Least squares",
+    };
     if f.method == "first-order" {
         return format!(
-            "Least squares on the column-scaled H (gains from {gains}), first order (not refined against the exact machine).\n"
+            "{ls} on the column-scaled H (gains from {gains}), first order (not refined against the exact machine).\n"
         );
     }
     format!(
-        "Least squares on the column-scaled H (gains from {gains}), refined against the exact machine: {} Gauss-Newton step{}{}; residual RMS {} µm (first order) -> {} µm.\n",
+        "{ls} on the column-scaled H (gains from {gains}), refined against the exact machine: {} Gauss-Newton step{}{}; residual RMS {} µm (first order) -> {} µm.\n",
         f.iterations,
         plural(f.iterations, "s"),
         if f.converged {

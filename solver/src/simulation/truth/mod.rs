@@ -6,6 +6,7 @@
 //! machine = "seed-ac"          # optional: the machine it is written for
 //! description = "example"      # optional text
 //! noise_um = 0.5               # standard deviation of the reading noise per direction, µm
+//! noise_phi = 0.8              # its lag-1 autocorrelation (AR(1)); default 0, white
 //! seed = 1                     # seed of the noise generator
 //! zeroed = false               # readings zeroed at the first sample
 //!
@@ -60,6 +61,10 @@ pub const MAX_SEED: u64 = i64::MAX as u64;
 /// would give readings beyond any plausible R-test reading.
 pub const MAX_NOISE_UM: f64 = 1000.0;
 
+/// The largest lag-1 autocorrelation of the reading noise (exclusive): the noise model's
+/// ([`crate::fitting::noise::MAX_PHI`]).
+pub const MAX_NOISE_PHI: f64 = crate::fitting::noise::MAX_PHI;
+
 /// The largest truth file read, bytes: a truth lists at most a few hundred terms.
 pub const MAX_TRUTH_BYTES: u64 = 1 << 20;
 
@@ -113,8 +118,11 @@ pub struct Truth {
     /// One coefficient per column of `model` (`Model::columns` order): mm for translational
     /// errors and sensor offsets, rad for angular errors; `harmonic:K` has two (cos, sin).
     pub coefficients: Vec<f64>,
-    /// Standard deviation of the Gaussian reading noise, per direction, mm.
+    /// Marginal standard deviation of the Gaussian reading noise, per direction, mm.
     pub noise_mm: f64,
+    /// Lag-1 autocorrelation of the reading noise, in [0, [`MAX_NOISE_PHI`]): an AR(1)
+    /// process per direction and record ([`crate::simulation::readings`]); 0 is white.
+    pub noise_phi: f64,
     /// Seed of the noise generator ([`crate::simulation::rng::Rng`]).
     pub seed: u64,
     /// `true`: the readings are zeroed at the first sample (subtracted from every sample).
@@ -145,6 +153,7 @@ impl Truth {
             model: Model::default(),
             coefficients: Vec::new(),
             noise_mm: 0.0,
+            noise_phi: 0.0,
             seed: 0,
             zeroed: false,
         }
@@ -257,7 +266,8 @@ impl Truth {
         out
     }
 
-    /// One line for people: source, number of terms, noise, seed, zeroing.
+    /// One line for people: source, number of terms, noise (with its φ when not white), seed,
+    /// zeroing.
     pub fn summary(&self, m: &Machine) -> String {
         let names: Vec<String> = self
             .model
@@ -268,8 +278,13 @@ impl Truth {
                 b => format!("{}@{b}", t.effect.name(m)),
             })
             .collect();
+        let phi = if self.noise_phi > 0.0 {
+            format!(" AR(1) phi {}", self.noise_phi)
+        } else {
+            String::new()
+        };
         format!(
-            "truth {}: {} term(s) [{}], noise {} um, seed {}, {}",
+            "truth {}: {} term(s) [{}], noise {} um{phi}, seed {}, {}",
             self.source,
             names.len(),
             names.join(" "),
@@ -296,6 +311,9 @@ impl Truth {
             self.seed,
             self.zeroed
         );
+        if self.noise_phi > 0.0 {
+            s += &format!("noise_phi = {}\n", toml_float(self.noise_phi));
+        }
         let defaults = m.default_parameters();
         let changed: Vec<usize> = (0..m.symbols.len())
             .filter(|&i| self.params[i].to_bits() != defaults[i].to_bits())

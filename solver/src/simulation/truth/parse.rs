@@ -1,7 +1,7 @@
 //! The validation of a truth file: every entry checked against the machine, every problem
 //! located by line and column.
 
-use super::{MAX_NOISE_UM, MAX_SEED, MAX_VALUE, Truth, TruthError, places};
+use super::{MAX_NOISE_PHI, MAX_NOISE_UM, MAX_SEED, MAX_VALUE, Truth, TruthError, places};
 use crate::model::{Basis, Carrier, Effect, Term};
 use model_spec::Machine;
 use model_spec::units::parse_scaled;
@@ -20,7 +20,8 @@ type Res<T> = Result<T, TruthError>;
 type Key<'i> = Spanned<std::borrow::Cow<'i, str>>;
 type Val<'i> = Spanned<DeValue<'i>>;
 
-const TOP_KEYS: &str = "machine, description, noise_um, seed, zeroed, [parameters], [errors]";
+const TOP_KEYS: &str =
+    "machine, description, noise_um, noise_phi, seed, zeroed, [parameters], [errors]";
 
 impl Parser<'_> {
     /// The truth of the text, validated.
@@ -75,6 +76,19 @@ impl Parser<'_> {
                         ));
                     }
                     t.noise_mm = self.scaled(&text, 3, v, what)?;
+                }
+                "noise_phi" => {
+                    let what = "`noise_phi` (lag-1 autocorrelation of the reading noise)";
+                    let (x, text) = self.number(v, what)?;
+                    if !(0.0..MAX_NOISE_PHI).contains(&x) {
+                        return Err(self.err(
+                            v.span(),
+                            format!(
+                                "{what} must be at least 0 and below {MAX_NOISE_PHI}, not {text}"
+                            ),
+                        ));
+                    }
+                    t.noise_phi = x;
                 }
                 "seed" => t.seed = self.seed(v)?,
                 "zeroed" => match v.get_ref() {

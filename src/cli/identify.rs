@@ -4,6 +4,7 @@
 use super::args::{self, RecordLimits, ValueBounds};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
+use solver::fitting::hmatrix::HMatrixError;
 use solver::fitting::streaming::{StreamingError, identify_file};
 use solver::fitting::{
     EstimateError, IdentifyOptions, RefineError, RefineOptions, check_values, identify,
@@ -120,6 +121,9 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             .map_err(|e| match e {
                 StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
                 e @ StreamingError::ReadTwice(_) => CliError::input(format!("--data: {e}")),
+                StreamingError::HMatrix(e @ HMatrixError::Times { .. }) => {
+                    CliError::input(format!("--data {data}: {e}"))
+                }
                 StreamingError::Estimate(e) => estimate_error(e),
                 other => CliError::computation(format!("--data: cannot identify: {other}")),
             })?;
@@ -131,6 +135,13 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         (ident, None, Some(streaming), String::new())
     } else {
         let record = super::read_record("--data", &m, &args.data, &read)?;
+        super::check_times(
+            "--data",
+            &args.data,
+            &m,
+            &opts.fitted_model(&model),
+            &record,
+        )?;
         let note = zeroed_note(&record, args.zeroed).to_string();
         if args.first_order {
             let ident = identify(&m, &model, &record, &opts).map_err(estimate_error)?;

@@ -61,12 +61,11 @@ impl ValueLimits {
 /// Identified values beyond the bounds.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error(
-    "{} beyond the plausibility bounds ({} µm, {} µrad, {} ms, {} for instrument terms): {}",
+    "{} beyond the plausibility bounds ({} µm, {} µrad{}): {}",
     if .values.len() == 1 { "a value is" } else { "values are" },
     short(.limits.translation_mm * UM_PER_MM),
     short(.limits.angle_rad * URAD_PER_RAD),
-    short(.limits.lag_ms),
-    short(.limits.instrument),
+    other_bounds(.values, .limits),
     .values.iter().map(|(n, v, u)| format!("{n} = {} {u}", short(*v))).collect::<Vec<_>>().join(", ")
 )]
 pub struct Implausible {
@@ -74,6 +73,18 @@ pub struct Implausible {
     pub values: Vec<(String, f64, &'static str)>,
     /// The bounds.
     pub limits: ValueLimits,
+}
+
+/// The bounds of lags and instrument terms, when an offending value is one (`, 1000 ms`).
+fn other_bounds(values: &[(String, f64, &'static str)], limits: &ValueLimits) -> String {
+    let mut s = String::new();
+    if values.iter().any(|v| v.2 == "ms") {
+        s += &format!(", {} ms", short(limits.lag_ms));
+    }
+    if values.iter().any(|v| v.2 == "1") {
+        s += &format!(", {} for instrument terms", short(limits.instrument));
+    }
+    s
 }
 
 /// Checks the values (`None`: undetermined, not checked) of `model`'s columns against `limits`.

@@ -4,13 +4,32 @@
 //! - `poly:K`: the Legendre polynomial of order K of the effect's own linear axis position,
 //!   normalised over the stroke to [−1, 1];
 //! - `reversal`: the sign of the effect's own axis's direction of motion (+1 or −1);
-//! - `time:K`: the Legendre polynomial of order K in time normalised over the record to [−1, 1].
+//! - `time:K`: the Legendre polynomial of order K in time normalised over the record to [−1, 1];
+//! - `period:P`: the pair cos(2π·x/P), sin(2π·x/P) of the effect's own linear axis position x
+//!   (mm, absolute), P in mm (a ball screw's pitch, a scale's period);
+//! - `step:V`: 0 below the own axis's position V, 1 from V on (mm, or degrees for a rotary axis);
+//! - `exp:TAU`: 1 − exp(−(t − t₀)/TAU) of the time t since the record's first sample t₀, TAU in
+//!   s (a warm-up, a settling set-up), for effects of no axis;
+//! - `velocity`: −v, the own axis's velocity (mm/ms, rad/ms) with the sign of a lag, for the
+//!   axis's positioning error; its coefficient is the servo lag τ in ms.
 //!
-//! A term (effect × basis) is one column of the H matrix, two for `harmonic:K` (cos, then sin).
+//! A term (effect × basis) is one column of the H matrix, two for `harmonic:K` and `period:P`
+//! (cos, then sin). Every basis is evaluated in one place, [`Basis::values`], at a
+//! [`BasisContext`] that the H-matrix builder and the simulator fill alike.
+//!
+//! The scanned parameters of `period`, `step` and `exp` are kept as whole numbers of thousandths
+//! (µm, thousandths of mm or degree, ms), so that a basis is `Copy + Eq + Hash + Ord`; they are
+//! written with at most three decimals and printed as the shortest decimal (`period:2.5`).
 
-use crate::limits::MAX_BASIS_ORDER;
+use crate::limits::{MAX_BASIS_ORDER, MAX_LENGTH_MM};
 use crate::{AxisKind, Machine};
 use std::fmt;
+
+/// Thousandths per unit: the scanned parameters are kept in thousandths of mm, degree or s.
+const MILLI: f64 = 1000.0;
+
+/// The largest time constant of `exp:TAU`, s (about 11.6 days).
+pub const MAX_TAU_S: f64 = 1e6;
 
 /// One basis of the vocabulary.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -25,6 +44,17 @@ pub enum Basis {
     Reversal,
     /// Legendre P_K of normalised time, K ≥ 1.
     Time(u32),
+    /// cos(2π·x/P), sin(2π·x/P) of the own linear axis position x (mm); the period P in µm
+    /// (thousandths of mm), P > 0.
+    Period(u32),
+    /// 1 from the own axis's position V on, 0 below it; V in thousandths of mm (linear axis) or
+    /// of a degree (rotary axis).
+    Step(i64),
+    /// 1 − exp(−(t − t₀)/TAU), t − t₀ the time since the record's first sample; TAU in ms,
+    /// TAU > 0.
+    Exp(u32),
+    /// −v, v the own axis's velocity (mm/ms or rad/ms); its coefficient is a lag in ms.
+    Velocity,
 }
 
 /// What a basis needs to know about the effect it multiplies.
@@ -32,7 +62,7 @@ pub enum Basis {
 pub enum Carrier {
     /// An error of this axis (index into `Machine::axes`).
     Axis(usize),
-    /// An effect of no axis (set-up errors, squareness, sensor offsets).
+    /// An effect of no axis (set-up errors, squareness, sensor offsets, instrument terms).
     None,
 }
 
@@ -41,8 +71,69 @@ pub enum Carrier {
 #[error("{0}")]
 pub struct BasisError(pub String);
 
+/// One sample as the bases see it, filled alike by the H-matrix builder and the simulator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BasisContext<'a> {
+    /// The commanded position of every axis (mm for linear axes, rad for rotary ones).
+    pub commands: &'a [f64],
+    /// The direction of motion of every axis (+1 or −1).
+    pub motion: &'a [i8],
+    /// The time normalised over the record, τ ∈ [−1, 1] (`time:K`).
+    pub tau: f64,
+    /// The time since the record's first sample, s (`exp:TAU`).
+    pub elapsed_s: f64,
+    /// The velocity of every axis, mm/ms or rad/ms (`velocity`); empty when no term needs it.
+    pub velocity: &'a [f64],
+    /// The measured reading x, y, z (mm): to first order the displacement the R-test's
+    /// instrument terms multiply. Zero where no reading exists (the simulator, which applies the
+    /// instrument terms to the displacement it computes).
+    pub reading: [f64; 3],
+}
+
+/// A decimal with at most three decimals (`12`, `-2.5`, `0.125`; no exponent), in thousandths.
+fn thousandths(text: &str) -> Option<i64> {
+    let (neg, rest) = match text.as_bytes().first()? {
+        b'-' => (true, &text[1..]),
+        b'+' => (false, &text[1..]),
+        _ => (false, text),
+    };
+    let (int, frac) = rest.split_once('.').unwrap_or((rest, ""));
+    let digits = |s: &str| s.bytes().all(|b| b.is_ascii_digit());
+    if int.is_empty() || !digits(int) || !digits(frac) || frac.len() > 3 || int.len() > 12 {
+        return None;
+    }
+    if rest.contains('.') && frac.is_empty() {
+        return None;
+    }
+    let whole: i64 = int.parse().ok()?;
+    let mut part: i64 = if frac.is_empty() {
+        0
+    } else {
+        frac.parse().ok()?
+    };
+    for _ in frac.len()..3 {
+        part *= 10;
+    }
+    let v = whole * 1000 + part;
+    Some(if neg { -v } else { v })
+}
+
+/// A number of thousandths as the shortest decimal: 2500 → `2.5`, −12500 → `-12.5`.
+fn decimal(v: i64) -> String {
+    let sign = if v < 0 { "-" } else { "" };
+    let a = v.unsigned_abs();
+    let (int, frac) = (a / 1000, a % 1000);
+    if frac == 0 {
+        return format!("{sign}{int}");
+    }
+    let f = format!("{frac:03}");
+    format!("{sign}{int}.{}", f.trim_end_matches('0'))
+}
+
 impl Basis {
-    /// Parses `const`, `harmonic:K`, `poly:K`, `reversal`, `time:K` (K ≥ 1).
+    /// Parses `const`, `harmonic:K`, `poly:K`, `reversal`, `time:K` (K ≥ 1), `period:P`
+    /// (P > 0 mm), `step:V` (mm or degrees), `exp:TAU` (TAU > 0 s) and `velocity`. P, V and TAU
+    /// are decimals with at most three decimals.
     pub fn parse(s: &str) -> Result<Basis, BasisError> {
         let s = s.trim();
         let order = |k: &str, name: &str| -> Result<u32, BasisError> {
@@ -53,37 +144,107 @@ impl Basis {
                 ))),
             }
         };
+        // A decimal of at most three decimals within ±max, in thousandths.
+        let value = |v: &str, what: &str, max: f64| -> Result<i64, BasisError> {
+            match thousandths(v) {
+                Some(x) if (x as f64).abs() <= max * MILLI => Ok(x),
+                Some(_) => Err(BasisError(format!(
+                    "`{s}`: {what} must be at most {max} in magnitude"
+                ))),
+                None => Err(BasisError(format!(
+                    "`{s}`: {what} must be a decimal number with at most three decimals (`10`, `2.5`, `-0.125`)"
+                ))),
+            }
+        };
+        let positive = |v: &str, what: &str, max: f64| -> Result<u32, BasisError> {
+            let x = value(v, what, max)?;
+            u32::try_from(x)
+                .ok()
+                .filter(|&x| x > 0)
+                .ok_or_else(|| BasisError(format!("`{s}`: {what} must be positive")))
+        };
         match s.split_once(':') {
             None if s == "const" => Ok(Basis::Const),
             None if s == "reversal" => Ok(Basis::Reversal),
+            None if s == "velocity" => Ok(Basis::Velocity),
             Some(("harmonic", k)) => Ok(Basis::Harmonic(order(k, "harmonic")?)),
             Some(("poly", k)) => Ok(Basis::Poly(order(k, "poly")?)),
             Some(("time", k)) => Ok(Basis::Time(order(k, "time")?)),
+            Some(("period", p)) => Ok(Basis::Period(positive(
+                p,
+                "the period P of `period:P` (mm)",
+                MAX_LENGTH_MM,
+            )?)),
+            Some(("step", v)) => Ok(Basis::Step(value(
+                v,
+                "the position V of `step:V` (mm or degrees)",
+                MAX_LENGTH_MM,
+            )?)),
+            Some(("exp", t)) => Ok(Basis::Exp(positive(
+                t,
+                "the time constant TAU of `exp:TAU` (s)",
+                MAX_TAU_S,
+            )?)),
             _ => Err(BasisError(format!(
-                "unknown basis `{s}` (expected const, harmonic:K, poly:K, reversal or time:K)"
+                "unknown basis `{s}` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU or velocity)"
             ))),
         }
     }
 
-    /// Number of H-matrix columns: 2 for `harmonic:K` (cos, sin), else 1.
+    /// Number of H-matrix columns: 2 for `harmonic:K` and `period:P` (cos, sin), else 1.
     pub fn width(self) -> usize {
-        if matches!(self, Basis::Harmonic(_)) {
+        if matches!(self, Basis::Harmonic(_) | Basis::Period(_)) {
             2
         } else {
             1
         }
     }
 
-    /// Names of the columns: `["harmonic:2:cos", "harmonic:2:sin"]`, or `[self]`.
+    /// Names of the columns: `["harmonic:2:cos", "harmonic:2:sin"]`, `["period:5:cos",
+    /// "period:5:sin"]`, or `[self]`.
     pub fn column_names(self) -> Vec<String> {
         match self {
-            Basis::Harmonic(_) => vec![format!("{self}:cos"), format!("{self}:sin")],
+            Basis::Harmonic(_) | Basis::Period(_) => {
+                vec![format!("{self}:cos"), format!("{self}:sin")]
+            }
             _ => vec![self.to_string()],
         }
     }
 
+    /// `true` for bases that need the real sample times (`velocity`, `exp:TAU`), not sample
+    /// numbers.
+    pub fn needs_times(self) -> bool {
+        matches!(self, Basis::Velocity | Basis::Exp(_))
+    }
+
+    /// The period P of `period:P`, mm.
+    pub fn period_mm(self) -> Option<f64> {
+        match self {
+            Basis::Period(p) => Some(f64::from(p) / MILLI),
+            _ => None,
+        }
+    }
+
+    /// The time constant TAU of `exp:TAU`, s.
+    pub fn tau_s(self) -> Option<f64> {
+        match self {
+            Basis::Exp(t) => Some(f64::from(t) / MILLI),
+            _ => None,
+        }
+    }
+
+    /// The position V of `step:V`: mm, or degrees for a rotary axis.
+    pub fn step_at(self) -> Option<f64> {
+        match self {
+            Basis::Step(v) => Some(v as f64 / MILLI),
+            _ => None,
+        }
+    }
+
     /// Checks that the basis fits an effect carried by `carrier` of machine `m`: harmonics need
-    /// a rotary axis, polynomials a linear axis, reversal an axis.
+    /// a rotary axis, polynomials and periods a linear axis, reversal, steps and velocity an
+    /// axis, `exp:TAU` an effect of no axis. (That `velocity` needs the positioning error, and
+    /// that instrument terms are constants, is checked by [`crate::terms::Term::new`].)
     pub fn check(self, m: &Machine, carrier: Carrier) -> Result<(), BasisError> {
         let kind = match carrier {
             Carrier::Axis(a) => Some(m.axes[a].kind),
@@ -92,31 +253,28 @@ impl Basis {
         match (self, kind) {
             (Basis::Const | Basis::Time(_), _) => Ok(()),
             (Basis::Harmonic(_), Some(AxisKind::Rotary)) => Ok(()),
-            (Basis::Poly(_), Some(AxisKind::Linear)) => Ok(()),
-            (Basis::Reversal, Some(_)) => Ok(()),
+            (Basis::Poly(_) | Basis::Period(_), Some(AxisKind::Linear)) => Ok(()),
+            (Basis::Reversal | Basis::Step(_) | Basis::Velocity, Some(_)) => Ok(()),
+            (Basis::Exp(_), None) => Ok(()),
             (Basis::Harmonic(_), _) => Err(BasisError(format!(
                 "`{self}` needs an error of a rotary axis"
             ))),
-            (Basis::Poly(_), _) => Err(BasisError(format!(
+            (Basis::Poly(_) | Basis::Period(_), _) => Err(BasisError(format!(
                 "`{self}` needs an error of a linear axis"
             ))),
-            (Basis::Reversal, None) => {
-                Err(BasisError("`reversal` needs an error of an axis".into()))
+            (Basis::Reversal | Basis::Step(_) | Basis::Velocity, None) => {
+                Err(BasisError(format!("`{self}` needs an error of an axis")))
             }
+            (Basis::Exp(_), Some(_)) => Err(BasisError(format!(
+                "`{self}` needs an effect of no axis (dx0 dy0 dz0, a location, squareness or set-up error)"
+            ))),
         }
     }
 
-    /// The values of the basis columns (one or two) for an effect carried by `carrier`, at a
-    /// sample with `commands` (mm, rad), direction of motion `motion` (per axis: +1, −1) and
-    /// normalised time `tau` ∈ [−1, 1]. The basis must fit the carrier ([`Basis::check`]).
-    pub fn values(
-        self,
-        m: &Machine,
-        carrier: Carrier,
-        commands: &[f64],
-        motion: &[i8],
-        tau: f64,
-    ) -> [f64; 2] {
+    /// The values of the basis columns (one or two) for an effect carried by `carrier`, at the
+    /// sample `cx`. The basis must fit the carrier ([`Basis::check`]); `cx.velocity` must have
+    /// one entry per axis for `velocity`.
+    pub fn values(self, m: &Machine, carrier: Carrier, cx: &BasisContext<'_>) -> [f64; 2] {
         let axis = match carrier {
             Carrier::Axis(a) => a,
             Carrier::None => usize::MAX,
@@ -124,16 +282,31 @@ impl Basis {
         match self {
             Basis::Const => [1.0, 0.0],
             Basis::Harmonic(k) => {
-                let (s, c) = (k as f64 * commands[axis]).sin_cos();
+                let (s, c) = (k as f64 * cx.commands[axis]).sin_cos();
                 [c, s]
             }
             Basis::Poly(k) => {
                 let [lo, hi] = m.axes[axis].limits;
-                let u = 2.0 * (commands[axis] - lo) / (hi - lo) - 1.0;
+                let u = 2.0 * (cx.commands[axis] - lo) / (hi - lo) - 1.0;
                 [legendre(k, u), 0.0]
             }
-            Basis::Reversal => [if motion[axis] < 0 { -1.0 } else { 1.0 }, 0.0],
-            Basis::Time(k) => [legendre(k, tau), 0.0],
+            Basis::Reversal => [if cx.motion[axis] < 0 { -1.0 } else { 1.0 }, 0.0],
+            Basis::Time(k) => [legendre(k, cx.tau), 0.0],
+            Basis::Period(p) => {
+                let phase = std::f64::consts::TAU * cx.commands[axis] * MILLI / f64::from(p);
+                let (s, c) = phase.sin_cos();
+                [c, s]
+            }
+            Basis::Step(v) => {
+                let at = v as f64 / MILLI;
+                let edge = match m.axes[axis].kind {
+                    AxisKind::Linear => at,
+                    AxisKind::Rotary => at.to_radians(),
+                };
+                [if cx.commands[axis] >= edge { 1.0 } else { 0.0 }, 0.0]
+            }
+            Basis::Exp(t) => [-(-cx.elapsed_s * MILLI / f64::from(t)).exp_m1(), 0.0],
+            Basis::Velocity => [-cx.velocity[axis], 0.0],
         }
     }
 }
@@ -146,6 +319,10 @@ impl fmt::Display for Basis {
             Basis::Poly(k) => write!(f, "poly:{k}"),
             Basis::Reversal => write!(f, "reversal"),
             Basis::Time(k) => write!(f, "time:{k}"),
+            Basis::Period(p) => write!(f, "period:{}", decimal(i64::from(*p))),
+            Basis::Step(v) => write!(f, "step:{}", decimal(*v)),
+            Basis::Exp(t) => write!(f, "exp:{}", decimal(i64::from(*t))),
+            Basis::Velocity => write!(f, "velocity"),
         }
     }
 }
@@ -171,12 +348,70 @@ mod tests {
 
     #[test]
     fn parse_and_print() {
-        for s in ["const", "harmonic:2", "poly:3", "reversal", "time:1"] {
+        for s in [
+            "const",
+            "harmonic:2",
+            "poly:3",
+            "reversal",
+            "time:1",
+            "velocity",
+        ] {
             assert_eq!(Basis::parse(s).unwrap().to_string(), s);
         }
         assert!(Basis::parse("harmonic:0").is_err());
         assert!(Basis::parse("harmonic").is_err());
         assert!(Basis::parse("cubic:2").is_err());
+    }
+
+    #[test]
+    fn scanned_parameters_round_trip_as_shortest_decimals() {
+        for (s, b) in [
+            ("period:10", Basis::Period(10_000)),
+            ("period:2.5", Basis::Period(2_500)),
+            ("period:0.001", Basis::Period(1)),
+            ("step:90", Basis::Step(90_000)),
+            ("step:-12.5", Basis::Step(-12_500)),
+            ("step:0", Basis::Step(0)),
+            ("step:-0.125", Basis::Step(-125)),
+            ("exp:20", Basis::Exp(20_000)),
+            ("exp:0.5", Basis::Exp(500)),
+            ("velocity", Basis::Velocity),
+        ] {
+            assert_eq!(Basis::parse(s).unwrap(), b, "{s}");
+            assert_eq!(b.to_string(), s);
+        }
+        // Other spellings of the same value print the shortest way.
+        assert_eq!(
+            Basis::parse("period:2.50").unwrap().to_string(),
+            "period:2.5"
+        );
+        assert_eq!(Basis::parse("step:+7.000").unwrap().to_string(), "step:7");
+        assert_eq!(
+            Basis::Period(2500).column_names(),
+            ["period:2.5:cos", "period:2.5:sin"]
+        );
+        assert_eq!(Basis::Period(2500).width(), 2);
+    }
+
+    #[test]
+    fn scanned_parameters_refused() {
+        for (s, why) in [
+            ("period:2.5001", "three decimals"),
+            ("period:0", "positive"),
+            ("period:-5", "positive"),
+            ("exp:0", "positive"),
+            ("exp:-1", "positive"),
+            ("exp:1e3", "three decimals"),
+            ("step:", "three decimals"),
+            ("step:1.", "three decimals"),
+            ("step:x", "three decimals"),
+            ("step:1000000", "at most"),
+            ("exp:2000000", "at most"),
+            ("velocity:2", "unknown basis"),
+        ] {
+            let e = Basis::parse(s).unwrap_err().0;
+            assert!(e.contains(why), "{s}: {e}");
+        }
     }
 
     #[test]

@@ -941,7 +941,7 @@ fn submodel_term_errors_are_located() {
             r#"errors = ["XOC", "ECC@cubic:2"]"#,
         ),
         &format!(
-            "m.toml:{line}:18: model `reduced`: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal or time:K)"
+            "m.toml:{line}:18: model `reduced`: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU or velocity)"
         ),
     );
     check(
@@ -962,4 +962,87 @@ fn submodel_term_errors_are_located() {
             "m.toml:{line}:11: model `reduced`: dx0: `poly:1` needs an error of a linear axis"
         ),
     );
+}
+
+#[test]
+fn measurement_effect_names_are_refused_as_symbols() {
+    for name in ["SXY", "SZZ", "dx0", "DZ0"] {
+        let e = err(&edit("Zc = 30.0\n", &format!("Zc = 30.0\n{name} = 1.0\n")));
+        assert_eq!(
+            e,
+            format!(
+                "m.toml:6:1: symbol `{name}` has a name reserved for an effect of the R-test measurement (dx0 dy0 dz0 SXX SXY SXZ SYX SYY SYZ SZX SZY SZZ): rename the symbol"
+            )
+        );
+    }
+    // Names that merely look alike are symbols like any other.
+    for name in ["SXW", "Sxy", "dx1"] {
+        parse_machine(
+            "m.toml",
+            &edit("Zc = 30.0\n", &format!("Zc = 30.0\n{name} = 1.0\n")),
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+}
+
+#[test]
+fn submodels_take_the_new_vocabulary() {
+    let text = edit(
+        r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+        r#"errors = ["EYY@velocity", "ECC@velocity", "SXY", "SZZ", "XOC@exp:20", "dz0@exp:0.5", "EYY@period:5", "EZY@step:-12.5", "ECC@step:90"]"#,
+    );
+    let m = parse_machine("m.toml", &text).unwrap();
+    let spelled: Vec<String> = m.models["reduced"]
+        .terms
+        .iter()
+        .map(|t| t.spelling(&m))
+        .collect();
+    assert_eq!(
+        spelled,
+        [
+            "EYY@velocity",
+            "ECC@velocity",
+            "SXY",
+            "SZZ",
+            "XOC@exp:20",
+            "dz0@exp:0.5",
+            "EYY@period:5",
+            "EZY@step:-12.5",
+            "ECC@step:90"
+        ]
+    );
+    let line = BASE
+        .lines()
+        .position(|l| l.contains(r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#))
+        .unwrap()
+        + 1;
+    for (term, why) in [
+        (
+            "EXY@velocity",
+            "XY: `velocity` needs the positioning error of an axis",
+        ),
+        (
+            "SXY@time:1",
+            "SXY: `SXY` is an instrument term of the R-test: constants only, not `time:1`",
+        ),
+        ("EYY@exp:2", "EYY: `exp:2` needs an effect of no axis"),
+        (
+            "ECC@period:5",
+            "ECC: `period:5` needs an error of a linear axis",
+        ),
+        ("XOC@step:1", "XOC: `step:1` needs an error of an axis"),
+        (
+            "EYY@period:0.0001",
+            "`period:0.0001`: the period P of `period:P` (mm) must be a decimal number with at most three decimals",
+        ),
+    ] {
+        let e = err(&edit(
+            r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+            &format!(r#"errors = ["{term}"]"#),
+        ));
+        assert!(
+            e.starts_with(&format!("m.toml:{line}:11: model `reduced`: ")) && e.contains(why),
+            "{term}: {e}"
+        );
+    }
 }

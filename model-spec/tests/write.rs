@@ -195,7 +195,7 @@ fn refused_terms() {
     );
     assert_eq!(
         e.to_string(),
-        "term `XOC`: `XOC` is neither an error of machine seed-3axis nor dx0/dy0/dz0"
+        "term `XOC`: `XOC` is neither an error of machine seed-3axis nor dx0/dy0/dz0 nor an instrument term SXX … SZY"
     );
     // In the catalogue but left out of the full model by `exclude`.
     let e = append_model(&m, BUILTIN[1].1, &strings(&["XOW"]), "d").unwrap_err();

@@ -320,6 +320,7 @@ fn synthetic_blocks(
                 commands: c,
                 t,
                 motion: vec![1; m.axes.len()],
+                timed: true,
             });
         }
         done += b;

@@ -1,7 +1,7 @@
 //! What a model fits: its terms in order ([`Effect`] × basis, see `model_spec::terms`); its
 //! H-matrix columns are the terms' columns in order.
 
-pub use model_spec::basis::{Basis, Carrier};
+pub use model_spec::basis::{Basis, BasisContext, Carrier};
 pub use model_spec::terms::{Effect, Term};
 use model_spec::{ErrorId, Machine};
 

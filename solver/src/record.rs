@@ -1,5 +1,13 @@
 //! A sequence of R-test samples along a path: the commanded pose of every axis, the time, the
 //! direction of motion of every axis, and (for measured records) the error vector read.
+//!
+//! Times are real (a `t_s` column, or a simulated path) or only sample numbers (a CSV without
+//! `t_s`): [`Sample::timed`] says which. Terms that need real times (`velocity`, `exp:TAU`)
+//! refuse a record whose samples are numbered ([`Record::check_times`]).
+//!
+//! Axis velocities ([`Record::velocities`]) are central differences of the commands over the
+//! times, `v_i = (q_{i+1} − q_{i−1}) / (t_{i+1} − t_{i−1})`, one-sided at the two ends
+//! (`(q_1 − q_0)/(t_1 − t_0)`, `(q_{n−1} − q_{n−2})/(t_{n−1} − t_{n−2})`), in mm/ms or rad/ms.
 
 /// One sample.
 #[derive(Clone, Debug, PartialEq)]
@@ -11,7 +19,15 @@ pub struct Sample {
     /// Direction of motion of every axis when the sample was taken: +1 or −1 (an axis at rest
     /// keeps the direction of its last move; +1 before any move).
     pub motion: Vec<i8>,
+    /// `true` when `t` is a real time (a `t_s` column, a simulated path); `false` when the CSV
+    /// had no `t_s` column and `t` is the sample's number (0, 1, 2 … s).
+    pub timed: bool,
 }
+
+/// Why a record's times cannot serve a term that needs them.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct TimesError(pub String);
 
 /// A record: samples and, when measured, the error vector at each (tool minus workpiece, tool
 /// frame, mm). Two records are equal when their samples and readings are: the lines they were
@@ -68,6 +84,67 @@ impl Record {
         self.measured.first() == Some(&[0.0; 3]) && self.measured.len() > 1
     }
 
+    /// `true` when every sample has a real time ([`Sample::timed`]).
+    pub fn has_times(&self) -> bool {
+        self.samples.iter().all(|s| s.timed)
+    }
+
+    /// Checks that `term` (its name, for the message) can be evaluated on this record: the
+    /// samples have real times.
+    ///
+    /// # Errors
+    /// [`TimesError`] naming the term when the samples are only numbered.
+    pub fn check_times(&self, term: &str) -> Result<(), TimesError> {
+        if self.has_times() {
+            Ok(())
+        } else {
+            Err(TimesError(format!(
+                "term `{term}` needs the real sample times (a `t_s` column, s), but the record has none: its samples are only numbered"
+            )))
+        }
+    }
+
+    /// The time since the first sample of sample `i`, s.
+    pub fn elapsed_s(&self, i: usize) -> f64 {
+        self.samples
+            .first()
+            .map_or(0.0, |a| self.samples[i].t - a.t)
+    }
+
+    /// The velocity of every axis at every sample (mm/ms for linear axes, rad/ms for rotary
+    /// ones), sample-major (`n_axes` values per sample): central differences of the commands
+    /// over the times, one-sided at the ends (see the module documentation).
+    ///
+    /// # Errors
+    /// [`TimesError`] when the samples are numbered, not timed ([`Record::check_times`] with
+    /// `term`), when there are fewer than two samples, or when a difference spans no time
+    /// (equal times around a sample).
+    pub fn velocities(&self, term: &str, n_axes: usize) -> Result<Vec<f64>, TimesError> {
+        self.check_times(term)?;
+        let s = &self.samples;
+        let n = s.len();
+        if n < 2 {
+            return Err(TimesError(format!(
+                "term `{term}` needs axis velocities, which take at least two samples; the record has {n}"
+            )));
+        }
+        let mut v = Vec::with_capacity(n * n_axes);
+        for i in 0..n {
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+            let dt_ms = (s[b].t - s[a].t) * 1000.0;
+            if dt_ms <= 0.0 || !dt_ms.is_finite() {
+                return Err(TimesError(format!(
+                    "term `{term}` needs axis velocities, but samples {a} and {b} have the same time ({} s): the velocity at sample {i} is undefined",
+                    s[a].t
+                )));
+            }
+            for k in 0..n_axes {
+                v.push((s[b].commands[k] - s[a].commands[k]) / dt_ms);
+            }
+        }
+        Ok(v)
+    }
+
     /// Normalised time τ ∈ [−1, 1] of sample `i` (0 when the record has no time span).
     pub fn tau(&self, i: usize) -> f64 {
         let (t0, t1) = match (self.samples.first(), self.samples.last()) {
@@ -82,8 +159,8 @@ impl Record {
     }
 }
 
-/// The samples of commands (per sample, one per axis: mm, rad), times (s) and directions of
-/// motion, zipped (the shortest of the three sets the count).
+/// The samples of commands (per sample, one per axis: mm, rad), real times (s) and directions
+/// of motion, zipped (the shortest of the three sets the count).
 pub fn samples_from(commands: Vec<Vec<f64>>, times: Vec<f64>, motion: Vec<Vec<i8>>) -> Vec<Sample> {
     commands
         .into_iter()
@@ -93,6 +170,7 @@ pub fn samples_from(commands: Vec<Vec<f64>>, times: Vec<f64>, motion: Vec<Vec<i8
             commands,
             t,
             motion,
+            timed: true,
         })
         .collect()
 }

@@ -197,6 +197,7 @@ fn static_record(noise: Vec<[f64; 3]>) -> Record {
                 commands: vec![0.0, 0.5],
                 t: i as f64 * 0.1,
                 motion: vec![1, 1],
+                timed: true,
             })
             .collect(),
         measured: noise,

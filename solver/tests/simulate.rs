@@ -8,7 +8,8 @@ mod common;
 
 use common::builtin;
 use model_spec::Machine;
-use solver::record::Record;
+use solver::model::BasisContext;
+use solver::record::{Record, Sample};
 use solver::simulation::VirtualMachine;
 use solver::simulation::paths::{builtin_path, record_from_commands};
 use solver::simulation::readings::{SimulateError, simulate};
@@ -92,9 +93,10 @@ fn readings_are_the_exact_error_vector_plus_offsets() {
     let vm = VirtualMachine::new(&m);
     for (i, s) in k4.samples.iter().enumerate() {
         let tau = k4.tau(i);
-        let e = t.error_values(&m, s, tau);
+        let cx = context(s, tau);
+        let e = t.error_values(&m, &cx);
         let v = vm.error_vector(&s.commands, &t.params, &e).position;
-        let o = t.sensor_offsets(&m, s, tau);
+        let o = t.sensor_offsets(&m, &cx);
         assert_eq!(o, [0.0015, 0.0, -0.002 * tau]);
         let want = [v.x + o[0], v.y + o[1], v.z + o[2]];
         for k in 0..3 {
@@ -125,7 +127,7 @@ fn the_reduced_truth_reads_the_first_order_gains_to_second_order() {
         let mut worst = 0.0f64;
         for (i, s) in k4.samples.iter().enumerate().step_by(10) {
             let g = solver::simulation::fd_gains(&m, &s.commands, &t.params, errors);
-            let e = t.error_values(&m, s, 0.0);
+            let e = t.error_values(&m, &context(s, 0.0));
             for k in 0..3 {
                 let lin: f64 = errors
                     .iter()
@@ -279,4 +281,16 @@ fn speed() {
     let path = builtin_path(&m, "K4").unwrap().unwrap();
     println!("build K4 path (IK): {:?}", start.elapsed());
     std::hint::black_box(path);
+}
+
+/// The basis context of a sample at normalised time `tau` (no velocities, no reading).
+fn context(s: &Sample, tau: f64) -> BasisContext<'_> {
+    BasisContext {
+        commands: &s.commands,
+        motion: &s.motion,
+        tau,
+        elapsed_s: 0.0,
+        velocity: &[],
+        reading: [0.0; 3],
+    }
 }

@@ -5,7 +5,7 @@ mod common;
 
 use common::{Scratch, builtin, commands, id};
 use model_spec::{Dir, Machine};
-use solver::model::Basis;
+use solver::model::{Basis, BasisContext};
 use solver::model::{Effect, Term};
 use solver::record::Sample;
 use solver::simulation::truth::{
@@ -118,8 +118,10 @@ dz0 = { const = 1.0, "time:1" = 0.5 }
         commands: commands(&m, &[("C", c), ("X", x)]),
         t: 0.0,
         motion,
+        timed: true,
     };
-    let e = t.error_values(&m, &s, -0.5);
+    let cx = context(&s, -0.5);
+    let e = t.error_values(&m, &cx);
     assert_eq!(e.len(), m.catalogue.len());
     let close = |a: f64, b: f64| (a - b).abs() < 1e-15;
     assert!(close(e[id(&m, "XOW")], 0.012));
@@ -131,7 +133,7 @@ dz0 = { const = 1.0, "time:1" = 0.5 }
         - e[id(&m, "ECC")].abs()
         - e[id(&m, "EXX")].abs();
     assert_eq!(others, 0.0);
-    let o = t.sensor_offsets(&m, &s, -0.5);
+    let o = t.sensor_offsets(&m, &cx);
     assert!(close(o[0], 0.002));
     assert_eq!(o[1], 0.0);
     assert!(close(o[2], 0.001 - 0.5 * 0.0005));
@@ -275,7 +277,7 @@ fn every_invalid_entry_names_file_line_and_column() {
         // Unknown error.
         (
             "[errors]\nXOQ = 1.0\n",
-            "t.toml:2:1: `XOQ` is neither an error of machine seed-ac nor a sensor offset dx0 dy0 dz0 (errors: EXX EYX",
+            "t.toml:2:1: `XOQ` is neither an error of machine seed-ac nor a sensor offset dx0 dy0 dz0 nor an instrument term SXX … SZY (errors: EXX EYX",
         ),
         // Bases that do not fit.
         (
@@ -296,7 +298,7 @@ fn every_invalid_entry_names_file_line_and_column() {
         ),
         (
             "[errors]\nECC = { \"cubic:2\" = 1 }\n",
-            "t.toml:2:9: ECC: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal or time:K)",
+            "t.toml:2:9: ECC: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU or velocity)",
         ),
         (
             "[errors]\nECC = { \"harmonic:0\" = [1, 2] }\n",
@@ -313,7 +315,7 @@ fn every_invalid_entry_names_file_line_and_column() {
         ),
         (
             "[errors]\nXOW = { const = [1, 2] }\n",
-            "t.toml:2:17: XOW `const` (µm) takes one number; only `harmonic:K` takes a pair [cos, sin]",
+            "t.toml:2:17: XOW `const` (µm) takes one number; only `harmonic:K` and `period:P` take a pair [cos, sin]",
         ),
         (
             "[errors]\nECC = { \"harmonic:2\" = [1, \"a\"] }\n",
@@ -410,6 +412,27 @@ fn every_invalid_entry_names_file_line_and_column() {
             "[errors]\nXOC = 1.0\nX0C = { const = 2.0 }\n",
             "t.toml:3:9: XOC with basis `const` is given twice (first at line 2)",
         ),
+        // The new vocabulary: bases that do not fit, values of the wrong shape.
+        (
+            "[errors]\nSXY = { \"time:1\" = 0.1 }\n",
+            "t.toml:2:9: SXY: basis does not fit: `SXY` is an instrument term of the R-test: constants only, not `time:1`",
+        ),
+        (
+            "[errors]\nEXY = { velocity = 0.5 }\n",
+            "t.toml:2:9: EXY: basis does not fit: `velocity` needs the positioning error of an axis",
+        ),
+        (
+            "[errors]\nEXX = { \"period:10\" = 2.0 }\n",
+            "t.toml:2:23: EXX `period:10` (µm) needs two numbers [cos, sin], not float",
+        ),
+        (
+            "[errors]\nECC = { velocity = [1, 2] }\n",
+            "t.toml:2:20: ECC `velocity` (ms) takes one number; only `harmonic:K` and `period:P` take a pair [cos, sin]",
+        ),
+        (
+            "[errors]\nXOC = { \"exp:0\" = 1.0 }\n",
+            "t.toml:2:9: XOC: `exp:0`: the time constant TAU of `exp:TAU` (s) must be positive",
+        ),
         // Unknown kinematic parameter.
         (
             "[parameters]\nZq = 1.0\n",
@@ -445,4 +468,16 @@ fn sensor_offsets_are_effects_too() {
     let e = t.entries(&m);
     assert_eq!((e[0].name.as_str(), e[0].unit), ("dy0", "um"));
     assert_eq!(e[0].values, vec![-3.0]);
+}
+
+/// The basis context of a sample at normalised time `tau` (no velocities, no reading).
+fn context(s: &Sample, tau: f64) -> BasisContext<'_> {
+    BasisContext {
+        commands: &s.commands,
+        motion: &s.motion,
+        tau,
+        elapsed_s: 0.0,
+        velocity: &[],
+        reading: [0.0; 3],
+    }
 }

@@ -47,6 +47,7 @@ fn path(m: &Machine, poses: impl Iterator<Item = (f64, f64)>) -> Record {
                 commands,
                 t: i as f64,
                 motion,
+                timed: true,
             })
             .collect(),
         measured: vec![],
@@ -312,11 +313,11 @@ fn bad_identify_json_names_the_file_and_the_field() {
         ),
         (
             ok.replace("\"XOC\"", "\"QQQ\""),
-            "id.json: field `parameters[0].error`: `QQQ` is neither an error of machine seed-ac nor dx0/dy0/dz0",
+            "id.json: field `parameters[0].error`: `QQQ` is neither an error of machine seed-ac nor dx0/dy0/dz0 nor an instrument term SXX … SZY",
         ),
         (
             ok.replacen("\"um\"", "\"urad\"", 1),
-            "id.json: field `parameters[0].unit`: `urad`: `XOC` is in `um`",
+            "id.json: field `parameters[0].unit`: `urad`: `XOC` `const` is in `um`",
         ),
         (
             ok.replace("1.5", "\"1.5\""),
@@ -332,7 +333,7 @@ fn bad_identify_json_names_the_file_and_the_field() {
         ),
         (
             ok.replace("\"const\"", "\"cubic\""),
-            "id.json: field `parameters[0].basis`: unknown basis `cubic` (expected const, harmonic:K, poly:K, reversal or time:K)",
+            "id.json: field `parameters[0].basis`: unknown basis `cubic` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU or velocity)",
         ),
         (
             ok.replace("\"model\": \"m\",", ""),

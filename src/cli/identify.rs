@@ -4,6 +4,7 @@
 use super::args::{self, RecordLimits, ValueBounds};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
+use solver::fitting::hmatrix::HMatrixError;
 use solver::fitting::noise::{NoiseChoice, NoiseModel};
 use solver::fitting::streaming::{StreamingError, identify_file};
 use solver::fitting::{
@@ -25,8 +26,10 @@ correlations, and what the data cannot separate. Values are in µm (translationa
 offsets) and µrad (angular errors).
 
 The model is --model NAME (the terms of a model of the machine: full, reduced, …), --terms LIST \
-(NAME or NAME@BASIS: XOC, ECC@harmonic:2, EXX@reversal, EXX@poly:2, dx0@time:1), or both (the \
-terms are added to the model). The record needs at least one reading (3 per sample) more than \
+(NAME or NAME@BASIS: XOC, ECC@harmonic:2, EXX@reversal, EXX@poly:2, dx0@time:1, \
+EXX@period:5, EXX@step:100, dz0@exp:20, ECC@velocity, SXY), or both (the terms are added to the \
+model). velocity (the servo lag, in ms) and exp:TAU need a `t_s` column; the instrument terms \
+SXX … SZY are dimensionless (docs/conventions.md). The record needs at least one reading (3 per sample) more than \
 the model has parameters.
 
 A parameter the data cannot determine gets no number: it is printed as \"not determined: \
@@ -81,7 +84,8 @@ pub struct IdentifyArgs {
     #[arg(long, value_name = "NAME")]
     model: Option<String>,
     /// Terms to identify, added to --model or alone: comma list of NAME or NAME@BASIS
-    /// (`ECC@harmonic:2,dx0@time:1`; bases const, harmonic:K, poly:K, reversal, time:K).
+    /// (`ECC@harmonic:2,dx0@time:1`; bases const, harmonic:K, poly:K, reversal, time:K,
+    /// period:P, step:V, exp:TAU, velocity; instrument terms SXX … SZY).
     #[arg(long, value_name = "LIST")]
     terms: Option<String>,
     /// The measurement CSV (axes in mm and degrees, dx_um,dy_um,dz_um in µm).
@@ -162,6 +166,9 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             .map_err(|e| match e {
                 StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
                 e @ StreamingError::ReadTwice(_) => CliError::input(format!("--data: {e}")),
+                StreamingError::HMatrix(e @ HMatrixError::Times { .. }) => {
+                    CliError::input(format!("--data {data}: {e}"))
+                }
                 StreamingError::Estimate(e) => estimate_error(e),
                 other => CliError::computation(format!("--data: cannot identify: {other}")),
             })?;
@@ -173,6 +180,13 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         (ident, None, Some(streaming), String::new())
     } else {
         let record = super::read_record("--data", &m, &args.data, &read)?;
+        super::check_times(
+            "--data",
+            &args.data,
+            &m,
+            &opts.fitted_model(&model),
+            &record,
+        )?;
         let note = zeroed_note(&record, args.zeroed).to_string();
         if args.first_order {
             let ident =

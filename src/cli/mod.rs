@@ -113,6 +113,25 @@ pub fn read_record(
         .map_err(|e| CliError::input(format!("{flag}: {e}")))
 }
 
+/// Refuses `record` (read from `path`, given by `flag`) for `model` when a term needs the real
+/// sample times (`velocity`, `exp:TAU`) and the file had no `t_s` column.
+pub fn check_times(
+    flag: &str,
+    path: &Path,
+    m: &Machine,
+    model: &solver::model::Model,
+    record: &Record,
+) -> CliResult<()> {
+    match model.terms.iter().find(|t| t.basis.needs_times()) {
+        Some(t) if !record.has_times() => Err(CliError::input(format!(
+            "{flag} {}: term `{}` needs the real sample times, but the file has no `t_s` column (its samples are only numbered): add the times in s",
+            path.display(),
+            t.spelling(m)
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// `--machine` as an input file, when it names one (a built-in name is not a file).
 pub fn machine_file(name_or_path: &str) -> Option<&Path> {
     let builtin = model_spec::BUILTIN.iter().any(|(n, _)| *n == name_or_path);

@@ -8,6 +8,7 @@ use output::{Outputs, Target};
 use solver::io::csv::{format_record, parse_measurement};
 use solver::io::text::simulation;
 use solver::simulation::paths::PathError;
+use solver::simulation::readings::SimulateError;
 use solver::simulation::truth::{MAX_NOISE_PHI, MAX_NOISE_UM, MAX_SEED, Truth, TruthError};
 use solver::simulation::{load_path, provenance, simulate};
 use std::path::Path;
@@ -150,8 +151,10 @@ pub fn run(args: &SimulateArgs) -> CliResult {
         truth.seed = s;
     }
     truth.zeroed |= args.zeroed;
-    let record =
-        simulate(&m, &truth, &path).map_err(|e| CliError::computation(format!("--truth: {e}")))?;
+    let record = simulate(&m, &truth, &path).map_err(|e| match e {
+        e @ SimulateError::Times { .. } => CliError::input(format!("--path {}: {e}", args.path)),
+        e => CliError::computation(format!("--truth: {e}")),
+    })?;
     let comments = provenance(&m, &args.path, &truth, record.samples.len());
     let csv = format_record(&m, &record, &comments)
         .map_err(|e| CliError::computation(format!("-o: {e}")))?;

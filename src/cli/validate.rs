@@ -98,6 +98,7 @@ pub fn run(args: &ValidateArgs) -> CliResult {
         ))
     })?;
     let record = super::read_record("--data", &m, &args.data, &args.records.read_options())?;
+    super::check_times("--data", &args.data, &m, &params.model, &record)?;
     let mut opts = ValidateOptions::default();
     opts.zeroed = args.zeroed;
     opts.exact = !args.first_order;

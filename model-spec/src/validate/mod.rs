@@ -109,6 +109,7 @@ impl Validator<'_> {
         let squareness_order = self.squareness_order(&raw.errors, &axes)?;
         let catalogue = build_catalogue(&axes, &squareness_order);
         self.symbols_not_errors(&raw_symbols, &catalogue)?;
+        self.symbols_not_measurement_effects(&raw_symbols)?;
         let mut machine = Machine {
             name,
             description: raw.description.trim().to_string(),

@@ -189,7 +189,7 @@ impl Validator<'_> {
                 Some((n, b)) => (n.trim(), Some(b.trim())),
                 None => (written, None),
             };
-            let effect = match Effect::parse_offset(name) {
+            let effect = match Effect::parse_measurement(name) {
                 Some(e) => e,
                 None => {
                     let id = self.error_id_at(name, item.span(), m)?;

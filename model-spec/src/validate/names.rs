@@ -5,6 +5,7 @@ use crate::catalogue::ErrorTerm;
 use crate::limits::MAX_NAME_CHARS;
 use crate::machine::{Axis, AxisKind, FULL_MODEL};
 use crate::raw::Num;
+use crate::terms::{Effect, MEASUREMENT_EFFECTS};
 use toml::Spanned;
 
 /// The names a machine reserves for the commands of an axis in formulas: the linear command
@@ -127,6 +128,29 @@ impl Validator<'_> {
                         ),
                     );
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// No symbol takes the name of an effect of the measurement (`dx0 dy0 dz0` in any case,
+    /// `SXX` … `SZY`): those names are terms of models, truths and reports. (No error can have
+    /// one: error names are built from axis letters, one upper-case letter other than E and O,
+    /// as `E<direction><axis>`, `<direction>O<axis>` or `<direction>OW`.)
+    pub(super) fn symbols_not_measurement_effects(
+        &self,
+        raw_symbols: &[(&Spanned<String>, &Spanned<Num>)],
+    ) -> Res<()> {
+        for &(k, _) in raw_symbols {
+            if Effect::parse_measurement(k.get_ref()).is_some() {
+                return self.err(
+                    k.span(),
+                    format!(
+                        "symbol `{}` has a name reserved for an effect of the R-test measurement ({}): rename the symbol",
+                        k.get_ref(),
+                        MEASUREMENT_EFFECTS.join(" ")
+                    ),
+                );
             }
         }
         Ok(())

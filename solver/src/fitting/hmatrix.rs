@@ -6,18 +6,31 @@
 //!   for `harmonic:K` (cos, then sin).
 //! - Entry: `g_d(pose_i) · b(sample_i)`, the position gain `g` of the term's effect (mm per mm
 //!   for translational errors, mm per rad for angular ones) times the basis value `b`
-//!   ([`crate::model::Basis::values`] with the effect's carrier, the sample's commands and
-//!   motion, and [`Record::tau`]). The sensor offsets `dx0 dy0 dz0` have gain `+1` in their own
-//!   direction and 0 in the others.
+//!   ([`crate::model::Basis::values`] with the effect's carrier at the sample's
+//!   [`BasisContext`]: commands, motion, [`Record::tau`], [`Record::elapsed_s`], the axis
+//!   velocities of [`Record::velocities`] and the measured reading). The sensor offsets
+//!   `dx0 dy0 dz0` have gain `+1` in their own direction and 0 in the others.
+//! - Instrument terms `S<i><j>` (dimensionless) act on the reading, not on the machine: the row
+//!   of direction `i` gets the displacement in direction `j`, for which the measured reading of
+//!   direction `j` stands. That is first order: the reading differs from the displacement by
+//!   the instrument terms themselves (S·d, S small) and by the sensor offsets (a constant,
+//!   which `dx0 dy0 dz0` absorb) and the noise. The noise in H biases the fit by about
+//!   (σ_noise / displacement)² relative, negligible when the noise is much smaller than the
+//!   displacements; the refinement against the exact machine (which applies `(I + S)` to the
+//!   displacement exactly) removes the first-order part.
+//! - `velocity` terms need the whole record (central differences across samples) and real
+//!   times; `exp:TAU` needs real times: a record whose samples are numbered is refused
+//!   ([`HMatrixError::Times`]).
 //!
-//! With `p` in mm (translational) and rad (angular), `H · p` is in mm.
+//! With `p` in mm (translational), rad (angular), ms (`velocity`) and 1 (instrument terms),
+//! `H · p` is in mm.
 //!
 //! Gains come from a [`GainSource`]: the compiled code of the `generated` crate for a built-in
 //! machine (its `full` model, the needed errors picked out), or the in-process evaluator of the
 //! straight-line IR ([`codegen::compile`] of a [`GainModel`] derived for the needed errors) for
 //! any machine, in particular machines given as files. Both give the same numbers to rounding.
 
-use crate::model::{Effect, Model, Term};
+use crate::model::{Basis, BasisContext, Effect, Model, Term};
 use crate::record::Record;
 use codegen::atoms::{AtomKind, AtomTable};
 use codegen::{GainModel, Program};
@@ -61,6 +74,14 @@ pub enum HMatrixError {
         /// The term's name.
         term: String,
         /// What is wrong.
+        message: String,
+    },
+    /// A term that needs real times (or velocities) on a record without them.
+    #[error("term `{term}`: {message}")]
+    Times {
+        /// The term's name (`EXX@velocity`).
+        term: String,
+        /// What is missing.
         message: String,
     },
     /// A sample that does not fit the machine.
@@ -414,7 +435,7 @@ pub fn parameter_names(m: &Machine, model: &Model) -> Vec<String> {
 }
 
 /// Checks that every term of `model` belongs to `m`: error ids in its catalogue, bases that fit
-/// their effects.
+/// their effects ([`Term::check`]).
 ///
 /// # Errors
 /// [`HMatrixError::UnknownError`] or [`HMatrixError::Term`].
@@ -429,12 +450,10 @@ pub fn check_model(m: &Machine, model: &Model) -> Result<(), HMatrixError> {
                 len: m.catalogue.len(),
             });
         }
-        t.basis
-            .check(m, t.effect.carrier(m))
-            .map_err(|e| HMatrixError::Term {
-                term: format!("{}@{}", t.effect.name(m), t.basis),
-                message: e.0,
-            })?;
+        t.check(m).map_err(|e| HMatrixError::Term {
+            term: t.spelling(m),
+            message: e.0,
+        })?;
     }
     Ok(())
 }
@@ -446,6 +465,37 @@ enum Gain {
     Slot(usize),
     /// A sensor offset: `+1` along this direction.
     Unit(usize),
+    /// An instrument term: the measured reading of direction `.1` in the row of direction `.0`.
+    Reading(usize, usize),
+}
+
+/// The axis velocities of `record` (sample-major, mm/ms or rad/ms) when `model` has a
+/// `velocity` term, else nothing; checks that the record has real times when a term needs them.
+fn times_for(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    block: bool,
+) -> Result<Vec<f64>, HMatrixError> {
+    let times_err = |t: &Term, message: String| HMatrixError::Times {
+        term: t.spelling(m),
+        message,
+    };
+    if let Some(t) = model.terms.iter().find(|t| t.basis.needs_times()) {
+        record
+            .check_times(&t.spelling(m))
+            .map_err(|e| times_err(t, e.0))?;
+    }
+    match model.terms.iter().find(|t| t.basis == Basis::Velocity) {
+        Some(t) if block => Err(times_err(
+            t,
+            "velocity terms need the whole record (central differences across samples), not a block of it".into(),
+        )),
+        Some(t) => record
+            .velocities(&t.spelling(m), m.axes.len())
+            .map_err(|e| times_err(t, e.0)),
+        None => Ok(Vec::new()),
+    }
 }
 
 /// Checks a sample's lengths and values against the machine.
@@ -497,7 +547,9 @@ pub fn h_matrix(
 }
 
 /// [`h_matrix`] of a block of a longer record: `time_span` `(t0, t1)` (s) is the whole
-/// record's, so that `time:K` terms are normalised over the record, not the block.
+/// record's, so that `time:K` terms are normalised over the record and `exp:TAU` counts from
+/// its first sample, not the block's. With a `time_span`, `velocity` terms are refused (they
+/// need the whole record).
 pub fn h_matrix_spanned(
     m: &Machine,
     model: &Model,
@@ -521,9 +573,23 @@ pub fn h_matrix_spanned(
                 }
             },
             Effect::SensorOffset(d) => Gain::Unit(d.index()),
+            Effect::Instrument {
+                reading,
+                displacement,
+            } => {
+                if record.measured.len() != record.samples.len() {
+                    return Err(HMatrixError::Term {
+                        term: term.spelling(m),
+                        message: "an instrument term needs the measured readings (its column is the reading of the displacement it takes)".into(),
+                    });
+                }
+                Gain::Reading(reading.index(), displacement.index())
+            }
         };
         cols.push((gain, term.effect.carrier(m), term.basis, k));
     }
+    let velocities = times_for(m, model, record, time_span.is_some())?;
+    let n_axes = m.axes.len();
     let n = record.samples.len();
     let mut h = DMatrix::<f64>::zeros(3 * n, cols.len());
     let mut g = vec![[0.0; 3]; source.errors().len()];
@@ -536,21 +602,27 @@ pub fn h_matrix_spanned(
                 HMatrixError::Sample { message, .. } => HMatrixError::Sample { sample: i, message },
                 other => other,
             })?;
-        let tau = match time_span {
-            Some((t0, t1)) if t1 > t0 => 2.0 * (s.t - t0) / (t1 - t0) - 1.0,
-            Some(_) => 0.0,
-            None => record.tau(i),
+        let (tau, elapsed_s) = match time_span {
+            Some((t0, t1)) if t1 > t0 => (2.0 * (s.t - t0) / (t1 - t0) - 1.0, s.t - t0),
+            Some((t0, _)) => (0.0, s.t - t0),
+            None => (record.tau(i), record.elapsed_s(i)),
+        };
+        let cx = BasisContext {
+            commands: &s.commands,
+            motion: &s.motion,
+            tau,
+            elapsed_s,
+            velocity: velocities.get(i * n_axes..(i + 1) * n_axes).unwrap_or(&[]),
+            reading: record.measured.get(i).copied().unwrap_or([0.0; 3]),
         };
         for (c, &(gain, carrier, basis, k)) in cols.iter().enumerate() {
-            let b = basis.values(m, carrier, &s.commands, &s.motion, tau)[k];
-            let v = match gain {
-                Gain::Slot(slot) => g[slot],
-                Gain::Unit(d) => {
-                    let mut u = [0.0; 3];
-                    u[d] = 1.0;
-                    u
-                }
-            };
+            let b = basis.values(m, carrier, &cx)[k];
+            let mut v = [0.0; 3];
+            match gain {
+                Gain::Slot(slot) => v = g[slot],
+                Gain::Unit(d) => v[d] = 1.0,
+                Gain::Reading(d, j) => v[d] = cx.reading[j],
+            }
             for d in 0..3 {
                 let x = v[d] * b;
                 if !x.is_finite() {

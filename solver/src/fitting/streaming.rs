@@ -98,10 +98,10 @@ pub enum StreamingError<E: std::error::Error + 'static> {
     /// A block's measurements, or the final solve, failed.
     #[error(transparent)]
     Estimate(#[from] EstimateError),
-    /// The record must be read twice (a model with `time:K` terms needs its time span first)
-    /// but is not a regular file (a pipe or a device can be read once only).
+    /// The record must be read twice (a model with `time:K` or `exp:TAU` terms needs its time
+    /// span first) but is not a regular file (a pipe or a device can be read once only).
     #[error(
-        "`{0}`: a model with time:K terms reads the record twice (its time span first), so it must be a regular file, not a pipe or a device"
+        "`{0}`: a model with time:K or exp:TAU terms reads the record twice (its time span first), so it must be a regular file, not a pipe or a device"
     )]
     ReadTwice(String),
 }
@@ -122,9 +122,14 @@ pub struct StreamingIdentification {
 }
 
 /// Identifies `model` from `blocks` of one record (each a [`Record`] with measurements;
-/// `time_span` `(t0, t1)` is the whole record's, s, for `time:K` terms), with gains from
-/// `source`. First-order least squares, as [`crate::fitting::identify_with`] without the
-/// refinement (which needs the whole record).
+/// `time_span` `(t0, t1)` is the whole record's, s, for `time:K` and `exp:TAU` terms), with
+/// gains from `source`. First-order least squares, as [`crate::fitting::identify_with`] without
+/// the refinement (which needs the whole record).
+///
+/// # Errors
+/// Besides reading and fitting errors, [`HMatrixError::Times`] for a model with `velocity`
+/// terms (the axis velocities are central differences across samples, which blocks cut) or
+/// with `exp:TAU` terms and no `time_span`.
 pub fn identify_streaming<E: std::error::Error + 'static>(
     m: &Machine,
     model: &Model,
@@ -134,6 +139,29 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
     constraint: &Constraint,
     tol: &Tolerances,
 ) -> Result<StreamingIdentification, StreamingError<E>> {
+    let refuse = |t: &crate::model::Term, message: &str| {
+        StreamingError::HMatrix(HMatrixError::Times {
+            term: t.spelling(m),
+            message: message.into(),
+        })
+    };
+    if let Some(t) = model.terms.iter().find(|t| t.basis == Basis::Velocity) {
+        return Err(refuse(
+            t,
+            "velocity terms need the whole record (central differences across samples): not available when the record is read in blocks",
+        ));
+    }
+    if time_span.is_none()
+        && let Some(t) = model
+            .terms
+            .iter()
+            .find(|t| matches!(t.basis, Basis::Exp(_)))
+    {
+        return Err(refuse(
+            t,
+            "exp:TAU terms count time from the record's first sample: give the record's time span",
+        ));
+    }
     let mut qr = StreamingQr::new(model.width());
     let (mut samples, mut count, mut largest, mut first) = (0, 0, 0, None);
     for block in blocks {
@@ -160,8 +188,8 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
 /// Identifies `model` of `m` from the measurement CSV at `path`, read in blocks of `block`
 /// samples with `read` (never the whole record, never the whole H): first-order least
 /// squares, with the options of [`crate::fitting::identify()`] (zeroed readings add
-/// `dx0 dy0 dz0`). A model with `time:K` terms costs one more pass over the file for the
-/// record's time span. Fewer readings than parameters plus one is an error, as in memory.
+/// `dx0 dy0 dz0`). A model with `time:K` or `exp:TAU` terms costs one more pass over the file
+/// for the record's time span; `velocity` terms are refused ([`identify_streaming`]). Fewer readings than parameters plus one is an error, as in memory.
 pub fn identify_file(
     m: &Machine,
     model: &Model,
@@ -175,7 +203,7 @@ pub fn identify_file(
     let has_time = fitted
         .terms
         .iter()
-        .any(|t| matches!(t.basis, Basis::Time(_)));
+        .any(|t| matches!(t.basis, Basis::Time(_) | Basis::Exp(_)));
     let span = if has_time {
         if !std::fs::metadata(path).is_ok_and(|f| f.is_file()) {
             return Err(StreamingError::ReadTwice(path.display().to_string()));

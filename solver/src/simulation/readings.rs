@@ -1,7 +1,8 @@
 //! Simulated R-test readings: the exact virtual machine run with a [`Truth`] along a path.
 //!
-//! At every sample `i` of the path, with commands `q` (mm, rad), directions of motion and
-//! normalised time `τ = record.tau(i)`:
+//! At every sample `i` of the path, with commands `q` (mm, rad), directions of motion,
+//! normalised time `τ = record.tau(i)`, time since the first sample and (for `velocity` terms)
+//! the axis velocities of [`Record::velocities`] — the [`BasisContext`] the H matrix uses too:
 //! 1. the truth gives every catalogue error's value and the sensor zero offsets
 //!    ([`Truth::evaluate_into`]);
 //! 2. the exact chains (no linearisation) with the truth's kinematic parameters give the error
@@ -9,16 +10,18 @@
 //!    workpiece; [`crate::simulation::exact::ErrorVector::position`]); it includes any nominal mismatch the
 //!    path leaves, e.g. when the truth's kinematic parameters differ from the defaults the path
 //!    was planned with;
-//! 3. the offsets `dx0 dy0 dz0` are added, then Gaussian noise of marginal standard deviation
-//!    σ = `truth.noise_mm` per direction, from standard normal draws `n_t` of
-//!    [`Rng::new`]`(truth.seed)` in sample order, x, y, z (no draws when the noise is zero): an
-//!    AR(1) process of lag-1 autocorrelation φ = `truth.noise_phi` per direction, stationary
-//!    from the first sample, `e_0 = σ·n_0`, `e_t = φ·e_{t−1} + σ·√(1−φ²)·n_t`; with φ = 0 it
-//!    is white, `e_t = σ·n_t`, the same draws as before AR(1) noise existed;
+//! 3. the instrument terms act on that displacement `d`: the reading is `(I + S)·d`
+//!    ([`Truth::instrument`]); the offsets `dx0 dy0 dz0` are added, then Gaussian noise of
+//!    marginal standard deviation σ = `truth.noise_mm` per direction, from standard normal
+//!    draws `n_t` of [`Rng::new`]`(truth.seed)` in sample order, x, y, z (no draws when the
+//!    noise is zero): an AR(1) process of lag-1 autocorrelation φ = `truth.noise_phi` per
+//!    direction, stationary from the first sample, `e_0 = σ·n_0`, `e_t = φ·e_{t−1} +
+//!    σ·√(1−φ²)·n_t`; with φ = 0 it is white, `e_t = σ·n_t`, the same draws as before AR(1)
+//!    noise existed;
 //! 4. when `truth.zeroed`, the first reading is subtracted from every reading (the first is
 //!    then exactly zero), as R-test software does.
 
-use crate::model::Effect;
+use crate::model::{Basis, BasisContext, Effect};
 use crate::record::Record;
 use crate::simulation::exact::VirtualMachine;
 use crate::simulation::rng::Rng;
@@ -44,6 +47,15 @@ pub enum SimulateError {
         /// The machine's number of axes.
         axes: usize,
     },
+    /// The truth has `velocity` or `exp:TAU` terms and the path has no real times (or too few
+    /// samples, or equal times, for velocities).
+    #[error("truth {source_name}: {why}")]
+    Times {
+        /// The truth's source.
+        source_name: String,
+        /// What is missing.
+        why: String,
+    },
     /// The truth was made for another machine.
     #[error("truth {source_name} does not fit machine {machine}: {why}")]
     Truth {
@@ -62,9 +74,28 @@ pub enum SimulateError {
 /// are ignored.
 ///
 /// # Errors
-/// [`SimulateError`] when a sample or the truth does not fit `m`.
+/// [`SimulateError`] when a sample or the truth does not fit `m`, or the truth needs real times
+/// the path lacks.
 pub fn simulate(m: &Machine, truth: &Truth, path: &Record) -> Result<Record, SimulateError> {
     check(m, truth, path)?;
+    let times_err = |e: crate::record::TimesError| SimulateError::Times {
+        source_name: truth.source.clone(),
+        why: e.0,
+    };
+    if let Some(t) = truth.model.terms.iter().find(|t| t.basis.needs_times()) {
+        path.check_times(&t.spelling(m)).map_err(times_err)?;
+    }
+    let n_axes = m.axes.len();
+    let velocities = match truth
+        .model
+        .terms
+        .iter()
+        .find(|t| t.basis == Basis::Velocity)
+    {
+        Some(t) => path.velocities(&t.spelling(m), n_axes).map_err(times_err)?,
+        None => Vec::new(),
+    };
+    let gain = truth.instrument();
     let vm = VirtualMachine::new(m);
     let params = &truth.params;
     let mut errors = vec![0.0; m.catalogue.len()];
@@ -76,14 +107,23 @@ pub fn simulate(m: &Machine, truth: &Truth, path: &Record) -> Result<Record, Sim
     let mut previous = [0.0; 3];
     let mut measured = Vec::with_capacity(path.samples.len());
     for (i, s) in path.samples.iter().enumerate() {
-        let tau = path.tau(i);
-        truth.evaluate_into(m, &s.commands, &s.motion, tau, &mut errors, &mut offsets);
+        let cx = BasisContext {
+            commands: &s.commands,
+            motion: &s.motion,
+            tau: path.tau(i),
+            elapsed_s: path.elapsed_s(i),
+            velocity: velocities.get(i * n_axes..(i + 1) * n_axes).unwrap_or(&[]),
+            reading: [0.0; 3],
+        };
+        truth.evaluate_into(m, &cx, &mut errors, &mut offsets);
         let value = |id: usize| errors[id];
         let tool = vm.transform_with(Side::Tool, &s.commands, params, &value);
         let work = vm.transform_with(Side::Work, &s.commands, params, &value);
         let gap = tool.translation.vector - work.translation.vector;
         let p = tool.rotation.inverse_transform_vector(&gap);
-        let mut r = [p.x + offsets[0], p.y + offsets[1], p.z + offsets[2]];
+        let d = [p.x, p.y, p.z];
+        let read = |k: usize| d[k] + (0..3).map(|j| gain[k][j] * d[j]).sum::<f64>() + offsets[k];
+        let mut r = [read(0), read(1), read(2)];
         if noise > 0.0 {
             for (v, e) in r.iter_mut().zip(&mut previous) {
                 *e = if i == 0 || phi == 0.0 {
@@ -165,7 +205,7 @@ fn check(m: &Machine, truth: &Truth, path: &Record) -> Result<(), SimulateError>
                 m.catalogue.len()
             )));
         }
-        if let Err(e) = t.basis.check(m, t.effect.carrier(m)) {
+        if let Err(e) = t.check(m) {
             return Err(bad(format!("term {}: {}", t.effect.name(m), e.0)));
         }
     }

@@ -105,6 +105,7 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
         let n_axes = self.m.axes.len();
         let mut moved = vec![false; n_axes];
         let mut n_moved = 0;
+        let mut timed = true;
         while commands.len() < self.block
             || (first && commands.len() < FIRST_LOOKAHEAD && n_moved < n_axes)
         {
@@ -126,6 +127,7 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
                     }
                 }
             }
+            timed &= time.is_some();
             times.push(time.unwrap_or((self.samples + commands.len()) as f64));
             commands.push(c);
             measured.push(d);
@@ -163,7 +165,10 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
             commands.last().cloned().unwrap_or_default(),
             motion.last().cloned().unwrap_or_default(),
         ));
-        let samples = samples_from(commands, times, motion);
+        let mut samples = samples_from(commands, times, motion);
+        for s in &mut samples {
+            s.timed = timed;
+        }
         Ok(Some(Record {
             samples,
             measured,

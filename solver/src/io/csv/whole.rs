@@ -46,11 +46,13 @@ pub fn read_csv<R: Read>(
     let (mut commands, mut times, mut measured, mut row_lines) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut last_t = None;
+    let mut timed = true;
     while let Some((line, text)) = lines.next_line(&cx)? {
         if !is_data(text) {
             continue;
         }
         let (c, t, d) = header.row(&cx, line, text, m, &mut last_t)?;
+        timed &= t.is_some();
         times.push(t.unwrap_or(commands.len() as f64));
         commands.push(c);
         measured.push(d);
@@ -67,6 +69,9 @@ pub fn read_csv<R: Read>(
         &row_lines,
     )?;
     let mut record = record_from_commands(commands, times);
+    for s in &mut record.samples {
+        s.timed = timed;
+    }
     if header.measured {
         record.measured = measured;
     }

@@ -27,7 +27,8 @@ use model_spec::Machine;
 use model_spec::units::UM_PER_MM;
 use serde::{Deserialize, Serialize};
 
-/// One parameter (H-matrix column) of an identification, in µm or µrad.
+/// One parameter (H-matrix column) of an identification, in its term's unit
+/// ([`crate::model::Term::unit`]): µm, µrad, ms (`velocity`) or 1 (instrument terms).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ParameterReport {
     /// The parameter's name (`XOC`, `ECC@harmonic:2:cos`, `dx0`).
@@ -36,13 +37,13 @@ pub struct ParameterReport {
     pub error: String,
     /// Basis column (`const`, `harmonic:2:cos`, `reversal`, …).
     pub basis: String,
-    /// Estimate, µm or µrad; `null` when the data do not determine it (and no constraint gives
+    /// Estimate, in `unit`; `null` when the data do not determine it (and no constraint gives
     /// it a value).
     pub value: Option<f64>,
-    /// Standard uncertainty, µm or µrad; `null` when undetermined, fixed, or without a degree
+    /// Standard uncertainty, in `unit`; `null` when undetermined, fixed, or without a degree
     /// of freedom.
     pub std: Option<f64>,
-    /// `um` or `urad`.
+    /// `um`, `urad`, `ms` (the lag of a `velocity` term) or `1` (an instrument term).
     pub unit: String,
     /// Whether the data determine it (fixed parameters count as determined).
     pub determined: bool,
@@ -238,7 +239,7 @@ impl IdentificationReport {
         let mut parameters = Vec::with_capacity(fit.names.len());
         for (j, (t, k)) in ident.model.columns().into_iter().enumerate() {
             let term = ident.model.terms[t];
-            let f = term.effect.display_factor(m);
+            let f = term.display_factor(m);
             let names = term.basis.column_names();
             let field = |what: &str| format!("parameters[{j}].{what}");
             parameters.push(ParameterReport {
@@ -247,7 +248,7 @@ impl IdentificationReport {
                 basis: names.get(k).unwrap_or(&names[0]).clone(),
                 value: finite_opt(|| field("value"), fit.values[j].map(|v| v * f))?,
                 std: finite_opt(|| field("std"), fit.std[j].map(|v| v * f))?,
-                unit: term.effect.unit(m).to_string(),
+                unit: term.unit(m).to_string(),
                 determined: id.determined[j],
                 fixed: fit.fixed[j],
                 over_mm: poly_stroke(m, &term),

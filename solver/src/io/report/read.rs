@@ -349,7 +349,7 @@ impl Reader<'_> {
                 self.bad(
                     &field("error"),
                     format!(
-                        "`{error}` is neither an error of machine {} nor dx0/dy0/dz0",
+                        "`{error}` is neither an error of machine {} nor dx0/dy0/dz0 nor an instrument term SXX … SZY",
                         m.name
                     ),
                 )
@@ -360,7 +360,7 @@ impl Reader<'_> {
                 _ => (basis_text.as_str(), None),
             };
             let basis = Basis::parse(basis_str).map_err(|e| self.bad(&field("basis"), e.0))?;
-            let harmonic = matches!(basis, Basis::Harmonic(_));
+            let harmonic = basis.width() == 2;
             if harmonic != (part == Some("cos")) {
                 return Err(self.bad(
                     &field("basis"),
@@ -401,17 +401,17 @@ impl Reader<'_> {
                     self.check_stroke(q, &field("over_mm"), &term, stroke)?;
                 }
                 let unit = self.string(q, "unit", &field("unit"))?;
-                if unit != effect.unit(m) {
+                if unit != term.unit(m) {
                     return Err(self.bad(
                         &field("unit"),
-                        format!("`{unit}`: `{error}` is in `{}`", effect.unit(m)),
+                        format!("`{unit}`: `{error}` `{basis}` is in `{}`", term.unit(m)),
                     ));
                 }
                 let value =
                     match q.get("value") {
                         Some(Value::Null) => None,
                         Some(Value::Number(x)) => match x.as_f64() {
-                            Some(v) if v.is_finite() => Some(v / effect.display_factor(m)),
+                            Some(v) if v.is_finite() => Some(v / term.display_factor(m)),
                             _ => {
                                 return Err(self
                                     .bad(&field("value"), format!("{x} is not a finite number")));

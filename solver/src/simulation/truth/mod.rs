@@ -15,23 +15,23 @@
 //!
 //! [errors]                     # µm for translations and dx0 dy0 dz0, µrad for angles
 //! XOW = 12.0                   # a number: constant
-//! ECC = { const = 3.0, "harmonic:2" = [8.0, 6.0] }   # [cos, sin] pair of a harmonic
-//! dz0 = { const = 1.0, "time:1" = 0.5 }              # sensor zero offset and drift
+//! ECC = { const = 3.0, "harmonic:2" = [8.0, 6.0], velocity = 0.5 }  # velocity: lag in ms
+//! dz0 = { const = 1.0, "time:1" = 0.5, "exp:20" = 2.0 }             # offset, drift, settling
+//! SXY = 0.03                   # instrument term (dimensionless): cross-talk
 //! ```
 //!
 //! Inside, a [`Truth`] holds the terms as a [`Model`] and one coefficient per model column in
-//! mm (translations, sensor offsets) or rad (angles). The value of an effect at a sample is
-//! `Σ coefficient · basis value` over its terms ([`crate::model::Basis::values`]). Every entry is
-//! validated against the machine, and every problem is a [`TruthError`] naming the file, the
-//! line and the column.
+//! mm (translations, sensor offsets), rad (angles), ms (`velocity`) or 1 (instrument terms,
+//! [`Truth::instrument`]). The value of an effect at a sample is `Σ coefficient · basis value`
+//! over its terms ([`crate::model::Basis::values`]). Every entry is validated against the
+//! machine, and every problem is a [`TruthError`] naming the file, the line and the column.
 //!
 //! Built-in truths for `seed-ac` ([`BUILTIN_TRUTHS`], files in `solver/truths/`): `seed-ac-demo`
 //! (the documented default of `rtest demo`) and `seed-ac-reduced` (the 11 errors of the reduced
 //! model only, constants, no noise).
 
 use crate::model::Basis;
-use crate::model::{Effect, Model, Term};
-use crate::record::Sample;
+use crate::model::{BasisContext, Effect, Model, Term};
 use model_spec::Machine;
 use model_spec::units::{format_scaled, parse_scaled};
 
@@ -74,8 +74,8 @@ pub const MAX_VALUE: f64 = 1e6;
 
 /// Decimal places between the unit people write and the unit inside: µm → mm is 3, µrad → rad
 /// is 6.
-fn places(m: &Machine, effect: Effect) -> i32 {
-    if effect.is_angular(m) { 6 } else { 3 }
+fn places(m: &Machine, term: &Term) -> i32 {
+    term.places(m)
 }
 
 /// A problem with a truth: its file cannot be read, or an entry is invalid.
@@ -116,7 +116,8 @@ pub struct Truth {
     /// The terms (effect × basis), sorted, each at most once.
     pub model: Model,
     /// One coefficient per column of `model` (`Model::columns` order): mm for translational
-    /// errors and sensor offsets, rad for angular errors; `harmonic:K` has two (cos, sin).
+    /// errors and sensor offsets, rad for angular errors, ms for `velocity`, 1 for instrument
+    /// terms; `harmonic:K` and `period:P` have two (cos, sin).
     pub coefficients: Vec<f64>,
     /// Marginal standard deviation of the Gaussian reading noise, per direction, mm.
     pub noise_mm: f64,
@@ -136,9 +137,9 @@ pub struct TruthEntry {
     pub term: Term,
     /// Effect name (`XOC`, `dx0`).
     pub name: String,
-    /// Its value(s): one, or `[cos, sin]` for `harmonic:K`; µm or µrad.
+    /// Its value(s): one, or `[cos, sin]` for `harmonic:K` and `period:P`; in `unit`.
     pub values: Vec<f64>,
-    /// `um` or `urad`.
+    /// `um`, `urad`, `ms` (`velocity`) or `1` (instrument terms): [`Term::unit`].
     pub unit: &'static str,
 }
 
@@ -192,19 +193,19 @@ impl Truth {
         None
     }
 
-    /// Evaluates every effect at a sample: `errors` (one per catalogue entry, mm or rad) and
-    /// `offsets` (`dx0 dy0 dz0`, mm) are overwritten. `commands` (mm, rad) and `motion` (+1/−1)
-    /// have one entry per axis; `tau` is the normalised time in [−1, 1] ([`crate::record::Record::tau`]).
+    /// Evaluates every machine error and sensor offset at the sample `cx`: `errors` (one per
+    /// catalogue entry, mm or rad) and `offsets` (`dx0 dy0 dz0`, mm) are overwritten. The
+    /// instrument terms act on the reading, not here ([`Truth::instrument`]). `cx` must carry
+    /// what the truth's bases need (commands and motion per axis, velocities for `velocity`).
     ///
     /// # Panics
-    /// When `errors` is not one per catalogue entry, or `commands`/`motion` not one per axis of
-    /// the machine the truth was parsed for.
+    /// When `errors` is not one per catalogue entry, or `cx` does not have one command,
+    /// direction (and velocity, for `velocity` terms) per axis of the machine the truth was
+    /// parsed for.
     pub fn evaluate_into(
         &self,
         m: &Machine,
-        commands: &[f64],
-        motion: &[i8],
-        tau: f64,
+        cx: &BasisContext<'_>,
         errors: &mut [f64],
         offsets: &mut [f64; 3],
     ) {
@@ -212,36 +213,60 @@ impl Truth {
         *offsets = [0.0; 3];
         let mut at = 0;
         for t in &self.model.terms {
-            let b = t
-                .basis
-                .values(m, t.effect.carrier(m), commands, motion, tau);
             let w = t.basis.width();
             let c = &self.coefficients[at..at + w];
+            at += w;
+            if matches!(t.effect, Effect::Instrument { .. }) {
+                continue;
+            }
+            let b = t.basis.values(m, t.effect.carrier(m), cx);
             let v = c.iter().zip(b).map(|(c, b)| c * b).sum::<f64>();
             match t.effect {
                 Effect::Error(e) => errors[e] += v,
                 Effect::SensorOffset(d) => offsets[d.index()] += v,
+                Effect::Instrument { .. } => {}
             }
-            at += w;
         }
     }
 
-    /// Every catalogue error's value at `sample` (catalogue order; mm or rad), with normalised
-    /// time `tau` ∈ [−1, 1].
-    pub fn error_values(&self, m: &Machine, sample: &Sample, tau: f64) -> Vec<f64> {
+    /// Every catalogue error's value at the sample `cx` (catalogue order; mm or rad).
+    pub fn error_values(&self, m: &Machine, cx: &BasisContext<'_>) -> Vec<f64> {
         let mut e = vec![0.0; m.catalogue.len()];
         let mut o = [0.0; 3];
-        self.evaluate_into(m, &sample.commands, &sample.motion, tau, &mut e, &mut o);
+        self.evaluate_into(m, cx, &mut e, &mut o);
         e
     }
 
-    /// The R-test zero offsets `dx0 dy0 dz0` at `sample` (mm, tool frame; added to the reading),
-    /// with normalised time `tau` ∈ [−1, 1].
-    pub fn sensor_offsets(&self, m: &Machine, sample: &Sample, tau: f64) -> [f64; 3] {
+    /// The R-test zero offsets `dx0 dy0 dz0` at the sample `cx` (mm, tool frame; added to the
+    /// reading).
+    pub fn sensor_offsets(&self, m: &Machine, cx: &BasisContext<'_>) -> [f64; 3] {
         let mut e = vec![0.0; m.catalogue.len()];
         let mut o = [0.0; 3];
-        self.evaluate_into(m, &sample.commands, &sample.motion, tau, &mut e, &mut o);
+        self.evaluate_into(m, cx, &mut e, &mut o);
         o
+    }
+
+    /// The instrument matrix `S` (dimensionless, constant): `S[i][j]` is the instrument term
+    /// `S<i><j>`, so that the reading is `(I + S) · displacement` plus the offsets.
+    pub fn instrument(&self) -> [[f64; 3]; 3] {
+        let mut s = [[0.0; 3]; 3];
+        let mut at = 0;
+        for t in &self.model.terms {
+            if let Effect::Instrument {
+                reading,
+                displacement,
+            } = t.effect
+            {
+                s[reading.index()][displacement.index()] += self.coefficients[at];
+            }
+            at += t.basis.width();
+        }
+        s
+    }
+
+    /// `true` when a term needs the real sample times (`velocity`, `exp:TAU`).
+    pub fn needs_times(&self) -> bool {
+        self.model.terms.iter().any(|t| t.basis.needs_times())
     }
 
     /// The terms in the units people see (µm, µrad), model order.
@@ -250,7 +275,7 @@ impl Truth {
         let mut out = Vec::new();
         for t in &self.model.terms {
             let w = t.basis.width();
-            let p = places(m, t.effect);
+            let p = places(m, t);
             out.push(TruthEntry {
                 term: *t,
                 name: t.effect.name(m),
@@ -259,7 +284,7 @@ impl Truth {
                     .iter()
                     .map(|&c| parse_scaled(&format_scaled(c, p), 0).unwrap_or(c * 10f64.powi(p)))
                     .collect(),
-                unit: t.effect.unit(m),
+                unit: t.unit(m),
             });
             at += w;
         }
@@ -330,7 +355,7 @@ impl Truth {
         let mut lines: Vec<(Effect, Vec<(Basis, String)>)> = Vec::new();
         for t in &self.model.terms {
             let w = t.basis.width();
-            let p = places(m, t.effect);
+            let p = places(m, t);
             let v: Vec<String> = self.coefficients[at..at + w]
                 .iter()
                 .map(|&c| format_scaled(c, p))

@@ -248,7 +248,7 @@ impl Parser<'_> {
                 return Err(self.err(
                     k.span(),
                     format!(
-                        "`{name}` is neither an error of machine {} nor a sensor offset dx0 dy0 dz0 (errors: {})",
+                        "`{name}` is neither an error of machine {} nor a sensor offset dx0 dy0 dz0 nor an instrument term SXX … SZY (errors: {})",
                         m.name,
                         m.catalogue.iter().map(|e| e.name.as_str()).collect::<Vec<_>>().join(" ")
                     ),
@@ -317,9 +317,9 @@ impl Parser<'_> {
                 ),
             ));
         }
-        let unit = effect.unit(m).replace('u', "µ");
+        let unit = term.unit(m).replace('u', "µ");
         let what = format!("{name} `{basis}` ({unit})");
-        let p = places(m, effect);
+        let p = places(m, &term);
         let values = if basis.width() == 2 {
             let arr = match v.get_ref() {
                 DeValue::Array(a) if a.len() == 2 => a,
@@ -353,7 +353,9 @@ impl Parser<'_> {
             if let DeValue::Array(_) = v.get_ref() {
                 return Err(self.err(
                     v.span(),
-                    format!("{what} takes one number; only `harmonic:K` takes a pair [cos, sin]"),
+                    format!(
+                        "{what} takes one number; only `harmonic:K` and `period:P` take a pair [cos, sin]"
+                    ),
                 ));
             }
             let (value, text) = self.number(v, &what)?;

@@ -103,6 +103,11 @@ pub struct FindingReport {
     /// `size ≤ limit`: named as a cause and in the extended model. `false`: it fits, but is
     /// implausible, and is left out of the extended model.
     pub plausible: bool,
+    /// What the finding is: `cause` (plausible, and the extended model is recommended: the
+    /// held-out records confirm it), `not confirmed` (plausible, but the extended model is not
+    /// recommended: it fits the fitted record, the held-out records do not confirm it, or there
+    /// are none to check) or `implausible`.
+    pub status: String,
 }
 
 /// An isolated reading far outside the residual's robust local scale, left out of the fits
@@ -568,6 +573,12 @@ impl DiagnosisReport {
                 size: finite(|| field("size"), f.size)?,
                 limit: f.limit,
                 plausible: f.plausible,
+                status: match (f.plausible, d.recommendation.recommended) {
+                    (false, _) => "implausible",
+                    (true, true) => "cause",
+                    (true, false) => "not confirmed",
+                }
+                .into(),
             });
         }
         let (name, file) = match &source.model_out {

@@ -61,6 +61,10 @@ pub fn findings(r: &DiagnosisReport) -> String {
                 value(f.size),
                 value(f.limit)
             ));
+        } else if f.status != "cause" {
+            out.push_str(
+                "     fits the fitted record, but not confirmed: the extended model is not recommended (below); not a cause\n",
+            );
         }
         if let (Some(h), Some(k)) = (&f.harmonic, f.basis.strip_prefix("harmonic:")) {
             let pm = |s: Option<f64>, digits: usize| {

@@ -162,7 +162,7 @@ fn truth_table(
     let mut rows = Vec::new();
     for (j, (t, k)) in ident.model.columns().into_iter().enumerate() {
         let term = ident.model.terms[t];
-        let f = term.effect.display_factor(m);
+        let f = term.display_factor(m);
         let true_value = truth.coefficient(&term).map_or(0.0, |c| c[k]) * f;
         let b = bias
             .and_then(|b| b.get(j).copied().flatten())
@@ -180,7 +180,7 @@ fn truth_table(
         };
         let mut row = vec![
             fit.names[j].clone(),
-            symbol(term.effect.unit(m)).to_string(),
+            symbol(term.unit(m)).to_string(),
             value(true_value),
             shown,
             std,
@@ -213,7 +213,7 @@ fn unexplained(m: &Machine, hidden: &HiddenTerms) -> String {
     let mut at = 0;
     let mut names = Vec::new();
     for t in &hidden.model.terms {
-        let f = t.effect.display_factor(m);
+        let f = t.display_factor(m);
         let w = t.basis.width();
         let parts: Vec<String> = hidden.values[at..at + w]
             .iter()
@@ -224,11 +224,7 @@ fn unexplained(m: &Machine, hidden: &HiddenTerms) -> String {
         } else {
             parts.join(", ")
         };
-        names.push(format!(
-            "{} = {shown} {}",
-            t.spelling(m),
-            symbol(t.effect.unit(m))
-        ));
+        names.push(format!("{} = {shown} {}", t.spelling(m), symbol(t.unit(m))));
         at += w;
     }
     let rms: Vec<String> = hidden.rms_mm.iter().map(|x| fixed(x * 1e3, 2)).collect();
@@ -271,8 +267,8 @@ fn diagnosis_text(m: &Machine, s: &Summary) -> String {
     // The check against the truth.
     let mut checks = Vec::new();
     for t in &s.hidden.model.terms {
-        let f = t.effect.display_factor(m);
-        let unit = symbol(t.effect.unit(m));
+        let f = t.display_factor(m);
+        let unit = symbol(t.unit(m));
         let want: Vec<f64> = s
             .truth
             .coefficient(t)

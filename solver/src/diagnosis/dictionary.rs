@@ -10,6 +10,24 @@
 //!
 //! Constant translational component errors, and constant angular component errors of rotary
 //! axes, are not candidates: they are the location and set-up errors under other names.
+//!
+//! Families with a scanned parameter ([`scanned`], when [`DictionaryOptions::scans`] is on):
+//! every scanned value is a candidate of its own, so the multiple-testing correction counts
+//! the scan. The grids follow the fitted record:
+//! - `period:P` of the positioning error of every linear axis that moves: P on a grid
+//!   uniform in 1/P (spacing a tenth of 1/range, so that the best grid value is within a
+//!   twentieth of a cycle of the true period over the range: a coarser grid loses half of a
+//!   10 mm period over 430 mm of X, and an alias can win), from two median steps of the axis
+//!   between samples (the sampling limit: near it, periods alias) to two thirds of its range, within
+//!   [`PERIOD_RANGE_MM`];
+//! - `step:V` of the positioning error of every axis that moves: [`STEPS`] positions evenly
+//!   between the 5 % and 95 % quantiles of the positions the record covers;
+//! - `exp:TAU` of `dx0 dy0 dz0` and of every location error (records with real times only):
+//!   [`TAUS`] time constants, geometric from two sample intervals to half the record's
+//!   duration (a longer warm-up is a linear drift over the record: `time:1`);
+//! - `time:1` of every location error (thermal drift of an axis line);
+//! - `velocity` of the positioning error of every axis that moves (records with real times);
+//! - the R-test's instrument terms `SXX … SZY`, constant.
 
 use model_spec::basis::Basis;
 use model_spec::terms::{Effect, Term};
@@ -25,6 +43,9 @@ pub struct DictionaryOptions {
     pub poly: u32,
     /// Highest Legendre order T in time of the sensor offsets.
     pub time: u32,
+    /// The scanned families (period, step, warm-up), servo lag, thermal drift of axis lines
+    /// and the instrument terms.
+    pub scans: bool,
 }
 
 impl DictionaryOptions {
@@ -35,6 +56,7 @@ impl DictionaryOptions {
             harmonics,
             poly,
             time,
+            scans: true,
         }
     }
 }
@@ -45,6 +67,7 @@ impl Default for DictionaryOptions {
             harmonics: 4,
             poly: 3,
             time: 2,
+            scans: true,
         }
     }
 }
@@ -103,4 +126,146 @@ pub fn dictionary(m: &Machine, model_terms: &[Term], o: &DictionaryOptions) -> V
         })
         .filter(|t| !model_terms.contains(t))
         .collect()
+}
+
+/// The range of periods scanned, mm.
+pub const PERIOD_RANGE_MM: [f64; 2] = [1.0, 100.0];
+
+/// Positions scanned per axis for `step:V`.
+pub const STEPS: usize = 24;
+
+/// Time constants scanned for `exp:TAU`.
+pub const TAUS: usize = 8;
+
+/// Sorted copy.
+fn sorted(mut v: Vec<f64>) -> Vec<f64> {
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+/// The scanned and record-dependent candidates of `m` on `record` that `model_terms` lacks
+/// (see the module documentation).
+pub fn scanned(
+    m: &Machine,
+    model_terms: &[Term],
+    record: &crate::record::Record,
+    o: &DictionaryOptions,
+) -> Vec<Term> {
+    if !o.scans || record.samples.len() < 3 {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    let positioning = |axis: usize| -> Option<Effect> {
+        (0..m.catalogue.len())
+            .map(Effect::Error)
+            .find(|e| e.is_positioning(m) && e.carrier(m) == model_spec::basis::Carrier::Axis(axis))
+    };
+    for (a, axis) in m.axes.iter().enumerate() {
+        let Some(effect) = positioning(a) else {
+            continue;
+        };
+        let rotary = axis.kind == AxisKind::Rotary;
+        let unit = if rotary {
+            180.0 / std::f64::consts::PI
+        } else {
+            1.0
+        };
+        let x = sorted(
+            record
+                .samples
+                .iter()
+                .map(|s| s.commands[a] * unit)
+                .collect(),
+        );
+        let (lo, hi) = (x[0], x[x.len() - 1]);
+        if hi - lo < 1e-6 {
+            continue;
+        }
+        // step:V between the 5 % and 95 % quantiles.
+        let (q0, q1) = (x[x.len() / 20], x[x.len() - 1 - x.len() / 20]);
+        for k in 0..STEPS {
+            let v = q0 + (q1 - q0) * (k as f64 + 0.5) / STEPS as f64;
+            out.push(Term {
+                effect,
+                basis: Basis::Step((v * 1000.0).round() as i64),
+            });
+        }
+        if record.has_times() {
+            out.push(Term {
+                effect,
+                basis: Basis::Velocity,
+            });
+        }
+        if !rotary {
+            // period:P, uniform in 1/P.
+            let mut steps: Vec<f64> = record
+                .samples
+                .windows(2)
+                .map(|w| ((w[1].commands[a] - w[0].commands[a]) * unit).abs())
+                .filter(|d| *d > 0.0)
+                .collect();
+            steps = sorted(steps);
+            let median = steps.get(steps.len() / 2).copied().unwrap_or(0.0);
+            let range = hi - lo;
+            let p_min = (2.0 * median).max(PERIOD_RANGE_MM[0]);
+            let p_max = (range / 1.5).min(PERIOD_RANGE_MM[1]);
+            if median > 0.0 && p_max > p_min {
+                let df = 0.1 / range;
+                let mut f = 1.0 / p_max;
+                while f <= 1.0 / p_min {
+                    let p_um = (1000.0 / f).round() as u32;
+                    let t = Term {
+                        effect,
+                        basis: Basis::Period(p_um),
+                    };
+                    if !out.contains(&t) {
+                        out.push(t);
+                    }
+                    f += df;
+                }
+            }
+        }
+    }
+    let location: Vec<Effect> = (0..m.catalogue.len())
+        .filter(|&e| matches!(m.catalogue[e].kind, ErrorKind::Location { .. }))
+        .map(Effect::Error)
+        .collect();
+    for &effect in &location {
+        out.push(Term {
+            effect,
+            basis: Basis::Time(1),
+        });
+    }
+    if record.has_times() {
+        let t0 = record.samples[0].t;
+        let duration = record.samples[record.samples.len() - 1].t - t0;
+        let dt = duration / (record.samples.len() - 1) as f64;
+        if duration > 0.0 && dt > 0.0 {
+            let (a, b) = (2.0 * dt, 0.5 * duration);
+            let taus: Vec<u32> = (0..TAUS)
+                .map(|k| {
+                    let tau = a * (b / a).powf(k as f64 / (TAUS - 1) as f64);
+                    (tau * 1000.0).round().max(1.0) as u32
+                })
+                .collect();
+            for effect in Dir::ALL
+                .into_iter()
+                .map(Effect::SensorOffset)
+                .chain(location.iter().copied())
+            {
+                for &ms in &taus {
+                    out.push(Term {
+                        effect,
+                        basis: Basis::Exp(ms),
+                    });
+                }
+            }
+        }
+    }
+    out.extend(Effect::instruments().map(|effect| Term {
+        effect,
+        basis: Basis::Const,
+    }));
+    out.retain(|t| !model_terms.contains(t) && t.check(m).is_ok());
+    out
 }

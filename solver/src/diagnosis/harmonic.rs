@@ -41,7 +41,7 @@ pub fn harmonic(m: &Machine, d: &Diagnosis, f: &Finding) -> Option<Harmonic> {
     if !matches!(f.term.basis, Basis::Harmonic(_)) || f.values.len() != 2 {
         return None;
     }
-    let k = f.term.effect.display_factor(m);
+    let k = f.term.display_factor(m);
     let (c, s) = (f.values[0]? * k, f.values[1]? * k);
     let a = c.hypot(s);
     let cols = columns_of(d, &f.term);

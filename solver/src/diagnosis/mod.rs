@@ -27,6 +27,7 @@ pub mod hidden;
 mod options;
 pub mod outliers;
 pub mod plausible;
+pub mod profile;
 mod search;
 pub mod select;
 pub mod structure;
@@ -40,7 +41,7 @@ use crate::fitting::validate::{ValidateError, ValidateOptions};
 use crate::fitting::{
     EstimateError, Identification, IdentifyOptions, measurement_vector, with_offsets,
 };
-use crate::model::Model;
+use crate::model::{Effect, Model};
 use crate::record::Record;
 use confounded::confounded_with;
 use dictionary::dictionary;
@@ -86,6 +87,9 @@ pub struct Finding {
     /// `size ≤ limit`: a plausible cause, in the extended model. An implausible finding fits
     /// the data but is not named as a cause and is left out of the extended model.
     pub plausible: bool,
+    /// For `period:P`, `step:V`, `exp:TAU`: the refined parameter and its 95 % interval
+    /// ([`profile`]); the values' standard uncertainties are conditional on it.
+    pub scan: Option<profile::Scan>,
     /// Share of the base model's residual sum of squares it explains beyond all the other
     /// findings (its step in the final exchange pass).
     pub explained_fraction: f64,
@@ -244,7 +248,8 @@ pub fn diagnose(
     } else {
         base.clone()
     };
-    let candidates = dictionary(m, &base.terms, &o.dictionary);
+    let mut candidates = dictionary(m, &base.terms, &o.dictionary);
+    candidates.extend(dictionary::scanned(m, &base.terms, record, &o.dictionary));
     // One gain source for every error the base model and the dictionary use.
     let mut all = base.clone();
     all.terms.extend(candidates.iter().copied());
@@ -276,9 +281,29 @@ pub fn diagnose(
     let before = heldout::predict(m, &base_fit, held_out, &mut source, &vopts)?;
     let (noise, estimated) = noise_model(&o.noise, &base_fit, held_out, &before);
     let layout = [record.samples.len()];
-    let h_raw = h_matrix(m, &all, record, &mut source)?;
-    let mut h_all = h_raw.clone();
     let mut y = measurement_vector(record)?;
+    let mut h_raw = h_matrix(m, &all, record, &mut source)?;
+    // The instrument candidates act on the displacement, which the H matrix takes from the
+    // readings; those carry the very misfit the selection looks for, so that a gain term
+    // "explains" a share of any residual. Here the displacement is the base model's
+    // prediction instead (first order in S all the same).
+    let predicted = &y - &base_fit.fit.residual;
+    let mut at = 0;
+    for t in &all.terms {
+        if let Effect::Instrument {
+            reading,
+            displacement,
+        } = t.effect
+        {
+            let mut col = h_raw.column_mut(at);
+            col.fill(0.0);
+            for i in 0..predicted.len() / 3 {
+                col[3 * i + reading.index()] = predicted[3 * i + displacement.index()];
+            }
+        }
+        at += t.basis.width();
+    }
+    let mut h_all = h_raw.clone();
     let whitening = if estimated {
         conservative(&noise)
     } else {
@@ -330,19 +355,29 @@ pub fn diagnose(
         o,
     };
     let (chosen, stop) = search::select(&problem);
+    // A scanned parameter refined on a fine grid, with every other finding in place.
+    let mut refined = Vec::new();
+    for k in 0..chosen.len() {
+        let q = search::basis_of(&problem, &chosen, Some(k));
+        let coarse = candidates[chosen[k].index];
+        refined.push(
+            match profile::refine(m, coarse, record, &mut source, &whitening, &q, &y)? {
+                Some((t, scan)) => (t, Some(scan)),
+                None => (coarse, None),
+            },
+        );
+    }
 
     // Every finding fitted together; the implausible ones are then left out of the extended
     // model, which is fitted again.
     let mut with_all = base.clone();
-    with_all
-        .terms
-        .extend(chosen.iter().map(|c| candidates[c.index]));
+    with_all.terms.extend(refined.iter().map(|r| r.0));
     let all_fit = fit(m, &with_all, record, &mut source, o)?;
     let mut findings: Vec<Finding> = chosen
         .iter()
         .enumerate()
         .map(|(k, c)| {
-            let term = candidates[c.index];
+            let (term, scan) = refined[k];
             let (values, stds) = term_values(&all_fit, nb + k);
             let known: Vec<f64> = values.iter().map(|v| v.unwrap_or(0.0)).collect();
             let (size, limit) = plausible::size_and_limit(m, &term, &known, &o.budget);
@@ -355,6 +390,7 @@ pub fn diagnose(
                 size,
                 limit,
                 plausible: size <= limit,
+                scan,
                 explained_fraction: c.fraction,
                 f: c.f,
                 p_value: c.p,
@@ -380,16 +416,24 @@ pub fn diagnose(
         e
     };
 
+    // The extended model's findings as candidates (their coarse grid values: the spans the
+    // selection saw).
+    let kept: Vec<usize> = chosen
+        .iter()
+        .zip(&findings)
+        .filter(|(_, f)| f.plausible)
+        .map(|(c, _)| c.index)
+        .collect();
+    let mut as_candidates = base.clone();
+    as_candidates
+        .terms
+        .extend(kept.iter().map(|&c| candidates[c]));
     let confounded = confounded_with(
-        &extended,
+        &as_candidates,
         &candidates,
-        &chosen
-            .iter()
-            .map(|c| c.index)
-            .filter(|&c| extended.terms.contains(&candidates[c]))
-            .collect::<Vec<_>>(),
+        &kept,
         &unexcited,
-        &q_of(&extended, nb, &candidates, &group),
+        &q_of(&as_candidates, nb, &candidates, &group),
         &|t| group(t),
         nb,
         &h_all,
@@ -412,11 +456,7 @@ pub fn diagnose(
         NoiseSource::Residual { why } => Err(why.clone()),
         _ => {
             let cols: Vec<usize> = (0..nb)
-                .chain(
-                    extended.terms[nb..]
-                        .iter()
-                        .filter_map(|t| candidates.iter().position(|c| c == t).map(|c| nb + c)),
-                )
+                .chain(kept.iter().map(|&c| nb + c))
                 .flat_map(|g| starts[g]..starts[g] + widths[g])
                 .collect();
             let h_ext = h_raw.select_columns(&cols);

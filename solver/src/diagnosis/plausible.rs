@@ -86,8 +86,8 @@ impl Budget {
 
 /// Size of a term with `values` (internal units), in the unit people see, and its limit.
 pub fn size_and_limit(m: &Machine, term: &Term, values: &[f64], budget: &Budget) -> (f64, f64) {
-    let size = values.iter().map(|v| v * v).sum::<f64>().sqrt() * term.effect.display_factor(m);
-    (size, budget.limit(term.effect.unit(m)))
+    let size = values.iter().map(|v| v * v).sum::<f64>().sqrt() * term.display_factor(m);
+    (size, budget.limit(term.unit(m)))
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ use crate::diagnosis::harmonic::harmonic;
 use crate::diagnosis::structure::Component;
 use crate::diagnosis::unexplained::{Shape, Unexplained};
 use crate::diagnosis::{Correction, DiagnoseOptions, Diagnosis};
-use crate::model::{Carrier, Term};
+use crate::model::{Basis, Carrier, Term};
 use model_spec::Machine;
 use model_spec::units::UM_PER_MM;
 use serde::{Deserialize, Serialize};
@@ -103,11 +103,30 @@ pub struct FindingReport {
     /// `size ≤ limit`: named as a cause and in the extended model. `false`: it fits, but is
     /// implausible, and is left out of the extended model.
     pub plausible: bool,
+    /// For `period:P`, `step:V`, `exp:TAU`: the refined parameter and its 95 % interval from
+    /// the profile of the fit (the values' stds are conditional on it); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scan: Option<ScanReport>,
     /// What the finding is: `cause` (plausible, and the extended model is recommended: the
     /// held-out records confirm it), `not confirmed` (plausible, but the extended model is not
     /// recommended: it fits the fitted record, the held-out records do not confirm it, or there
     /// are none to check) or `implausible`.
     pub status: String,
+}
+
+/// A scanned parameter and its interval.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScanReport {
+    /// `P`, `V` or `TAU`.
+    pub parameter: String,
+    /// Its value.
+    pub value: f64,
+    /// The lower end of its 95 % interval.
+    pub low: f64,
+    /// The upper end.
+    pub high: f64,
+    /// `mm`, `deg` or `s`.
+    pub unit: String,
 }
 
 /// An isolated reading far outside the residual's robust local scale, left out of the fits
@@ -529,7 +548,7 @@ impl DiagnosisReport {
         let mut findings = Vec::new();
         for (i, f) in d.findings.iter().enumerate() {
             let field = |what: &str| format!("findings[{i}].{what}");
-            let k = f.term.effect.display_factor(m);
+            let k = f.term.display_factor(m);
             let h = harmonic(m, d, f);
             findings.push(FindingReport {
                 error: f.term.effect.name(m),
@@ -549,7 +568,7 @@ impl DiagnosisReport {
                     .iter()
                     .map(|s| finite_opt(|| field("stds"), s.map(|s| s * k)))
                     .collect::<Result<_, _>>()?,
-                unit: f.term.effect.unit(m).into(),
+                unit: f.term.unit(m).into(),
                 columns: f.term.basis.column_names(),
                 harmonic: match h {
                     Some(h) => Some(HarmonicReport {
@@ -573,6 +592,25 @@ impl DiagnosisReport {
                 size: finite(|| field("size"), f.size)?,
                 limit: f.limit,
                 plausible: f.plausible,
+                scan: f.scan.map(|sc| {
+                    let (parameter, unit) = match f.term.basis {
+                        Basis::Period(_) => ("P", "mm"),
+                        Basis::Exp(_) => ("TAU", "s"),
+                        _ => match f.term.effect.carrier(m) {
+                            Carrier::Axis(a) if m.axes[a].kind == model_spec::AxisKind::Rotary => {
+                                ("V", "deg")
+                            }
+                            _ => ("V", "mm"),
+                        },
+                    };
+                    ScanReport {
+                        parameter: parameter.into(),
+                        value: sc.value,
+                        low: sc.low,
+                        high: sc.high,
+                        unit: unit.into(),
+                    }
+                }),
                 status: match (f.plausible, d.recommendation.recommended) {
                     (false, _) => "implausible",
                     (true, true) => "cause",

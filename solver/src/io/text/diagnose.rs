@@ -55,6 +55,16 @@ pub fn findings(r: &DiagnosisReport) -> String {
     for (i, f) in r.findings.iter().enumerate() {
         let unit = symbol(&f.unit);
         out.push_str(&format!("  {}. {}: {}\n", i + 1, f.description, values(f)));
+        if let Some(sc) = &f.scan {
+            out.push_str(&format!(
+                "     {} = {} {} (95 % interval {} .. {} from the profile of the fit; the values' stds are conditional on it)\n",
+                sc.parameter,
+                fixed(sc.value, 3),
+                sc.unit,
+                fixed(sc.low, 3),
+                fixed(sc.high, 3)
+            ));
+        }
         if !f.plausible {
             out.push_str(&format!(
                 "     fits, but implausible: size {} {unit} beyond the budget of {} {unit}; not a cause, left out of the extended model\n",
@@ -382,7 +392,7 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
     out.push_str(&structure(r));
     let [k, p, t] = r.dictionary_extent;
     out.push_str(&format!(
-        "\nCandidates: {} terms the model lacks (harmonic:1..{k} of rotary-axis errors, poly:1..{p} of linear-axis errors, reversal of positioning errors, const location, squareness and set-up errors, dx0 dy0 dz0 const and time:1..{t}); {} do not vary on {} (unexcited).\n",
+        "\nCandidates: {} terms the model lacks (harmonic:1..{k} of rotary-axis errors, poly:1..{p} of linear-axis errors, reversal of positioning errors, const location, squareness and set-up errors, dx0 dy0 dz0 const and time:1..{t}; scanned: period:P and step:V of positioning errors, exp:TAU of the zero offsets and location errors, time:1 of location errors, velocity of positioning errors, the instrument terms SXX..SZY); {} do not vary on {} (unexcited).\n",
         r.dictionary_size,
         r.unexcited.len(),
         r.data

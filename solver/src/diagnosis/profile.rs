@@ -1,0 +1,190 @@
+//! The scanned parameter of a finding (P of `period:P`, V of `step:V`, TAU of `exp:TAU`),
+//! refined and given an interval from the profile of the fit.
+//!
+//! The selection picks the best value of the coarse grid ([`super::dictionary::scanned`]). Here
+//! the parameter is scanned again on a fine grid around it (41 values: ±1 coarse step in 1/P,
+//! every distinct position between the neighbouring grid steps for V, ±half a coarse ratio
+//! in ln TAU within the coarse grid's range), with every other term of the model in place, in the whitened rows: the value
+//! that explains most (largest ΔRSS) is the finding's, and its 95 % interval is the set of
+//! values whose ΔRSS lies within `3.84·s²` of the best (`s²` the whitened residual variance of
+//! the model with the finding: the profile-likelihood interval of one parameter). The
+//! amplitudes' standard uncertainties are then those of the fit at that value: conditional
+//! on it.
+
+use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::noise::NoiseModel;
+use crate::model::{Basis, Model, Term};
+use crate::record::Record;
+use model_spec::Machine;
+use nalgebra::{DMatrix, DVector};
+
+use super::select::Span;
+
+/// A refined scanned parameter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scan {
+    /// The value (mm for P; mm or degrees for V; s for TAU).
+    pub value: f64,
+    /// The lower end of its 95 % interval.
+    pub low: f64,
+    /// The upper end.
+    pub high: f64,
+}
+
+/// The scanned parameter of `basis`, in its unit.
+pub fn parameter(basis: Basis) -> Option<f64> {
+    basis
+        .period_mm()
+        .or_else(|| basis.step_at())
+        .or_else(|| basis.tau_s())
+}
+
+/// The basis with parameter `v` (same family as `basis`), rounded to the vocabulary's
+/// thousandths.
+fn with_parameter(basis: Basis, v: f64) -> Basis {
+    let milli = (v * 1000.0).round();
+    match basis {
+        Basis::Period(_) => Basis::Period(milli.max(1.0) as u32),
+        Basis::Exp(_) => Basis::Exp(milli.max(1.0) as u32),
+        Basis::Step(_) => Basis::Step(milli as i64),
+        other => other,
+    }
+}
+
+/// The fine grid around the coarse value of `basis` on axis values `x` (sorted; for steps).
+fn grid(basis: Basis, x: &[f64], tau_range: (f64, f64)) -> Vec<f64> {
+    let n = 41;
+    match basis {
+        Basis::Period(_) => {
+            let p = basis.period_mm().unwrap_or(1.0);
+            let range = x.last().copied().unwrap_or(0.0) - x.first().copied().unwrap_or(0.0);
+            let df = 0.1 / range.max(1e-9);
+            (0..n)
+                .map(|k| 1.0 / (1.0 / p + df * (2.0 * k as f64 / (n - 1) as f64 - 1.0)))
+                .filter(|p| p.is_finite() && *p > 0.0)
+                .collect()
+        }
+        Basis::Step(_) => {
+            let v = basis.step_at().unwrap_or(0.0);
+            let n_steps = super::dictionary::STEPS as f64;
+            let (lo, hi) = (
+                x.first().copied().unwrap_or(v),
+                x.last().copied().unwrap_or(v),
+            );
+            let half = (hi - lo) / n_steps;
+            let mut out: Vec<f64> = x
+                .windows(2)
+                .filter(|w| w[1] > w[0])
+                .map(|w| 0.5 * (w[0] + w[1]))
+                .filter(|m| (m - v).abs() <= half)
+                .collect();
+            out.dedup();
+            out
+        }
+        Basis::Exp(_) => {
+            let t = basis.tau_s().unwrap_or(1.0);
+            let (lo, hi) = tau_range;
+            (0..n)
+                .map(|k| t * (0.5 * (2.0 * k as f64 / (n - 1) as f64 - 1.0)).exp())
+                .filter(|v| (lo..=hi).contains(v))
+                .collect()
+        }
+        _ => Vec::new(),
+    }
+}
+
+/// What a term explains beyond `q` in the whitened rows: ΔRSS, or `None` when it adds no
+/// direction.
+#[allow(clippy::too_many_arguments)]
+fn explains(
+    m: &Machine,
+    term: Term,
+    record: &Record,
+    source: &mut GainSource,
+    whitening: &NoiseModel,
+    q: &Span,
+    y: &DVector<f64>,
+) -> Result<Option<f64>, HMatrixError> {
+    let model = Model { terms: vec![term] };
+    let mut h: DMatrix<f64> = h_matrix(m, &model, record, source)?;
+    whitening
+        .whiten_matrix(&[record.samples.len()], &mut h)
+        .map_err(|e| HMatrixError::Term {
+            term: term.spelling(m),
+            message: e.to_string(),
+        })?;
+    let d = q.new_directions(&h);
+    Ok((d.ncols() > 0).then(|| d.tr_mul(&q.project_out(y)).norm_squared()))
+}
+
+/// The refined term and its interval: `term`'s scanned parameter on the fine grid, with the
+/// model `q` (orthonormal, whitened, every other term) in place; `y` the whitened readings.
+/// `None` for a term without a scanned parameter.
+#[allow(clippy::too_many_arguments)]
+pub fn refine(
+    m: &Machine,
+    term: Term,
+    record: &Record,
+    source: &mut GainSource,
+    whitening: &NoiseModel,
+    q: &Span,
+    y: &DVector<f64>,
+) -> Result<Option<(Term, Scan)>, HMatrixError> {
+    if parameter(term.basis).is_none() {
+        return Ok(None);
+    }
+    let axis = match term.effect.carrier(m) {
+        model_spec::basis::Carrier::Axis(a) => Some(a),
+        model_spec::basis::Carrier::None => None,
+    };
+    let mut x: Vec<f64> = match axis {
+        Some(a) => {
+            let k = if m.axes[a].kind == model_spec::AxisKind::Rotary {
+                180.0 / std::f64::consts::PI
+            } else {
+                1.0
+            };
+            record.samples.iter().map(|s| s.commands[a] * k).collect()
+        }
+        None => Vec::new(),
+    };
+    x.sort_by(f64::total_cmp);
+    let mut profile: Vec<(f64, Term, f64)> = Vec::new();
+    let coarse = parameter(term.basis).unwrap_or(0.0);
+    let tau_range = match (record.samples.first(), record.samples.last()) {
+        (Some(a), Some(b)) if record.samples.len() > 1 => {
+            let duration = b.t - a.t;
+            (
+                2.0 * duration / (record.samples.len() - 1) as f64,
+                0.5 * duration,
+            )
+        }
+        _ => (coarse, coarse),
+    };
+    for v in grid(term.basis, &x, tau_range).into_iter().chain([coarse]) {
+        let t = Term {
+            effect: term.effect,
+            basis: with_parameter(term.basis, v),
+        };
+        if t.check(m).is_err() {
+            continue;
+        }
+        if let Some(gain) = explains(m, t, record, source, whitening, q, y)? {
+            profile.push((parameter(t.basis).unwrap_or(v), t, gain));
+        }
+    }
+    let Some(&(value, best, top)) = profile.iter().max_by(|a, b| a.2.total_cmp(&b.2)) else {
+        return Ok(None);
+    };
+    let rss = q.project_out(y).norm_squared() - top;
+    let dof = y.len().saturating_sub(q.rank() + best.basis.width()).max(1);
+    let s2 = rss / dof as f64;
+    let inside: Vec<f64> = profile
+        .iter()
+        .filter(|(_, _, g)| top - g <= 3.84 * s2)
+        .map(|(v, _, _)| *v)
+        .collect();
+    let low = inside.iter().copied().fold(value, f64::min);
+    let high = inside.iter().copied().fold(value, f64::max);
+    Ok(Some((best, Scan { value, low, high })))
+}

@@ -385,6 +385,57 @@ fn no_hidden_effect_no_finding() {
     assert_eq!(entries(&dir.join("figs")).len(), 6);
 }
 
+/// An effect outside the dictionary (a seventh harmonic of C's radial motion): the text and
+/// the JSON say the residual is not the noise and describe what remains; the figure of it is
+/// written; nothing is recommended that makes a held-out file worse; the finding fields are
+/// there.
+#[test]
+fn an_effect_outside_the_dictionary_is_described_as_unexplained() {
+    let dir = temp_dir("outside");
+    let truth = dir.join("t.toml");
+    std::fs::write(
+        &truth,
+        "machine = \"seed-ac\"\nnoise_um = 0.5\n[errors]\nXOC = 10.0\nEYC = { \"harmonic:7\" = [3.0, 0.0] }\n",
+    )
+    .unwrap();
+    simulate_all(&dir, "t.toml", &[]);
+    let out = diagnose(&dir, &["--json", "d.json", "--plot", "figs"]);
+    println!("{out}");
+    assert!(out.contains("Noise model of every test: "), "{out}");
+    assert!(out.contains("NOT consistent with the noise"), "{out}");
+    assert!(!out.contains("down to the noise"), "{out}");
+    let j = read_json(&dir.join("d.json"));
+    let a = &j["adequacy"];
+    assert_eq!(a["consistent_with_noise"], false);
+    assert!(num(&a["p_value"]) < 0.01);
+    assert_eq!(a["records"].as_array().unwrap().len(), 3);
+    let un = j["unexplained"].as_array().unwrap();
+    assert!(!un.is_empty());
+    for u in un {
+        assert!(u["data"].is_string() && u["direction"].is_string() && u["shape"].is_string());
+        assert!(num(&u["rms_um"]) > 0.5);
+    }
+    assert!(j["noise_model"].as_str().unwrap().contains("estimated"));
+    for f in j["findings"].as_array().unwrap() {
+        assert!(f["plausible"].is_boolean() && f["status"].is_string() && f["size"].is_number());
+    }
+    if j["recommended"] == true {
+        for v in j["gain"]["validation"].as_array().unwrap() {
+            assert!(num(&v["residual_rms_um_after"]) <= num(&v["residual_rms_um_before"]));
+        }
+    }
+    assert!(
+        j["recommendation"]
+            .as_array()
+            .is_some_and(|r| !r.is_empty())
+    );
+    let figs = entries(&dir.join("figs"));
+    assert!(
+        figs.iter().any(|f| f.contains("unexplained")),
+        "no figure of what remains: {figs:?}"
+    );
+}
+
 #[test]
 fn the_demo_diagnoses_the_reduced_model_and_writes_its_files() {
     let dir = temp_dir("demo");

@@ -1,8 +1,11 @@
 //! The whole diagnosis of `seed-ac`: fitted on K4 (241 samples, 723 rows), K1 and K2
 //! held out, the full dictionary (harmonics 1–4, polynomials 1–3, time 1–2: every error of the
-//! topology the reduced model lacks), default options (α = 0.01, 1000 Monte-Carlo draws). It
-//! includes the base and extended fits refined against the exact machine and the exact
-//! predictions of the held-out records.
+//! topology the reduced model lacks; and the scanned families: periods, steps, warm-ups, lags,
+//! drift of axis lines, instrument terms), default options (α = 0.01, 1000 Monte-Carlo draws,
+//! the noise estimated from the records). It includes the outlier search, the noise estimate,
+//! the base and extended fits (generalized least squares, refined against the exact machine),
+//! the refinement of scanned parameters, the exact predictions of the held-out records and the
+//! lack-of-fit bootstrap (400 draws per record).
 //!
 //! - `diagnose/demo`: truth `seed-ac-demo` (one hidden effect, ECC harmonic:2; one finding);
 //! - `diagnose/budget`: truth `seed-ac-budget` (the full error budget; several findings, the
@@ -15,7 +18,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use model_spec::Machine;
-use solver::diagnosis::dictionary::{DictionaryOptions, dictionary};
+use solver::diagnosis::dictionary::{DictionaryOptions, dictionary, scanned};
 use solver::diagnosis::{DiagnoseOptions, diagnose};
 use solver::model::Model;
 use solver::record::Record;
@@ -56,9 +59,10 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("diagnose");
     g.sample_size(30);
     for (name, truth, o) in cases {
-        let candidates = dictionary(&m, &base.terms, &o.dictionary);
-        let columns: usize = candidates.iter().map(|t| t.basis.width()).sum();
         let recs = records(&m, truth);
+        let mut candidates = dictionary(&m, &base.terms, &o.dictionary);
+        candidates.extend(scanned(&m, &base.terms, &recs[0].1, &o.dictionary));
+        let columns: usize = candidates.iter().map(|t| t.basis.width()).sum();
         let d = diagnose(&m, &base, &recs[0].1, &recs[1..], &o).expect("diagnosis");
         println!(
             "{name}: dictionary of {} candidate terms, {columns} H-matrix columns (base: {}), K4 {} rows; {} finding(s): {}",

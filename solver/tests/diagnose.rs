@@ -30,7 +30,7 @@ mod helpers;
 
 use helpers::*;
 use solver::diagnosis::Diagnosis;
-use solver::model::Term;
+use solver::fitting::noise::{NoiseChoice, NoiseModel, NoiseSource};
 
 /// One hidden-effect scenario.
 struct Case {
@@ -219,6 +219,8 @@ fn reversal() {
 /// Drift of the reading in time (thermal), linear over each record.
 #[test]
 fn drift() {
+    // On K4 dx0 and XOC, dz0 and ZOA have one span, and so do their drifts: the drift of the
+    // R-test's zero is named, the axis line's is its alternative.
     check_all(&[case("dx0@time:1", &[2.0]), case("dz0@time:1", &[4.0])]);
 }
 
@@ -249,11 +251,15 @@ fn two_hidden_effects_are_both_found() {
         let d = run(&m, &base_model(&m, &[]), &recs, &options());
         let line = summary(&m, &d, &recs);
         println!("{} + {}: {line}", pair[0].term, pair[1].term);
-        let found: Vec<Term> = d.findings.iter().take(2).map(|f| f.term).collect();
+        // A finding or one of its alternatives (exact aliases on K4: dz0 and ZOA drift).
         for h in &pair {
+            let t = term(&m, h.term);
             assert!(
-                found.contains(&term(&m, h.term)),
-                "{} is not among the first two findings: {line}",
+                d.findings
+                    .iter()
+                    .take(2)
+                    .any(|f| f.term == t || f.alternatives.contains(&t)),
+                "{} is not among the first two findings or their alternatives: {line}",
                 h.term
             );
         }
@@ -267,13 +273,13 @@ fn two_hidden_effects_are_both_found() {
 // ---------------------------------------------------------------------------------------------
 // 3. Nothing hidden: the false-finding rate is α.
 
-/// Noise seeds of the null test: 200; the environment variable `NULL_SEEDS` overrides it (1000
-/// for docs/diagnosis.md).
+/// Noise seeds of the null test: 100; the environment variable `NULL_SEEDS` overrides it (200
+/// and 1000 for docs/diagnosis.md).
 fn null_seeds() -> u64 {
     std::env::var("NULL_SEEDS")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(200)
+        .unwrap_or(100)
 }
 
 /// `[lo, hi]`: the central interval of Binomial(n, p) holding at least `level` of its mass
@@ -299,10 +305,12 @@ fn binomial_interval(n: u64, p: f64, level: f64) -> (u64, u64) {
     (lo, hi)
 }
 
-/// The base truth alone (nothing hidden), α = 0.05 so that the rate is measurable: the share of
-/// noise seeds with a finding lies in the 99 % binomial interval around α (not merely below
-/// it: the Monte-Carlo null of the selection rule makes the step's level α exactly), and so
-/// does the share of first-step corrected p-values below 0.5 (the p-value is uniform).
+/// The base truth alone (nothing hidden), α = 0.05 so that the rate is measurable, the noise
+/// declared (white, its true σ): the share of noise seeds with a finding lies in the 99 %
+/// binomial interval around α (not merely below it: the Monte-Carlo null of the selection rule
+/// makes the step's level α exactly under a right noise model), and so does the share of
+/// first-step corrected p-values below 0.5 (the p-value is uniform). With the noise estimated
+/// from the record the level is at most α (`diagnose_noise.rs`).
 #[test]
 fn no_hidden_effect_gives_findings_at_rate_alpha() {
     let m = machine();
@@ -313,7 +321,10 @@ fn no_hidden_effect_gives_findings_at_rate_alpha() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(0.05);
-    let o = options().alpha(alpha);
+    let mut o = options().alpha(alpha);
+    o.noise = NoiseChoice::Model(NoiseModel::white(NOISE_MM, NoiseSource::Declared));
+    // The findings only: no lack-of-fit bootstrap.
+    o.adequacy_draws = 0;
     let seeds = null_seeds();
     let (mut found, mut below_half) = (0, 0);
     for s in 0..seeds {

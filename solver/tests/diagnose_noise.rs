@@ -6,13 +6,14 @@
 //! stationary start, σ the marginal standard deviation. Effects outside the dictionary are
 //! added to the readings as what they do at the ball.
 //!
-//! Runs: `NOISE_SEEDS` (default 40) seeds per null-rate case.
+//! Runs: `NOISE_SEEDS` (default 30) seeds per null-rate case.
 
 #[path = "diagnose/helpers.rs"]
 mod helpers;
 
 use helpers::*;
 use solver::diagnosis::Diagnosis;
+use solver::fitting::noise::{NoiseChoice, NoiseModel, NoiseSource};
 use solver::record::Record;
 use solver::simulation::rng::Rng;
 
@@ -20,7 +21,7 @@ fn seeds() -> u64 {
     std::env::var("NOISE_SEEDS")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(40)
+        .unwrap_or(30)
 }
 
 /// Noise-free records of `truth` on `paths`.
@@ -50,12 +51,18 @@ fn with_ar1(recs: &[(String, Record)], phi: f64, sigma: f64, seed: u64) -> Vec<(
     out
 }
 
-/// The number of diagnoses with a finding, over the seeds, for AR(1) noise (φ, σ mm).
-fn false_findings(phi: f64, sigma: f64, alpha: f64) -> (u64, u64, Vec<String>) {
+/// The number of diagnoses with a finding, over the seeds, for AR(1) noise (φ, σ mm), the noise
+/// estimated from the records, or declared (its true φ and σ) when `declared`.
+fn false_findings(phi: f64, sigma: f64, alpha: f64, declared: bool) -> (u64, u64, Vec<String>) {
     let m = machine();
     let base = base_model(&m, &[]);
     let recs = clean(&m, &["K4", "K1", "K2"]);
-    let o = options().alpha(alpha);
+    let mut o = options().alpha(alpha);
+    // The findings and the verdict only: no lack-of-fit bootstrap.
+    o.adequacy_draws = 0;
+    if declared {
+        o.noise = NoiseChoice::Model(NoiseModel::ar1(phi, sigma, NoiseSource::Declared));
+    }
     let n = seeds();
     let mut found = 0;
     let mut worse = Vec::new();
@@ -93,23 +100,29 @@ fn upper(n: u64, alpha: f64) -> u64 {
     (mean + 2.576 * (mean * (1.0 - alpha)).sqrt() + 1.0).floor() as u64
 }
 
-/// White noise and AR(1) noise up to φ = 0.8 with the noise estimated from the records: the
-/// false-finding rate stays at or below α (α = 0.05 so that a rate is measurable), and no
-/// recommended extension makes a held-out record worse.
+/// White noise and AR(1) noise up to φ = 0.8 with the noise estimated from the records, and
+/// φ = 0.9 declared: the false-finding rate stays at or below α (α = 0.05 so that a rate is
+/// measurable), and no recommended extension makes a held-out record worse.
 #[test]
 fn correlated_noise_does_not_make_findings() {
     let alpha = 0.05;
-    for (phi, sigma) in [(0.0, 0.5e-3), (0.5, 0.3e-3), (0.8, 0.3e-3)] {
-        let (found, n, worse) = false_findings(phi, sigma, alpha);
+    for (phi, sigma, declared) in [
+        (0.0, 0.5e-3, false),
+        (0.5, 0.3e-3, false),
+        (0.8, 0.3e-3, false),
+        (0.9, 0.3e-3, true),
+    ] {
+        let (found, n, worse) = false_findings(phi, sigma, alpha, declared);
+        let how = if declared { "declared" } else { "estimated" };
         println!(
-            "AR(1) φ = {phi}, σ = {} µm: {found} of {n} seeds with a finding",
+            "AR(1) φ = {phi}, σ = {} µm, {how}: {found} of {n} seeds with a finding",
             sigma * 1e3
         );
         assert!(
             found <= upper(n, alpha),
-            "φ = {phi}: {found} of {n} seeds gave a finding at α = {alpha}"
+            "φ = {phi} ({how}): {found} of {n} seeds gave a finding at α = {alpha}"
         );
-        assert!(worse.is_empty(), "φ = {phi}: {worse:?}");
+        assert!(worse.is_empty(), "φ = {phi} ({how}): {worse:?}");
     }
 }
 
@@ -133,12 +146,21 @@ fn outside(
     name: &str,
     effect: impl Fn(&model_spec::Machine, &Record, usize) -> [f64; 3],
 ) -> Diagnosis {
+    outside_with(name, &options(), effect)
+}
+
+/// As [`outside`], with the options `o`.
+fn outside_with(
+    name: &str,
+    o: &solver::diagnosis::DiagnoseOptions,
+    effect: impl Fn(&model_spec::Machine, &Record, usize) -> [f64; 3],
+) -> Diagnosis {
     let m = machine();
     let base = base_model(&m, &[]);
     let mut recs = clean(&m, &["K4", "K1", "K2"]);
     add(&mut recs, |r, i| effect(&m, r, i));
     let recs = with_ar1(&recs, 0.0, 0.5e-3, 7);
-    let d = run(&m, &base, &recs, &options());
+    let d = run(&m, &base, &recs, o);
     let a = d.adequacy.as_ref().expect("a noise model");
     println!(
         "{name}: noise {}; {a:?}; findings {:?}",
@@ -163,9 +185,13 @@ fn outside(
     d
 }
 
+/// Without the scanned families, a ballscrew period of X is outside the dictionary: described
+/// as periodic in X, with its period (with them it is found: `diagnose_families.rs`).
 #[test]
 fn a_ballscrew_period_of_x_is_described_not_hidden() {
-    let d = outside("ballscrew", |m, r, i| {
+    let mut o = options();
+    o.dictionary.scans = false;
+    let d = outside_with("ballscrew", &o, |m, r, i| {
         let x = r.samples[i].commands[m.axis_by_name("X").unwrap()];
         [2e-3 * (std::f64::consts::TAU * x / 10.0).sin(), 0.0, 0.0]
     });
@@ -177,6 +203,37 @@ fn a_ballscrew_period_of_x_is_described_not_hidden() {
         }
         ref s => panic!("{s:?}"),
     }
+}
+
+/// The angle of C at a sample, degrees.
+fn c_deg(m: &model_spec::Machine, r: &Record, i: usize) -> f64 {
+    r.samples[i].commands[m.axis_by_name("C").unwrap()].to_degrees()
+}
+
+#[test]
+fn a_seventh_harmonic_of_c_is_described_not_hidden() {
+    // 3 µm in y, seven times per revolution: beyond the dictionary's harmonics 1–4.
+    outside("7th harmonic", |m, r, i| {
+        [0.0, 3e-3 * (7.0 * c_deg(m, r, i).to_radians()).cos(), 0.0]
+    });
+}
+
+#[test]
+fn a_local_bump_in_c_is_described_not_hidden() {
+    // 4 µm in x around C = 200°, 8° wide.
+    outside("bump", |m, r, i| {
+        let c = c_deg(m, r, i);
+        [4e-3 * (-((c - 200.0) / 8.0).powi(2)).exp(), 0.0, 0.0]
+    });
+}
+
+#[test]
+fn a_cross_term_z_times_t_is_described_not_hidden() {
+    // z grows with Z and time together: 0.1 µm per (mm · 100 s).
+    outside("Z·t", |m, r, i| {
+        let z = r.samples[i].commands[m.axis_by_name("Z").unwrap()];
+        [0.0, 0.0, 1e-6 * z * r.samples[i].t]
+    });
 }
 
 #[test]
@@ -218,8 +275,17 @@ fn a_random_walk_drift_is_never_a_geometric_cause() {
                 .map(|h| (h.before_rms * 1e3, h.after_rms * 1e3))
                 .collect::<Vec<_>>()
         );
-        // Whatever fits the walk on K4 is not confirmed on K1 and K2: no geometric cause.
-        assert!(!d.recommendation.recommended, "seed {seed}");
+        // No geometric cause: a finding confirmed by the held-out records is the instrument's
+        // (a drift of its zero, a gain), never an error of the machine.
+        if d.recommendation.recommended {
+            for f in d.findings.iter().filter(|f| f.plausible) {
+                assert!(
+                    !matches!(f.term.effect, solver::model::Effect::Error(_)),
+                    "seed {seed}: {} named a cause",
+                    f.term.spelling(&m)
+                );
+            }
+        }
         let a = d.adequacy.as_ref().expect("a noise model");
         assert!(
             !a.consistent_with_noise || d.findings.is_empty(),

@@ -5,10 +5,54 @@
 use super::{CliError, CliResult};
 use model_spec::units::UM_PER_MM;
 use model_spec::{ErrorId, Machine};
+use solver::fitting::noise::{NoiseChoice, NoiseModel};
 use solver::fitting::{Constraint, ValueLimits};
 use solver::io::csv::ReadOptions;
 use solver::model::{Effect, Model, Term};
 use std::path::PathBuf;
+
+/// The noise model of the tests and uncertainties: declared, from a static record, or
+/// estimated (the default). For `identify` and `diagnose`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct NoiseArgs {
+    /// The noise the uncertainties and tests assume: `white:sigma=S` or `ar1:phi=F,sigma=S` (S
+    /// the marginal standard deviation of a reading in µm, 0 ≤ F < 0.99), or `white` (ordinary
+    /// least squares). Default: estimated from the records.
+    #[arg(long, value_name = "SPEC", conflicts_with = "noise_record")]
+    pub noise: Option<String>,
+    /// A record of the machine standing still (a measurement CSV, at least 100 samples): the
+    /// noise model's σ and φ per direction, by Yule-Walker.
+    #[arg(long, value_name = "FILE")]
+    pub noise_record: Option<PathBuf>,
+}
+
+impl NoiseArgs {
+    /// The input file it reads, for the check that no output names an input.
+    pub fn input(&self) -> Option<(&'static str, &std::path::Path)> {
+        self.noise_record.as_deref().map(|p| ("--noise-record", p))
+    }
+
+    /// `--noise` as parsed (the static record is read by [`NoiseArgs::choice`]).
+    pub fn declared(&self) -> CliResult<NoiseChoice> {
+        match self.noise.as_deref() {
+            Some(spec) => {
+                NoiseChoice::parse(spec).map_err(|e| CliError::usage(format!("--noise: {e}")))
+            }
+            None => Ok(NoiseChoice::Estimate),
+        }
+    }
+
+    /// The noise choice: `--noise`, or the model of the static record `--noise-record`.
+    pub fn choice(&self, m: &Machine, read: &ReadOptions) -> CliResult<NoiseChoice> {
+        let Some(path) = &self.noise_record else {
+            return self.declared();
+        };
+        let still = super::read_record("--noise-record", m, path, read)?;
+        let model = NoiseModel::from_static_record(&still)
+            .map_err(|e| CliError::input(format!("--noise-record: {}: {e}", path.display())))?;
+        Ok(NoiseChoice::Model(model))
+    }
+}
 
 /// What a record read must be: plausible readings, poses within the strokes. For the verbs
 /// that read or write records.

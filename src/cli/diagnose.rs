@@ -20,21 +20,38 @@ and degrees, dx_um,dy_um,dz_um in µm), extends the model with it and measures t
 fitted data and on held-out measurements (--validate, e.g. K1 and K2).
 
 1. Base fit: the model --model is identified on --data (least squares, refined against the \
-exact machine); its residual RMS (µm).
-2. Residual structure: the residual per direction x, y, z of the tool frame against every axis \
-that moves (harmonics 1..K of rotary angles, Legendre polynomials 1..P of linear positions), \
-time (1..T) and direction of motion (reversal); the largest components in µm.
-3. Candidates: every term of the machine's topology the model lacks: harmonic:1..K of rotary-axis \
+exact machine); its residual RMS (µm). Outliers (isolated readings beyond 6 robust scales of the \
+residual's local deviation, one or two samples in a row) are listed with file, line and \
+direction, and their samples left out of everything after.
+2. Noise model (--noise, --noise-record, else estimated from the fitted and held-out records by \
+the variogram of second differences): σ and AR(1) φ per direction x, y, z. The readings and \
+every column are whitened by it, so that every test and p-value below accounts for serially \
+correlated noise, and the fits are generalized least squares under it.
+3. Residual structure: the residual per direction against every axis that moves (harmonics \
+1..K of rotary angles, Legendre polynomials 1..P of linear positions), time (1..T) and direction \
+of motion (reversal); the largest components in µm.
+4. Candidates: every term of the machine's topology the model lacks: harmonic:1..K of rotary-axis \
 component errors, poly:1..P of linear-axis component errors (and const of their angular ones), \
 reversal of positioning errors (backlash), const location, squareness and ball set-up errors, \
-and the R-test's zero offsets dx0 dy0 dz0 (const and time:1..T: drift).
-4. Selection: one candidate at a time, the one that explains most of what is left; kept if its \
-F-test against the noise is significant at --alpha after a correction for the number of \
-candidates tried (Bonferroni, else a Monte-Carlo null of the selection itself). Candidates the \
-model already spans are refused and listed as confounded (with what); candidates the data cannot \
-tell from a finding are named with it. The selection stops when nothing significant remains.
-5. Gain: the extended model (model + findings) is fitted on --data and predicts every --validate \
-file (exact prediction); residual RMS before and after, µm.
+the R-test's zero offsets dx0 dy0 dz0 (const and time:1..T: drift); and scanned: period:P \
+(ballscrew, scale) and step:V of positioning errors, exp:TAU (warm-up) of the zero offsets and \
+location errors, time:1 of location errors, velocity (servo lag, records with t_s) of \
+positioning errors, and the instrument terms SXX..SZY (sensor gain and cross-talk).
+5. Selection: one candidate at a time, the one that explains most of what is left; kept if its \
+F-test is significant at --alpha after a correction for the number of candidates tried, every \
+scanned value counted (Bonferroni, else a Monte-Carlo null of the selection itself). Candidates \
+the model already spans are listed as confounded (with what); candidates the data cannot tell \
+from a finding are named with it. A scanned parameter (P, V, TAU) is refined with a 95 % \
+interval. A finding beyond --budget is 'implausible': not a cause, not in the extended model.
+6. Gain: the extended model (model + plausible findings) is fitted on --data and predicts every \
+--validate file (exact prediction, with only what the fits determine: a file whose prediction \
+needs an undetermined combination is flagged and not counted); residual RMS before and after, \
+µm.
+7. Verdict: the residual of the extended model on every file is tested against the noise \
+(parametric bootstrap; 'down to the noise' only when it passes); where it fails, what remains is \
+described (what it follows, its shape, its RMS). The extended model is recommended only when no \
+held-out file gets worse and the held-out residual falls; otherwise the findings are 'not \
+confirmed' and the text says why.
 
 Values of findings are in µm (translational errors, offsets) and µrad (angular errors); a \
 harmonic is printed as its cos and sin coefficients, its amplitude √(cos² + sin²) and phase φ \
@@ -44,12 +61,16 @@ whose values are beyond --max-error-um / --max-error-urad, is an error (exit cod
 --json writes the report (docs/diagnosis.md): {machine, data, base_model, zeroed, alpha, \
 base_fit, structure, dictionary_size, unexcited, findings: [{error, basis, description, values, \
 stds, unit, amplitude, phase_deg, explained_fraction, f, p_value, correction, candidates_tried, \
-alternatives, …}], stop, confounded, extended_model, gain: {fit, validation}}; `--json -` writes \
+alternatives, size, limit, plausible, status, scan, …}], stop, confounded, extended_model, gain: \
+{fit, validation: [{…, estimable, undetermined}]}, outliers, budget, recommended, \
+recommendation, noise_model, adequacy: {records, p_value, consistent_with_noise, …}, \
+unexplained}; `--json -` writes \
 it to standard output. --model-out writes the machine description (the text of --machine) with \
 the extended model appended as [models.extended] (extended2, … if that name is taken). --plot \
 DIR writes SVG figures: per record the measured error against the base and extended \
-predictions along the path (<name>-path.svg), and the residual spectrum before and after \
-(<name>-spectrum.svg). Every output is computed first; they are all written or none is.";
+predictions along the path (<name>-path.svg), the residual spectrum before and after \
+(<name>-spectrum.svg), and what remains unexplained against what it follows \
+(<name>-unexplained-<dir>.svg). Every output is computed first; they are all written or none is.";
 
 /// Flags of `rtest diagnose`.
 #[derive(Debug, clap::Args)]
@@ -103,6 +124,8 @@ pub struct DiagnoseArgs {
     /// flagged and not counted either way.
     #[arg(long, value_name = "none|min-norm|zero:NAME,…")]
     constraint: Option<String>,
+    #[command(flatten)]
+    noise: args::NoiseArgs,
     /// Also write the diagnosis as JSON to FILE (values in µm and µrad; `-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
@@ -137,6 +160,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     };
     let mut inputs: Vec<(&str, &Path)> = vec![("--data", args.data.as_path())];
     inputs.extend(held_files.iter().map(|f| ("--validate", f.as_path())));
+    inputs.extend(args.noise.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     outputs.extend(args.model_out.iter().map(|t| ("--model-out", t)));
@@ -157,6 +181,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     opts.alpha = args.alpha;
     opts.zeroed = args.zeroed;
     opts.constraint = args::constraint(args.constraint.as_deref())?;
+    opts.noise = args.noise.choice(&m, &read)?;
     if let Some(b) = &args.budget {
         opts.budget = solver::diagnosis::plausible::Budget::parse(b)
             .map_err(|e| CliError::usage(format!("--budget: {e}")))?;

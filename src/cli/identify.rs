@@ -5,7 +5,7 @@ use super::args::{self, RecordLimits, ValueBounds};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
 use solver::fitting::hmatrix::HMatrixError;
-use solver::fitting::noise::{NoiseChoice, NoiseModel};
+use solver::fitting::noise::NoiseChoice;
 use solver::fitting::streaming::{StreamingError, identify_file};
 use solver::fitting::{
     EstimateError, IdentifyOptions, RefineError, RefineOptions, check_values, identify_noise,
@@ -111,15 +111,8 @@ pub struct IdentifyArgs {
     /// refinement needs the whole record).
     #[arg(long)]
     stream: bool,
-    /// The noise the uncertainties assume: `white:sigma=S` or `ar1:phi=F,sigma=S` (S the
-    /// marginal standard deviation of a reading in µm, 0 ≤ F < 0.99), or `white` (ordinary
-    /// least squares). Default: estimated from the residual.
-    #[arg(long, value_name = "SPEC", conflicts_with = "noise_record")]
-    noise: Option<String>,
-    /// A record of the machine standing still (a measurement CSV, at least 100 samples): the
-    /// noise model's σ and φ per direction, by Yule-Walker.
-    #[arg(long, value_name = "FILE")]
-    noise_record: Option<PathBuf>,
+    #[command(flatten)]
+    noise: args::NoiseArgs,
     /// Samples per block with --stream (at least 1).
     #[arg(long, value_name = "N", default_value_t = 4096, requires = "stream",
           value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
@@ -137,29 +130,21 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let opts = IdentifyOptions::new()
         .zeroed(args.zeroed)
         .constraint(args::constraint(args.constraint.as_deref())?);
-    let mut noise = match args.noise.as_deref() {
-        Some(spec) => {
-            NoiseChoice::parse(spec).map_err(|e| CliError::usage(format!("--noise: {e}")))?
-        }
-        None => NoiseChoice::Estimate,
-    };
-    if args.stream && (args.noise_record.is_some() || matches!(noise, NoiseChoice::Model(_))) {
+    let declared = args.noise.declared()?;
+    if args.stream
+        && (args.noise.noise_record.is_some() || matches!(declared, NoiseChoice::Model(_)))
+    {
         return Err(CliError::usage(
             "--stream fits by ordinary least squares in one pass; --noise models and --noise-record need the whole record (drop --stream, or use --noise white)",
         ));
     }
     let mut inputs = vec![("--data", args.data.as_path())];
-    inputs.extend(args.noise_record.as_deref().map(|p| ("--noise-record", p)));
+    inputs.extend(args.noise.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
     let read = args.records.read_options();
-    if let Some(path) = &args.noise_record {
-        let still = super::read_record("--noise-record", &m, path, &read)?;
-        let model = NoiseModel::from_static_record(&still)
-            .map_err(|e| CliError::input(format!("--noise-record: {}: {e}", path.display())))?;
-        noise = NoiseChoice::Model(model);
-    }
+    let noise = args.noise.choice(&m, &read)?;
     let data = args.data.display().to_string();
     let (ident, refinement, streaming, notes) = if args.stream {
         let (ident, run) = identify_file(&m, &model, &args.data, &opts, args.block as usize, &read)

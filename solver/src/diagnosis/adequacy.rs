@@ -38,8 +38,8 @@ use crate::fitting::noise::{NoiseError, NoiseModel};
 use crate::simulation::rng::Rng;
 use nalgebra::{DMatrix, DVector};
 
-/// Draws of the bootstrap null.
-pub const DRAWS: usize = 400;
+/// Draws of the bootstrap null by default ([`super::DiagnoseOptions::adequacy_draws`]).
+pub const DRAWS: usize = 200;
 
 /// Below this many draws at least as large, the p-value is the Gaussian tail of `ln T`.
 pub const TAIL_DRAWS: usize = 5;
@@ -207,6 +207,7 @@ pub fn adequacy(
     residuals: &[Residual],
     alpha: f64,
     seed: u64,
+    draws: usize,
 ) -> Result<Adequacy, NoiseError> {
     let observed: Vec<Vec<[f64; 3]>> = residuals
         .iter()
@@ -225,7 +226,7 @@ pub fn adequacy(
     let mut rng = Rng::new(seed);
     let mut exceed = vec![[0usize; 3]; residuals.len()];
     let mut logs = vec![[(0.0f64, 0.0f64); 3]; residuals.len()];
-    for _ in 0..DRAWS {
+    for _ in 0..draws {
         let drawn = draw_residuals(noise, residuals, &fits, &mut rng)?;
         // A draw whose σ cannot be estimated counts as exceeding: conservative, it can only
         // make the residuals look more consistent with the noise.
@@ -255,11 +256,11 @@ pub fn adequacy(
             residual_sigma_mm: mean_squares(&observed[k]).map(f64::sqrt),
             statistic: stats[k],
             p_values: std::array::from_fn(|d| {
-                let rank = (1 + exceed[k][d]) as f64 / (DRAWS + 1) as f64;
+                let rank = (1 + exceed[k][d]) as f64 / (draws + 1) as f64;
                 if exceed[k][d] >= TAIL_DRAWS {
                     return rank;
                 }
-                let n = DRAWS as f64;
+                let n = draws.max(1) as f64;
                 let mean = logs[k][d].0 / n;
                 let sd = (logs[k][d].1 / n - mean * mean).max(0.0).sqrt();
                 let z = (stats[k][d].max(f64::MIN_POSITIVE).ln() - mean) / sd;
@@ -278,7 +279,7 @@ pub fn adequacy(
         noise: noise.clone(),
         records,
         p_value,
-        draws: DRAWS,
+        draws,
         consistent_with_noise: p_value >= alpha,
     })
 }

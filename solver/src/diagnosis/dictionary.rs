@@ -15,9 +15,9 @@
 //! every scanned value is a candidate of its own, so the multiple-testing correction counts
 //! the scan. The grids follow the fitted record:
 //! - `period:P` of the positioning error of every linear axis that moves: P on a grid
-//!   uniform in 1/P (spacing a tenth of 1/range, so that the best grid value is within a
-//!   twentieth of a cycle of the true period over the range: a coarser grid loses half of a
-//!   10 mm period over 430 mm of X, and an alias can win), from two median steps of the axis
+//!   uniform in 1/P (spacing a fifth of 1/range, so that the best grid value is within a tenth
+//!   of a cycle of the true period over the range and explains at least 80 % of it; the
+//!   profile refines it, [`super::profile`]), from two median steps of the axis
 //!   between samples (the sampling limit: near it, periods alias) to two thirds of its range, within
 //!   [`PERIOD_RANGE_MM`];
 //! - `step:V` of the positioning error of every axis that moves: [`STEPS`] positions evenly
@@ -210,7 +210,7 @@ pub fn scanned(
             let p_min = (2.0 * median).max(PERIOD_RANGE_MM[0]);
             let p_max = (range / 1.5).min(PERIOD_RANGE_MM[1]);
             if median > 0.0 && p_max > p_min {
-                let df = 0.1 / range;
+                let df = 0.2 / range;
                 let mut f = 1.0 / p_max;
                 while f <= 1.0 / p_min {
                     let p_um = (1000.0 / f).round() as u32;

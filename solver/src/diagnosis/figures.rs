@@ -1,6 +1,7 @@
 //! The data of the diagnosis figures, as plain series for a plotting library: per record, the
 //! measured error against the base and extended predictions along the path (x, y, z), and the
-//! residual components before and after the extension.
+//! residual components before and after the extension, and what remains unexplained against what
+//! it follows.
 
 use super::structure::{self, Component};
 use super::{DiagnoseOptions, Diagnosis};
@@ -180,7 +181,7 @@ pub fn figures(
             let values: Vec<Option<f64>> = if *fitted {
                 fit.fit.solution.iter().map(|&v| Some(v)).collect()
             } else {
-                fit.fit.values.clone()
+                super::heldout::estimable_values(fit)
             };
             let mut opts = ValidateOptions::new()
                 .zeroed(o.zeroed && !fitted)
@@ -247,6 +248,54 @@ pub fn figures(
                 rows,
             });
         }
+    }
+    // What remains unexplained, against what it follows (sorted by it).
+    for u in &d.unexplained {
+        let residual: Vec<f64> = if u.data == records[0].0 {
+            let r = &d.extended_fit.fit.residual;
+            (0..r.len() / 3).map(|i| r[3 * i + u.direction]).collect()
+        } else {
+            match d.validation.iter().find(|h| h.name == u.data) {
+                Some(h) => h.residual_after.iter().map(|v| v[u.direction]).collect(),
+                None => continue,
+            }
+        };
+        if residual.len() != u.x.len() {
+            continue;
+        }
+        let mut order: Vec<usize> = (0..u.x.len()).collect();
+        order.sort_by(|&a, &b| u.x[a].total_cmp(&u.x[b]));
+        let dir = ["x", "y", "z"][u.direction];
+        let follows = u.follows.clone().unwrap_or_else(|| "sample".into());
+        let s = stem(&format!("{}-unexplained-{dir}", u.data), &mut taken);
+        out.paths.push(PathFigure {
+            file_name: format!("{s}.svg"),
+            what: format!(
+                "figure: what remains in {dir} on {}, against {follows}",
+                u.data
+            ),
+            title: format!(
+                "{}: residual in {dir} of the extended model against {follows}, µm",
+                u.data
+            ),
+            x_label: if u.unit.is_empty() {
+                follows.clone()
+            } else {
+                format!("{follows} ({})", u.unit)
+            },
+            x: order.iter().map(|&i| u.x[i]).collect(),
+            panels: vec![Panel {
+                name: format!("{dir} residual"),
+                measured: Series {
+                    label: "residual of the extended model".into(),
+                    values: order.iter().map(|&i| residual[i] * 1e3).collect(),
+                },
+                predictions: vec![Series {
+                    label: "the shape described".into(),
+                    values: order.iter().map(|&i| u.fitted[i] * 1e3).collect(),
+                }],
+            }],
+        });
     }
     Ok(out)
 }

@@ -36,7 +36,7 @@ pub mod verdict;
 
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
 use crate::fitting::noise::{self, NoiseChoice, NoiseError, NoiseModel, NoiseSource};
-use crate::fitting::refine::{RefineError, RefineOptions, identify_refined_with};
+use crate::fitting::refine::{RefineError, RefineOptions, identify_refined_with_noise};
 use crate::fitting::validate::{ValidateError, ValidateOptions};
 use crate::fitting::{
     EstimateError, Identification, IdentifyOptions, measurement_vector, with_offsets,
@@ -192,12 +192,14 @@ pub enum DiagnoseError {
     Noise(#[from] NoiseError),
 }
 
+/// The refined fit of `model` on `record`, by generalized least squares under `noise`.
 fn fit(
     m: &Machine,
     model: &Model,
     record: &Record,
     source: &mut GainSource,
     o: &DiagnoseOptions,
+    noise: &NoiseChoice,
 ) -> Result<Identification, DiagnoseError> {
     let opts = IdentifyOptions {
         zeroed: false,
@@ -205,8 +207,15 @@ fn fit(
         tolerances: o.tolerances,
         params: None,
     };
-    let (mut ident, _) =
-        identify_refined_with(m, model, record, source, &opts, &RefineOptions::default())?;
+    let (mut ident, _) = identify_refined_with_noise(
+        m,
+        model,
+        record,
+        source,
+        &opts,
+        &RefineOptions::default(),
+        noise,
+    )?;
     ident.zeroed = o.zeroed;
     Ok(ident)
 }
@@ -258,7 +267,7 @@ pub fn diagnose(
 
     // Outliers of the fitted record, from the base fit's residual: everything after works
     // without their samples.
-    let first_fit = fit(m, &base, record, &mut source, o)?;
+    let first_fit = fit(m, &base, record, &mut source, o, &NoiseChoice::Ordinary)?;
     let outliers = outliers::find_in(record, &residual_rows(&first_fit));
     let fit_rms_with_outliers = first_fit.fit.residual_rms();
     let cleaned;
@@ -266,7 +275,7 @@ pub fn diagnose(
         (record, first_fit)
     } else {
         cleaned = record.without(&outliers::samples(&outliers));
-        let f = fit(m, &base, &cleaned, &mut source, o)?;
+        let f = fit(m, &base, &cleaned, &mut source, o, &NoiseChoice::Ordinary)?;
         (&cleaned, f)
     };
 
@@ -280,6 +289,19 @@ pub fn diagnose(
     };
     let before = heldout::predict(m, &base_fit, held_out, &mut source, &vopts)?;
     let (noise, estimated) = noise_model(&o.noise, &base_fit, held_out, &before);
+    // Every fit from here on is the generalized least-squares fit under that model, so that
+    // the standard uncertainties assume it.
+    let gls = match noise.source {
+        NoiseSource::Residual { .. } => NoiseChoice::Ordinary,
+        _ => NoiseChoice::Model(noise.clone()),
+    };
+    let (base_fit, before) = if gls == NoiseChoice::Ordinary {
+        (base_fit, before)
+    } else {
+        let f = fit(m, &base, record, &mut source, o, &gls)?;
+        let b = heldout::predict(m, &f, held_out, &mut source, &vopts)?;
+        (f, b)
+    };
     let layout = [record.samples.len()];
     let mut y = measurement_vector(record)?;
     let mut h_raw = h_matrix(m, &all, record, &mut source)?;
@@ -372,7 +394,7 @@ pub fn diagnose(
     // model, which is fitted again.
     let mut with_all = base.clone();
     with_all.terms.extend(refined.iter().map(|r| r.0));
-    let all_fit = fit(m, &with_all, record, &mut source, o)?;
+    let all_fit = fit(m, &with_all, record, &mut source, o, &gls)?;
     let mut findings: Vec<Finding> = chosen
         .iter()
         .enumerate()
@@ -406,7 +428,7 @@ pub fn diagnose(
     let extended_fit = if extended.terms.len() == with_all.terms.len() {
         all_fit
     } else {
-        let e = fit(m, &extended, record, &mut source, o)?;
+        let e = fit(m, &extended, record, &mut source, o, &gls)?;
         for f in findings.iter_mut().filter(|f| f.plausible) {
             let t = e.model.terms.iter().position(|t| *t == f.term);
             if let Some(t) = t {
@@ -454,6 +476,7 @@ pub fn diagnose(
     // where it fails, described.
     let adequacy = match &noise.source {
         NoiseSource::Residual { why } => Err(why.clone()),
+        _ if o.adequacy_draws == 0 => Err("not asked for (no bootstrap draws)".into()),
         _ => {
             let cols: Vec<usize> = (0..nb)
                 .chain(kept.iter().map(|&c| nb + c))
@@ -490,8 +513,15 @@ pub fn diagnose(
                         zeroed: o.zeroed,
                     }),
             );
-            adequacy::adequacy(&noise, estimated, &residuals, o.alpha, o.seed)
-                .map_err(|e| e.to_string())
+            adequacy::adequacy(
+                &noise,
+                estimated,
+                &residuals,
+                o.alpha,
+                o.seed,
+                o.adequacy_draws,
+            )
+            .map_err(|e| e.to_string())
         }
     };
     let unexplained = match &adequacy {

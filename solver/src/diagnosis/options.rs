@@ -37,6 +37,8 @@ pub struct DiagnoseOptions {
     pub noise: NoiseChoice,
     /// The fitted record's name in reports (default `fitted`).
     pub data_name: String,
+    /// Bootstrap draws of the lack-of-fit test (default 400); 0: no test.
+    pub adequacy_draws: usize,
 }
 
 impl Default for DiagnoseOptions {
@@ -54,6 +56,7 @@ impl Default for DiagnoseOptions {
             budget: Budget::default(),
             noise: NoiseChoice::Estimate,
             data_name: "fitted".into(),
+            adequacy_draws: super::adequacy::DRAWS,
         }
     }
 }

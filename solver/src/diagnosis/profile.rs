@@ -58,7 +58,7 @@ fn grid(basis: Basis, x: &[f64], tau_range: (f64, f64)) -> Vec<f64> {
         Basis::Period(_) => {
             let p = basis.period_mm().unwrap_or(1.0);
             let range = x.last().copied().unwrap_or(0.0) - x.first().copied().unwrap_or(0.0);
-            let df = 0.1 / range.max(1e-9);
+            let df = 0.2 / range.max(1e-9);
             (0..n)
                 .map(|k| 1.0 / (1.0 / p + df * (2.0 * k as f64 / (n - 1) as f64 - 1.0)))
                 .filter(|p| p.is_finite() && *p > 0.0)

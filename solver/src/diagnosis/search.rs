@@ -110,16 +110,22 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         };
         // Candidates of one span explain exactly the same, and which one has the largest ΔRSS
         // is a matter of rounding. Name the one with the fewest parameters (AOC rather than
-        // EZC harmonic:1 when the base lacks AOC), then an error of an axis line (location,
+        // EZC harmonic:1 when the base lacks AOC), then a drift of the R-test's zero (below),
+        // then an error of an axis line (location,
         // squareness, set-up: the squareness AOZ rather than the pitch EAY, the straightness
         // EYZ poly:1 or the angular error EAZ poly:1 that read the same at the ball), then
         // another constant, then the one that needs the smallest change to do it (coefficients
         // of its unit-norm columns): the one least entangled with the model (with a base
         // lacking XOW, ECC@reversal, a constant on K4, spans what XOW spans only through YOW,
         // with 0.043 rad for 12 µm).
+        // A drift or warm-up that the zero offsets of the R-test explain as well as an axis
+        // line is named as the instrument's: the first suspect of a slow change over a record,
+        // and a random-walk drift of the instrument is never named a geometric cause.
         let rank = |t: &Term| -> u8 {
             use model_spec::ErrorKind::{Location, Setup, Squareness};
+            use model_spec::basis::Basis::{Exp, Time};
             match (t.effect, t.basis) {
+                (model_spec::terms::Effect::SensorOffset(_), Time(_) | Exp(_)) => 0,
                 (model_spec::terms::Effect::Error(e), _)
                     if matches!(
                         m.catalogue[e].kind,

@@ -22,7 +22,10 @@
 //! A step is measured by the largest change of the prediction it makes, `‖H·Δ‖∞` (mm), and the
 //! iteration has converged when a step is below [`RefineOptions::tolerance_mm`] (1e-12 mm), or
 //! below the rounding floor `64·ε·κ·‖y‖∞` of an ill-conditioned fit when that is larger (a
-//! least-squares solution is rounded by about ε·κ relative). Otherwise, after
+//! least-squares solution is rounded by about ε·κ relative). Under a noise model κ is
+//! multiplied by the whitening's amplification `a = (1 + φ)/√(1 − φ²)`, and the floor is at
+//! least `64·ε·a·L`, L the largest coordinate of the machine and the path (mm): the exact
+//! prediction is rounded at that scale, and whitening with φ near 1 no longer averages it away. Otherwise, after
 //! [`RefineOptions::max_iterations`] steps (8), it has not converged: a slow or diverging
 //! iteration (noisy readings of a few samples give first-order values far from any machine,
 //! where the second-order terms are no longer small), which is reported as such, never as a
@@ -231,8 +234,29 @@ fn refine_under(
     // The rounding floor of a correction: relative rounding of the least-squares solution is
     // about ε·κ, so its prediction cannot settle below a multiple of ε·κ·‖y‖∞. A step below
     // the floor is rounding, not a correction.
-    let kappa = ident.fit.condition.unwrap_or(1.0);
-    let floor = ROUNDING_FLOOR_FACTOR * f64::EPSILON * kappa * y.amax();
+    // Whitening multiplies the condition by up to (1 + φ)/√(1 − φ²) (the Prais–Winsten
+    // filter's gain at the highest frequency over its gain at the lowest), and the exact
+    // prediction's own rounding enters the whitened correction amplified alike: with φ near 1
+    // a generalized refinement settles about an order of magnitude above the ordinary floor.
+    let amplification = noise.map_or(1.0, |n| {
+        n.phi
+            .iter()
+            .map(|&p| (1.0 + p) / (1.0 - p * p).max(f64::MIN_POSITIVE).sqrt())
+            .fold(1.0, f64::max)
+    });
+    let kappa = ident.fit.condition.unwrap_or(1.0) * amplification;
+    // Under a noise model the exact prediction's own rounding (ε times the machine's
+    // coordinates, mm) is whitened too, and a correction cannot settle below it.
+    let coordinates = params
+        .iter()
+        .chain(record.samples.iter().flat_map(|s| s.commands.iter()))
+        .fold(1.0f64, |a, v| a.max(v.abs()));
+    let prediction_floor = if noise.is_some() {
+        ROUNDING_FLOOR_FACTOR * f64::EPSILON * amplification * coordinates
+    } else {
+        0.0
+    };
+    let floor = (ROUNDING_FLOOR_FACTOR * f64::EPSILON * kappa * y.amax()).max(prediction_floor);
     let tolerance = opts.tolerance_mm.max(floor);
     // Iterate on the whole minimum-norm solution, undetermined parameters included: it is what
     // the linear model's prediction is made of. Which values are reported is decided at the end.

@@ -126,6 +126,28 @@ fn correlated_noise_does_not_make_findings() {
     }
 }
 
+/// On clean data the lack-of-fit test says "not the noise" at a rate of at most α (α = 0.05),
+/// white and AR(1) φ = 0.8 noise, the noise estimated from the records.
+#[test]
+fn the_lack_of_fit_test_holds_its_level() {
+    let m = machine();
+    let base = base_model(&m, &[]);
+    let recs = clean(&m, &["K4", "K1", "K2"]);
+    let alpha = 0.05;
+    let n = 20;
+    for (phi, sigma) in [(0.0, 0.5e-3), (0.8, 0.3e-3)] {
+        let mut rejected = 0;
+        for s in 0..n {
+            let noisy = with_ar1(&recs, phi, sigma, 70_000 + s);
+            let d = run(&m, &base, &noisy, &options().alpha(alpha));
+            let a = d.adequacy.as_ref().expect("a noise model");
+            rejected += u64::from(!a.consistent_with_noise);
+        }
+        println!("φ = {phi}: {rejected} of {n} clean diagnoses called not the noise");
+        assert!(rejected <= upper(n, alpha), "φ = {phi}: {rejected} of {n}");
+    }
+}
+
 /// What an effect does at the ball, added to the readings of every record: `f(record, sample)`
 /// in mm per direction.
 fn add(recs: &mut [(String, Record)], f: impl Fn(&Record, usize) -> [f64; 3]) {

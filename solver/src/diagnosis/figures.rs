@@ -267,7 +267,10 @@ pub fn figures(
         order.sort_by(|&a, &b| u.x[a].total_cmp(&u.x[b]));
         let dir = ["x", "y", "z"][u.direction];
         let follows = u.follows.clone().unwrap_or_else(|| "sample".into());
-        let s = stem(&format!("{}-unexplained-{dir}", u.data), &mut taken);
+        let base = Path::new(&u.data)
+            .file_stem()
+            .map_or("data".to_string(), |s| s.to_string_lossy().into_owned());
+        let s = stem(&format!("{base}-unexplained-{dir}"), &mut taken);
         out.paths.push(PathFigure {
             file_name: format!("{s}.svg"),
             what: format!(

@@ -495,26 +495,37 @@ pub fn diagnose(
                     )
                 })
                 .collect();
+            // The extended model's columns on every held-out record (outliers' samples left
+            // out): the bootstrap carries the fit's own uncertainty into those predictions.
+            let mut predicted = Vec::new();
+            for (h, (_, rec)) in validation.iter().zip(held_out) {
+                let drop = outliers::samples(&h.outliers);
+                match h_matrix(m, &as_candidates, &rec.without(&drop), &mut source) {
+                    Ok(hh) => predicted.push(hh),
+                    Err(e) => return Err(DiagnoseError::HMatrix(e)),
+                }
+            }
             let data = o.data_name.as_str();
             let mut residuals = vec![adequacy::Residual {
                 name: data,
                 residual: &extended_fit.fit.residual,
                 fitted: Some(&h_ext),
+                predicted: None,
                 zeroed: false,
             }];
-            residuals.extend(
-                validation
-                    .iter()
-                    .zip(&held)
-                    .map(|(h, r)| adequacy::Residual {
-                        name: &h.name,
-                        residual: r,
-                        fitted: None,
-                        zeroed: o.zeroed,
-                    }),
-            );
+            residuals.extend(validation.iter().zip(held.iter().zip(&predicted)).map(
+                |(h, (r, p))| adequacy::Residual {
+                    name: &h.name,
+                    residual: r,
+                    fitted: None,
+                    predicted: Some(p),
+                    zeroed: o.zeroed,
+                },
+            ));
+            // Drawn with φ raised as for the selection: an estimate of φ that runs low would make
+            // the draws too tame and the test too eager.
             adequacy::adequacy(
-                &noise,
+                &whitening,
                 estimated,
                 &residuals,
                 o.alpha,
@@ -526,7 +537,14 @@ pub fn diagnose(
     };
     let unexplained = match &adequacy {
         Ok(a) if !a.consistent_with_noise => {
+            // Every (record, direction) whose own p-value passes after a Bonferroni factor;
+            // at least the one with the smallest.
             let tests = 3.0 * a.records.len() as f64;
+            let smallest = a
+                .records
+                .iter()
+                .flat_map(|r| r.p_values)
+                .fold(f64::INFINITY, f64::min);
             let mut out = Vec::new();
             for (k, r) in a.records.iter().enumerate() {
                 let (name, rec, res) = if k == 0 {
@@ -539,7 +557,9 @@ pub fn diagnose(
                         h.residual_after.clone(),
                     )
                 };
-                for d in (0..3).filter(|&d| tests * r.p_values[d] < o.alpha) {
+                let described =
+                    |d: usize| tests * r.p_values[d] < o.alpha || r.p_values[d] == smallest;
+                for d in (0..3).filter(|&d| described(d)) {
                     out.push(unexplained::describe(m, (name, rec), &res, d));
                 }
             }

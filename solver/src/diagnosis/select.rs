@@ -153,6 +153,18 @@ pub fn monte_carlo_p(
     draws: usize,
     seed: u64,
 ) -> f64 {
+    monte_carlo_p_stopping(model, scored, p_observed, draws, seed, SEQUENTIAL_H)
+}
+
+/// As [`monte_carlo_p`], stopping at the `h`-th draw at least as extreme (`usize::MAX`: never).
+fn monte_carlo_p_stopping(
+    model: &Span,
+    scored: &[Scored],
+    p_observed: f64,
+    draws: usize,
+    seed: u64,
+    h: usize,
+) -> f64 {
     let n = model.rows();
     let rank = model.rank();
     let widths: Vec<usize> = scored.iter().map(|s| s.directions.ncols()).collect();
@@ -193,8 +205,8 @@ pub fn monte_carlo_p(
                 && f_p_value(f, best_q, n, rank) <= p_observed
             {
                 exceed += 1;
-                if exceed == SEQUENTIAL_H {
-                    return SEQUENTIAL_H as f64 / (done + d + 1) as f64;
+                if exceed == h {
+                    return h as f64 / (done + d + 1) as f64;
                 }
             }
         }
@@ -247,7 +259,14 @@ mod tests {
         }];
         for f in [1.0, 4.0, 7.0] {
             let exact = f_p_value(f, 1, n, 0);
-            let mc = monte_carlo_p(&model, &scored, exact, 20_000, 3);
+            // Stopped sequentially, the p-value is coarser, and never below h / draws.
+            let sequential = monte_carlo_p(&model, &scored, exact, 20_000, 3);
+            assert!(sequential >= SEQUENTIAL_H as f64 / 20_000.0);
+            assert!(
+                (sequential - exact).abs() < 0.6 * exact + 1e-3,
+                "F {f}: {sequential}"
+            );
+            let mc = monte_carlo_p_stopping(&model, &scored, exact, 20_000, 3, usize::MAX);
             assert!(
                 (mc - exact).abs() < 4.0 * (exact * (1.0 - exact) / 20_000.0).sqrt() + 1e-3,
                 "F {f}: {mc} vs {exact}"

@@ -277,8 +277,8 @@ pub struct AdequacyReport {
     pub test: String,
     /// Per record: the fitted one, then the held-out ones.
     pub records: Vec<RecordAdequacyReport>,
-    /// The smallest p-value times the number of tests (Bonferroni over records and
-    /// directions), at most 1.
+    /// The family-wise p-value over records and directions (the maximum of the standardised
+    /// statistics against its bootstrap distribution).
     pub p_value: f64,
     /// Bootstrap draws per record.
     pub draws: usize,
@@ -478,7 +478,7 @@ fn adequacy(a: &Adequacy) -> Result<AdequacyReport, NonFinite> {
         .collect::<Result<_, NonFinite>>()?;
     Ok(AdequacyReport {
         test: format!(
-            "per record and direction, the residual's mean square over the noise variance, against a parametric bootstrap of the fit (or, held out, of the noise alone) under the noise model ({} draws); Bonferroni over records and directions",
+            "per record and direction, the residual's mean square over the noise variance, against a parametric bootstrap of the fit and its predictions under the noise model ({} draws); family-wise by the maximum of the standardised statistics (max-T)",
             a.draws
         ),
         records,

@@ -51,12 +51,30 @@ fn with_ar1(recs: &[(String, Record)], phi: f64, sigma: f64, seed: u64) -> Vec<(
     out
 }
 
+/// The residual RMS (mm) of the base and of the extended model of `d` on a third path the
+/// diagnosis did not see (`K1R`: C out and back at A = −30°), from `recs`' truth: `third`.
+fn on_third_path(m: &model_spec::Machine, d: &Diagnosis, third: &Record) -> (f64, f64) {
+    let rms = |fit: &solver::fitting::Identification| {
+        let v = solver::fitting::validate(
+            m,
+            &fit.model,
+            &solver::diagnosis::heldout::estimable_values(fit),
+            third,
+            &solver::fitting::ValidateOptions::new().exact(true),
+        )
+        .expect("validation");
+        v.overall.residual_rms
+    };
+    (rms(&d.base_fit), rms(&d.extended_fit))
+}
+
 /// The number of diagnoses with a finding, over the seeds, for AR(1) noise (φ, σ mm), the noise
 /// estimated from the records, or declared (its true φ and σ) when `declared`.
 fn false_findings(phi: f64, sigma: f64, alpha: f64, declared: bool) -> (u64, u64, Vec<String>) {
     let m = machine();
     let base = base_model(&m, &[]);
     let recs = clean(&m, &["K4", "K1", "K2"]);
+    let third_clean = clean(&m, &["K1R"]);
     let mut o = options().alpha(alpha);
     // The findings and the verdict only: no lack-of-fit bootstrap.
     o.adequacy_draws = 0;
@@ -87,6 +105,12 @@ fn false_findings(phi: f64, sigma: f64, alpha: f64, declared: bool) -> (u64, u64
                 if h.after_rms > h.before_rms {
                     worse.push(format!("seed {s}: {} worse", h.name));
                 }
+            }
+            // Judged on a third path the diagnosis did not see.
+            let third = with_ar1(&third_clean, phi, sigma, 60_000 + s);
+            let (b, a) = on_third_path(&m, &d, &third[0].1);
+            if a > b {
+                worse.push(format!("seed {s}: K1R worse, {b:e} → {a:e} mm"));
             }
         }
     }
@@ -123,6 +147,37 @@ fn correlated_noise_does_not_make_findings() {
             "φ = {phi} ({how}): {found} of {n} seeds gave a finding at α = {alpha}"
         );
         assert!(worse.is_empty(), "φ = {phi} ({how}): {worse:?}");
+    }
+}
+
+/// The recommendation on effects outside the dictionary, judged on a third path (K1R) the
+/// diagnosis did not see: a recommended extension does not make it worse.
+#[test]
+fn recommendations_hold_on_a_third_path() {
+    let m = machine();
+    let base = base_model(&m, &[]);
+    let effects: [(&str, fn(&model_spec::Machine, &Record, usize) -> [f64; 3]); 3] = [
+        ("7th harmonic", |m, r, i| {
+            [0.0, 3e-3 * (7.0 * c_deg(m, r, i).to_radians()).cos(), 0.0]
+        }),
+        ("bump", |m, r, i| {
+            let c = c_deg(m, r, i);
+            [4e-3 * (-((c - 200.0) / 8.0).powi(2)).exp(), 0.0, 0.0]
+        }),
+        ("nonlinearity", |_, r, i| {
+            let y = r.measured[i][1] * 1e3;
+            [0.0, 2e-3 * y * y * 1e-3, 0.0]
+        }),
+    ];
+    for (name, effect) in effects {
+        let mut recs = clean(&m, &["K4", "K1", "K2", "K1R"]);
+        add(&mut recs, |r, i| effect(&m, r, i));
+        let recs = with_ar1(&recs, 0.0, 0.5e-3, 11);
+        let d = run(&m, &base, &recs[..3], &options());
+        if d.recommendation.recommended {
+            let (b, a) = on_third_path(&m, &d, &recs[3].1);
+            assert!(a <= b, "{name}: K1R {b:e} → {a:e} mm");
+        }
     }
 }
 

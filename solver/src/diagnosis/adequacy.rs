@@ -41,6 +41,10 @@ use crate::fitting::noise::{NoiseError, NoiseModel};
 use crate::simulation::rng::Rng;
 use nalgebra::{DMatrix, DVector};
 
+/// Records whose σ estimates of one direction differ by more than this factor are not
+/// measuring the same noise.
+pub const HOMOGENEITY: f64 = 1.5;
+
 /// Draws of the bootstrap null by default ([`super::DiagnoseOptions::adequacy_draws`]).
 pub const DRAWS: usize = 200;
 
@@ -108,13 +112,38 @@ fn mean_squares(r: &[[f64; 3]]) -> [f64; 3] {
     std::array::from_fn(|d| r.iter().map(|v| v[d] * v[d]).sum::<f64>() / n)
 }
 
-/// Records whose σ estimates of one direction differ by more than this factor are not
-/// measuring the same noise.
-pub const HOMOGENEITY: f64 = 1.5;
+/// The noise of several records' residual series, estimated from all of them together; except
+/// in a direction where the records' own estimates of σ differ by more than [`HOMOGENEITY`]:
+/// there σ and φ are those of the record with the smallest σ (a misfit that looks like noise on
+/// one record, a fast period or a harmonic beyond the model's, is absent where its axis does not
+/// move, and that record's estimate is the noise's).
+///
+/// # Errors
+/// [`NoiseError`] when the noise cannot be estimated from the series together.
+pub fn estimate_records(residuals: &[&[[f64; 3]]]) -> Result<NoiseModel, NoiseError> {
+    let mut out = NoiseModel::estimate(residuals)?;
+    let own: Vec<NoiseModel> = residuals
+        .iter()
+        .filter_map(|r| NoiseModel::estimate(&[r]).ok())
+        .collect();
+    for d in 0..3 {
+        let lo = own
+            .iter()
+            .min_by(|a, b| a.sigma_mm[d].total_cmp(&b.sigma_mm[d]));
+        let hi = own.iter().map(|m| m.sigma_mm[d]).fold(0.0f64, f64::max);
+        if let Some(lo) = lo
+            && own.len() > 1
+            && hi > HOMOGENEITY * lo.sigma_mm[d]
+        {
+            out.sigma_mm[d] = lo.sigma_mm[d];
+            out.phi[d] = lo.phi[d];
+        }
+    }
+    Ok(out)
+}
 
-/// The σ per direction the statistics divide by: the model's; or, when it was estimated, the
-/// estimate from all residuals together, except in a direction where the records' own
-/// estimates differ by more than [`HOMOGENEITY`]: then the smallest of them.
+/// The σ per direction the statistics divide by: the model's; or, when it was estimated, that
+/// of [`estimate_records`] on the residuals tested.
 fn reference_sigma(
     noise: &NoiseModel,
     estimated: bool,
@@ -124,21 +153,7 @@ fn reference_sigma(
         return Ok(noise.sigma_mm);
     }
     let all: Vec<&[[f64; 3]]> = residuals.iter().map(Vec::as_slice).collect();
-    let mut out = NoiseModel::estimate(&all)?.sigma_mm;
-    let own: Vec<[f64; 3]> = residuals
-        .iter()
-        .filter_map(|r| NoiseModel::estimate(&[r]).ok().map(|m| m.sigma_mm))
-        .collect();
-    for d in 0..3 {
-        let (lo, hi) = own
-            .iter()
-            .map(|s| s[d])
-            .fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
-        if own.len() > 1 && hi > HOMOGENEITY * lo {
-            out[d] = lo;
-        }
-    }
-    Ok(out)
+    Ok(estimate_records(&all)?.sigma_mm)
 }
 
 /// AR(1) noise of `noise` on `samples` samples: 3 rows per sample.

@@ -621,7 +621,8 @@ fn conservative(noise: &NoiseModel) -> NoiseModel {
 /// The noise model of a diagnosis, and whether it was estimated from the records: declared or
 /// from a static record as given; estimated from the base model's residual on the fitted record
 /// and its prediction residual on every held-out record without outliers (independent
-/// realisations of the same instrument); white with the base fit's σ̂ when it cannot be
+/// realisations of the same instrument; [`adequacy::estimate_records`]: in a direction where
+/// the records disagree, the cleanest record's); white with the base fit's σ̂ when it cannot be
 /// estimated (noise-free data) or ordinary least squares was asked for.
 fn noise_model(
     choice: &NoiseChoice,
@@ -645,7 +646,7 @@ fn noise_model(
                     series.push(&v.residual);
                 }
             }
-            match NoiseModel::estimate(&series) {
+            match adequacy::estimate_records(&series) {
                 Ok(model) => (model, true),
                 Err(e) => (
                     NoiseModel::residual(sigma, format!("the noise cannot be estimated: {e}")),

@@ -156,7 +156,8 @@ fn correlated_noise_does_not_make_findings() {
 fn recommendations_hold_on_a_third_path() {
     let m = machine();
     let base = base_model(&m, &[]);
-    let effects: [(&str, fn(&model_spec::Machine, &Record, usize) -> [f64; 3]); 3] = [
+    type Effect = fn(&model_spec::Machine, &Record, usize) -> [f64; 3];
+    let effects: [(&str, Effect); 3] = [
         ("7th harmonic", |m, r, i| {
             [0.0, 3e-3 * (7.0 * c_deg(m, r, i).to_radians()).cos(), 0.0]
         }),

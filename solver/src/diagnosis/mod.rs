@@ -572,7 +572,15 @@ pub fn diagnose(
         (base_fit.fit.rss / rows).sqrt(),
         (extended_fit.fit.rss / rows).sqrt(),
     );
-    let recommendation = verdict::recommend(&findings, &validation);
+    let noise_mm = match &adequacy {
+        Ok(a) => a
+            .records
+            .first()
+            .map(|r| (r.noise_sigma_mm.iter().map(|s| s * s).sum::<f64>() / 3.0).sqrt()),
+        Err(_) => None,
+    };
+    let consistent = adequacy.as_ref().ok().map(|a| a.consistent_with_noise);
+    let recommendation = verdict::recommend(&findings, &validation, noise_mm, consistent);
     let (k, p, t) = (o.dictionary.harmonics, o.dictionary.poly, o.dictionary.time);
     Ok(Diagnosis {
         structure_before: structure::analyse(m, record, &residual_rows(&base_fit), k, p, t),

@@ -7,7 +7,10 @@
 //!    determined ([`super::heldout`]): without one the gain cannot be checked;
 //! 3. no such held-out record is predicted worse than by the base model;
 //! 4. the residual moves toward the noise: the RMS pooled over those records (weighted by
-//!    their readings) falls.
+//!    their readings) falls, and either the lack-of-fit test finds what remains consistent with
+//!    the noise, or on every such record the excess of the RMS over the noise,
+//!    `√(max(0, RMS² − σ²))`, at least halves: look-alikes that fit the fitted path and nudge the
+//!    others are not a cause.
 //!
 //! Otherwise the reasons say which condition failed, with the records and sizes involved.
 
@@ -28,8 +31,15 @@ fn um(v: f64) -> String {
     format!("{:.3} µm", v * UM_PER_MM)
 }
 
-/// The verdict on the extension of `findings`, from the held-out gain `held`.
-pub fn recommend(findings: &[Finding], held: &[HeldOut]) -> Recommendation {
+/// The verdict on the extension of `findings`, from the held-out gain `held`; `noise_mm` the
+/// noise's σ over the three directions and `consistent` the lack-of-fit test's verdict, when
+/// there is one.
+pub fn recommend(
+    findings: &[Finding],
+    held: &[HeldOut],
+    noise_mm: Option<f64>,
+    consistent: Option<bool>,
+) -> Recommendation {
     let mut reasons = Vec::new();
     let implausible = findings.iter().filter(|f| !f.plausible).count();
     if !findings.iter().any(|f| f.plausible) {
@@ -94,6 +104,20 @@ pub fn recommend(findings: &[Finding], held: &[HeldOut]) -> Recommendation {
             um(before),
             um(after)
         ));
+    }
+    if let (Some(sigma), false) = (noise_mm, consistent == Some(true)) {
+        let excess = |rms: f64| (rms * rms - sigma * sigma).max(0.0).sqrt();
+        for h in &estimable {
+            let (b, a) = (excess(h.before_rms), excess(h.after_rms));
+            if a > 0.5 * b {
+                reasons.push(format!(
+                    "on {} the residual does not move toward the noise: its excess over the noise falls {} → {}, less than half, and what remains is not the noise",
+                    h.name,
+                    um(b),
+                    um(a)
+                ));
+            }
+        }
     }
     let recommended = reasons.is_empty();
     if recommended {

@@ -20,10 +20,8 @@
 //! K4). The sizes are round values near the smallest that pass on 30 of 30 noise seeds (the
 //! ignored `rates` below reproduces the table of docs/diagnosis.md).
 //!
-//! Run time (2 cores): about 7 s in release (`cargo test --release -p solver --test diagnose`),
-//! most of it the null-rate test's 200 noise seeds. In the dev profile (solver not optimised)
-//! the null-rate test runs 40 seeds and every diagnosis 199 Monte-Carlo draws instead of 1000
-//! (`helpers::options`, `null_seeds`); the file then takes about a minute (53–76 s measured).
+//! Run time (2 cores, the test profile optimised): about 30 s, most of it the null-rate test's
+//! 100 noise seeds.
 
 #[path = "diagnose/helpers.rs"]
 mod helpers;

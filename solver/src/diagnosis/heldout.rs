@@ -47,6 +47,8 @@ pub struct HeldOut {
     pub undetermined_after: Vec<Vec<String>>,
     /// The extended model's residual per sample, mm (outliers included).
     pub residual_after: Vec<[f64; 3]>,
+    /// The base model's residual per sample, mm (outliers included).
+    pub residual_before: Vec<[f64; 3]>,
 }
 
 impl HeldOut {
@@ -174,6 +176,7 @@ pub fn held_out_gain(
             before_rms: rms_without(&before.residual, &outliers),
             after_rms: rms_without(&after.residual, &outliers),
             residual_after: after.residual,
+            residual_before: before.residual.clone(),
             outliers,
             undetermined_before: needed_groups(m, base, rec, source, opts.zeroed)?,
             undetermined_after: needed_groups(m, extended, rec, source, opts.zeroed)?,

@@ -572,15 +572,18 @@ pub fn diagnose(
         (base_fit.fit.rss / rows).sqrt(),
         (extended_fit.fit.rss / rows).sqrt(),
     );
-    let noise_mm = match &adequacy {
-        Ok(a) => a
-            .records
-            .first()
-            .map(|r| (r.noise_sigma_mm.iter().map(|s| s * s).sum::<f64>() / 3.0).sqrt()),
-        Err(_) => None,
-    };
+    // The verdict under the noise the tests assume (φ raised when estimated), with σ the
+    // lack-of-fit test's reference.
+    let verdict_noise = adequacy.as_ref().ok().map(|a| {
+        let mut n = whitening.clone();
+        if let Some(r) = a.records.first() {
+            n.sigma_mm = r.noise_sigma_mm;
+        }
+        n
+    });
     let consistent = adequacy.as_ref().ok().map(|a| a.consistent_with_noise);
-    let recommendation = verdict::recommend(&findings, &validation, noise_mm, consistent);
+    let recommendation =
+        verdict::recommend(&findings, &validation, verdict_noise.as_ref(), consistent);
     let (k, p, t) = (o.dictionary.harmonics, o.dictionary.poly, o.dictionary.time);
     Ok(Diagnosis {
         structure_before: structure::analyse(m, record, &residual_rows(&base_fit), k, p, t),

@@ -10,12 +10,20 @@
 //!    their readings) falls, and either the lack-of-fit test finds what remains consistent with
 //!    the noise, or on every such record the excess of the RMS over the noise,
 //!    `√(max(0, RMS² − σ²))`, at least halves: look-alikes that fit the fitted path and nudge the
-//!    others are not a cause.
+//!    others are not a cause;
+//! 5. the held-out gain is more than the noise could give: with `Δp` the change of the
+//!    prediction on a held-out reading and `r` the base model's residual there, the gain
+//!    `Σ (r² − (r − Δp)²)` over the held-out readings must exceed twice its standard deviation
+//!    when the findings are spurious (`r` then the noise: `2σ·√(Σ Δp²·(1 + φ)/(1 − φ))`, the
+//!    factor the low-frequency power of AR(1) noise over white noise's), so that a false
+//!    finding (at rate α) that happens to nudge the held-out records the right way is not
+//!    recommended.
 //!
 //! Otherwise the reasons say which condition failed, with the records and sizes involved.
 
 use super::Finding;
 use super::heldout::HeldOut;
+use crate::fitting::noise::NoiseModel;
 use model_spec::units::UM_PER_MM;
 
 /// The verdict on the extended model.
@@ -37,9 +45,10 @@ fn um(v: f64) -> String {
 pub fn recommend(
     findings: &[Finding],
     held: &[HeldOut],
-    noise_mm: Option<f64>,
+    noise: Option<&NoiseModel>,
     consistent: Option<bool>,
 ) -> Recommendation {
+    let noise_mm = noise.map(|n| (n.sigma_mm.iter().map(|s| s * s).sum::<f64>() / 3.0).sqrt());
     let mut reasons = Vec::new();
     let implausible = findings.iter().filter(|f| !f.plausible).count();
     if !findings.iter().any(|f| f.plausible) {
@@ -117,6 +126,31 @@ pub fn recommend(
                     um(a)
                 ));
             }
+        }
+    }
+    if let Some(n) = noise {
+        let (mut gain, mut var) = (0.0, 0.0);
+        for h in &estimable {
+            let drop = super::outliers::samples(&h.outliers);
+            for (i, (b, a)) in h.residual_before.iter().zip(&h.residual_after).enumerate() {
+                if drop.contains(&i) {
+                    continue;
+                }
+                for d in 0..3 {
+                    let dp = b[d] - a[d];
+                    gain += b[d] * b[d] - a[d] * a[d];
+                    // A smooth Δp meets correlated noise at its low-frequency power, (1 + φ)/(1 − φ)
+                    // times the white noise's.
+                    let (s, p) = (n.sigma_mm[d], n.phi[d]);
+                    var += 4.0 * s * s * (1.0 + p) / (1.0 - p) * dp * dp;
+                }
+            }
+        }
+        if !estimable.is_empty() && gain <= 2.0 * var.sqrt() {
+            reasons.push(format!(
+                "the held-out gain is within what the noise gives ({:.2} standard deviations of a spurious finding's, 2 needed)",
+                gain / var.sqrt().max(f64::MIN_POSITIVE)
+            ));
         }
     }
     let recommended = reasons.is_empty();

@@ -291,20 +291,7 @@ pub fn identify_with(
     source: &mut GainSource,
     opts: &IdentifyOptions,
 ) -> Result<Identification, EstimateError> {
-    let fitted = opts.fitted_model(model);
-    check_readings(record.samples.len(), fitted.width())?;
-    let y = measurement_vector(record)?;
-    let h = h_matrix(m, &fitted, record, source)?;
-    let names = parameter_names(m, &fitted);
-    let fit = least_squares(&h, &y, &names, &opts.constraint, &opts.tolerances)?;
-    Ok(Identification::new(
-        m,
-        fitted,
-        fit,
-        record.samples.len(),
-        opts.zeroed,
-        source.backend(),
-    ))
+    identify_with_noise(m, model, record, source, opts, &NoiseChoice::Ordinary)
 }
 
 impl Identification {

@@ -52,6 +52,17 @@ pub struct HeldOut {
 }
 
 impl HeldOut {
+    /// The extended model's residual without the outliers' samples: 3 rows per sample, mm.
+    pub fn residual_after_without_outliers(&self) -> nalgebra::DVector<f64> {
+        let drop = outliers::samples(&self.outliers);
+        nalgebra::DVector::from_iterator(
+            3 * (self.residual_after.len() - drop.len()),
+            (0..self.residual_after.len())
+                .filter(|i| !drop.contains(i))
+                .flat_map(|i| self.residual_after[i]),
+        )
+    }
+
     /// `true` when both predictions use only what the fits determined, so that the change of
     /// RMS is the extension's gain.
     pub fn estimable(&self) -> bool {

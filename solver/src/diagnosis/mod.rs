@@ -24,6 +24,7 @@ pub mod figures;
 pub mod harmonic;
 pub mod heldout;
 pub mod hidden;
+mod noise_model;
 mod options;
 pub mod outliers;
 pub mod plausible;
@@ -35,7 +36,7 @@ pub mod unexplained;
 pub mod verdict;
 
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
-use crate::fitting::noise::{self, NoiseChoice, NoiseError, NoiseModel, NoiseSource};
+use crate::fitting::noise::{NoiseChoice, NoiseError, NoiseModel, NoiseSource};
 use crate::fitting::refine::{RefineError, RefineOptions, identify_refined_with_noise};
 use crate::fitting::validate::{ValidateError, ValidateOptions};
 use crate::fitting::{
@@ -288,7 +289,7 @@ pub fn diagnose(
         ..Default::default()
     };
     let before = heldout::predict(m, &base_fit, held_out, &mut source, &vopts)?;
-    let (noise, estimated) = noise_model(&o.noise, &base_fit, held_out, &before);
+    let (noise, estimated) = noise_model::choose(&o.noise, &base_fit, held_out, &before);
     // Every fit from here on is the generalized least-squares fit under that model, so that
     // the standard uncertainties assume it.
     let gls = match noise.source {
@@ -327,7 +328,7 @@ pub fn diagnose(
     }
     let mut h_all = h_raw.clone();
     let whitening = if estimated {
-        conservative(&noise)
+        noise_model::conservative(&noise)
     } else {
         noise.clone()
     };
@@ -347,12 +348,9 @@ pub fn diagnose(
     let group = |t: usize| h_all.columns(starts[t], widths[t]).into_owned();
     let nb = base.terms.len();
 
-    let mut q_base = Span::empty(n);
-    for t in 0..nb {
-        let d = q_base.new_directions(&group(t));
-        q_base.extend(&d);
-    }
-    let rss_base = q_base.project_out(&y).norm_squared();
+    let rss_base = Span::of_groups(n, 0..nb, &group)
+        .project_out(&y)
+        .norm_squared();
     let unexcited: Vec<Term> = (0..candidates.len())
         .filter(|&c| {
             h_raw
@@ -455,7 +453,7 @@ pub fn diagnose(
         &candidates,
         &kept,
         &unexcited,
-        &q_of(&as_candidates, nb, &candidates, &group),
+        &Span::of_groups(n, (0..nb).chain(kept.iter().map(|&c| nb + c)), &group),
         &|t| group(t),
         nb,
         &h_all,
@@ -485,15 +483,7 @@ pub fn diagnose(
             let h_ext = h_raw.select_columns(&cols);
             let held: Vec<DVector<f64>> = validation
                 .iter()
-                .map(|h| {
-                    let drop = outliers::samples(&h.outliers);
-                    DVector::from_iterator(
-                        3 * (h.residual_after.len() - drop.len()),
-                        (0..h.residual_after.len())
-                            .filter(|i| !drop.contains(i))
-                            .flat_map(|i| h.residual_after[i]),
-                    )
-                })
+                .map(heldout::HeldOut::residual_after_without_outliers)
                 .collect();
             // The extended model's columns on every held-out record (outliers' samples left
             // out): the bootstrap carries the fit's own uncertainty into those predictions.
@@ -536,36 +526,17 @@ pub fn diagnose(
         }
     };
     let unexplained = match &adequacy {
-        Ok(a) if !a.consistent_with_noise => {
-            // Every (record, direction) whose own p-value passes after a Bonferroni factor;
-            // at least the one with the smallest.
-            let tests = 3.0 * a.records.len() as f64;
-            let smallest = a
-                .records
-                .iter()
-                .flat_map(|r| r.p_values)
-                .fold(f64::INFINITY, f64::min);
-            let mut out = Vec::new();
-            for (k, r) in a.records.iter().enumerate() {
-                let (name, rec, res) = if k == 0 {
-                    (o.data_name.as_str(), record, residual_rows(&extended_fit))
-                } else {
-                    let h = &validation[k - 1];
-                    (
-                        h.name.as_str(),
-                        &held_out[k - 1].1,
-                        h.residual_after.clone(),
-                    )
-                };
-                let described =
-                    |d: usize| tests * r.p_values[d] < o.alpha || r.p_values[d] == smallest;
-                for d in (0..3).filter(|&d| described(d)) {
-                    out.push(unexplained::describe(m, (name, rec), &res, d));
-                }
-            }
-            out
+        Ok(a) => {
+            let mut records = vec![(o.data_name.as_str(), record, residual_rows(&extended_fit))];
+            records.extend(
+                validation
+                    .iter()
+                    .zip(held_out)
+                    .map(|(h, (_, rec))| (h.name.as_str(), rec, h.residual_after.clone())),
+            );
+            unexplained::describe_failures(m, a, &records, o.alpha)
         }
-        _ => Vec::new(),
+        Err(_) => Vec::new(),
     };
     let rows = n.max(1) as f64;
     let fit_rms = (
@@ -607,85 +578,6 @@ pub fn diagnose(
         adequacy,
         unexplained,
     })
-}
-
-/// The noise model the selection whitens with when the noise was estimated: φ raised by two
-/// standard errors of its estimate, `2·√((1 − φ²)/N)` with N the samples pooled (twice the
-/// Yule–Walker standard error: the variogram estimate's spread, measured on AR(1) records of
-/// the built-in paths' lengths), the raise shrunk in proportion below φ = 0.3. A φ estimated
-/// too low leaves correlated noise that the F-tests and the Monte-Carlo null take for
-/// structure, and that matters where the correlation is strong; one too high only makes them
-/// conservative for the slowly varying candidates, which costs power where the noise is white.
-fn conservative(noise: &NoiseModel) -> NoiseModel {
-    let samples = match noise.source {
-        NoiseSource::Estimated { samples, .. } => samples.max(1) as f64,
-        _ => return noise.clone(),
-    };
-    let mut out = noise.clone();
-    for p in &mut out.phi {
-        let se = 2.0 * ((1.0 - *p * *p) / samples).sqrt();
-        *p = (*p + 2.0 * se * (*p / 0.3).min(1.0)).min(noise::MAX_ESTIMATED_PHI);
-    }
-    out
-}
-
-/// The noise model of a diagnosis, and whether it was estimated from the records: declared or
-/// from a static record as given; estimated from the base model's residual on the fitted record
-/// and its prediction residual on every held-out record without outliers (independent
-/// realisations of the same instrument; [`adequacy::estimate_records`]: in a direction where
-/// the records disagree, the cleanest record's); white with the base fit's σ̂ when it cannot be
-/// estimated (noise-free data) or ordinary least squares was asked for.
-fn noise_model(
-    choice: &NoiseChoice,
-    base_fit: &Identification,
-    held_out: &[(String, Record)],
-    before: &[crate::fitting::Validation],
-) -> (NoiseModel, bool) {
-    let sigma = base_fit
-        .fit
-        .sigma
-        .filter(|s| *s > 0.0)
-        .unwrap_or(noise::NOISE_FLOOR_MM);
-    match choice {
-        NoiseChoice::Model(model) => (model.clone(), false),
-        NoiseChoice::Ordinary => (NoiseModel::residual(sigma, "ordinary least squares"), false),
-        NoiseChoice::Estimate => {
-            let fitted = residual_rows(base_fit);
-            let mut series: Vec<&[[f64; 3]]> = vec![&fitted];
-            for ((_, rec), v) in held_out.iter().zip(before) {
-                if outliers::find_in(rec, &v.residual).is_empty() {
-                    series.push(&v.residual);
-                }
-            }
-            match adequacy::estimate_records(&series) {
-                Ok(model) => (model, true),
-                Err(e) => (
-                    NoiseModel::residual(sigma, format!("the noise cannot be estimated: {e}")),
-                    false,
-                ),
-            }
-        }
-    }
-}
-
-/// The orthonormal basis of the columns of `model` (the base terms, then candidates).
-fn q_of(
-    model: &Model,
-    nb: usize,
-    candidates: &[Term],
-    group: &dyn Fn(usize) -> nalgebra::DMatrix<f64>,
-) -> Span {
-    let mut q = Span::empty(group(0).nrows());
-    let groups = (0..nb).chain(
-        model.terms[nb..]
-            .iter()
-            .filter_map(|t| candidates.iter().position(|c| c == t).map(|c| nb + c)),
-    );
-    for g in groups {
-        let d = q.new_directions(&group(g));
-        q.extend(&d);
-    }
-    q
 }
 
 impl Diagnosis {

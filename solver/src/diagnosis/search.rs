@@ -51,7 +51,6 @@ pub(super) struct Chosen {
 
 /// The model's basis: the base and the chosen terms (but `skip`).
 pub(super) fn basis_of(p: &Problem, chosen: &[Chosen], skip: Option<usize>) -> Span {
-    let mut q = Span::empty(p.y.len());
     let terms = (0..p.nb).chain(
         chosen
             .iter()
@@ -59,11 +58,7 @@ pub(super) fn basis_of(p: &Problem, chosen: &[Chosen], skip: Option<usize>) -> S
             .filter(|(k, _)| Some(*k) != skip)
             .map(|(_, c)| p.nb + c.index),
     );
-    for t in terms {
-        let d = q.new_directions(&(p.group)(t));
-        q.extend(&d);
-    }
-    q
+    Span::of_groups(p.y.len(), terms, p.group)
 }
 
 /// The forward selection and its exchange pass: the findings in order, and why it stopped.

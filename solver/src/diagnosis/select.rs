@@ -89,6 +89,21 @@ impl Span {
         }
     }
 
+    /// The basis of the column groups `groups` (in order) of `n` rows, `group(g)` giving the
+    /// columns of group `g`.
+    pub fn of_groups(
+        n: usize,
+        groups: impl IntoIterator<Item = usize>,
+        group: &dyn Fn(usize) -> DMatrix<f64>,
+    ) -> Span {
+        let mut q = Span::empty(n);
+        for g in groups {
+            let d = q.new_directions(&group(g));
+            q.extend(&d);
+        }
+        q
+    }
+
     /// Appends orthonormal directions orthogonal to the basis (from [`Span::new_directions`]).
     pub fn extend(&mut self, directions: &DMatrix<f64>) {
         if directions.ncols() == 0 {

@@ -420,6 +420,35 @@ pub fn describe(
     }
 }
 
+/// What remains where the lack-of-fit test `a` fails (nothing when it passes): every (record,
+/// direction) whose own p-value passes after a Bonferroni factor over all of them, and at least
+/// the one with the smallest. `records`: name, record and residual per sample (mm), in the
+/// order of `a.records`.
+pub fn describe_failures(
+    m: &Machine,
+    a: &super::adequacy::Adequacy,
+    records: &[(&str, &Record, Vec<[f64; 3]>)],
+    alpha: f64,
+) -> Vec<Unexplained> {
+    if a.consistent_with_noise {
+        return Vec::new();
+    }
+    let tests = 3.0 * a.records.len() as f64;
+    let smallest = a
+        .records
+        .iter()
+        .flat_map(|r| r.p_values)
+        .fold(f64::INFINITY, f64::min);
+    let mut out = Vec::new();
+    for (r, (name, rec, res)) in a.records.iter().zip(records) {
+        let described = |d: usize| tests * r.p_values[d] < alpha || r.p_values[d] == smallest;
+        for d in (0..3).filter(|&d| described(d)) {
+            out.push(describe(m, (name, rec), res, d));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,11 +2,12 @@
 //! findings with their significance, what the data cannot see, the extended model and its gain
 //! on the fitted and the held-out records. Values in µm and µrad.
 
+use super::verdict::{
+    AdequacyReport, BudgetReport, OutlierReport, UnexplainedReport, adequacy, outliers, unexplained,
+};
 use super::{NonFinite, finite, finite_opt};
-use crate::diagnosis::adequacy::Adequacy;
 use crate::diagnosis::harmonic::harmonic;
 use crate::diagnosis::structure::Component;
-use crate::diagnosis::unexplained::{Shape, Unexplained};
 use crate::diagnosis::{Correction, DiagnoseOptions, Diagnosis};
 use crate::model::{Basis, Carrier, Term};
 use model_spec::Machine;
@@ -129,50 +130,6 @@ pub struct ScanReport {
     pub unit: String,
 }
 
-/// An isolated reading far outside the residual's robust local scale, left out of the fits
-/// and of the RMS.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct OutlierReport {
-    /// The record's file.
-    pub data: String,
-    /// The 1-based line of the sample in that file; absent when not read from a file.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub line: Option<usize>,
-    /// The 1-based sample number in the record.
-    pub sample: usize,
-    /// `x`, `y` or `z`.
-    pub direction: String,
-    /// The residual of the base model at that reading, µm.
-    pub residual_um: f64,
-    /// Its deviation from the running median of the residual, µm.
-    pub deviation_um: f64,
-    /// The threshold it exceeded, µm.
-    pub threshold_um: f64,
-}
-
-/// Whether the extended model is recommended.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RecommendationReport {
-    /// `true`: use the extended model.
-    pub recommended: bool,
-    /// Why (not), one sentence each.
-    pub reasons: Vec<String>,
-}
-
-/// The size budget findings are compared with.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct BudgetReport {
-    /// Translational errors and offsets, µm.
-    pub um: f64,
-    /// Angular errors, µrad.
-    pub urad: f64,
-    /// Servo lag, ms.
-    pub ms: f64,
-    /// Instrument gain and cross-talk, a fraction.
-    #[serde(rename = "1")]
-    pub fraction: f64,
-}
-
 /// The amplitude and phase of a harmonic finding.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HarmonicReport {
@@ -251,70 +208,6 @@ pub struct GainReport {
     pub fit: GainRow,
     /// On every held-out record.
     pub validation: Vec<GainRow>,
-}
-
-/// The lack-of-fit test on one record.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RecordAdequacyReport {
-    /// The record's file.
-    pub data: String,
-    /// `true` for the fitted record.
-    pub fitted: bool,
-    /// The noise's σ per direction x, y, z the test used, µm.
-    pub noise_sigma_um: [f64; 3],
-    /// The residual's RMS per direction, µm.
-    pub residual_sigma_um: [f64; 3],
-    /// Per direction, the residual's mean square over the noise variance.
-    pub statistic: [f64; 3],
-    /// Per direction, the bootstrap p-value.
-    pub p_values: [f64; 3],
-}
-
-/// The lack-of-fit test of the extended model's residuals against the noise model.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct AdequacyReport {
-    /// The test, for people.
-    pub test: String,
-    /// Per record: the fitted one, then the held-out ones.
-    pub records: Vec<RecordAdequacyReport>,
-    /// The family-wise p-value over records and directions (the maximum of the standardised
-    /// statistics against its bootstrap distribution).
-    pub p_value: f64,
-    /// Bootstrap draws per record.
-    pub draws: usize,
-    /// `p_value ≥ alpha`: what remains is consistent with the noise.
-    pub consistent_with_noise: bool,
-}
-
-/// What remains in a direction the noise does not account for, described.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct UnexplainedReport {
-    /// The record's file.
-    pub data: String,
-    /// `x`, `y` or `z`.
-    pub direction: String,
-    /// RMS of the residual in that direction, µm.
-    pub rms_um: f64,
-    /// What it follows (`C`, `X`, `time`, `velocity of A`, `direction of motion of C`,
-    /// `sample`); absent when it follows nothing simple.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub follows: Option<String>,
-    /// The unit of what it follows (`deg`, `mm`, `s`, `deg/s`, `mm/s`, `±1`; empty for
-    /// `sample`).
-    pub unit: String,
-    /// `smooth`, `periodic`, `step`, `local` or `irregular`.
-    pub shape: String,
-    /// The period of a periodic shape, in `unit`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub period: Option<f64>,
-    /// Where a step is, in `unit`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub at: Option<f64>,
-    /// The first and last sample (1-based) of a local deviation.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub samples: Option<[usize; 2]>,
-    /// RMS of what the shape explains, µm.
-    pub explained_rms_um: f64,
 }
 
 /// The diagnosis report.
@@ -452,86 +345,6 @@ fn gain_row(
             after * UM_PER_MM,
         )?,
     })
-}
-
-fn adequacy(a: &Adequacy) -> Result<AdequacyReport, NonFinite> {
-    let records = a
-        .records
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            let three = |what: &str, v: [f64; 3], k: f64| -> Result<[f64; 3], NonFinite> {
-                for x in v {
-                    finite(|| format!("adequacy.records[{i}].{what}"), x * k)?;
-                }
-                Ok(v.map(|x| x * k))
-            };
-            Ok(RecordAdequacyReport {
-                data: r.name.clone(),
-                fitted: r.fitted,
-                noise_sigma_um: three("noise_sigma_um", r.noise_sigma_mm, UM_PER_MM)?,
-                residual_sigma_um: three("residual_sigma_um", r.residual_sigma_mm, UM_PER_MM)?,
-                statistic: three("statistic", r.statistic, 1.0)?,
-                p_values: r.p_values,
-            })
-        })
-        .collect::<Result<_, NonFinite>>()?;
-    Ok(AdequacyReport {
-        test: format!(
-            "per record and direction, the residual's mean square over the noise variance, against a parametric bootstrap of the fit and its predictions under the noise model ({} draws); family-wise by the maximum of the standardised statistics (max-T)",
-            a.draws
-        ),
-        records,
-        p_value: a.p_value,
-        draws: a.draws,
-        consistent_with_noise: a.consistent_with_noise,
-    })
-}
-
-fn unexplained(i: usize, u: &Unexplained) -> Result<UnexplainedReport, NonFinite> {
-    let um = |what: &str, v: f64| finite(|| format!("unexplained[{i}].{what}"), v * UM_PER_MM);
-    let (shape, period, at, samples) = match u.shape {
-        Shape::Smooth => ("smooth", None, None, None),
-        Shape::Periodic { period } => ("periodic", Some(period), None, None),
-        Shape::Step { at } => ("step", None, Some(at), None),
-        Shape::Local { first, last } => ("local", None, None, Some([first + 1, last + 1])),
-        Shape::Irregular => ("irregular", None, None, None),
-    };
-    Ok(UnexplainedReport {
-        data: u.data.clone(),
-        direction: ["x", "y", "z"][u.direction].into(),
-        rms_um: um("rms_um", u.rms_mm)?,
-        follows: u.follows.clone(),
-        unit: u.unit.clone(),
-        shape: shape.into(),
-        period,
-        at,
-        samples,
-        explained_rms_um: um("explained_rms_um", u.explained_rms_mm)?,
-    })
-}
-
-/// The outliers of the fitted record (`data`) and of every held-out record.
-fn outliers(data: &str, d: &Diagnosis) -> Result<Vec<OutlierReport>, NonFinite> {
-    let all = d.outliers.iter().map(|o| (data, o)).chain(
-        d.validation
-            .iter()
-            .flat_map(|h| h.outliers.iter().map(move |o| (h.name.as_str(), o))),
-    );
-    all.enumerate()
-        .map(|(i, (file, o))| {
-            let um = |what: &str, v: f64| finite(|| format!("outliers[{i}].{what}"), v * UM_PER_MM);
-            Ok(OutlierReport {
-                data: file.into(),
-                line: o.line,
-                sample: o.sample + 1,
-                direction: ["x", "y", "z"][o.direction].into(),
-                residual_um: um("residual_um", o.residual_mm)?,
-                deviation_um: um("deviation_um", o.deviation_mm)?,
-                threshold_um: um("threshold_um", o.threshold_mm)?,
-            })
-        })
-        .collect()
 }
 
 impl DiagnosisReport {

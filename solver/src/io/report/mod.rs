@@ -20,6 +20,7 @@ pub mod gains;
 pub mod identify;
 pub mod read;
 pub mod validate;
+pub mod verdict;
 
 pub use diagnose::{DiagnosisReport, DiagnosisSource};
 pub use gains::{GainTableReport, PoseGainsReport};

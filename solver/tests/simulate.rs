@@ -5,11 +5,11 @@
 #![allow(clippy::needless_range_loop)] // x, y, z components read best by index
 
 mod common;
+use common::context;
 
 use common::builtin;
 use model_spec::Machine;
-use solver::model::BasisContext;
-use solver::record::{Record, Sample};
+use solver::record::Record;
 use solver::simulation::VirtualMachine;
 use solver::simulation::paths::{builtin_path, record_from_commands};
 use solver::simulation::readings::{SimulateError, simulate};
@@ -281,16 +281,4 @@ fn speed() {
     let path = builtin_path(&m, "K4").unwrap().unwrap();
     println!("build K4 path (IK): {:?}", start.elapsed());
     std::hint::black_box(path);
-}
-
-/// The basis context of a sample at normalised time `tau` (no velocities, no reading).
-fn context(s: &Sample, tau: f64) -> BasisContext<'_> {
-    BasisContext {
-        commands: &s.commands,
-        motion: &s.motion,
-        tau,
-        elapsed_s: 0.0,
-        velocity: &[],
-        reading: [0.0; 3],
-    }
 }

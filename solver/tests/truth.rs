@@ -2,10 +2,11 @@
 //! invalid entry reported with file, line and column.
 
 mod common;
+use common::context;
 
 use common::{Scratch, builtin, commands, id};
 use model_spec::{Dir, Machine};
-use solver::model::{Basis, BasisContext};
+use solver::model::Basis;
 use solver::model::{Effect, Term};
 use solver::record::Sample;
 use solver::simulation::truth::{
@@ -468,16 +469,4 @@ fn sensor_offsets_are_effects_too() {
     let e = t.entries(&m);
     assert_eq!((e[0].name.as_str(), e[0].unit), ("dy0", "um"));
     assert_eq!(e[0].values, vec![-3.0]);
-}
-
-/// The basis context of a sample at normalised time `tau` (no velocities, no reading).
-fn context(s: &Sample, tau: f64) -> BasisContext<'_> {
-    BasisContext {
-        commands: &s.commands,
-        motion: &s.motion,
-        tau,
-        elapsed_s: 0.0,
-        velocity: &[],
-        reading: [0.0; 3],
-    }
 }

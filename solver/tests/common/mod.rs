@@ -2,6 +2,8 @@
 #![allow(dead_code)]
 
 use model_spec::{AxisKind, Machine};
+use solver::model::BasisContext;
+use solver::record::Sample;
 use std::path::PathBuf;
 
 /// A small deterministic generator (xorshift64*), so the tests need no extra crate.
@@ -85,5 +87,17 @@ impl Scratch {
 impl Drop for Scratch {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// The basis context of a sample at normalised time `tau` (no velocities, no reading).
+pub fn context(s: &Sample, tau: f64) -> BasisContext<'_> {
+    BasisContext {
+        commands: &s.commands,
+        motion: &s.motion,
+        tau,
+        elapsed_s: 0.0,
+        velocity: &[],
+        reading: [0.0; 3],
     }
 }

@@ -26,6 +26,17 @@ fn zero3() -> Vec3 {
     [Poly::zero(), Poly::zero(), Poly::zero()]
 }
 
+/// The coordinate unit vector `e_d`.
+fn unit(d: usize) -> Vec3 {
+    std::array::from_fn(|k| {
+        if k == d {
+            Poly::constant(Rational::ONE)
+        } else {
+            Poly::zero()
+        }
+    })
+}
+
 fn cross_unit(d: usize, v: &Vec3) -> Vec3 {
     // e_d × v
     match d {
@@ -81,12 +92,24 @@ fn mat_mul(a: &[[Poly; 3]; 3], b: &[[Poly; 3]; 3]) -> [[Poly; 3]; 3] {
     })
 }
 
+/// What a carried vector is, so that each step acts on it as it should.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Carried {
+    /// A point: offsets, motions and error translations move it, rotations turn it.
+    Point,
+    /// A direction: only rotations turn it.
+    Direction,
+    /// The small rotation of the end frame (a rotation vector, rad per unit of error): each
+    /// error rotation adds its axis, and the nominal rotations turn the sum. Its nominal part
+    /// is zero.
+    Rotation,
+}
+
 /// A first-order vector: nominal part plus one vector per tracked error.
 #[derive(Clone, Debug)]
 struct FirstOrder {
     nominal: Vec3,
-    /// `true` for a point (translations act), `false` for a direction.
-    point: bool,
+    kind: Carried,
     by_error: BTreeMap<usize, Vec3>,
 }
 
@@ -132,14 +155,14 @@ impl Deriver<'_> {
     fn apply(&self, step: &Step, v: &mut FirstOrder) {
         match step {
             Step::Offset(o) => {
-                if v.point {
+                if v.kind == Carried::Point {
                     for (n, &value) in v.nominal.iter_mut().zip(o) {
                         *n = n.add(&self.value(value));
                     }
                 }
             }
             Step::ErrorTranslation(ids) => {
-                if v.point {
+                if v.kind == Carried::Point {
                     for (k, id) in ids.iter().enumerate() {
                         if let Some(&slot) = id.as_ref().and_then(|id| self.slot.get(id)) {
                             let mut t = zero3();
@@ -152,7 +175,10 @@ impl Deriver<'_> {
             Step::ErrorRotation(ids) => {
                 for (k, id) in ids.iter().enumerate() {
                     if let Some(&slot) = id.as_ref().and_then(|id| self.slot.get(id)) {
-                        let d = cross_unit(k, &v.nominal);
+                        let d = match v.kind {
+                            Carried::Rotation => unit(k),
+                            _ => cross_unit(k, &v.nominal),
+                        };
                         v.add_to(slot, d);
                     }
                 }
@@ -165,7 +191,7 @@ impl Deriver<'_> {
                 let d = a.direction.dir.index();
                 match a.kind {
                     AxisKind::Linear => {
-                        if v.point {
+                        if v.kind == Carried::Point {
                             let q = Poly::atom(self.atoms.find(AtomKind::Command(*axis)));
                             let sign = Rational::int(if a.direction.negative { -1 } else { 1 });
                             v.nominal[d] = v.nominal[d].add(&q.scale(sign));
@@ -175,7 +201,10 @@ impl Deriver<'_> {
                         if let Some(&slot) =
                             positioning_error.as_ref().and_then(|id| self.slot.get(id))
                         {
-                            let dv = cross_unit(d, &v.nominal);
+                            let dv = match v.kind {
+                                Carried::Rotation => unit(d),
+                                _ => cross_unit(d, &v.nominal),
+                            };
                             v.add_to(slot, dv);
                         }
                         let (s, c) = self.sin_cos(*axis);
@@ -190,14 +219,13 @@ impl Deriver<'_> {
         }
     }
 
-    fn end(&self, side: Side, point: bool) -> FirstOrder {
+    fn end(&self, side: Side, kind: Carried) -> FirstOrder {
         let mut v = FirstOrder {
-            nominal: if point {
-                zero3()
-            } else {
-                [Poly::zero(), Poly::zero(), Poly::constant(Rational::ONE)]
+            nominal: match kind {
+                Carried::Direction => unit(2),
+                Carried::Point | Carried::Rotation => zero3(),
             },
-            point,
+            kind,
             by_error: BTreeMap::new(),
         };
         for step in chain_steps(self.m, side).iter().rev() {
@@ -208,11 +236,17 @@ impl Deriver<'_> {
 
     /// The nominal rotation of the tool frame.
     fn tool_rotation(&self) -> [[Poly; 3]; 3] {
+        self.rotation_of(Side::Tool)
+    }
+
+    /// The nominal rotation of the end frame of the chain on `side` (the product of its rotary
+    /// motions, bed first).
+    fn rotation_of(&self, side: Side) -> [[Poly; 3]; 3] {
         let one = Poly::constant(Rational::ONE);
         let mut r: [[Poly; 3]; 3] = std::array::from_fn(|i| {
             std::array::from_fn(|j| if i == j { one.clone() } else { Poly::zero() })
         });
-        for step in chain_steps(self.m, Side::Tool) {
+        for step in chain_steps(self.m, side) {
             if let Step::Motion { axis, .. } = step
                 && self.m.axes[axis].kind == AxisKind::Rotary
             {
@@ -225,6 +259,83 @@ impl Deriver<'_> {
         }
         r
     }
+}
+
+/// The nominal kinematics compensation needs, as polynomials in the machine's atoms.
+#[derive(Clone, Debug)]
+pub struct NominalPose {
+    /// The tool point in the frame of the last element of the work chain (the frame the work
+    /// end's offset is given in), mm.
+    pub tool_point_in_work: Vec3,
+    /// The rotation from the tool frame to that work frame (row-major): a tool-frame vector
+    /// `v` is `R·v` in work coordinates.
+    pub tool_to_work: [[Poly; 3]; 3],
+}
+
+/// The nominal pose of the tool frame relative to the last frame of the work chain.
+pub fn nominal_pose(m: &Machine) -> NominalPose {
+    let atoms = AtomTable::new(m);
+    let d = Deriver {
+        m,
+        atoms: &atoms,
+        slot: BTreeMap::new(),
+    };
+    let pairs = atoms.trig_pairs();
+    let tool = d.end(Side::Tool, Carried::Point).nominal;
+    // The work frame's origin: the work chain without its end offset (and set-up errors).
+    let steps = chain_steps(m, Side::Work);
+    let end = steps
+        .iter()
+        .rposition(|s| matches!(s, Step::Offset(o) if *o == m.work.end_offset))
+        .unwrap_or(steps.len());
+    let mut origin = FirstOrder {
+        nominal: zero3(),
+        kind: Carried::Point,
+        by_error: BTreeMap::new(),
+    };
+    for step in steps[..end].iter().rev() {
+        d.apply(step, &mut origin);
+    }
+    let rw = d.rotation_of(Side::Work);
+    let rt = d.rotation_of(Side::Tool);
+    let gap: Vec3 = std::array::from_fn(|k| tool[k].sub(&origin.nominal[k]));
+    let rw_t: [[Poly; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| rw[j][i].clone()));
+    NominalPose {
+        tool_point_in_work: mat_vec(&rw_t, &gap).map(|p| p.reduce(&pairs)),
+        tool_to_work: mat_mul(&rw_t, &rt).map(|row| row.map(|p| p.reduce(&pairs))),
+    }
+}
+
+/// The rotation gains of `errors`: for each, the small rotation of the tool frame relative to
+/// the work frame per unit of the error, as a rotation vector in the nominal tool frame (rad per
+/// mm for translational errors, rad per rad for angular ones). Unlike the orientation rows of
+/// [`GainModel`] (the seed's change of the tool's z direction), these hold the rotation about
+/// the tool axis too.
+pub fn rotation_gains(m: &Machine, errors: &[ErrorId]) -> Vec<Vec3> {
+    let atoms = AtomTable::new(m);
+    let slot = errors.iter().enumerate().map(|(i, &e)| (e, i)).collect();
+    let d = Deriver {
+        m,
+        atoms: &atoms,
+        slot,
+    };
+    let (wt, ww) = (
+        d.end(Side::Tool, Carried::Rotation),
+        d.end(Side::Work, Carried::Rotation),
+    );
+    let r0 = d.tool_rotation();
+    let pairs = atoms.trig_pairs();
+    let z = zero3();
+    (0..errors.len())
+        .map(|i| {
+            let (a, b) = (
+                wt.by_error.get(&i).unwrap_or(&z),
+                ww.by_error.get(&i).unwrap_or(&z),
+            );
+            let v: Vec3 = std::array::from_fn(|k| a[k].sub(&b[k]));
+            mat_t_vec(&r0, &v).map(|p| p.reduce(&pairs))
+        })
+        .collect()
 }
 
 /// The symbolic first-order gains of a set of errors of one machine.
@@ -255,8 +366,14 @@ impl GainModel {
             atoms: &atoms,
             slot,
         };
-        let (pt, pw) = (d.end(Side::Tool, true), d.end(Side::Work, true));
-        let (zt, zw) = (d.end(Side::Tool, false), d.end(Side::Work, false));
+        let (pt, pw) = (
+            d.end(Side::Tool, Carried::Point),
+            d.end(Side::Work, Carried::Point),
+        );
+        let (zt, zw) = (
+            d.end(Side::Tool, Carried::Direction),
+            d.end(Side::Work, Carried::Direction),
+        );
         let r0 = d.tool_rotation();
         let pairs = atoms.trig_pairs();
         let diff = |a: &FirstOrder, b: &FirstOrder, i: usize| -> Vec3 {

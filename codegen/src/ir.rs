@@ -26,6 +26,8 @@ pub enum Op {
     Mul(Var, Var),
     /// `−a`.
     Neg(Var),
+    /// `a / b` (only in compensation programs; gain programs are `+ − ×` only).
+    Div(Var, Var),
 }
 
 /// An output slot: a value or a constant.
@@ -70,12 +72,14 @@ pub struct OpCounts {
     pub mul: usize,
     /// Negations.
     pub neg: usize,
+    /// Divisions (compensation programs only).
+    pub div: usize,
 }
 
 impl OpCounts {
     /// All arithmetic operations.
     pub fn total(&self) -> usize {
-        self.add + self.mul + self.neg
+        self.add + self.mul + self.neg + self.div
     }
 }
 
@@ -88,7 +92,11 @@ impl fmt::Display for OpCounts {
             self.add,
             self.mul,
             self.neg
-        )
+        )?;
+        if self.div > 0 {
+            write!(f, ", {} div", self.div)?;
+        }
+        Ok(())
     }
 }
 
@@ -101,6 +109,7 @@ impl Program {
                 Op::Add(..) | Op::Sub(..) => c.add += 1,
                 Op::Mul(..) => c.mul += 1,
                 Op::Neg(..) => c.neg += 1,
+                Op::Div(..) => c.div += 1,
                 Op::Input(_) | Op::Const(_) => {}
             }
         }
@@ -131,6 +140,7 @@ impl Program {
                 Op::Sub(a, b) => scratch[a as usize] - scratch[b as usize],
                 Op::Mul(a, b) => scratch[a as usize] * scratch[b as usize],
                 Op::Neg(a) => -scratch[a as usize],
+                Op::Div(a, b) => scratch[a as usize] / scratch[b as usize],
             };
             scratch.push(v);
         }

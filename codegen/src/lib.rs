@@ -8,6 +8,7 @@
 #![warn(missing_docs)]
 
 pub mod atoms;
+pub mod compensation;
 pub mod derive;
 pub mod poly;
 pub mod rational;

@@ -9,7 +9,7 @@
 //! and folded into `+`/`−`, so negations are rare. The result is deterministic: the same model
 //! always gives the same program.
 
-use crate::atoms::AtomKind;
+use crate::atoms::{AtomKind, AtomTable};
 use crate::derive::GainModel;
 use crate::ir::{Input, Op, Output, Program, Var};
 use crate::poly::{Atom, Monomial, Poly};
@@ -18,17 +18,31 @@ use model_spec::Machine;
 use std::collections::HashMap;
 
 /// A value up to sign: `(var, negated)`.
-type Signed = (Var, bool);
+pub(crate) type Signed = (Var, bool);
 
-struct Builder {
+/// Builds one program: hash-consed instructions, polynomials memoised up to a constant factor.
+pub(crate) struct Builder {
     ops: Vec<Op>,
     interned: HashMap<Op, Var>,
     memo: HashMap<Poly, Signed>,
-    atom_vars: Vec<Var>,
+    /// The value each atom of the polynomials stands for.
+    pub(crate) atom_vars: Vec<Var>,
 }
 
 impl Builder {
-    fn push(&mut self, op: Op) -> Var {
+    /// An empty program whose polynomials will read their atoms from `atom_vars` (set it once
+    /// the inputs are pushed).
+    pub(crate) fn new() -> Builder {
+        Builder {
+            ops: Vec::new(),
+            interned: HashMap::new(),
+            memo: HashMap::new(),
+            atom_vars: Vec::new(),
+        }
+    }
+
+    /// Appends (or finds) an instruction.
+    pub(crate) fn push(&mut self, op: Op) -> Var {
         let op = match op {
             Op::Add(a, b) if a > b => Op::Add(b, a),
             Op::Mul(a, b) if a > b => Op::Mul(b, a),
@@ -43,7 +57,7 @@ impl Builder {
         v
     }
 
-    fn constant(&mut self, c: f64) -> Var {
+    pub(crate) fn constant(&mut self, c: f64) -> Var {
         self.push(Op::Const(c.to_bits()))
     }
 
@@ -88,7 +102,7 @@ impl Builder {
     }
 
     /// The value of a non-zero polynomial.
-    fn poly(&mut self, p: &Poly) -> Signed {
+    pub(crate) fn poly(&mut self, p: &Poly) -> Signed {
         let lead = p.leading_coefficient();
         let unit = p.scale(Rational::new(lead.denom(), lead.numer()));
         let v = match self.memo.get(&unit) {
@@ -143,11 +157,15 @@ fn best_atom(p: &Poly) -> Atom {
 /// The input descriptions of a machine's programs, in atom order: sines and cosines of the
 /// rotary commands, linear commands (mm), kinematic parameters (mm).
 pub fn inputs(m: &Machine, model: &GainModel) -> Vec<Input> {
-    model
-        .atoms
+    inputs_of(m, &model.atoms)
+}
+
+/// The input descriptions of the atoms `atoms` of `m`, in order.
+pub(crate) fn inputs_of(m: &Machine, atoms: &AtomTable) -> Vec<Input> {
+    atoms
         .kinds
         .iter()
-        .zip(&model.atoms.names)
+        .zip(&atoms.names)
         .map(|(k, name)| {
             let (field, parameter) = match *k {
                 AtomKind::Sin(a) => (
@@ -293,6 +311,18 @@ fn compile_polys(m: &Machine, model: &GainModel, polys: &[&Poly]) -> Program {
     })
 }
 
+impl Builder {
+    /// The finished program: `inputs`, the instructions, `outputs`, without the instructions
+    /// no output depends on.
+    pub(crate) fn finish(self, inputs: Vec<Input>, outputs: Vec<Output>) -> Program {
+        prune(Program {
+            inputs,
+            ops: self.ops,
+            outputs,
+        })
+    }
+}
+
 /// Drops the instructions no output depends on (unused inputs, say), renumbering the rest.
 fn prune(p: Program) -> Program {
     let mut live = vec![false; p.ops.len()];
@@ -304,7 +334,7 @@ fn prune(p: Program) -> Program {
     for i in (0..p.ops.len()).rev() {
         if live[i] {
             match p.ops[i] {
-                Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) => {
+                Op::Add(a, b) | Op::Sub(a, b) | Op::Mul(a, b) | Op::Div(a, b) => {
                     live[a as usize] = true;
                     live[b as usize] = true;
                 }
@@ -322,6 +352,7 @@ fn prune(p: Program) -> Program {
                 Op::Add(a, b) => Op::Add(r(a), r(b)),
                 Op::Sub(a, b) => Op::Sub(r(a), r(b)),
                 Op::Mul(a, b) => Op::Mul(r(a), r(b)),
+                Op::Div(a, b) => Op::Div(r(a), r(b)),
                 Op::Neg(a) => Op::Neg(r(a)),
                 other => other,
             };

@@ -84,6 +84,10 @@ fn lets(p: &Program, locals: &[Ident]) -> TokenStream {
                 let a = l(a);
                 quote!(-#a)
             }
+            Op::Div(a, b) => {
+                let (a, b) = (l(a), l(b));
+                quote!(#a / #b)
+            }
         };
         quote!(let #dst = #rhs;)
     });

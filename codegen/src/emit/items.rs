@@ -97,6 +97,7 @@ pub(crate) fn sum_counts<'a>(programs: impl Iterator<Item = &'a Program>) -> OpC
             add: a.add + c.add,
             mul: a.mul + c.mul,
             neg: a.neg + c.neg,
+            div: a.div + c.div,
         }
     })
 }

@@ -1,0 +1,190 @@
+//! The corrected pose of one commanded pose, on the host: the generated compensation programs
+//! evaluated in process ([`codegen::Program::eval`]), step for step what the generated
+//! `compensate` function does, then checked and, where needed, refined.
+
+use codegen::compensation::{
+    CompensationError, CompensationPrograms, RESIDUALS, STEPS, compile_compensation,
+};
+use model_spec::{ErrorId, Machine};
+
+/// The predicted remainder a corrected pose must reach (mm): 1 nm.
+pub const POSITION_TOLERANCE: f64 = 1e-6;
+
+/// The most refinement steps after the [`STEPS`] fixed ones.
+pub const MAX_REFINEMENT_STEPS: usize = 20;
+
+/// A corrected pose.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Corrected {
+    /// The corrected command of every axis (mm, rad), machine order.
+    pub commands: Vec<f64>,
+    /// The predicted remainder at the corrected pose, tool frame: position (mm).
+    pub position: [f64; 3],
+    /// The predicted tilt of the tool axis that remains (rad, about x and y of the tool frame).
+    pub tilt: [f64; 2],
+    /// The predicted rotation about the tool axis (rad): no axis removes it.
+    pub roll: f64,
+    /// Refinement steps the host took after the fixed ones (0 where the fixed steps were
+    /// enough).
+    pub refinements: usize,
+}
+
+/// The host side of the generated compensation of one model.
+#[derive(Clone, Debug)]
+pub struct Compensator {
+    programs: CompensationPrograms,
+    rotary: Vec<usize>,
+    linear: Vec<usize>,
+    params: Vec<f64>,
+    scratch: Vec<f64>,
+    inputs: Vec<f64>,
+    out: Vec<f64>,
+}
+
+impl Compensator {
+    /// Compiles the compensation of the errors `errors` (catalogue order of `m` as the model
+    /// lists them) with the kinematic parameters `params` (mm, one per symbol of `m`).
+    ///
+    /// # Errors
+    /// When the topology is outside what the solver handles.
+    pub fn new(
+        m: &Machine,
+        errors: &[ErrorId],
+        params: Vec<f64>,
+    ) -> Result<Compensator, CompensationError> {
+        let programs = compile_compensation(m, errors)?;
+        Ok(Compensator {
+            rotary: m.rotary_axes().collect(),
+            linear: m.linear_axes().collect(),
+            params,
+            programs,
+            scratch: Vec::new(),
+            inputs: Vec::new(),
+            out: Vec::new(),
+        })
+    }
+
+    /// The compiled programs.
+    pub fn programs(&self) -> &CompensationPrograms {
+        &self.programs
+    }
+
+    /// Loads pose and parameters into the input buffer (sines and cosines by `f64::sin_cos`,
+    /// as the generated code's caller does on the host).
+    fn load_pose(&mut self, commands: &[f64]) {
+        self.inputs.clear();
+        for &a in &self.rotary {
+            let (s, c) = commands[a].sin_cos();
+            self.inputs.extend([s, c]);
+        }
+        for &a in &self.linear {
+            self.inputs.push(commands[a]);
+        }
+        self.inputs.extend_from_slice(&self.params);
+    }
+
+    /// The target of a commanded pose: the tool point and the tool axis in the work frame.
+    pub fn target(&mut self, commanded: &[f64]) -> [f64; 6] {
+        self.load_pose(commanded);
+        let mut t = [0.0; 6];
+        self.programs
+            .target
+            .eval(&self.inputs, &mut self.scratch, &mut t);
+        t
+    }
+
+    /// One step from `at` towards `target` with the error values `values` (mm, rad, model
+    /// order): returns the change of every axis (mm, rad) and fills `residual` with the
+    /// residual at `at`.
+    fn step(
+        &mut self,
+        at: &[f64],
+        values: &[f64],
+        target: &[f64; 6],
+        residual: &mut [f64; RESIDUALS],
+    ) -> &[f64] {
+        self.load_pose(at);
+        self.inputs.extend_from_slice(values);
+        self.inputs.extend_from_slice(target);
+        let n = self.programs.axis_count();
+        self.out.resize(n + RESIDUALS, 0.0);
+        self.programs
+            .step
+            .eval(&self.inputs, &mut self.scratch, &mut self.out);
+        residual.copy_from_slice(&self.out[n..]);
+        &self.out[..n]
+    }
+
+    /// The [`STEPS`] fixed steps of the generated `compensate` function, from the commanded
+    /// pose with the values at the commanded pose: bit for bit what the generated function
+    /// returns when its caller's sine and cosine are `f64::sin_cos`.
+    pub fn fixed_steps(&mut self, commanded: &[f64], values: &[f64]) -> Vec<f64> {
+        let target = self.target(commanded);
+        let mut q = commanded.to_vec();
+        let mut residual = [0.0; RESIDUALS];
+        for _ in 0..STEPS {
+            let change = self.step(&q, values, &target, &mut residual).to_vec();
+            for (qi, d) in q.iter_mut().zip(change) {
+                *qi += d;
+            }
+        }
+        q
+    }
+
+    /// The corrected pose of `commanded` (mm, rad): the fixed steps with the values at the
+    /// commanded pose, then steps with the values at the corrected pose (`values_at(commands,
+    /// out)` fills one value per model error) until the predicted position remainder is below
+    /// [`POSITION_TOLERANCE`].
+    ///
+    /// # Errors
+    /// The remainder after [`MAX_REFINEMENT_STEPS`] more steps, when it is still above the
+    /// tolerance.
+    pub fn correct(
+        &mut self,
+        commanded: &[f64],
+        values_at: &mut dyn FnMut(&[f64], &mut [f64]),
+    ) -> Result<Corrected, f64> {
+        let mut values = vec![0.0; self.programs.errors.len()];
+        values_at(commanded, &mut values);
+        let target = self.target(commanded);
+        let mut q = self.fixed_steps(commanded, &values);
+        let mut residual = [0.0; RESIDUALS];
+        let mut refinements = 0;
+        loop {
+            values_at(&q, &mut values);
+            let change = self.step(&q, &values, &target, &mut residual).to_vec();
+            let remainder = residual[..3].iter().map(|r| r * r).sum::<f64>().sqrt();
+            if remainder < POSITION_TOLERANCE {
+                break;
+            }
+            if refinements == MAX_REFINEMENT_STEPS {
+                return Err(remainder);
+            }
+            for (qi, d) in q.iter_mut().zip(change) {
+                *qi += d;
+            }
+            refinements += 1;
+        }
+        Ok(Corrected {
+            commands: q,
+            position: [residual[0], residual[1], residual[2]],
+            tilt: [residual[3], residual[4]],
+            roll: residual[5],
+            refinements,
+        })
+    }
+
+    /// The first-order correction of `commanded` alone (the generated `f32` function's
+    /// computation, in `f64`): the change of every axis (mm, rad).
+    pub fn first_order(&mut self, commanded: &[f64], values: &[f64]) -> Vec<f64> {
+        self.load_pose(commanded);
+        self.inputs.extend_from_slice(values);
+        let n = self.programs.axis_count();
+        let mut out = vec![0.0; n + RESIDUALS];
+        self.programs
+            .first_step
+            .eval(&self.inputs, &mut self.scratch, &mut out);
+        out.truncate(n);
+        out
+    }
+}

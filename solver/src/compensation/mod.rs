@@ -1,0 +1,6 @@
+//! Compensation: what was identified, put back onto the machine.
+//!
+//! - [`correct`]: the corrected pose of a commanded pose, through the generated compensation
+//!   programs (the same instructions the `no_std` code runs).
+
+pub mod correct;

@@ -39,7 +39,7 @@ fn main() {
         for model in machine.model_names() {
             let _ = writeln!(
                 table,
-                "    CompiledModel {{ machine: \"{}\", model: \"{model}\", errors: &{module}::{model}::ERRORS, pose_inputs: &{module}::POSE_INPUTS, parameters: &{module}::PARAMETERS, operations: {module}::{model}::OPERATIONS, gains: {module}::{model}::gains_slice, position_gains: {module}::{model}::position_gains_slice, position_operations: {module}::{model}::POSITION_OPERATIONS }},",
+                "    CompiledModel {{ machine: \"{}\", model: \"{model}\", errors: &{module}::{model}::ERRORS, pose_inputs: &{module}::POSE_INPUTS, parameters: &{module}::PARAMETERS, operations: {module}::{model}::OPERATIONS, gains: {module}::{model}::gains_slice, position_gains: {module}::{model}::position_gains_slice, position_operations: {module}::{model}::POSITION_OPERATIONS, compensate: {module}::{model}::compensation::compensate_slice, first_order_f32: {module}::{model}::compensation::first_order_f32_slice }},",
                 machine.name
             );
         }

@@ -24,6 +24,12 @@
 #![no_std]
 #![warn(missing_docs)]
 
+/// `compensate(commanded, params, values, sin_cos, out)` of a compiled model, on slices.
+pub type CompensateFn = fn(&[f64], &[f64], &[f64], fn(f64) -> (f64, f64), &mut [f64]);
+
+/// `first_order_f32(pose, params, values, out)` of a compiled model, on slices.
+pub type FirstOrderF32Fn = fn(&[f32], &[f32], &[f32], &mut [f32]);
+
 /// A compiled model, for callers that choose the machine and model at run time.
 #[derive(Clone, Copy, Debug)]
 pub struct CompiledModel {
@@ -47,6 +53,14 @@ pub struct CompiledModel {
     pub position_gains: fn(&[f64], &[f64], &mut [f64]),
     /// Arithmetic operations of one position-gain evaluation.
     pub position_operations: usize,
+    /// `compensate(commanded, params, values, sin_cos, out)`: the model's `compensation::compensate`
+    /// on slices; `commanded` and `out` one command per axis (mm, rad, machine order), `values`
+    /// one per error (mm, rad).
+    pub compensate: CompensateFn,
+    /// `first_order_f32(pose, params, values, out)`: the model's
+    /// `compensation::first_order_f32` on slices; `out` holds one change per axis then the six
+    /// residuals.
+    pub first_order_f32: FirstOrderF32Fn,
 }
 
 /// The compiled model `model` of the built-in machine `machine`.

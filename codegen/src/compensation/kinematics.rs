@@ -37,6 +37,8 @@ pub struct Ingredients {
     pub tool_to_work: [[Poly; 3]; 3],
     /// The model errors: position gains (tool frame) and rotation gains (tool frame).
     pub errors: Vec<(Vec3, Vec3)>,
+    /// Their names.
+    pub error_names: Vec<String>,
     /// Every axis, machine order: its position and rotation gains per unit of command (mm or
     /// rad), i.e. the column of the nominal Jacobian in the tool frame.
     pub columns: Vec<(Vec3, Vec3)>,
@@ -150,6 +152,10 @@ impl Ingredients {
             tool_point: nominal.tool_point_in_work,
             tool_to_work: nominal.tool_to_work,
             errors: (0..n).map(pair).collect(),
+            error_names: errors
+                .iter()
+                .map(|&e| m.catalogue[e].name.clone())
+                .collect(),
             columns,
             linear: m.linear_axes().collect(),
             rotary: m.rotary_axes().collect(),

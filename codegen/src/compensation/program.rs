@@ -8,12 +8,15 @@ use crate::ir::{Input, Op, Output, Program, Var};
 use crate::lower::{Builder, Signed, inputs_of};
 use crate::poly::Poly;
 
-/// The damping of the rotary axes' least squares, (rad/rad)²: about (sin 1°)². Where the rotary
-/// axes can turn the tool axis by more than about 1° per radian in every direction, the step
-/// is the exact inverse to within `DAMPING / σ²`; near a singular pose (the tool axis on the
-/// last rotary axis, `A = 0` on a table-table A/C machine) the orientation correction fades to
-/// zero instead of growing without bound.
-pub const DAMPING: f64 = 3e-4;
+/// The damping `μ0` of the rotary axes' least squares at a singular pose, (rad/rad)²: 2⁻¹²,
+/// about (sin 0.9°)², a power of two so that it and `1/μ0²` are exact. The damping used is
+/// `μ = μ0 / (1 + (w/μ0)²)`, `w` about the smallest squared singular value of the
+/// orientation Jacobian: where the rotary axes turn the tool axis by more than about 1° per
+/// radian in every direction it vanishes (one step is the exact inverse to within `(μ0/w)³`:
+/// 5e-8 at 15° from the singular pose); at a singular pose (the
+/// tool axis on the last rotary axis, `A = 0` on a table-table A/C machine) it is `μ0`, and
+/// the orientation correction fades to zero instead of growing without bound.
+pub const DAMPING: f64 = 1.0 / 4096.0;
 
 /// A value under construction: a constant (folded) or an instruction up to sign.
 #[derive(Clone, Copy, Debug)]
@@ -183,7 +186,6 @@ pub(crate) fn build(ing: &Ingredients, atoms: &AtomTable, kind: Kind) -> Program
         let outputs = tip.iter().chain(&axis).map(|&v| c.output(v)).collect();
         return c.b.finish(inputs, outputs);
     }
-    let n = ing.errors.len();
     let mut next = n_atoms as u32;
     let mut input = |c: &mut Ctx, inputs: &mut Vec<Input>, name: String| {
         inputs.push(Input {
@@ -195,12 +197,15 @@ pub(crate) fn build(ing: &Ingredients, atoms: &AtomTable, kind: Kind) -> Program
         next += 1;
         Val::Var((v, false))
     };
-    let values: Vec<Val> = (0..n)
-        .map(|i| input(&mut c, &mut inputs, format!("value{i}")))
+    let values: Vec<Val> = ing
+        .error_names
+        .iter()
+        .map(|name| input(&mut c, &mut inputs, name.clone()))
         .collect();
     let target: Vec<Val> = match kind {
-        Kind::Step => (0..6)
-            .map(|i| input(&mut c, &mut inputs, format!("target{i}")))
+        Kind::Step => ["tool_x", "tool_y", "tool_z", "axis_x", "axis_y", "axis_z"]
+            .iter()
+            .map(|name| input(&mut c, &mut inputs, name.to_string()))
             .collect(),
         _ => Vec::new(),
     };
@@ -253,21 +258,38 @@ pub(crate) fn build(ing: &Ingredients, atoms: &AtomTable, kind: Kind) -> Program
             [r[1], c.neg(r[0])]
         })
         .collect();
-    let mu = Val::Const(DAMPING);
     let g: Vec<Val> = j.iter().map(|ji| c.dot(ji, &tilt)).collect();
+    // Variable damping: `μ = μ0 / (1 + (w/μ0)²)` with `w` about the smallest squared singular
+    // value (`det / (trace + μ0)` of `JᵀJ`): `μ0` at a singular pose, vanishing (as `μ0³/w²`)
+    // away from it, so that one step is the exact inverse there. Branch-free.
+    let mu0 = Val::Const(DAMPING);
+    let inverse_square = Val::Const(1.0 / (DAMPING * DAMPING));
+    let damping = |c: &mut Ctx, w: Val| {
+        let w2 = c.mul(w, w);
+        let scaled = c.mul(w2, inverse_square);
+        let d = c.add(Val::Const(1.0), scaled);
+        c.div(mu0, d)
+    };
     match j.len() {
         1 => {
             let m11 = c.dot(&j[0], &j[0]);
+            let mu = damping(&mut c, m11);
             let m11 = c.add(m11, mu);
             let q = c.div(g[0], m11);
             change[ing.rotary[0]] = c.neg(q);
         }
         2 => {
             let m11 = c.dot(&j[0], &j[0]);
-            let m11 = c.add(m11, mu);
             let m22 = c.dot(&j[1], &j[1]);
-            let m22 = c.add(m22, mu);
             let m12 = c.dot(&j[0], &j[1]);
+            let (p, q) = (c.mul(m11, m22), c.mul(m12, m12));
+            let det0 = c.sub(p, q);
+            let trace = c.add(m11, m22);
+            let trace = c.add(trace, mu0);
+            let w = c.div(det0, trace);
+            let mu = damping(&mut c, w);
+            let m11 = c.add(m11, mu);
+            let m22 = c.add(m22, mu);
             let (p, q) = (c.mul(m11, m22), c.mul(m12, m12));
             let det = c.sub(p, q);
             let inv = c.div(Val::Const(1.0), det);

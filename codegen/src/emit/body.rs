@@ -25,6 +25,11 @@ pub(crate) fn ident(name: &str) -> Ident {
 
 /// One output cell: a value, a negated value or a literal.
 fn cell(locals: &[Ident], o: &Output) -> TokenStream {
+    cell_with(locals, o, Float::F64)
+}
+
+/// One output cell, literals of type `float`.
+pub(crate) fn cell_with(locals: &[Ident], o: &Output, float: Float) -> TokenStream {
     match *o {
         Output::Var(v) => {
             let v = &locals[v as usize];
@@ -34,7 +39,10 @@ fn cell(locals: &[Ident], o: &Output) -> TokenStream {
             let v = &locals[v as usize];
             quote!(-#v)
         }
-        Output::Const(c) => float_literal(c),
+        Output::Const(c) => match float {
+            Float::F64 => float_literal(c),
+            Float::F32 => float_literal_f32(c),
+        },
     }
 }
 
@@ -53,21 +61,56 @@ pub fn reads(p: &Program) -> (bool, bool) {
     r
 }
 
+/// An exact `f32` literal of `x` rounded to single precision (shortest round-trip decimal,
+/// `f32` suffix), negative values as a unary minus.
+pub fn float_literal_f32(x: f64) -> TokenStream {
+    let x = x as f32;
+    let lit = Literal::f32_suffixed(x.abs());
+    if x.is_sign_negative() && x != 0.0 {
+        quote!(-#lit)
+    } else {
+        quote!(#lit)
+    }
+}
+
+/// The floating-point type of emitted code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Float {
+    /// `f64`: bit for bit the in-process evaluation.
+    F64,
+    /// `f32`: the same instructions in single precision.
+    F32,
+}
+
 /// One `let` per instruction: `let zc = params.Zc;`, `let t3 = t1 * zc;`.
 fn lets(p: &Program, locals: &[Ident]) -> TokenStream {
+    let load = |k: usize| {
+        let input = &p.inputs[k];
+        let f = ident(&input.field);
+        if input.parameter {
+            quote!(params.#f)
+        } else {
+            quote!(pose.#f)
+        }
+    };
+    lets_with(p, locals, &load, Float::F64)
+}
+
+/// One `let` per instruction, inputs loaded by `load(input index)`, literals of type `float`.
+pub(crate) fn lets_with(
+    p: &Program,
+    locals: &[Ident],
+    load: &dyn Fn(usize) -> TokenStream,
+    float: Float,
+) -> TokenStream {
     let lets = p.ops.iter().zip(locals).map(|(op, dst)| {
         let l = |v: u32| &locals[v as usize];
         let rhs = match *op {
-            Op::Input(k) => {
-                let input = &p.inputs[k as usize];
-                let f = ident(&input.field);
-                if input.parameter {
-                    quote!(params.#f)
-                } else {
-                    quote!(pose.#f)
-                }
-            }
-            Op::Const(bits) => float_literal(f64::from_bits(bits)),
+            Op::Input(k) => load(k as usize),
+            Op::Const(bits) => match float {
+                Float::F64 => float_literal(f64::from_bits(bits)),
+                Float::F32 => float_literal_f32(f64::from_bits(bits)),
+            },
             Op::Add(a, b) => {
                 let (a, b) = (l(a), l(b));
                 quote!(#a + #b)

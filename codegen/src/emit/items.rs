@@ -6,6 +6,7 @@ use super::docs;
 use super::names::snake_case;
 use crate::GainModel;
 use crate::atoms::AtomKind;
+use crate::compensation::CompensationPrograms;
 use crate::ir::{Input, OpCounts, Program};
 use crate::lower::Part;
 use model_spec::Machine;
@@ -109,7 +110,15 @@ fn read_flags(args: &(Ident, Ident)) -> (bool, bool) {
 }
 
 /// One model's module (`pub mod reduced { … }`).
-pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStream {
+///
+/// With `compensation`, the module holds a `compensation` module too
+/// ([`super::compensation`]).
+pub fn model_module(
+    module: &str,
+    model: &GainModel,
+    parts: &[Part],
+    compensation: Option<&CompensationPrograms>,
+) -> TokenStream {
     let module_doc = format!(" Model `{module}` of machine `{}`.", model.machine);
     let module = ident(module);
     let n_value = model.errors.len();
@@ -154,6 +163,7 @@ pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStr
     ];
     let gains_slice_doc = docs::panics(&[args[0], args[1], ("out", "`6 * N`", 6 * n_value)]);
     let pos_slice_doc = docs::panics(&[args[0], args[1], ("out", "`3 * N`", 3 * n_value)]);
+    let compensation = compensation.map(super::compensation::compensation_module);
     quote! {
         #[doc = #module_doc]
         pub mod #module {
@@ -206,6 +216,7 @@ pub fn model_module(module: &str, model: &GainModel, parts: &[Part]) -> TokenStr
                     dst.copy_from_slice(src);
                 }
             }
+            #compensation
         }
     }
 }
@@ -305,13 +316,26 @@ pub fn input_structs(m: &Machine, inputs: &[Input]) -> TokenStream {
     }
 }
 
+/// What one model's module is emitted from.
+#[derive(Clone, Debug)]
+pub struct ModelCode<'a> {
+    /// The model's name (the module's).
+    pub name: &'a str,
+    /// Its gains.
+    pub model: &'a GainModel,
+    /// Its compiled parts.
+    pub parts: Vec<Part>,
+    /// Its compensation programs (none for a topology the solver does not handle).
+    pub compensation: Option<CompensationPrograms>,
+}
+
 /// The code of one machine: its `Pose`, `Params` and one module per model, as a token stream
 /// (the content of a module; no crate attributes, so it can be `include!`d).
-pub fn machine_tokens(m: &Machine, models: &[(&str, &GainModel, Vec<Part>)]) -> TokenStream {
-    let inputs = crate::lower::inputs(m, models.first().expect("at least one model").1);
+pub fn machine_tokens(m: &Machine, models: &[ModelCode<'_>]) -> TokenStream {
+    let inputs = crate::lower::inputs(m, models.first().expect("at least one model").model);
     let structs = input_structs(m, &inputs);
     let modules = models
         .iter()
-        .map(|(name, model, parts)| model_module(name, model, parts));
+        .map(|c| model_module(c.name, c.model, &c.parts, c.compensation.as_ref()));
     quote!(#structs #(#modules)*)
 }

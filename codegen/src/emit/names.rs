@@ -3,7 +3,8 @@
 //! An input keeps the snake case of its field (`pose.sin_a` is loaded into `sin_a`, `pose.x`
 //! into `x`, `params.Zc` into `zc`); only intermediates get generated names, `t0`, `t1`, … in
 //! instruction order. The input names of a program are unique, never a Rust keyword, never the
-//! name of an argument of the generated functions (`pose`, `params`, `out`) and never of the
+//! name of an argument of the generated functions (`pose`, `params`, `out`, `values`,
+//! `target`) and never of the
 //! form `t` + digits, so they cannot collide with an intermediate. A name that would be one of
 //! those gets a deterministic suffix: a keyword, an argument name or an intermediate-like name
 //! gets a trailing `_` (`in_`, `out_`, `t0_`), a name already taken by an earlier input gets
@@ -14,7 +15,7 @@ use proc_macro2::{Ident, Span};
 use std::collections::HashSet;
 
 /// The arguments of the generated functions, which a local must not shadow.
-const ARGUMENTS: &[&str] = &["pose", "params", "out"];
+const ARGUMENTS: &[&str] = &["pose", "params", "out", "values", "target"];
 
 /// The snake case of an ASCII identifier: a word starts at an upper-case letter that follows a
 /// lower-case letter or a digit, or that starts a capitalised word after a run of capitals

@@ -15,6 +15,7 @@
 //! [`identify::IdentificationReport`] can be read back ([`read::IdentifiedValues`]): `validate`
 //! takes its model and values, after checking that it belongs to the machine.
 
+pub mod compensate;
 pub mod diagnose;
 pub mod gains;
 pub mod identify;

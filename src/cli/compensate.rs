@@ -1,0 +1,324 @@
+//! `rtest compensate`: what `identify` found, put back onto the machine: corrected commands
+//! (a CSV of poses or an NC program), a corrected kinematic description, axis compensation
+//! tables.
+
+use super::args::ValueBounds;
+use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use output::{Outputs, Target};
+use solver::compensation::kinematics::corrected_description;
+use solver::compensation::run::{CommandedPose, compensate_poses};
+use solver::compensation::tables::{Pitch, axis_tables};
+use solver::compensation::values::MachineErrors;
+use solver::fitting::hmatrix::parameter_names;
+use solver::fitting::sanity::check_model_values;
+use solver::io::nc::{Dialect, WriteOptions, read_program};
+use solver::io::poses::{axis_words, read_pose_file};
+use solver::io::report::compensate::{
+    CompensationReport, CompensationSource, KinematicsReport, LeftOutReport,
+};
+use solver::io::report::{read_identification, to_json};
+use solver::io::text::compensate::compensation;
+use std::path::PathBuf;
+
+const LONG_ABOUT: &str = "\
+Puts identified errors back onto the machine. The values are those of an `rtest identify` JSON \
+(--params, position-dependent terms included); what is compensated is the machine's geometric \
+errors only: set-up errors of the ball, the R-test's sensor offsets and instrument terms, time, \
+velocity and reversal terms are left out and listed. A value the identification could not \
+determine is refused (identify with a constraint, or with another path).
+
+--path IN -o OUT: corrected commands. IN is a CSV of commanded poses (one column per machine \
+axis named by its letter, mm and degrees; other columns kept as they are) or, with --nc \
+iso|heidenhain, an NC program in machine coordinates (absolute G0/G1 or L blocks; every other \
+line passed through byte for byte; arcs, incremental moves, datum shifts and TCP are refused with \
+the line). OUT has the same format with the corrected axis values: at the corrected pose the \
+model's predicted tool point and tool axis are the commanded ones (nominal kinematics plus the \
+identified first-order error, iterated until the predicted position remainder is below 1 nm). \
+The linear axes correct the position, two rotary axes the tilt of the tool axis (damped near a \
+singular pose, where the report says what remains); the rotation about the tool axis cannot be \
+corrected and is reported. A corrected pose outside a stroke or range is refused with its line. \
+NC words keep their decimals (--decimals N for more); the rounding this costs is reported.
+
+--kinematics-out FILE: the machine description with the location errors folded into its \
+kinematic offsets; what cannot be folded (angular location errors, squareness, component \
+errors) is listed. --tables DIR: one CSV per axis of its component errors against its position \
+at --pitch mm (--pitch-deg for rotary axes), with the positioning correction in the axis's own \
+sense (docs/compensation-tables.md).
+
+The workpiece point of the correction is the material point under the tool tip; --param sets \
+kinematic symbols (the tool length, say) as in `gains`. --json writes the summary \
+(docs/compensation.md).";
+
+/// Flags of `rtest compensate`.
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Compensate: corrected commands (CSV or NC), corrected kinematics, axis tables",
+    long_about = LONG_ABOUT,
+    after_help = EXIT_CODES
+)]
+pub struct CompensateArgs {
+    /// Built-in machine (see `rtest machines`) or path of a machine TOML file.
+    #[arg(long, value_name = "NAME|FILE")]
+    machine: String,
+    /// The JSON written by `rtest identify --json` (values in µm and µrad).
+    #[arg(long, value_name = "FILE")]
+    params: PathBuf,
+    /// The commanded poses: a CSV (columns named by the axis letters) or, with --nc, a program.
+    #[arg(long, value_name = "FILE", requires = "output")]
+    path: Option<PathBuf>,
+    /// Where the corrected poses go, in the format of --path.
+    #[arg(short = 'o', long = "output", value_name = "FILE", requires = "path")]
+    output: Option<Target>,
+    /// --path is an NC program of this dialect.
+    #[arg(long, value_name = "iso|heidenhain", value_parser = ["iso", "heidenhain"])]
+    nc: Option<String>,
+    /// The fewest decimals of a corrected NC word (default: the program's own).
+    #[arg(long, value_name = "N")]
+    decimals: Option<usize>,
+    /// Kinematic symbols (mm), `NAME=VALUE,...`, overriding the machine's defaults.
+    #[arg(long, value_name = "LIST")]
+    param: Option<String>,
+    /// Also write the machine description with the location errors folded into its offsets.
+    #[arg(long, value_name = "FILE")]
+    kinematics_out: Option<Target>,
+    /// Also write one axis compensation table per axis into this directory.
+    #[arg(long, value_name = "DIR")]
+    tables: Option<PathBuf>,
+    /// Pitch of the tables of linear axes, mm.
+    #[arg(long, value_name = "MM", default_value_t = 10.0, value_parser = super::args::positive)]
+    pitch: f64,
+    /// Pitch of the tables of rotary axes, degrees.
+    #[arg(long, value_name = "DEG", default_value_t = 5.0, value_parser = super::args::positive)]
+    pitch_deg: f64,
+    /// Also write the summary as JSON to FILE (`-`: standard output).
+    #[arg(long, value_name = "FILE")]
+    json: Option<Target>,
+    #[command(flatten)]
+    bounds: ValueBounds,
+}
+
+/// Runs `rtest compensate`.
+pub fn run(args: &CompensateArgs) -> CliResult {
+    if args.path.is_none() && args.kinematics_out.is_none() && args.tables.is_none() {
+        return Err(CliError::usage(
+            "nothing to write: give --path IN -o OUT, --kinematics-out FILE or --tables DIR",
+        ));
+    }
+    if args.json.is_some() && args.path.is_none() {
+        return Err(CliError::usage("--json summarises corrected poses: give --path"));
+    }
+    if args.nc.is_none() && args.decimals.is_some() {
+        return Err(CliError::usage("--decimals applies to NC programs (--nc)"));
+    }
+    let (m, machine_text) = super::load_machine_and_text(&args.machine)?;
+    let mut inputs = vec![("--params", args.params.as_path())];
+    inputs.extend(args.path.as_deref().map(|p| ("--path", p)));
+    inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
+    let outputs: Vec<(&str, &Target)> = [
+        ("-o", args.output.as_ref()),
+        ("--kinematics-out", args.kinematics_out.as_ref()),
+        ("--json", args.json.as_ref()),
+    ]
+    .into_iter()
+    .filter_map(|(f, t)| t.map(|t| (f, t)))
+    .collect();
+    let dirs: Vec<(&str, &std::path::Path)> =
+        args.tables.iter().map(|d| ("--tables", d.as_path())).collect();
+    check_outputs(&inputs, &outputs, &dirs)?;
+    let params = super::pose_args::params(&m, args.param.as_deref())?;
+    let id = read_identification(&args.params, &m)
+        .map_err(|e| CliError::input(format!("--params: {e}")))?;
+    let names = parameter_names(&m, &id.model);
+    check_model_values(&m, &id.model, &names, &id.values, &args.bounds.values()).map_err(|e| {
+        CliError::input(format!(
+            "--params: {}: {e}: these cannot be the errors of a machine tool (--max-error-um, --max-error-urad change the bounds)",
+            args.params.display()
+        ))
+    })?;
+    let (errors, left_out) = MachineErrors::from_identified(&m, &id)
+        .map_err(|e| CliError::input(format!("--params: {e}")))?;
+    let mut files = Outputs::new();
+    let params_file = args.params.display().to_string();
+    let mut source = CompensationSource {
+        machine: m.name.clone(),
+        model: id.model_name.clone(),
+        params_file: params_file.clone(),
+        input: String::new(),
+        output: String::new(),
+        format: String::new(),
+        compensated: errors
+            .errors()
+            .iter()
+            .map(|&e| m.catalogue[e].name.clone())
+            .collect(),
+        left_out: left_out
+            .iter()
+            .map(|l| LeftOutReport {
+                term: l.term.clone(),
+                reason: l.reason.clone(),
+            })
+            .collect(),
+        rounding: None,
+        kinematics: None,
+        tables: Vec::new(),
+    };
+    let mut summary = None;
+    if let (Some(path), Some(out)) = (&args.path, &args.output) {
+        let words = axis_words(&m);
+        let file = path.display().to_string();
+        let to_rad = |commands: &[f64]| -> Vec<f64> {
+            commands
+                .iter()
+                .zip(&m.axes)
+                .map(|(&q, a)| match a.kind {
+                    model_spec::AxisKind::Rotary => q.to_radians(),
+                    model_spec::AxisKind::Linear => q,
+                })
+                .collect()
+        };
+        let to_deg = |commands: &[f64]| -> Vec<f64> {
+            commands
+                .iter()
+                .zip(&m.axes)
+                .map(|(&q, a)| match a.kind {
+                    model_spec::AxisKind::Rotary => q.to_degrees(),
+                    model_spec::AxisKind::Linear => q,
+                })
+                .collect()
+        };
+        let mut values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
+        let run = |poses: &[solver::io::poses::CommandedPose],
+                   values_at: &mut dyn FnMut(&[f64], &mut [f64])| {
+            let commanded: Vec<CommandedPose> = poses
+                .iter()
+                .map(|p| CommandedPose {
+                    line: p.line,
+                    commands: to_rad(&p.commands),
+                })
+                .collect();
+            compensate_poses(
+                &m,
+                errors.errors(),
+                params.clone(),
+                &file,
+                &commanded,
+                values_at,
+            )
+            .map_err(|e| match e {
+                solver::compensation::run::RunError::NotConverged { .. } => {
+                    CliError::computation(format!("--path: {e}"))
+                }
+                other => CliError::input(format!("--path: {other}")),
+            })
+        };
+        let (text, rounding, format, s) = match &args.nc {
+            Some(name) => {
+                let dialect = Dialect::from_name(name).expect("clap checks the dialect");
+                let program = read_program(path, dialect, &words)
+                    .map_err(|e| CliError::input(format!("--path: {e}")))?;
+                let done = run(program.poses(), &mut values_at)?;
+                let corrected: Vec<Vec<f64>> = done.poses.iter().map(|q| to_deg(q)).collect();
+                let options = WriteOptions::with_min_decimals(args.decimals.unwrap_or(0));
+                let written = program
+                    .write(&corrected, &options)
+                    .map_err(|e| CliError::input(format!("-o: {e}")))?;
+                let rounding = written
+                    .rounding
+                    .iter()
+                    .zip(&m.axes)
+                    .map(|(&r, a)| match a.kind {
+                        model_spec::AxisKind::Rotary => r.to_radians(),
+                        model_spec::AxisKind::Linear => r,
+                    })
+                    .collect();
+                (written.text, Some(rounding), name.clone(), done.summary)
+            }
+            None => {
+                let table = read_pose_file(path, &words)
+                    .map_err(|e| CliError::input(format!("--path: {e}")))?;
+                let done = run(table.poses(), &mut values_at)?;
+                let corrected: Vec<Vec<f64>> = done.poses.iter().map(|q| to_deg(q)).collect();
+                let text = table
+                    .write(&corrected)
+                    .map_err(|e| CliError::input(format!("-o: {e}")))?;
+                (text, None, "csv".to_string(), done.summary)
+            }
+        };
+        files.add("-o", out.clone(), text);
+        source.input = file;
+        source.output = out.to_string();
+        source.format = format;
+        source.rounding = rounding;
+        summary = Some(s);
+    }
+    if let Some(target) = &args.kinematics_out {
+        let corrected = corrected_description(&m, &machine_text, &errors)
+            .map_err(|e| CliError::input(format!("--kinematics-out: {e}")))?;
+        source.kinematics = Some(KinematicsReport {
+            file: target.to_string(),
+            folded: corrected.folded.iter().map(|f| f.place.clone()).collect(),
+            not_folded: corrected
+                .not_folded
+                .iter()
+                .map(|n| format!("{}: {}", n.spelling, n.reason))
+                .collect(),
+        });
+        files.add("--kinematics-out", target.clone(), corrected.toml);
+    }
+    if let Some(dir) = &args.tables {
+        let pitch = Pitch {
+            linear_mm: args.pitch,
+            rotary_deg: args.pitch_deg,
+        };
+        let tables = axis_tables(&m, &errors, pitch)
+            .map_err(|e| CliError::usage(format!("--tables: {e}")))?;
+        for t in &tables {
+            let name = t.file_name();
+            source.tables.push(dir.join(&name).display().to_string());
+            files.add_in_dir("--tables", dir, &name, t.to_csv());
+        }
+    }
+    let text = match &summary {
+        Some(s) => {
+            let report = CompensationReport::new(source, s)
+                .map_err(|e| CliError::computation(format!("--path: {e}")))?;
+            if let Some(target) = &args.json {
+                let json =
+                    to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+                files.add("--json", target.clone(), json);
+            }
+            compensation(&report)
+        }
+        None => kinematics_and_tables_text(&source),
+    };
+    let mut text = text;
+    text.push_str(&wrote(&write(files)?));
+    let stdout_taken = [&args.output, &args.kinematics_out, &args.json]
+        .iter()
+        .any(|t| matches!(t, Some(Target::Stdout)));
+    print_text(&text, stdout_taken)
+}
+
+/// The text when no poses were corrected: the corrected description and the tables.
+fn kinematics_and_tables_text(source: &CompensationSource) -> String {
+    let mut text = format!(
+        "Machine {}, model {} with the values of {}\n",
+        source.machine, source.model, source.params_file
+    );
+    if let Some(k) = &source.kinematics {
+        text.push_str(&format!("Corrected kinematic description: {}\n", k.file));
+        for f in &k.folded {
+            text.push_str(&format!("  folded: {f}\n"));
+        }
+        for f in &k.not_folded {
+            text.push_str(&format!("  not folded: {f}\n"));
+        }
+    }
+    if !source.tables.is_empty() {
+        text.push_str(&format!(
+            "Axis compensation tables: {}\n",
+            source.tables.join(", ")
+        ));
+    }
+    text
+}

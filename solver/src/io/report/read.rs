@@ -13,7 +13,12 @@
 //!   base model (and the sensor offsets when the readings were zeroed): no parameter is missing;
 //! - a `poly:K` parameter was normalised over the stroke this machine has for its axis;
 //! - the refinement, when the report has one, converged (an identification that did not is no
-//!   result).
+//!   result);
+//! - what the fit says of each value, when the report says it: `std` (a finite number or
+//!   `null`), `determined` and `fixed` (booleans; a fixed parameter has the value 0), and
+//!   `constraint` (`none`, `minimum-norm` or `zero: NAME, …`). Reports written by rtest always
+//!   have them; a report without them reads as an unconstrained fit whose values are determined
+//!   where they are not `null`.
 
 use super::identify::poly_stroke;
 use crate::model::{Basis, Effect, Model, Term};
@@ -58,14 +63,41 @@ pub enum ReportError {
 /// The model and values of an identification report, in internal units.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IdentifiedValues {
+    /// The file the values were read from, as named in messages.
+    pub file: String,
     /// The machine it was identified on.
     pub machine: String,
+    /// The fingerprint of the machine description it was identified on (the machine's own:
+    /// another one is refused when the report is read).
+    pub fingerprint: String,
     /// The model's label.
     pub model_name: String,
     /// The model (terms in file order; the two columns of a harmonic are one term).
     pub model: Model,
-    /// One value per model column (mm or rad); `None` where the file has `null`.
+    /// One value per model column, in the term's unit inside ([`Term::places`]: mm, rad; ms
+    /// for `velocity`; 1 for instrument terms); `None` where the file has `null`.
     pub values: Vec<Option<f64>>,
+    /// One standard uncertainty per model column, in the unit of `values`; `None` where the
+    /// file has `null` (undetermined, fixed, or no degree of freedom) or no `std`.
+    pub std: Vec<Option<f64>>,
+    /// Per model column: whether the data determine it (`determined`; a fixed parameter
+    /// counts as determined). Without the field: `true` where the value is not `null`.
+    pub determined: Vec<bool>,
+    /// Per model column: fixed to 0 by the constraint (`fixed`; `false` without the field).
+    pub fixed: Vec<bool>,
+    /// The constraint of the fit as the report writes it: `none`, `minimum-norm` or
+    /// `zero: NAME, …` (`none` without the field). Under `minimum-norm` an undetermined
+    /// parameter has a value (`determined: false`): the minimum-norm choice, not a measurement.
+    pub constraint: String,
+}
+
+impl IdentifiedValues {
+    /// `true` when the fit was constrained (`constraint` other than `none`): its undetermined
+    /// parameters got a value from the constraint (0 for `zero:`, the minimum-norm choice for
+    /// `minimum-norm`), not from the data.
+    pub fn constrained(&self) -> bool {
+        self.constraint != "none"
+    }
 }
 
 /// Reads the identification report at `path` for machine `m`; see [`parse_identification`].
@@ -164,7 +196,7 @@ pub fn parse_identification(
         ));
     }
     let model_name = r.string(&root, "model", "model")?;
-    let (model, values) = r.parameters(&root)?;
+    let (model, columns) = r.parameters(&root)?;
     let spelled: Vec<String> = model.terms.iter().map(|t| t.spelling(m)).collect();
     let items = match root.get("terms") {
         Some(Value::Array(items)) => items,
@@ -230,12 +262,45 @@ pub fn parse_identification(
             ));
         }
     }
+    let constraint = match root.get("constraint") {
+        None | Some(Value::Null) => "none".to_string(),
+        Some(Value::String(c)) if c == "none" || c == "minimum-norm" || c.starts_with("zero:") => {
+            c.clone()
+        }
+        Some(other) => {
+            return Err(r.bad(
+                "constraint",
+                format!("expected `none`, `minimum-norm` or `zero: NAME, …`, found {other}"),
+            ));
+        }
+    };
+    let Columns {
+        values,
+        std,
+        determined,
+        fixed,
+    } = columns;
     Ok(IdentifiedValues {
+        file: file.to_string(),
         machine,
+        fingerprint,
         model_name,
         model,
         values,
+        std,
+        determined,
+        fixed,
+        constraint,
     })
+}
+
+/// What a report says of each model column, in internal units.
+#[derive(Default)]
+struct Columns {
+    values: Vec<Option<f64>>,
+    std: Vec<Option<f64>>,
+    determined: Vec<bool>,
+    fixed: Vec<bool>,
 }
 
 /// A JSON syntax error located in characters: the parser counts columns in bytes.
@@ -325,7 +390,7 @@ impl Reader<'_> {
     }
 
     /// The model and values of `parameters`.
-    fn parameters(&self, root: &Value) -> Result<(Model, Vec<Option<f64>>), ReportError> {
+    fn parameters(&self, root: &Value) -> Result<(Model, Columns), ReportError> {
         let m = self.m;
         let params = match root.get("parameters") {
             Some(Value::Array(a)) if !a.is_empty() => a,
@@ -336,7 +401,7 @@ impl Reader<'_> {
             None => return Err(self.bad("parameters", "missing".into())),
         };
         let mut model = Model::default();
-        let mut values = Vec::new();
+        let mut columns = Columns::default();
         let mut i = 0;
         while i < params.len() {
             let field = |name: &str| format!("parameters[{i}].{name}");
@@ -428,11 +493,56 @@ impl Reader<'_> {
                                 .bad(&field("value"), "missing (write null for no value)".into()));
                         }
                     };
-                values.push(value);
+                let std = self.number_or_null(q, "std", &field("std"), &term)?;
+                let determined = self.flag(q, "determined", &field("determined"))?;
+                let fixed = self.flag(q, "fixed", &field("fixed"))?.unwrap_or(false);
+                if fixed && value != Some(0.0) {
+                    return Err(self.bad(
+                        &field("value"),
+                        "a parameter fixed by the constraint (`fixed: true`) has the value 0"
+                            .into(),
+                    ));
+                }
+                columns.values.push(value);
+                columns.std.push(std);
+                columns
+                    .determined
+                    .push(determined.unwrap_or(value.is_some()));
+                columns.fixed.push(fixed);
             }
             model.terms.push(term);
             i += basis.width();
         }
-        Ok((model, values))
+        Ok((model, columns))
+    }
+
+    /// The optional number `key` of the parameter `q` (`null` or absent: `None`), divided by
+    /// the term's display factor; named `field` in errors.
+    fn number_or_null(
+        &self,
+        q: &Value,
+        key: &str,
+        field: &str,
+        term: &Term,
+    ) -> Result<Option<f64>, ReportError> {
+        match q.get(key) {
+            None | Some(Value::Null) => Ok(None),
+            Some(Value::Number(x)) => match x.as_f64() {
+                Some(v) if v.is_finite() && v >= 0.0 => Ok(Some(v / term.display_factor(self.m))),
+                _ => Err(self.bad(field, format!("{x} is not a finite number of at least 0"))),
+            },
+            Some(other) => {
+                Err(self.bad(field, format!("expected a number or null, found {other}")))
+            }
+        }
+    }
+
+    /// The optional boolean `key` of the parameter `q`; named `field` in errors.
+    fn flag(&self, q: &Value, key: &str, field: &str) -> Result<Option<bool>, ReportError> {
+        match q.get(key) {
+            None => Ok(None),
+            Some(Value::Bool(b)) => Ok(Some(*b)),
+            Some(other) => Err(self.bad(field, format!("expected true or false, found {other}"))),
+        }
     }
 }

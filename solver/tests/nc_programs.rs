@@ -71,6 +71,16 @@ fn axis_words_follow_the_machine() {
         assert_eq!(a.kind, w.kind);
     }
     assert!(w.iter().any(|a| a.letter == 'B' && a.kind == Rotary));
+    // The order of the description: the work chain, then the tool chain.
+    let order = |name: &str| -> String {
+        axis_words(&model_spec::builtin(name).unwrap().unwrap())
+            .iter()
+            .map(|a| a.letter)
+            .collect()
+    };
+    assert_eq!(order("head-table-bc"), "CXYZB");
+    assert_eq!(order("seed-ac"), "XACYZ");
+    assert_eq!(order("seed-3axis"), "YXZ");
 }
 
 #[test]
@@ -531,6 +541,8 @@ fn block_texts(words: &[(usize, String)], extra: u8, n: usize) -> (String, Strin
     (iso, hh)
 }
 
+/// A number as a program may write it: up to five digits before the point, none to four
+/// after, with or without the point, a `+`, a leading zero; never a negative zero.
 fn number() -> impl Strategy<Value = String> {
     (
         any::<bool>(),
@@ -538,19 +550,27 @@ fn number() -> impl Strategy<Value = String> {
         prop::option::of(0usize..5),
         any::<u32>(),
         any::<bool>(),
+        any::<bool>(),
     )
-        .prop_map(|(neg, int, decimals, frac, plus)| {
-            let sign = if neg && int > 0 {
+        .prop_map(|(neg, int, decimals, frac, plus, lead)| {
+            let d = decimals.unwrap_or(0);
+            let frac = frac % 10u32.pow(d as u32);
+            let sign = if neg && (int > 0 || frac > 0) {
                 "-"
             } else if plus {
                 "+"
             } else {
                 ""
             };
+            let int = if int == 0 && d > 0 && !lead {
+                String::new()
+            } else {
+                int.to_string()
+            };
             match decimals {
                 None => format!("{sign}{int}"),
                 Some(0) => format!("{sign}{int}."),
-                Some(d) => format!("{sign}{int}.{:0d$}", frac % 10u32.pow(d as u32), d = d),
+                Some(d) => format!("{sign}{int}.{frac:0d$}"),
             }
         })
 }
@@ -605,4 +625,73 @@ proptest! {
             prop_assert!(w.rounding.iter().all(|&r| (r - 1e-7).abs() < 1e-9), "{:?}", w.rounding);
         }
     }
+}
+
+/// The corrected poses of the examples of `docs/nc-programs.md` (X Y Z mm, A C degrees).
+fn documented_corrections() -> Vec<Vec<f64>> {
+    vec![
+        vec![-217.5062, -0.2771, 211.5384, 0.0011, -0.0008],
+        vec![-217.5061, -0.2772, 211.5384, 0.0011, 1.4993],
+        vec![-217.5058, -0.2774, 211.5386, -0.0142, 2.9991],
+        vec![-217.5021, -0.2786, 211.5416, -0.0142, 2.9991],
+    ]
+}
+
+#[test]
+fn the_documented_examples() {
+    let before = "%\n\
+O1000 (R-TEST K4)\n\
+N10 G90 G21 G94 G17 G40 G49 G80\n\
+N20 G0 X-217.504 Y-0.279 Z211.537 A0.0000 C0.0000\n\
+N30 G1 C1.5000 F2000\n\
+N40 A-0.0154 C3.0000\n\
+N50 X-217.500 Y-0.280 Z211.540\n\
+N60 M30\n\
+%\n";
+    let after = "%\n\
+O1000 (R-TEST K4)\n\
+N10 G90 G21 G94 G17 G40 G49 G80\n\
+N20 G0 X-217.506 Y-0.277 Z211.538 A0.0011 C-0.0008\n\
+N30 G1 C1.4993 F2000\n\
+N40 A-0.0142 C2.9991 Z211.539\n\
+N50 X-217.502 Y-0.279 Z211.542\n\
+N60 M30\n\
+%\n";
+    let w = iso(before)
+        .unwrap()
+        .write(&documented_corrections(), &WriteOptions::new())
+        .unwrap();
+    assert_eq!(w.text, after);
+    let um: Vec<i64> = w
+        .rounding
+        .iter()
+        .map(|r| (r * 1e4).round() as i64)
+        .collect();
+    assert_eq!(um, [2, 4, 4, 0, 0], "{:?}", w.rounding);
+
+    let before = "0 BEGIN PGM K4 MM\n\
+1 BLK FORM 0.1 Z X-500 Y-400 Z-500\n\
+2 BLK FORM 0.2 X+500 Y+400 Z+500\n\
+3 TOOL CALL 0 Z S0\n\
+4 L X-217.504 Y-0.279 Z+211.537 A+0.0000 C+0.0000 R0 FMAX\n\
+5 L C+1.5000 R0 F2000\n\
+6 L A-0.0154 C+3.0000 ; two rotary axes\n\
+7 L X-217.500 Y-0.280 Z+211.540\n\
+8 STOP M30\n\
+9 END PGM K4 MM\n";
+    let after = "0 BEGIN PGM K4 MM\n\
+1 BLK FORM 0.1 Z X-500 Y-400 Z-500\n\
+2 BLK FORM 0.2 X+500 Y+400 Z+500\n\
+3 TOOL CALL 0 Z S0\n\
+4 L X-217.506 Y-0.277 Z+211.538 A+0.0011 C-0.0008 R0 FMAX\n\
+5 L C+1.4993 R0 F2000\n\
+6 L A-0.0142 C+2.9991 Z+211.539 ; two rotary axes\n\
+7 L X-217.502 Y-0.279 Z+211.542\n\
+8 STOP M30\n\
+9 END PGM K4 MM\n";
+    let w = hh(before)
+        .unwrap()
+        .write(&documented_corrections(), &WriteOptions::new())
+        .unwrap();
+    assert_eq!(w.text, after);
 }

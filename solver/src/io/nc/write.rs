@@ -110,10 +110,10 @@ impl NcProgram {
                 axis: self.axes[axis].letter,
                 message,
             };
-            let write = |axis: usize, style: &NumberStyle| {
+            let write = |out: &mut String, axis: usize, style: &NumberStyle| {
                 let x = c[axis];
                 let decimals = style.decimals.max(options.min_decimals);
-                write_number(x, style, decimals).ok_or_else(|| {
+                write_number(out, x, style, decimals).ok_or_else(|| {
                     value_err(
                         axis,
                         format!(
@@ -132,11 +132,11 @@ impl NcProgram {
                     out.push_str(&self.text[f.start..f.end]);
                     f.value
                 } else {
-                    let (text, value) = write(f.axis, &f.style)?;
-                    if text != self.text[f.start..f.end] {
+                    let mark = out.len();
+                    let value = write(&mut out, f.axis, &f.style)?;
+                    if out[mark..] != self.text[f.start..f.end] {
                         changed_words += 1;
                     }
-                    out.push_str(&text);
                     value
                 };
                 in_force[f.axis] = Some((value, f.style));
@@ -151,13 +151,15 @@ impl NcProgram {
                 let value = if c[a].to_bits() == held.to_bits() {
                     held
                 } else {
-                    let (text, value) = write(a, &style)?;
-                    if value != held {
-                        if block.spaced {
-                            out.push(' ');
-                        }
-                        out.push(style.letter as char);
-                        out.push_str(&text);
+                    let mark = out.len();
+                    if block.spaced {
+                        out.push(' ');
+                    }
+                    out.push(style.letter as char);
+                    let value = write(&mut out, a, &style)?;
+                    if value == held {
+                        out.truncate(mark);
+                    } else {
                         inserted_words += 1;
                         in_force[a] = Some((value, style));
                     }

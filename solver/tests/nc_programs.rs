@@ -1,0 +1,697 @@
+//! NC programs of commanded poses (`solver::io::nc`): read in both dialects, written back with
+//! only the axis words changed; every refusal names the line, the column and the word; modal
+//! axes, inserted words, decimals, signs and the rounding report; random programs round-trip.
+
+use model_spec::AxisKind::{Linear, Rotary};
+use proptest::prelude::*;
+use solver::io::nc::{Dialect, NcError, NcProgram, WriteOptions, parse_program};
+use solver::io::poses::{AxisWord, axis_words};
+
+/// X Y Z A C, the axis letters of `seed-ac`, in this order.
+fn xyzac() -> Vec<AxisWord> {
+    let l = |letter| AxisWord {
+        letter,
+        kind: Linear,
+    };
+    let r = |letter| AxisWord {
+        letter,
+        kind: Rotary,
+    };
+    vec![l('X'), l('Y'), l('Z'), r('A'), r('C')]
+}
+
+fn iso(text: &str) -> Result<NcProgram, NcError> {
+    parse_program("p.nc", text, Dialect::Iso, &xyzac())
+}
+
+fn hh(text: &str) -> Result<NcProgram, NcError> {
+    parse_program("p.h", text, Dialect::Heidenhain, &xyzac())
+}
+
+fn commands(p: &NcProgram) -> Vec<Vec<f64>> {
+    p.poses().iter().map(|q| q.commands.clone()).collect()
+}
+
+const ISO: &str = "%\n\
+O1000 (R-TEST PATH K4)\n\
+N10 G90 G21 G94 G17 G40 G49 G80\n\
+N20 G0 X0 Y0 Z100. A0 C0 ; start position\n\
+N30 G1 X-217.504 Y-0.279 Z211.537 F2000  \n\
+N40 C1.5\n\
+N50 A-0.0154 C3.000 M8\n\
+\n\
+(two axes in one block without spaces)\n\
+N60G1X-217.5Y-0.28\n\
+N70 M30\n\
+%\n";
+
+const HEIDENHAIN: &str = "0 BEGIN PGM K4 MM\n\
+1 BLK FORM 0.1 Z X-500 Y-400 Z-500\n\
+2 BLK FORM 0.2 X+500 Y+400 Z+500\n\
+3 TOOL CALL 0 Z S0\n\
+4 ; start position\n\
+5 L X+0 Y+0 Z+100 A+0 C+0 R0 FMAX M3\n\
+6 L X-217.504 Y-0.279 Z+211.537 R0 F2000\n\
+7 L C+1.5\n\
+8 L A-0.0154 C+3.000 ; two axes\n\
+9 * - section\n\
+10 CYCL DEF 9.0 DWELL TIME\n\
+11 CYCL DEF 9.1 DWELL 1.5\n\
+12 L  Z+150   FMAX\n\
+13 STOP M30\n\
+14 END PGM K4 MM\n";
+
+#[test]
+fn axis_words_follow_the_machine() {
+    let m = model_spec::builtin("head-table-bc").unwrap().unwrap();
+    let w = axis_words(&m);
+    assert_eq!(w.len(), m.axes.len());
+    for (a, w) in m.axes.iter().zip(&w) {
+        assert_eq!(a.name, w.letter.to_string());
+        assert_eq!(a.kind, w.kind);
+    }
+    assert!(w.iter().any(|a| a.letter == 'B' && a.kind == Rotary));
+    // The order of the description: the work chain, then the tool chain.
+    let order = |name: &str| -> String {
+        axis_words(&model_spec::builtin(name).unwrap().unwrap())
+            .iter()
+            .map(|a| a.letter)
+            .collect()
+    };
+    assert_eq!(order("head-table-bc"), "CXYZB");
+    assert_eq!(order("seed-ac"), "XACYZ");
+    assert_eq!(order("seed-3axis"), "YXZ");
+}
+
+#[test]
+fn modal_poses_of_both_dialects() {
+    let p = iso(ISO).unwrap();
+    let lines: Vec<usize> = p.poses().iter().map(|q| q.line).collect();
+    assert_eq!(lines, [4, 5, 6, 7, 10]);
+    assert_eq!(
+        commands(&p),
+        [
+            vec![0.0, 0.0, 100.0, 0.0, 0.0],
+            vec![-217.504, -0.279, 211.537, 0.0, 0.0],
+            vec![-217.504, -0.279, 211.537, 0.0, 1.5],
+            vec![-217.504, -0.279, 211.537, -0.0154, 3.0],
+            vec![-217.5, -0.28, 211.537, -0.0154, 3.0],
+        ]
+    );
+    let h = hh(HEIDENHAIN).unwrap();
+    let lines: Vec<usize> = h.poses().iter().map(|q| q.line).collect();
+    assert_eq!(lines, [6, 7, 8, 9, 13]);
+    assert_eq!(commands(&h)[..4], commands(&p)[..4]);
+    assert_eq!(commands(&h)[4], [-217.504, -0.279, 150.0, -0.0154, 3.0]);
+}
+
+#[test]
+fn unchanged_poses_give_the_same_bytes() {
+    for (text, dialect) in [(ISO, Dialect::Iso), (HEIDENHAIN, Dialect::Heidenhain)] {
+        for t in [
+            text.to_string(),
+            text.replace('\n', "\r\n"),
+            format!("\u{feff}{}", text.trim_end()),
+        ] {
+            let p = parse_program("p", &t, dialect, &xyzac()).unwrap();
+            for opts in [WriteOptions::new(), WriteOptions::with_min_decimals(4)] {
+                let w = p.write(&commands(&p), &opts).unwrap();
+                assert_eq!(w.text, t);
+                assert_eq!(w.rounding, [0.0; 5]);
+                assert_eq!((w.changed_words, w.inserted_words), (0, 0));
+            }
+        }
+    }
+}
+
+/// `line` with the number of every axis word (`X`, `Y`, `Z`, `A`, `C` after a blank, a digit or
+/// the line start) replaced by `#`: what must not change when only axis words do.
+fn mask(line: &str) -> String {
+    let mut out = String::new();
+    let mut chars = line.chars().peekable();
+    let mut prev = ' ';
+    while let Some(c) = chars.next() {
+        out.push(c);
+        if "XYZAC".contains(c) && (prev == ' ' || prev.is_ascii_digit() || prev == '.') {
+            let mut any = false;
+            while let Some(&d) = chars.peek() {
+                if d.is_ascii_digit() || "+-.".contains(d) {
+                    chars.next();
+                    any = true;
+                } else {
+                    break;
+                }
+            }
+            if any {
+                out.push('#');
+                prev = '0';
+                continue;
+            }
+        }
+        prev = c;
+    }
+    out
+}
+
+/// Whether masked line `y` is masked line `x` with axis words (` X#`, `Y#`) inserted right
+/// after the last axis word of `x`.
+fn only_inserted(x: &str, y: &str) -> bool {
+    let i = x.rfind('#').map_or(0, |i| i + 1);
+    let (head, tail) = x.split_at(i);
+    let Some(middle) = y.strip_prefix(head).and_then(|r| r.strip_suffix(tail)) else {
+        return false;
+    };
+    middle
+        .replace(' ', "")
+        .as_bytes()
+        .chunks(2)
+        .all(|w| w.len() == 2 && b"XYZAC".contains(&w[0]) && w[1] == b'#')
+}
+
+#[test]
+fn corrected_poses_change_only_axis_words() {
+    for (text, dialect) in [(ISO, Dialect::Iso), (HEIDENHAIN, Dialect::Heidenhain)] {
+        for t in [text.to_string(), text.replace('\n', "\r\n")] {
+            let p = parse_program("p", &t, dialect, &xyzac()).unwrap();
+            // A correction that grows by more than the coarsest resolution (1 mm, 1°) from pose
+            // to pose, so that modal axes change too.
+            let corrected: Vec<Vec<f64>> = commands(&p)
+                .iter()
+                .enumerate()
+                .map(|(k, c)| c.iter().map(|x| x + 0.7 + 1.1 * k as f64).collect())
+                .collect();
+            let w = p.write(&corrected, &WriteOptions::new()).unwrap();
+            assert!(w.inserted_words > 0 && w.changed_words > 0);
+            let a: Vec<&str> = t.split_inclusive('\n').collect();
+            let b: Vec<&str> = w.text.split_inclusive('\n').collect();
+            assert_eq!(a.len(), b.len());
+            let posed: Vec<usize> = p.poses().iter().map(|q| q.line).collect();
+            for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+                if posed.contains(&(i + 1)) {
+                    assert_ne!(x, y, "line {}", i + 1);
+                    assert!(
+                        only_inserted(&mask(x), &mask(y)),
+                        "line {}: {x:?} -> {y:?}",
+                        i + 1
+                    );
+                } else {
+                    assert_eq!(x, y, "line {}", i + 1);
+                }
+            }
+            // Read back, the program gives the corrected poses to its own resolution.
+            let back = parse_program("p", &w.text, dialect, &xyzac()).unwrap();
+            for (q, c) in back.poses().iter().zip(&corrected) {
+                for (a, (x, y)) in q.commands.iter().zip(c).enumerate() {
+                    assert!((x - y).abs() <= w.rounding[a] + 1e-12, "{x} {y}");
+                }
+            }
+            assert!(
+                w.rounding.iter().all(|&r| r <= 0.5 + 1e-12),
+                "{:?}",
+                w.rounding
+            );
+        }
+    }
+}
+
+#[test]
+fn words_keep_decimals_and_signs_and_modal_axes_are_inserted() {
+    let t = "G90 G0 X0 Y0 Z100. A0 C0\nG1 X10.500 F100\nN5G1Y.25\n";
+    let p = iso(t).unwrap();
+    let c = vec![
+        vec![0.0, 0.0, 100.0, 0.0, 0.0],
+        vec![10.5004, 0.0, 100.0, 0.0, 0.0],
+        vec![10.5004, 0.2512, 100.2, 0.0, 0.0],
+    ];
+    let w = p.write(&c, &WriteOptions::new()).unwrap();
+    // X keeps its three decimals, Y its two without a leading zero; Z, modal in the last
+    // block, rounds to the value in force at the resolution of the word that set it
+    // (`Z100.`): nothing changes.
+    assert_eq!(w.text, t);
+    assert_eq!((w.changed_words, w.inserted_words), (0, 0));
+    // With three decimals at least, Z is inserted after Y, without a space in a packed block.
+    let w = p.write(&c, &WriteOptions::with_min_decimals(3)).unwrap();
+    assert_eq!(
+        w.text,
+        "G90 G0 X0 Y0 Z100. A0 C0\nG1 X10.500 F100\nN5G1Y.251Z100.200\n"
+    );
+    assert_eq!((w.changed_words, w.inserted_words), (1, 1));
+    assert!((w.rounding[1] - 0.0002).abs() < 1e-12);
+    assert!((w.rounding[0] - 0.0004).abs() < 1e-12);
+
+    let t = "1 L X+0 Y+0 Z+100 A+0 C+0 R0 FMAX\n2 L X+10.5 R0 F100 ; cut\n3 L C-90.000\n";
+    let p = hh(t).unwrap();
+    let c = vec![
+        vec![0.0, -0.00004, 100.0, 0.0, 0.0],
+        vec![10.5026, -0.0006, 100.0, -0.6, 0.0],
+        vec![10.5026, -0.0006, 100.0, -0.6, -90.0011],
+    ];
+    // A correction that rounds to zero is written without a minus sign (line 1), the `+` of
+    // the program is kept, and the modal Y and A are inserted in the order of the axes.
+    let w = p.write(&c, &WriteOptions::with_min_decimals(3)).unwrap();
+    assert_eq!(
+        w.text,
+        "1 L X+0 Y+0.000 Z+100 A+0 C+0 R0 FMAX\n\
+         2 L X+10.503 Y-0.001 A-0.600 R0 F100 ; cut\n\
+         3 L C-90.001\n"
+    );
+}
+
+#[test]
+fn unchanged_words_keep_their_text_and_rounding_is_reported() {
+    let t = "G90 G0 X0 Y0 Z0 A0 C0\nG1 X1.25\n";
+    let p = iso(t).unwrap();
+    let c = vec![vec![0.0; 5], vec![1.2549, 0.3, 0.0, 0.0, 0.0]];
+    let w = p.write(&c, &WriteOptions::new()).unwrap();
+    // Y0 has no decimals: 0.3 rounds to the 0 in force, nothing inserted.
+    assert_eq!(w.text, "G90 G0 X0 Y0 Z0 A0 C0\nG1 X1.25\n");
+    assert!((w.rounding[0] - 0.0049).abs() < 1e-12);
+    assert!((w.rounding[1] - 0.3).abs() < 1e-12);
+}
+
+#[test]
+fn values_that_cannot_be_written_are_errors() {
+    let p = iso("G90 G0 X0 Y0 Z0 A0 C0\n").unwrap();
+    let e = p
+        .write(
+            &[vec![99_999.999_6, 0.0, 0.0, 0.0, 0.0]],
+            &WriteOptions::with_min_decimals(3),
+        )
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            NcError::Value {
+                line: 1,
+                axis: 'X',
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = p
+        .write(&[vec![0.0, f64::NAN, 0.0, 0.0, 0.0]], &WriteOptions::new())
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("p.nc:1: axis Y: cannot write NaN"),
+        "{e}"
+    );
+    let e = p.write(&[], &WriteOptions::new()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "p.nc: 0 corrected poses for the 1 poses of the program"
+    );
+    let e = p.write(&[vec![0.0; 4]], &WriteOptions::new()).unwrap_err();
+    assert!(e.to_string().contains("4 values for 5 axes"), "{e}");
+    let e = p
+        .write(&[vec![0.0; 5]], &WriteOptions::with_min_decimals(10))
+        .unwrap_err();
+    assert!(e.to_string().contains("at most 9"), "{e}");
+}
+
+/// Checks that `result` is a refused block at `line` and `column`, about `word` (none when
+/// empty), its message containing `why`.
+fn refused(result: Result<NcProgram, NcError>, line: usize, column: usize, word: &str, why: &str) {
+    let e = match result {
+        Err(e @ NcError::Block { .. }) => e,
+        other => panic!("expected a refused block, got {other:?}"),
+    };
+    let text = e.to_string();
+    if let NcError::Block {
+        line: l,
+        column: c,
+        word: w,
+        message,
+        ..
+    } = e
+    {
+        assert_eq!((l, c), (line, column), "{text}");
+        assert_eq!(w.as_deref(), (!word.is_empty()).then_some(word), "{text}");
+        assert!(message.contains(why), "{text}");
+        let located = match w {
+            Some(w) => format!(":{line}:{column}: `{w}`: {message}"),
+            None => format!(":{line}:{column}: {message}"),
+        };
+        assert!(text.ends_with(&located), "{text}");
+    }
+}
+
+const START: &str = "N1 G90 G0 X0 Y0 Z0 A0 C0\n";
+
+#[test]
+fn iso_refusals_name_line_and_word() {
+    let cases: &[(&str, usize, &str, &str)] = &[
+        ("G91 G1 X1", 1, "G91", "incremental"),
+        ("G2 X1 Y1 I1 J0", 1, "G2", "arcs"),
+        ("G03 X1 Y1 R1", 1, "G03", "arcs"),
+        ("G1 X1 I1", 7, "I1", "arc words"),
+        ("G1 X1 R1", 7, "R1", "arc words"),
+        ("G20", 1, "G20", "inch"),
+        ("G92 X0", 1, "G92", "machine coordinates"),
+        ("G52 X10", 1, "G52", "machine coordinates"),
+        ("G54", 1, "G54", "machine coordinates"),
+        ("G59", 1, "G59", "machine coordinates"),
+        ("G54.1 P1", 1, "G54.1", "machine coordinates"),
+        ("G68 X0 Y0 R30", 1, "G68", "rotation"),
+        ("G43.4 H1", 1, "G43.4", "tool centre point"),
+        ("G43.5 H1", 1, "G43.5", "tool centre point"),
+        ("G43 H1 Z100", 1, "G43", "tool length"),
+        ("G41 D1 X1", 1, "G41", "radius"),
+        ("G28 X0", 1, "G28", "reference position"),
+        ("G30 Z0", 1, "G30", "reference position"),
+        ("G53 Z0", 1, "G53", "one-shot"),
+        ("G81 Z-5 R1", 1, "G81", "canned cycles"),
+        ("G5.1 Q1", 1, "G5.1", "not a G code rtest reads"),
+        ("G1 U5", 4, "U5", "not an axis of this machine"),
+        ("G1 B5", 4, "B5", "not an axis of this machine"),
+        ("G1 W5", 4, "W5", "not an axis of this machine"),
+        ("G1 X1 X2", 7, "X2", "second `X`"),
+        ("G1 X1 F100 F200", 12, "F200", "second `F`"),
+        ("G0 G1 X1", 4, "G1", "same mode"),
+        ("G1 X1..2", 4, "X1..2", "cannot read the number"),
+        ("G1 X#100", 4, "X#100", "cannot read the number"),
+        ("G1 X1e3", 6, "e3", "not read in an ISO program"),
+        ("M98 P100", 1, "M98", "subprogram"),
+        ("G1 X1 H1", 7, "H1", "tool offset"),
+        ("G4 X1.5", 4, "X1.5", "dwell"),
+        ("G1 X1 P1", 7, "P1", "outside a dwell"),
+        ("/G1 X1", 1, "/", "skip"),
+        ("G1 X123456", 4, "X123456", "beyond"),
+    ];
+    for &(block, column, word, why) in cases {
+        let text = format!("{START}N2 M3\n{block}\n");
+        refused(iso(&text), 3, column, word, why);
+    }
+    refused(iso("G90 G1 X1 (open\n"), 1, 11, "", "does not close");
+}
+
+#[test]
+fn heidenhain_refusals_name_line_and_word() {
+    let cases: &[(&str, usize, &str, &str)] = &[
+        ("3 L IX+5 R0", 5, "IX+5", "incremental"),
+        ("3 CC X+0 Y+0", 3, "CC X+0 Y+0", "circles"),
+        ("3 C X+1 Y+0 DR+", 3, "C X+1 Y+0 DR+", "circles"),
+        ("3 CR X+1 Y+0 R+5 DR+", 3, "CR X+1 Y+0 R+5 DR+", "circles"),
+        ("3 CT X+1 Y+0", 3, "CT X+1 Y+0", "circles"),
+        ("3 CP PA+90 IZ+1", 3, "CP PA+90 IZ+1", "circles"),
+        ("3 RND R5", 3, "RND R5", "roundings"),
+        ("3 CHF 2", 3, "CHF 2", "chamfers"),
+        (
+            "3 LN X+1 Y+0 Z+0 NX+0 NY+0 NZ+1",
+            3,
+            "LN X+1 Y+0 Z+0 NX+0 NY+0 NZ+1",
+            "vector",
+        ),
+        ("3 L X+1 R0 F100 M128", 17, "M128", "M128"),
+        (
+            "3 FUNCTION TCPM F TCP AXIS POS",
+            3,
+            "FUNCTION TCPM F TCP AXIS POS",
+            "TCPM",
+        ),
+        (
+            "3 CYCL DEF 7.0 DATUM SHIFT",
+            3,
+            "CYCL DEF 7.0 DATUM SHIFT",
+            "datum shift",
+        ),
+        (
+            "3 CYCL DEF 10.0 ROTATION",
+            3,
+            "CYCL DEF 10.0 ROTATION",
+            "rotation",
+        ),
+        (
+            "3 PLANE SPATIAL SPA+0 SPB+45 SPC+0",
+            3,
+            "PLANE SPATIAL SPA+0 SPB+45 SPC+0",
+            "tilted",
+        ),
+        (
+            "3 TRANS DATUM AXIS X+10",
+            3,
+            "TRANS DATUM AXIS X+10",
+            "datum shift",
+        ),
+        ("3 BEGIN PGM A INCH", 3, "BEGIN PGM A INCH", "inch"),
+        (
+            "3 CYCL DEF 200 DRILLING",
+            3,
+            "CYCL DEF 200 DRILLING",
+            "machining cycles",
+        ),
+        ("3 CALL LBL 1", 3, "CALL LBL 1", "labels and calls"),
+        ("3 L X+1 U+5", 9, "U+5", "not an axis of this machine"),
+        ("3 L X+1 B+5", 9, "B+5", "not an axis of this machine"),
+        ("3 L X+1 X+2", 9, "X+2", "second `X`"),
+        ("3 L X+1 RL", 9, "RL", "radius compensation"),
+        ("3 L X+1.2.3", 5, "X+1.2.3", "cannot read the number"),
+        ("3 L X+Q1", 5, "X+Q1", "cannot read the number"),
+        ("3 L X+1 DL+1", 9, "DL+1", "not read in an L block"),
+    ];
+    for &(block, column, word, why) in cases {
+        let text = format!("1 L X+0 Y+0 Z+0 A+0 C+0 R0 FMAX\n2 ; comment\n{block}\n");
+        refused(hh(&text), 3, column, word, why);
+    }
+}
+
+#[test]
+fn a_move_before_every_axis_is_known_needs_a_start_position() {
+    let e = iso("G90\nG0 X0 Y0 Z0\nG1 C10\n").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "p.nc:2:4: `X0`: a move with axis A, C not yet known: give a start position (a block that sets every axis, X, Y, Z, A, C) before the first move"
+    );
+    let e = hh("1 L Z+100 R0 FMAX\n").unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("p.h:1:5: `Z+100`: a move with axis X, Y, A, C not yet known"),
+        "{e}"
+    );
+    let e = iso("G0 X0 Y0 Z0 A0 C0\n").unwrap_err();
+    assert!(e.to_string().contains("before G90"), "{e}");
+}
+
+#[test]
+fn programs_without_moves_and_clashing_letters_are_refused() {
+    let e = iso("%\nG90 G21\nM30\n%\n").unwrap_err();
+    assert!(matches!(e, NcError::Program { .. }), "{e}");
+    assert!(e.to_string().contains("no move"), "{e}");
+    let mut axes = xyzac();
+    axes[3].letter = 'F';
+    let e = parse_program("p.nc", START, Dialect::Iso, &axes).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("axis F, the letter of the feed word"),
+        "{e}"
+    );
+    let e = parse_program("p.h", "1 L X+0\n", Dialect::Heidenhain, &axes).unwrap_err();
+    assert!(e.to_string().contains("axis F"), "{e}");
+    let long = format!("{START}({})\n", "x".repeat(70_000));
+    let e = iso(&long).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("p.nc:2:1: line longer than 65536 bytes"),
+        "{e}"
+    );
+}
+
+#[test]
+fn lower_case_iso_letters_and_comments_pass() {
+    let t = "g90 g0 x0 y0 z0 a0 c0 (HOME; X10)\ng1 x5. ; X7\n";
+    let p = iso(t).unwrap();
+    assert_eq!(p.poses()[1].commands[0], 5.0);
+    let w = p
+        .write(
+            &[vec![0.0; 5], vec![5.25, 0.0, 0.0, 0.0, 0.0]],
+            &WriteOptions::with_min_decimals(2),
+        )
+        .unwrap();
+    assert_eq!(w.text, "g90 g0 x0 y0 z0 a0 c0 (HOME; X10)\ng1 x5.25 ; X7\n");
+}
+
+/// One random block of an allowed kind: (ISO text, Heidenhain text), each naming the axes
+/// given with the numbers given.
+fn block_texts(words: &[(usize, String)], extra: u8, n: usize) -> (String, String) {
+    const L: [char; 5] = ['X', 'Y', 'Z', 'A', 'C'];
+    let iso_words: Vec<String> = words.iter().map(|(a, t)| format!("{}{t}", L[*a])).collect();
+    let hh_words: Vec<String> = words
+        .iter()
+        .map(|(a, t)| {
+            let t = if t.starts_with('-') || t.starts_with('+') {
+                t.clone()
+            } else {
+                format!("+{t}")
+            };
+            format!("{}{t}", L[*a])
+        })
+        .collect();
+    let iso = match extra % 4 {
+        0 => format!("N{n} G1 {} F1000", iso_words.join(" ")),
+        1 => format!("G0 {} (rapid)", iso_words.join(" ")),
+        2 => format!("N{n}{}", iso_words.concat()),
+        _ => format!("{} M8 ; coolant", iso_words.join("  ")),
+    };
+    let hh = match extra % 3 {
+        0 => format!("{n} L {} R0 FMAX", hh_words.join(" ")),
+        1 => format!("{n} L {} R0 F500 M3 ; cut", hh_words.join(" ")),
+        _ => format!("{n} L  {}", hh_words.join("  ")),
+    };
+    (iso, hh)
+}
+
+/// A number as a program may write it: up to five digits before the point, none to four
+/// after, with or without the point, a `+`, a leading zero; never a negative zero.
+fn number() -> impl Strategy<Value = String> {
+    (
+        any::<bool>(),
+        0u32..100_000,
+        prop::option::of(0usize..5),
+        any::<u32>(),
+        any::<bool>(),
+        any::<bool>(),
+    )
+        .prop_map(|(neg, int, decimals, frac, plus, lead)| {
+            let d = decimals.unwrap_or(0);
+            let frac = frac % 10u32.pow(d as u32);
+            let sign = if neg && (int > 0 || frac > 0) {
+                "-"
+            } else if plus {
+                "+"
+            } else {
+                ""
+            };
+            let int = if int == 0 && d > 0 && !lead {
+                String::new()
+            } else {
+                int.to_string()
+            };
+            match decimals {
+                None => format!("{sign}{int}"),
+                Some(0) => format!("{sign}{int}."),
+                Some(d) => format!("{sign}{int}.{frac:0d$}"),
+            }
+        })
+}
+
+/// A block: the axis words it names (axis index, number text).
+type Words = Vec<(usize, String)>;
+
+fn program() -> impl Strategy<Value = (Vec<Words>, Vec<u8>, bool)> {
+    let block = prop::collection::btree_map(0usize..5, number(), 1..=5)
+        .prop_map(|m| m.into_iter().collect::<Vec<_>>());
+    (
+        prop::collection::vec(block, 1..20),
+        prop::collection::vec(any::<u8>(), 20),
+        any::<bool>(),
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Random programs of allowed blocks: written with the commands read, the text is the same;
+    /// written with every command moved by far less than the last decimal, it is the same too
+    /// (each word rewritten in its own style), and the rounding is that small move.
+    #[test]
+    fn random_programs_round_trip((blocks, extras, crlf) in program()) {
+        let end = if crlf { "\r\n" } else { "\n" };
+        let start: Vec<(usize, String)> = (0..5).map(|a| (a, "0".to_string())).collect();
+        let (mut iso_text, mut hh_text) = (format!("%{end}G90 G21{end}"), format!("0 BEGIN PGM P MM{end}"));
+        for (k, words) in std::iter::once(&start).chain(&blocks).enumerate() {
+            let (i, h) = block_texts(words, extras[k % extras.len()], k + 1);
+            iso_text += &format!("{i}{end}");
+            hh_text += &format!("{h}{end}");
+            if extras[k % extras.len()] % 5 == 0 {
+                iso_text += &format!("(comment){end}");
+                hh_text += &format!("* - part{end}");
+            }
+        }
+        iso_text += &format!("M30{end}%{end}");
+        hh_text += &format!("{} END PGM P MM{end}", blocks.len() + 2);
+        for (text, dialect) in [(iso_text, Dialect::Iso), (hh_text, Dialect::Heidenhain)] {
+            let p = parse_program("r", &text, dialect, &xyzac()).unwrap();
+            prop_assert_eq!(p.poses().len(), blocks.len() + 1);
+            let c = commands(&p);
+            let w = p.write(&c, &WriteOptions::new()).unwrap();
+            prop_assert_eq!(&w.text, &text);
+            let nudged: Vec<Vec<f64>> = c
+                .iter()
+                .map(|v| v.iter().map(|x| x + 1e-7).collect())
+                .collect();
+            let w = p.write(&nudged, &WriteOptions::new()).unwrap();
+            prop_assert_eq!(&w.text, &text);
+            prop_assert!(w.rounding.iter().all(|&r| (r - 1e-7).abs() < 1e-9), "{:?}", w.rounding);
+        }
+    }
+}
+
+/// The corrected poses of the examples of `docs/nc-programs.md` (X Y Z mm, A C degrees).
+fn documented_corrections() -> Vec<Vec<f64>> {
+    vec![
+        vec![-217.5062, -0.2771, 211.5384, 0.0011, -0.0008],
+        vec![-217.5061, -0.2772, 211.5384, 0.0011, 1.4993],
+        vec![-217.5058, -0.2774, 211.5386, -0.0142, 2.9991],
+        vec![-217.5021, -0.2786, 211.5416, -0.0142, 2.9991],
+    ]
+}
+
+#[test]
+fn the_documented_examples() {
+    let before = "%\n\
+O1000 (R-TEST K4)\n\
+N10 G90 G21 G94 G17 G40 G49 G80\n\
+N20 G0 X-217.504 Y-0.279 Z211.537 A0.0000 C0.0000\n\
+N30 G1 C1.5000 F2000\n\
+N40 A-0.0154 C3.0000\n\
+N50 X-217.500 Y-0.280 Z211.540\n\
+N60 M30\n\
+%\n";
+    let after = "%\n\
+O1000 (R-TEST K4)\n\
+N10 G90 G21 G94 G17 G40 G49 G80\n\
+N20 G0 X-217.506 Y-0.277 Z211.538 A0.0011 C-0.0008\n\
+N30 G1 C1.4993 F2000\n\
+N40 A-0.0142 C2.9991 Z211.539\n\
+N50 X-217.502 Y-0.279 Z211.542\n\
+N60 M30\n\
+%\n";
+    let w = iso(before)
+        .unwrap()
+        .write(&documented_corrections(), &WriteOptions::new())
+        .unwrap();
+    assert_eq!(w.text, after);
+    let um: Vec<i64> = w
+        .rounding
+        .iter()
+        .map(|r| (r * 1e4).round() as i64)
+        .collect();
+    assert_eq!(um, [2, 4, 4, 0, 0], "{:?}", w.rounding);
+
+    let before = "0 BEGIN PGM K4 MM\n\
+1 BLK FORM 0.1 Z X-500 Y-400 Z-500\n\
+2 BLK FORM 0.2 X+500 Y+400 Z+500\n\
+3 TOOL CALL 0 Z S0\n\
+4 L X-217.504 Y-0.279 Z+211.537 A+0.0000 C+0.0000 R0 FMAX\n\
+5 L C+1.5000 R0 F2000\n\
+6 L A-0.0154 C+3.0000 ; two rotary axes\n\
+7 L X-217.500 Y-0.280 Z+211.540\n\
+8 STOP M30\n\
+9 END PGM K4 MM\n";
+    let after = "0 BEGIN PGM K4 MM\n\
+1 BLK FORM 0.1 Z X-500 Y-400 Z-500\n\
+2 BLK FORM 0.2 X+500 Y+400 Z+500\n\
+3 TOOL CALL 0 Z S0\n\
+4 L X-217.506 Y-0.277 Z+211.538 A+0.0011 C-0.0008 R0 FMAX\n\
+5 L C+1.4993 R0 F2000\n\
+6 L A-0.0142 C+2.9991 Z+211.539 ; two rotary axes\n\
+7 L X-217.502 Y-0.279 Z+211.542\n\
+8 STOP M30\n\
+9 END PGM K4 MM\n";
+    let w = hh(before)
+        .unwrap()
+        .write(&documented_corrections(), &WriteOptions::new())
+        .unwrap();
+    assert_eq!(w.text, after);
+}

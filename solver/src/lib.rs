@@ -47,6 +47,7 @@
 
 #![warn(missing_docs)]
 
+pub mod compensation;
 pub mod demo;
 pub mod diagnosis;
 pub mod fitting;

@@ -1,0 +1,3 @@
+//! Compensation: putting what was measured or identified back onto the machine.
+
+pub mod volumetric;

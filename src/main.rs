@@ -43,12 +43,21 @@ enum Verb {
     Demo(cli::demo::DemoArgs),
     Bench(cli::bench::BenchArgs),
     Diagnose(cli::diagnose::DiagnoseArgs),
+    Volumetric(cli::volumetric::VolumetricArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 9] = [
-    "machines", "gains", "generate", "simulate", "identify", "validate", "diagnose", "demo",
+const VERBS: [&str; 10] = [
+    "machines",
+    "gains",
+    "generate",
+    "simulate",
+    "identify",
+    "validate",
+    "diagnose",
+    "demo",
     "bench",
+    "volumetric",
 ];
 
 /// A clap error as one line: its message and its hints, without the usage block.
@@ -103,6 +112,7 @@ fn main() -> ExitCode {
         Verb::Demo(a) => cli::demo::run(a),
         Verb::Bench(a) => cli::bench::run(a),
         Verb::Diagnose(a) => cli::diagnose::run(a),
+        Verb::Volumetric(a) => cli::volumetric::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

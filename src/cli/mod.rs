@@ -14,6 +14,7 @@ pub mod machines;
 pub mod pose_args;
 pub mod simulate;
 pub mod validate;
+pub mod volumetric;
 
 use model_spec::{LoadError, Machine};
 use output::{Outputs, Target, WriteError, Written};

@@ -6,10 +6,13 @@
 //! - [`run`]: every pose of a file corrected, checked against strokes and ranges, summarised;
 //! - [`kinematics`]: the corrected kinematic description (location errors folded into the
 //!   offsets);
-//! - [`tables`]: axis compensation tables.
+//! - [`tables`]: axis compensation tables;
+//! - [`volumetric`]: the three-axis scheme from 6D laser-interferometer measurements (the
+//!   kinematic-parameter independent model and its volumetric grid).
 
 pub mod correct;
 pub mod kinematics;
 pub mod run;
 pub mod tables;
 pub mod values;
+pub mod volumetric;

@@ -43,11 +43,12 @@ enum Verb {
     Demo(cli::demo::DemoArgs),
     Bench(cli::bench::BenchArgs),
     Diagnose(cli::diagnose::DiagnoseArgs),
+    Compensate(cli::compensate::CompensateArgs),
     Volumetric(cli::volumetric::VolumetricArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 10] = [
+const VERBS: [&str; 11] = [
     "machines",
     "gains",
     "generate",
@@ -57,6 +58,7 @@ const VERBS: [&str; 10] = [
     "diagnose",
     "demo",
     "bench",
+    "compensate",
     "volumetric",
 ];
 
@@ -112,6 +114,7 @@ fn main() -> ExitCode {
         Verb::Demo(a) => cli::demo::run(a),
         Verb::Bench(a) => cli::bench::run(a),
         Verb::Diagnose(a) => cli::diagnose::run(a),
+        Verb::Compensate(a) => cli::compensate::run(a),
         Verb::Volumetric(a) => cli::volumetric::run(a),
     };
     match result {

@@ -4,6 +4,7 @@
 
 use super::args::ValueBounds;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use model_spec::units::{compact, readable};
 use output::{Outputs, Target};
 use solver::compensation::kinematics::corrected_description;
 use solver::compensation::run::{CommandedPose, compensate_poses};
@@ -105,7 +106,9 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         ));
     }
     if args.json.is_some() && args.path.is_none() {
-        return Err(CliError::usage("--json summarises corrected poses: give --path"));
+        return Err(CliError::usage(
+            "--json summarises corrected poses: give --path",
+        ));
     }
     if args.nc.is_none() && args.decimals.is_some() {
         return Err(CliError::usage("--decimals applies to NC programs (--nc)"));
@@ -122,8 +125,11 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     .into_iter()
     .filter_map(|(f, t)| t.map(|t| (f, t)))
     .collect();
-    let dirs: Vec<(&str, &std::path::Path)> =
-        args.tables.iter().map(|d| ("--tables", d.as_path())).collect();
+    let dirs: Vec<(&str, &std::path::Path)> = args
+        .tables
+        .iter()
+        .map(|d| ("--tables", d.as_path()))
+        .collect();
     check_outputs(&inputs, &outputs, &dirs)?;
     let params = super::pose_args::params(&m, args.param.as_deref())?;
     let id = read_identification(&args.params, &m)
@@ -256,7 +262,20 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             .map_err(|e| CliError::input(format!("--kinematics-out: {e}")))?;
         source.kinematics = Some(KinematicsReport {
             file: target.to_string(),
-            folded: corrected.folded.iter().map(|f| f.place.clone()).collect(),
+            folded: corrected
+                .folded
+                .iter()
+                .map(|f| {
+                    format!(
+                        "{} = {} µm into {}: {} -> {} mm",
+                        f.name,
+                        readable(f.value_mm * 1e3, 4),
+                        f.place,
+                        compact(f.before_mm),
+                        compact(f.after_mm)
+                    )
+                })
+                .collect(),
             not_folded: corrected
                 .not_folded
                 .iter()

@@ -20,7 +20,9 @@
 //! The roll about the tool axis is not corrected (no axis of a five-axis machine turns the tool
 //! about its own axis relative to the workpiece without moving the tilt): it is an output.
 //! [`STEPS`] steps take the predicted remainder far below 1 nm on every built-in machine; the
-//! host checks it and goes on where it is not.
+//! host checks it and goes on where it is not, with the rotary axes held (near a singular pose
+//! the damped orientation converges slowly, and each of its steps would move the predicted
+//! error by about the error times the rotary change).
 
 mod kinematics;
 mod program;
@@ -61,6 +63,9 @@ pub struct CompensationPrograms {
     /// Pose, params, values → as `step` with the pose's own target: the first-order
     /// correction of the commanded pose and the predicted error there.
     pub first_step: Program,
+    /// As `step` with the rotary axes held (their changes 0): the host's refinement of the
+    /// position once the fixed steps have settled the orientation.
+    pub position_step: Program,
 }
 
 impl CompensationPrograms {
@@ -98,5 +103,6 @@ pub fn compile_compensation(
         target: program::build(&ing, &atoms, program::Kind::Target),
         step: program::build(&ing, &atoms, program::Kind::Step),
         first_step: program::build(&ing, &atoms, program::Kind::FirstStep),
+        position_step: program::build(&ing, &atoms, program::Kind::PositionStep),
     })
 }

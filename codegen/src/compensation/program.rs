@@ -152,6 +152,9 @@ pub(crate) enum Kind {
     /// As `Step` from the commanded pose itself (the target is the pose's own): inputs pose,
     /// params, values.
     FirstStep,
+    /// As `Step` with the rotary axes held: the linear axes alone remove the position
+    /// residual (the host's refinement once the orientation is settled).
+    PositionStep,
 }
 
 /// Builds one program over the atoms `atoms` of the original machine.
@@ -203,10 +206,12 @@ pub(crate) fn build(ing: &Ingredients, atoms: &AtomTable, kind: Kind) -> Program
         .map(|name| input(&mut c, &mut inputs, name.clone()))
         .collect();
     let target: Vec<Val> = match kind {
-        Kind::Step => ["tool_x", "tool_y", "tool_z", "axis_x", "axis_y", "axis_z"]
-            .iter()
-            .map(|name| input(&mut c, &mut inputs, name.to_string()))
-            .collect(),
+        Kind::Step | Kind::PositionStep => {
+            ["tool_x", "tool_y", "tool_z", "axis_x", "axis_y", "axis_z"]
+                .iter()
+                .map(|name| input(&mut c, &mut inputs, name.to_string()))
+                .collect()
+        }
         _ => Vec::new(),
     };
     // The predicted error at this pose, tool frame.
@@ -222,7 +227,7 @@ pub(crate) fn build(ing: &Ingredients, atoms: &AtomTable, kind: Kind) -> Program
         }
     }
     // The residual: tool point and tool axis against the target, tool frame.
-    let (position, b) = if kind == Kind::Step {
+    let (position, b) = if matches!(kind, Kind::Step | Kind::PositionStep) {
         let gap: Vec<Val> = (0..3).map(|k| c.sub(tip[k], target[k])).collect();
         let col = |c: &mut Ctx, j: usize, v: &[Val]| {
             let column = [rot[0][j], rot[1][j], rot[2][j]];
@@ -270,7 +275,12 @@ pub(crate) fn build(ing: &Ingredients, atoms: &AtomTable, kind: Kind) -> Program
         let d = c.add(Val::Const(1.0), scaled);
         c.div(mu0, d)
     };
-    match j.len() {
+    let rotary_count = if kind == Kind::PositionStep {
+        0
+    } else {
+        j.len()
+    };
+    match rotary_count {
         1 => {
             let m11 = c.dot(&j[0], &j[0]);
             let mu = damping(&mut c, m11);

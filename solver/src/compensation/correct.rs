@@ -102,15 +102,19 @@ impl Compensator {
         values: &[f64],
         target: &[f64; 6],
         residual: &mut [f64; RESIDUALS],
+        rotary_held: bool,
     ) -> &[f64] {
         self.load_pose(at);
         self.inputs.extend_from_slice(values);
         self.inputs.extend_from_slice(target);
         let n = self.programs.axis_count();
         self.out.resize(n + RESIDUALS, 0.0);
-        self.programs
-            .step
-            .eval(&self.inputs, &mut self.scratch, &mut self.out);
+        let program = if rotary_held {
+            &self.programs.position_step
+        } else {
+            &self.programs.step
+        };
+        program.eval(&self.inputs, &mut self.scratch, &mut self.out);
         residual.copy_from_slice(&self.out[n..]);
         &self.out[..n]
     }
@@ -123,7 +127,9 @@ impl Compensator {
         let mut q = commanded.to_vec();
         let mut residual = [0.0; RESIDUALS];
         for _ in 0..STEPS {
-            let change = self.step(&q, values, &target, &mut residual).to_vec();
+            let change = self
+                .step(&q, values, &target, &mut residual, false)
+                .to_vec();
             for (qi, d) in q.iter_mut().zip(change) {
                 *qi += d;
             }
@@ -132,8 +138,9 @@ impl Compensator {
     }
 
     /// The corrected pose of `commanded` (mm, rad): the fixed steps with the values at the
-    /// commanded pose, then steps with the values at the corrected pose (`values_at(commands,
-    /// out)` fills one value per model error) until the predicted position remainder is below
+    /// commanded pose, then steps of the linear axes alone (the rotary axes held where the fixed
+    /// steps put them) with the values at the corrected pose (`values_at(commands, out)` fills
+    /// one value per model error) until the predicted position remainder is below
     /// [`POSITION_TOLERANCE`].
     ///
     /// # Errors
@@ -152,7 +159,9 @@ impl Compensator {
         let mut refinements = 0;
         loop {
             values_at(&q, &mut values);
-            let change = self.step(&q, &values, &target, &mut residual).to_vec();
+            let change = self
+                .step(&q, &values, &target, &mut residual, true)
+                .to_vec();
             let remainder = residual[..3].iter().map(|r| r * r).sum::<f64>().sqrt();
             if remainder < POSITION_TOLERANCE {
                 break;

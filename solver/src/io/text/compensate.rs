@@ -60,6 +60,18 @@ pub fn compensation(r: &CompensationReport) -> String {
         .collect();
     text.push_str("Corrections (corrected minus commanded):\n");
     text.push_str(&table(&header(&head), &rows));
+    let coarse: Vec<&str> = r
+        .axes
+        .iter()
+        .filter(|a| a.rounding.is_some_and(|x| x > 0.1 * a.largest.abs() && x > 0.0))
+        .map(|a| a.axis.as_str())
+        .collect();
+    if !coarse.is_empty() {
+        text.push_str(&format!(
+            "The program's decimals lose more than a tenth of the largest correction on {}: give --decimals N for more.\n",
+            coarse.join(", ")
+        ));
+    }
     text.push_str(&format!(
         "\nPredicted remainder at the corrected poses: position {} µm (at most)",
         readable(r.position_remainder_um, 2)

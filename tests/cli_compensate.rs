@@ -1,0 +1,401 @@
+//! End-to-end tests of `rtest compensate`: a record simulated and identified with the binary,
+//! then poses (CSV) and programs (ISO, Heidenhain) compensated; the corrected values equal the
+//! library's; every line but the corrected words kept; the corrected description and the
+//! tables written; bad input refused with one stderr line, the right exit code and no output.
+
+use model_spec::{AxisKind, Machine};
+use solver::compensation::run::{CommandedPose, compensate_poses};
+use solver::compensation::values::MachineErrors;
+use solver::io::report::read_identification;
+use std::path::Path;
+
+mod common;
+use common::{TempDir, entries, fails, ok, read_json};
+
+fn machine() -> Machine {
+    model_spec::builtin("seed-ac").unwrap().unwrap()
+}
+
+/// A directory with `k4.csv` (demo truth) and `id.json` (reduced + ECC@harmonic:2 on K4), and
+/// `poses.csv`: the first 40 poses of K4 with an extra `note` column.
+fn set_up(name: &str) -> TempDir {
+    let dir = common::temp_dir_tagged("cli-comp", name);
+    let d = &dir.0;
+    ok(
+        d,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "K4",
+            "--truth",
+            "seed-ac-demo",
+            "-o",
+            "k4.csv",
+        ],
+    );
+    ok(
+        d,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--terms",
+            "ECC@harmonic:2",
+            "--data",
+            "k4.csv",
+            "--json",
+            "id.json",
+        ],
+    );
+    let k4 = std::fs::read_to_string(d.join("k4.csv")).unwrap();
+    let mut csv = String::from("X,Y,Z,A,C,note\n");
+    for (i, line) in k4
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .take(40)
+        .enumerate()
+    {
+        let f: Vec<&str> = line.split(',').take(5).collect();
+        csv.push_str(&format!("{},\"pose {i}, kept\"\n", f.join(",")));
+    }
+    std::fs::write(d.join("poses.csv"), csv).unwrap();
+    dir
+}
+
+/// The library's corrected poses of `poses.csv` (mm and degrees, in the file's column order).
+fn library(dir: &Path) -> Vec<Vec<f64>> {
+    let m = machine();
+    let id = read_identification(&dir.join("id.json"), &m).unwrap();
+    let (errors, _) = MachineErrors::from_identified(&m, &id).unwrap();
+    let text = std::fs::read_to_string(dir.join("poses.csv")).unwrap();
+    // Columns X, Y, Z, A, C; machine axes X, A, C, Y, Z.
+    let column: Vec<usize> = ["X", "Y", "Z", "A", "C"]
+        .iter()
+        .map(|n| m.axis_by_name(n).unwrap())
+        .collect();
+    let poses: Vec<CommandedPose> = text
+        .lines()
+        .skip(1)
+        .enumerate()
+        .map(|(i, l)| {
+            let mut commands = vec![0.0; 5];
+            for (v, &a) in l.split(',').take(5).zip(&column) {
+                let x: f64 = v.parse().unwrap();
+                commands[a] = if m.axes[a].kind == AxisKind::Rotary {
+                    x.to_radians()
+                } else {
+                    x
+                };
+            }
+            CommandedPose {
+                line: i + 2,
+                commands,
+            }
+        })
+        .collect();
+    let mut values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
+    let done = compensate_poses(
+        &m,
+        errors.errors(),
+        m.default_parameters(),
+        "poses.csv",
+        &poses,
+        &mut values_at,
+    )
+    .unwrap();
+    done.poses
+        .iter()
+        .map(|q| {
+            column
+                .iter()
+                .map(|&a| {
+                    if m.axes[a].kind == AxisKind::Rotary {
+                        q[a].to_degrees()
+                    } else {
+                        q[a]
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn csv_poses_corrected_as_the_library_does_other_columns_kept() {
+    let dir = set_up("csv");
+    let d = &dir.0;
+    let text = ok(
+        d,
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--path",
+            "poses.csv",
+            "-o",
+            "out.csv",
+            "--json",
+            "comp.json",
+        ],
+    );
+    assert!(text.contains("Compensated: 9 machine error(s)"), "{text}");
+    assert!(text.contains("XOW: a set-up error"), "{text}");
+    let out = std::fs::read_to_string(d.join("out.csv")).unwrap();
+    let expected = library(d);
+    let input = std::fs::read_to_string(d.join("poses.csv")).unwrap();
+    for ((line, inp), want) in out
+        .lines()
+        .skip(1)
+        .zip(input.lines().skip(1))
+        .zip(&expected)
+    {
+        let fields: Vec<&str> = line.splitn(6, ',').collect();
+        let got: Vec<f64> = fields[..5].iter().map(|v| v.parse().unwrap()).collect();
+        assert_eq!(&got, want, "corrected values read back bit for bit");
+        assert_eq!(fields[5], inp.splitn(6, ',').nth(5).unwrap(), "note kept");
+    }
+    let json = read_json(&d.join("comp.json"));
+    assert_eq!(json["poses"], 40);
+    assert_eq!(json["format"], "csv");
+    assert!(json["position_remainder_um"].as_f64().unwrap() < 1e-3);
+    assert_eq!(json["axes"].as_array().unwrap().len(), 5);
+    assert!(json["axes"][0]["rounding"].is_null());
+    let left: Vec<&str> = json["left_out"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["term"].as_str().unwrap())
+        .collect();
+    assert_eq!(left, ["XOW", "YOW", "ZOW"]);
+}
+
+#[test]
+fn iso_program_keeps_every_other_byte() {
+    let dir = set_up("iso");
+    let d = &dir.0;
+    let program = "%\r\nO1000 (R-TEST CHECK)\r\nG21 G90 G94\r\nN10 G0 X217.5040 Y-0.2790 Z56.6610 A0.0000 C0.0000\r\nN20 G1 A-30.0000 C45.0000 F1000 ; tilt\r\n(comment)\r\nN30 G1 X210.1230 Y-10.5000\r\nM30\r\n%\r\n";
+    std::fs::write(d.join("p.nc"), program).unwrap();
+    let text = ok(
+        d,
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--path",
+            "p.nc",
+            "--nc",
+            "iso",
+            "-o",
+            "out.nc",
+        ],
+    );
+    assert!(text.contains("3 poses, iso"), "{text}");
+    let out = std::fs::read_to_string(d.join("out.nc")).unwrap();
+    let (a, b): (Vec<&str>, Vec<&str>) = (
+        program.split_inclusive('\n').collect(),
+        out.split_inclusive('\n').collect(),
+    );
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        if x.contains("G1") || x.contains("G0") {
+            // Outside the axis words, the same bytes.
+            let strip = |s: &str| -> String {
+                s.split(' ')
+                    .filter(|w| !w.starts_with(['X', 'Y', 'Z', 'A', 'C']))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            };
+            assert_eq!(strip(x), strip(y), "{x:?} -> {y:?}");
+            assert_ne!(x, y, "the pose line was corrected");
+        } else {
+            assert_eq!(x, y);
+        }
+    }
+}
+
+#[test]
+fn heidenhain_program_compensated() {
+    let dir = set_up("heidenhain");
+    let d = &dir.0;
+    let program = "0 BEGIN PGM TEST MM\n1 L X+217.504 Y-0.279 Z+56.661 A+0 C+0 R0 FMAX\n2 L A-30.000 C+45.000 F1000\n3 END PGM TEST MM\n";
+    std::fs::write(d.join("p.h"), program).unwrap();
+    ok(
+        d,
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--path",
+            "p.h",
+            "--nc",
+            "heidenhain",
+            "--decimals",
+            "4",
+            "-o",
+            "out.h",
+        ],
+    );
+    let out = std::fs::read_to_string(d.join("out.h")).unwrap();
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "0 BEGIN PGM TEST MM");
+    assert_eq!(lines[3], "3 END PGM TEST MM");
+    // Four decimals asked for; signs kept; the modal axes of block 2 inserted after its last
+    // axis word, before the feed.
+    let words: Vec<&str> = lines[1].split(' ').collect();
+    assert_eq!(words[..2], ["1", "L"]);
+    assert_eq!(words[7..], ["R0", "FMAX"]);
+    for (w, axis) in words[2..7].iter().zip(["X+", "Y-", "Z+", "A", "C"]) {
+        assert!(w.starts_with(axis), "{w}");
+        assert_eq!(w.split('.').nth(1).unwrap().len(), 4, "{w}");
+    }
+    assert_ne!(words[5], "A+0", "A corrected at the singular pose");
+    let block2: Vec<&str> = lines[2].split(' ').collect();
+    assert_eq!(block2.len(), 8, "{}", lines[2]);
+    assert_eq!(block2[7], "F1000");
+}
+
+#[test]
+fn description_and_tables_written() {
+    let dir = set_up("tables");
+    let d = &dir.0;
+    let text = ok(
+        d,
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--kinematics-out",
+            "corrected.toml",
+            "--tables",
+            "tables",
+            "--pitch-deg",
+            "10",
+        ],
+    );
+    assert!(text.contains("folded: XOC"), "{text}");
+    assert!(text.contains("not folded: AOC"), "{text}");
+    assert_eq!(entries(&d.join("tables")), ["axis_C.csv"]);
+    let table = std::fs::read_to_string(d.join("tables/axis_C.csv")).unwrap();
+    let rows = table.lines().filter(|l| !l.starts_with('#')).count();
+    assert_eq!(rows, 1 + 37, "header and 0..360 every 10 degrees: {table}");
+    let corrected = std::fs::read_to_string(d.join("corrected.toml")).unwrap();
+    model_spec::parse_machine("corrected.toml", &corrected).unwrap();
+}
+
+#[test]
+fn bad_input_refused_without_output() {
+    let dir = set_up("bad");
+    let d = &dir.0;
+    let base = ["compensate", "--machine", "seed-ac", "--params", "id.json"];
+    let with = |extra: &[&'static str]| -> Vec<&'static str> {
+        base.iter().copied().chain(extra.iter().copied()).collect()
+    };
+    // Nothing asked for, --json without poses: usage errors.
+    fails(d, &with(&[]), 2, &["nothing to write"]);
+    fails(
+        d,
+        &with(&["--tables", "t", "--json", "c.json"]),
+        2,
+        &["--json"],
+    );
+    // An incremental move, an arc: the line is named, nothing written.
+    std::fs::write(d.join("g91.nc"), "G90\nG0 X1 Y1 Z1 A0 C0\nG91\nG1 X1\n").unwrap();
+    fails(
+        d,
+        &with(&["--path", "g91.nc", "--nc", "iso", "-o", "o.nc"]),
+        1,
+        &["g91.nc", "3"],
+    );
+    std::fs::write(d.join("arc.nc"), "G90\nG0 X1 Y1 Z1 A0 C0\nG2 X2 Y2 I1 J0\n").unwrap();
+    fails(
+        d,
+        &with(&["--path", "arc.nc", "--nc", "iso", "-o", "o.nc"]),
+        1,
+        &["arc.nc", "3"],
+    );
+    // A commanded pose outside a stroke.
+    std::fs::write(d.join("far.csv"), "X,Y,Z,A,C\n0,0,0,0,0\n9999,0,0,0,0\n").unwrap();
+    fails(
+        d,
+        &with(&["--path", "far.csv", "-o", "o.csv"]),
+        1,
+        &["far.csv", "line 3"],
+    );
+    // A corrected pose that leaves the stroke: X at its limit, corrected outwards.
+    let m = machine();
+    let x = m.axis_by_name("X").unwrap();
+    let [lo, hi] = m.axes[x].limits;
+    let probe = format!("X,Y,Z,A,C\n{lo},0,0,-30,45\n{hi},0,0,-30,45\n");
+    std::fs::write(d.join("edge.csv"), probe).unwrap();
+    fails(
+        d,
+        &with(&["--path", "edge.csv", "-o", "o.csv"]),
+        1,
+        &["edge.csv", "leave a stroke or range"],
+    );
+    // Values from another machine.
+    std::fs::write(d.join("bc.csv"), "X,Y,Z,B,C\n0,0,0,0,0\n").unwrap();
+    fails(
+        d,
+        &[
+            "compensate",
+            "--machine",
+            "head-table-bc",
+            "--params",
+            "id.json",
+            "--path",
+            "bc.csv",
+            "-o",
+            "o.csv",
+        ],
+        1,
+        &["--params", "seed-ac"],
+    );
+    // A rank-deficient identification: the undetermined term is named.
+    ok(
+        d,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--terms",
+            "XOW,YOW,ZOW,XOC,YOC,AOC,BOC,dx0",
+            "--data",
+            "k4.csv",
+            "--json",
+            "deficient.json",
+        ],
+    );
+    fails(
+        d,
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "deficient.json",
+            "--path",
+            "poses.csv",
+            "-o",
+            "o.csv",
+        ],
+        1,
+        &["XOC", "--constraint"],
+    );
+    for f in ["o.nc", "o.csv", "t", "c.json"] {
+        assert!(!d.join(f).exists(), "{f} written on failure");
+    }
+}

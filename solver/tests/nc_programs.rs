@@ -378,6 +378,28 @@ fn iso_refusals_name_line_and_word() {
         ("G1 X1 P1", 7, "P1", "outside a dwell"),
         ("/G1 X1", 1, "/", "skip"),
         ("G1 X123456", 4, "X123456", "beyond"),
+        ("G10 L2 P1 X0", 1, "G10", "machine coordinates"),
+        ("G16", 1, "G16", "polar coordinates"),
+        ("G51 X0 Y0 P2", 1, "G51", "scaling"),
+        ("G50", 1, "G50", "scaling"),
+        ("G51.1 X0", 1, "G51.1", "mirroring"),
+        ("G68.2 X0 Y0 Z0 I0 J45 K0", 1, "G68.2", "rotation"),
+        ("G44 H1", 1, "G44", "tool length"),
+        ("G43.1 Z5", 1, "G43.1", "tool length"),
+        ("G42 D1", 1, "G42", "radius"),
+        ("G65 P9000", 1, "G65", "macro"),
+        ("G7.1 C50", 1, "G7.1", "cylindrical"),
+        ("G112", 1, "G112", "polar interpolation"),
+        ("G73 Z-5 Q1", 1, "G73", "canned cycles"),
+        ("M99", 1, "M99", "subprogram"),
+        ("M198 P1", 1, "M198", "subprogram"),
+        ("G1 X1 Q1", 7, "Q1", "not read in an ISO program"),
+        ("G1 X1 L2", 7, "L2", "not read in an ISO program"),
+        ("G1 X1 K1", 7, "K1", "arc words"),
+        ("G1 X1 D1", 7, "D1", "tool offset"),
+        ("G1 X1 M3.5", 7, "M3.5", "cannot read the number"),
+        ("N3 G1 X1 N4", 10, "N4", "second `N`"),
+        ("X1 [2]", 4, "[", "not part of an ISO word"),
     ];
     for &(block, column, word, why) in cases {
         let text = format!("{START}N2 M3\n{block}\n");
@@ -449,6 +471,73 @@ fn heidenhain_refusals_name_line_and_word() {
         ("3 L X+1.2.3", 5, "X+1.2.3", "cannot read the number"),
         ("3 L X+Q1", 5, "X+Q1", "cannot read the number"),
         ("3 L X+1 DL+1", 9, "DL+1", "not read in an L block"),
+        ("3 LP PR+10 PA+45", 3, "LP PR+10 PA+45", "polar"),
+        (
+            "3 APPR LT X+1 Y+0 LEN5 RL",
+            3,
+            "APPR LT X+1 Y+0 LEN5 RL",
+            "approach",
+        ),
+        ("3 DEP LT LEN5", 3, "DEP LT LEN5", "approach"),
+        ("3 FL X+1 Y+2", 3, "FL X+1 Y+2", "free contour"),
+        ("3 FN 0: Q1 = +5", 3, "FN 0: Q1 = +5", "Q parameter"),
+        ("3 Q1 = 5", 3, "Q1 = 5", "Q parameters"),
+        ("3 L X+1 M114", 9, "M114", "M114"),
+        ("3 L X+1 M144", 9, "M144", "M144"),
+        ("3 L X+1 M118", 9, "M118", "handwheel"),
+        ("3 L Z+1 M140", 9, "M140", "retraction"),
+        ("3 L X+1 M92", 9, "M92", "maker's reference"),
+        ("3 L X+1 M99", 9, "M99", "cycle call"),
+        ("3 L X+1 M89", 9, "M89", "cycle call"),
+        ("3 L X+1 RR", 9, "RR", "radius compensation"),
+        ("3 L X+1 R+", 9, "R+", "radius compensation"),
+        ("3 L X+1 M3 M3", 12, "M3", "twice"),
+        ("3 CYCL CALL", 3, "CYCL CALL", "cycle call"),
+        (
+            "3 CYCL DEF 8.0 MIRROR IMAGE",
+            3,
+            "CYCL DEF 8.0 MIRROR IMAGE",
+            "mirroring",
+        ),
+        (
+            "3 CYCL DEF 11.0 SCALING",
+            3,
+            "CYCL DEF 11.0 SCALING",
+            "scaling",
+        ),
+        (
+            "3 CYCL DEF 26.0 AXIS-SPEC. SCALING",
+            3,
+            "CYCL DEF 26.0 AXIS-SPEC. SCALING",
+            "scaling",
+        ),
+        (
+            "3 CYCL DEF 19.0 WORKING PLANE",
+            3,
+            "CYCL DEF 19.0 WORKING PLANE",
+            "tilted",
+        ),
+        (
+            "3 CYCL DEF 247 DATUM SETTING",
+            3,
+            "CYCL DEF 247 DATUM SETTING",
+            "datum shift",
+        ),
+        (
+            "3 TCH PROBE 400 BASIC ROTATION",
+            3,
+            "TCH PROBE 400 BASIC ROTATION",
+            "probing",
+        ),
+        ("3 CALL PGM SUB", 3, "CALL PGM SUB", "calls"),
+        ("3 LBL 1", 3, "LBL 1", "labels"),
+        (
+            "3 FUNCTION PARAXCOMP DISPLAY",
+            3,
+            "FUNCTION PARAXCOMP DISPLAY",
+            "FUNCTION",
+        ),
+        ("3 l x+1", 3, "l x+1", "does not read"),
     ];
     for &(block, column, word, why) in cases {
         let text = format!("1 L X+0 Y+0 Z+0 A+0 C+0 R0 FMAX\n2 ; comment\n{block}\n");
@@ -541,12 +630,13 @@ fn block_texts(words: &[(usize, String)], extra: u8, n: usize) -> (String, Strin
     (iso, hh)
 }
 
-/// A number as a program may write it: up to five digits before the point, none to four
-/// after, with or without the point, a `+`, a leading zero; never a negative zero.
+/// A number as a program may write it: up to five digits before the point (below 99 990, so
+/// that a correction of ±2 stays writable), none to four after, with or without the point, a
+/// `+`, a leading zero; never a negative zero.
 fn number() -> impl Strategy<Value = String> {
     (
         any::<bool>(),
-        0u32..100_000,
+        0u32..99_990,
         prop::option::of(0usize..5),
         any::<u32>(),
         any::<bool>(),
@@ -595,7 +685,10 @@ proptest! {
     /// written with every command moved by far less than the last decimal, it is the same too
     /// (each word rewritten in its own style), and the rounding is that small move.
     #[test]
-    fn random_programs_round_trip((blocks, extras, crlf) in program()) {
+    fn random_programs_round_trip(
+        (blocks, extras, crlf) in program(),
+        shifts in prop::collection::vec(-2.0f64..2.0, 1..40),
+    ) {
         let end = if crlf { "\r\n" } else { "\n" };
         let start: Vec<(usize, String)> = (0..5).map(|a| (a, "0".to_string())).collect();
         let (mut iso_text, mut hh_text) = (format!("%{end}G90 G21{end}"), format!("0 BEGIN PGM P MM{end}"));
@@ -623,6 +716,38 @@ proptest! {
             let w = p.write(&nudged, &WriteOptions::new()).unwrap();
             prop_assert_eq!(&w.text, &text);
             prop_assert!(w.rounding.iter().all(|&r| (r - 1e-7).abs() < 1e-9), "{:?}", w.rounding);
+            // Corrections of up to ±2 (mm, degrees), different at every pose: read back, the
+            // program gives each corrected pose to within the reported rounding, which is at
+            // most half a unit of the coarsest word (1: a word without decimals).
+            let moved: Vec<Vec<f64>> = c
+                .iter()
+                .enumerate()
+                .map(|(k, v)| {
+                    v.iter()
+                        .enumerate()
+                        .map(|(a, x)| x + shifts[(k * 5 + a) % shifts.len()])
+                        .collect()
+                })
+                .collect();
+            for min_decimals in [0, 4] {
+                let w = p.write(&moved, &WriteOptions::with_min_decimals(min_decimals)).unwrap();
+                let back = parse_program("r", &w.text, dialect, &xyzac()).unwrap();
+                prop_assert_eq!(back.poses().len(), moved.len());
+                for (q, m) in back.poses().iter().zip(&moved) {
+                    for (a, (x, y)) in q.commands.iter().zip(m).enumerate() {
+                        prop_assert!((x - y).abs() <= w.rounding[a] + 1e-9, "{} {} {:?}", x, y, w.rounding);
+                    }
+                }
+                let bound = if min_decimals == 4 { 0.5e-4 } else { 0.5 };
+                prop_assert!(w.rounding.iter().all(|&r| r <= bound + 1e-9), "{:?}", w.rounding);
+                // Lines that do not move are untouched.
+                let posed: Vec<usize> = p.poses().iter().map(|q| q.line).collect();
+                for (i, (x, y)) in text.split_inclusive('\n').zip(w.text.split_inclusive('\n')).enumerate() {
+                    if !posed.contains(&(i + 1)) {
+                        prop_assert_eq!(x, y);
+                    }
+                }
+            }
         }
     }
 }
@@ -694,4 +819,34 @@ N60 M30\n\
         .write(&documented_corrections(), &WriteOptions::new())
         .unwrap();
     assert_eq!(w.text, after);
+}
+
+#[test]
+fn what_passes_through() {
+    let t = "%\nO1000\nG90 G93 G61 G9 G15 G69\nG95 G64\nG94\nG0 X0 Y0 Z0 A0 C0 T1 M6 S1000 M3 M8\nG4 P500\n/M1\nG1 X1 F100.5\n%\n";
+    let p = iso(t).unwrap();
+    assert_eq!(p.poses().len(), 2);
+    assert_eq!(
+        p.write(&commands(&p), &WriteOptions::new()).unwrap().text,
+        t
+    );
+    let t = "0 BEGIN PGM A MM\n\
+1 TOOL DEF 1 L+0 R+0\n\
+2 TOOL CALL 1 Z S1000\n\
+3 CYCL DEF 32.0 TOLERANCE\n\
+4 CYCL DEF 32.1 T0.005\n\
+5 FUNCTION RESET TCPM\n\
+6 L X+0 Y+0 Z+0 A+0 C+0 R0 FAUTO M91\n\
+7 L X+1 R0 FU0.1 M126 M3\n\
+8 L Z+5 FZ0.05\n\
+9 L R0 FMAX M5\n\
+10 STOP\n\
+11 END PGM A MM\n";
+    let p = hh(t).unwrap();
+    let lines: Vec<usize> = p.poses().iter().map(|q| q.line).collect();
+    assert_eq!(lines, [7, 8, 9]);
+    assert_eq!(
+        p.write(&commands(&p), &WriteOptions::new()).unwrap().text,
+        t
+    );
 }

@@ -205,14 +205,21 @@ impl<'a> HeidenhainReader<'a> {
 impl BlockReader for HeidenhainReader<'_> {
     fn block(&mut self, place: &Place, offset: usize) -> Result<Option<BlockAxes>, NcError> {
         let line = place.text;
-        let content = &line[..line.find(';').unwrap_or(line.len())];
-        let mut tokens: Vec<(&str, usize)> = Vec::new();
-        let mut rest = content;
-        while let Some(s) = rest.find(|c: char| c != ' ' && c != '\t') {
-            let len = rest[s..].find([' ', '\t']).unwrap_or(rest.len() - s);
-            let at = content.len() - rest.len() + s;
-            tokens.push((&content[at..at + len], at));
-            rest = &rest[s + len..];
+        let b = line.as_bytes();
+        let content = &line[..b.iter().position(|&c| c == b';').unwrap_or(b.len())];
+        let mut tokens: Vec<(&str, usize)> = Vec::with_capacity(16);
+        let mut i = 0;
+        let cb = content.as_bytes();
+        while i < cb.len() {
+            if matches!(cb[i], b' ' | b'\t') {
+                i += 1;
+                continue;
+            }
+            let at = i;
+            while i < cb.len() && !matches!(cb[i], b' ' | b'\t') {
+                i += 1;
+            }
+            tokens.push((&content[at..i], at));
         }
         let mut k = 0;
         if tokens

@@ -5,11 +5,12 @@
 
 use model_spec::Machine;
 use serde_json::Value;
-use solver::compensation::volumetric::path::correct_path_csv;
+use solver::compensation::volumetric::path::correct_poses;
 use solver::compensation::volumetric::simulate::{LaserPlan, measure};
 use solver::compensation::volumetric::{
     VolumetricModel, correct, format_laser, format_squareness, parse_squareness,
 };
+use solver::io::poses::{axis_words, read_pose_csv};
 use solver::simulation::Truth;
 
 mod common;
@@ -122,7 +123,15 @@ fn grid_path_and_summary() {
     }
     // The corrected path: what the library writes.
     let written = std::fs::read_to_string(dir.join("out.csv")).unwrap();
-    let (expected, _) = correct_path_csv("p.csv", PATH, &m, &model).unwrap();
+    let table = read_pose_csv("p.csv", PATH, &axis_words(&m)).unwrap();
+    let poses: Vec<(usize, Vec<f64>)> = table
+        .poses()
+        .iter()
+        .map(|p| (p.line, p.commands.clone()))
+        .collect();
+    let corrected = correct_poses("p.csv", &m, &model, &poses).unwrap();
+    let commands: Vec<Vec<f64>> = corrected.iter().map(|c| c.commands.clone()).collect();
+    let expected = table.write(&commands).unwrap();
     assert_eq!(written, expected);
     assert!(written.starts_with("N,X,Y,Z,F\n1,") && written.ends_with(",900\n# end\n"));
 }

@@ -4,12 +4,13 @@
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use model_spec::{AxisKind, Machine};
 use output::{Outputs, Target};
-use solver::compensation::volumetric::path::correct_path_file;
+use solver::compensation::volumetric::path::correct_poses;
 use solver::compensation::volumetric::summary::{SetSummary, VolumetricReport};
 use solver::compensation::volumetric::{
     AxisMeasurement, GridSpec, VolumetricError, VolumetricModel, format_grid, read_laser,
     read_squareness,
 };
+use solver::io::poses::{axis_words, read_pose_file};
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
@@ -195,8 +196,19 @@ pub fn run(args: &VolumetricArgs) -> CliResult {
         sets.push(summary);
     }
     if let (Some(path), Some(target)) = (&args.path, &args.output) {
-        let (text, corrected) =
-            correct_path_file(path, &m, &model).map_err(|e| failure("--path", e))?;
+        let table = read_pose_file(path, &axis_words(&m))
+            .map_err(|e| CliError::input(format!("--path: {e}")))?;
+        let poses: Vec<(usize, Vec<f64>)> = table
+            .poses()
+            .iter()
+            .map(|p| (p.line, p.commands.clone()))
+            .collect();
+        let corrected =
+            correct_poses(table.file(), &m, &model, &poses).map_err(|e| failure("--path", e))?;
+        let commands: Vec<Vec<f64>> = corrected.iter().map(|c| c.commands.clone()).collect();
+        let text = table
+            .write(&commands)
+            .map_err(|e| CliError::input(format!("-o: {e}")))?;
         let du = corrected
             .iter()
             .map(|c| model.du(&c.commanded).map_err(|e| failure("--path", e)))

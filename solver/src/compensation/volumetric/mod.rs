@@ -14,7 +14,7 @@
 //! - [`model`]: the model and `du`;
 //! - [`compensate`]: the corrected commands;
 //! - [`grid`]: the volumetric grid CSV;
-//! - [`path`]: the commanded poses of a path CSV replaced by their corrected commands;
+//! - [`path`]: commanded poses corrected, each refusal naming its line;
 //! - [`summary`]: largest and RMS predicted error and correction per axis, for people and JSON;
 //! - [`simulate`]: the laser measurements, taken on the exact virtual machine, and the exact
 //!   tool-end error in the model's frame, to check all of the above.

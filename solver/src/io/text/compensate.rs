@@ -63,7 +63,10 @@ pub fn compensation(r: &CompensationReport) -> String {
     let coarse: Vec<&str> = r
         .axes
         .iter()
-        .filter(|a| a.rounding.is_some_and(|x| x > 0.1 * a.largest.abs() && x > 0.0))
+        .filter(|a| {
+            a.rounding
+                .is_some_and(|x| x > 0.1 * a.largest.abs() && x > 0.0)
+        })
         .map(|a| a.axis.as_str())
         .collect();
     if !coarse.is_empty() {

@@ -20,7 +20,7 @@ use codegen::{GainModel, compile};
 use model_spec::{AxisKind, Machine, Side, parse_machine};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
-use solver::simulation::exact::{chain_transform, tool_centre_point_ik};
+use solver::simulation::exact::chain_transform;
 use solver::simulation::fd::fd_gains;
 
 /// The two test machines with negative directions.
@@ -40,40 +40,8 @@ fn machines() -> Vec<Machine> {
     .collect()
 }
 
-/// A pose and kinematic parameters drawn from `unit` (numbers in [0, 1)): parameters within
-/// ±100 mm of their defaults, rotary commands across their range (±180° when unlimited),
-/// linear commands by the nominal inverse kinematics (the tool point on the ball).
-fn pose(m: &Machine, unit: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let mut u = unit.iter().copied().cycle();
-    let params: Vec<f64> = m
-        .symbols
-        .iter()
-        .map(|s| s.default + 200.0 * (u.next().unwrap() - 0.5))
-        .collect();
-    let mut commands: Vec<f64> = m
-        .axes
-        .iter()
-        .map(|a| match a.kind {
-            AxisKind::Linear => 0.0,
-            AxisKind::Rotary => {
-                let [lo, hi] = a.limits;
-                let (lo, hi) = if lo.is_finite() {
-                    (lo, hi)
-                } else {
-                    (-180.0, 180.0)
-                };
-                (lo + (hi - lo) * u.next().unwrap()).to_radians()
-            }
-        })
-        .collect();
-    tool_centre_point_ik(m, &mut commands, &params)
-        .expect("the test machines have three independent linear axes");
-    (commands, params)
-}
-
-fn close(a: f64, b: f64, tol: f64) -> bool {
-    (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
-}
+mod common;
+use common::gains::{close, pose};
 
 #[test]
 fn the_test_machines_have_negative_directions_in_both_chains() {

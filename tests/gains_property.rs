@@ -9,42 +9,12 @@
 //! - the compiled code of the `generated` crate equals the IR evaluator, for every model.
 
 use codegen::{GainModel, compile};
-use model_spec::{AxisKind, Machine, all_builtin};
+use model_spec::all_builtin;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-/// A pose and parameters drawn from `unit` (numbers in [0, 1)).
-fn pose(m: &Machine, unit: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let mut u = unit.iter().copied().cycle();
-    let params: Vec<f64> = m
-        .symbols
-        .iter()
-        .map(|s| s.default + 200.0 * (u.next().unwrap() - 0.5))
-        .collect();
-    let mut commands: Vec<f64> = m
-        .axes
-        .iter()
-        .map(|a| match a.kind {
-            AxisKind::Linear => 0.0,
-            AxisKind::Rotary => {
-                let [lo, hi] = a.limits;
-                let (lo, hi) = if lo.is_finite() {
-                    (lo, hi)
-                } else {
-                    (-180.0, 180.0)
-                };
-                (lo + (hi - lo) * u.next().unwrap()).to_radians()
-            }
-        })
-        .collect();
-    solver::simulation::exact::tool_centre_point_ik(m, &mut commands, &params)
-        .expect("built-in machines have three independent linear axes");
-    (commands, params)
-}
-
-fn close(a: f64, b: f64, tol: f64) -> bool {
-    (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
-}
+mod common;
+use common::gains::{close, pose};
 
 #[test]
 fn symbolic_gains_equal_finite_differences_of_the_exact_chain() {

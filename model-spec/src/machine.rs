@@ -100,6 +100,16 @@ pub struct Chain {
     pub end_offset: Offset,
 }
 
+impl Chain {
+    /// The axes of the chain, from the bed outwards.
+    pub fn axes(&self) -> impl Iterator<Item = AxisId> + '_ {
+        self.links.iter().filter_map(|l| match l {
+            Link::Axis(a) => Some(*a),
+            Link::Fixed { .. } => None,
+        })
+    }
+}
+
 /// A named sub-model: terms over a subset of the machine's errors (and the R-test's sensor
 /// offsets).
 #[derive(Clone, Debug, PartialEq)]

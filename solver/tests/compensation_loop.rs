@@ -119,6 +119,26 @@ fn machine_truth(m: &Machine, truth: &Truth, q: &[f64]) -> Vec<f64> {
     e
 }
 
+/// The compensated commands of one pose `q` with kinematic parameters `params`.
+fn compensated(m: &Machine, errors: &MachineErrors, q: &[f64], params: &[f64]) -> Vec<f64> {
+    let commanded = [CommandedPose {
+        line: 1,
+        commands: q.to_vec(),
+    }];
+    let mut values_at = |c: &[f64], out: &mut [f64]| errors.values_at(m, c, out);
+    compensate_poses(
+        m,
+        errors.errors(),
+        params.to_vec(),
+        "test",
+        &commanded,
+        &mut values_at,
+    )
+    .unwrap()
+    .poses
+    .remove(0)
+}
+
 /// Error RMS (mm, over the three directions as `validate` reports it) of poses (with their
 /// parameters) on the exact machine, before and after compensation.
 fn before_after(
@@ -132,21 +152,7 @@ fn before_after(
     for (q, params) in poses {
         let e = vm.error_vector(q, params, &machine_truth(m, truth, q));
         before += e.position.norm_squared();
-        let commanded = [CommandedPose {
-            line: 1,
-            commands: q.clone(),
-        }];
-        let mut values_at = |c: &[f64], out: &mut [f64]| errors.values_at(m, c, out);
-        let done = compensate_poses(
-            m,
-            errors.errors(),
-            params.clone(),
-            "test",
-            &commanded,
-            &mut values_at,
-        )
-        .unwrap();
-        let qc = &done.poses[0];
+        let qc = &compensated(m, errors, q, params);
         let e = vm.error_vector(qc, params, &machine_truth(m, truth, qc));
         after += e.position.norm_squared();
     }
@@ -216,21 +222,7 @@ fn rtest_view(
     let motion = vec![1i8; m.axes.len()];
     let mut sum = 0.0;
     for (q, params) in poses {
-        let commanded = [CommandedPose {
-            line: 1,
-            commands: q.clone(),
-        }];
-        let mut values_at = |c: &[f64], out: &mut [f64]| errors.values_at(m, c, out);
-        let done = compensate_poses(
-            m,
-            errors.errors(),
-            params.clone(),
-            "test",
-            &commanded,
-            &mut values_at,
-        )
-        .unwrap();
-        let qc = &done.poses[0];
+        let qc = &compensated(m, errors, q, params);
         let cx = BasisContext {
             commands: qc,
             motion: &motion,

@@ -18,7 +18,7 @@ use solver::io::report::compensate::{
     CompensationReport, CompensationSource, KinematicsReport, LeftOutReport,
 };
 use solver::io::report::{read_identification, to_json};
-use solver::io::text::compensate::compensation;
+use solver::io::text::compensate::{compensation, kinematics_and_tables};
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -172,26 +172,21 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     if let (Some(path), Some(out)) = (&args.path, &args.output) {
         let words = axis_words(&m);
         let file = path.display().to_string();
-        let to_rad = |commands: &[f64]| -> Vec<f64> {
+        // Files hold rotary commands in degrees; the computation takes radians.
+        let rotary: Vec<bool> = m
+            .axes
+            .iter()
+            .map(|a| a.kind == model_spec::AxisKind::Rotary)
+            .collect();
+        let convert = |commands: &[f64], f: fn(f64) -> f64| -> Vec<f64> {
             commands
                 .iter()
-                .zip(&m.axes)
-                .map(|(&q, a)| match a.kind {
-                    model_spec::AxisKind::Rotary => q.to_radians(),
-                    model_spec::AxisKind::Linear => q,
-                })
+                .zip(&rotary)
+                .map(|(&q, &r)| if r { f(q) } else { q })
                 .collect()
         };
-        let to_deg = |commands: &[f64]| -> Vec<f64> {
-            commands
-                .iter()
-                .zip(&m.axes)
-                .map(|(&q, a)| match a.kind {
-                    model_spec::AxisKind::Rotary => q.to_degrees(),
-                    model_spec::AxisKind::Linear => q,
-                })
-                .collect()
-        };
+        let to_rad = |c: &[f64]| convert(c, f64::to_radians);
+        let to_deg = |c: &[f64]| convert(c, f64::to_degrees);
         let mut values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
         let run = |poses: &[solver::io::poses::CommandedPose],
                    values_at: &mut dyn FnMut(&[f64], &mut [f64])| {
@@ -228,15 +223,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
                 let written = program
                     .write(&corrected, &options)
                     .map_err(|e| CliError::input(format!("-o: {e}")))?;
-                let rounding = written
-                    .rounding
-                    .iter()
-                    .zip(&m.axes)
-                    .map(|(&r, a)| match a.kind {
-                        model_spec::AxisKind::Rotary => r.to_radians(),
-                        model_spec::AxisKind::Linear => r,
-                    })
-                    .collect();
+                let rounding = to_rad(&written.rounding);
                 (written.text, Some(rounding), name.clone(), done.summary)
             }
             None => {
@@ -308,7 +295,13 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             }
             compensation(&report)
         }
-        None => kinematics_and_tables_text(&source),
+        None => format!(
+            "Machine {}, model {} with the values of {}\n{}",
+            source.machine,
+            source.model,
+            source.params_file,
+            kinematics_and_tables(source.kinematics.as_ref(), &source.tables)
+        ),
     };
     let mut text = text;
     text.push_str(&wrote(&write(files)?));
@@ -316,28 +309,4 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         .iter()
         .any(|t| matches!(t, Some(Target::Stdout)));
     print_text(&text, stdout_taken)
-}
-
-/// The text when no poses were corrected: the corrected description and the tables.
-fn kinematics_and_tables_text(source: &CompensationSource) -> String {
-    let mut text = format!(
-        "Machine {}, model {} with the values of {}\n",
-        source.machine, source.model, source.params_file
-    );
-    if let Some(k) = &source.kinematics {
-        text.push_str(&format!("Corrected kinematic description: {}\n", k.file));
-        for f in &k.folded {
-            text.push_str(&format!("  folded: {f}\n"));
-        }
-        for f in &k.not_folded {
-            text.push_str(&format!("  not folded: {f}\n"));
-        }
-    }
-    if !source.tables.is_empty() {
-        text.push_str(&format!(
-            "Axis compensation tables: {}\n",
-            source.tables.join(", ")
-        ));
-    }
-    text
 }

@@ -122,7 +122,12 @@ pub enum PoseCsvError {
     Text(TextError),
 }
 
-fn located(file: &str, line: usize, column: &Option<(usize, String)>, message: &str) -> String {
+pub(crate) fn located(
+    file: &str,
+    line: usize,
+    column: &Option<(usize, String)>,
+    message: &str,
+) -> String {
     match column {
         Some((i, name)) => format!("{file}:{line}: column {i} `{name}`: {message}"),
         None => format!("{file}:{line}: {message}"),

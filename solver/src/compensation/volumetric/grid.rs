@@ -164,14 +164,8 @@ pub fn format_grid(
 ) -> String {
     let poses = grid.poses(m.axes.len());
     debug_assert_eq!(poses.len(), du.len());
-    let mut out = String::with_capacity(64 * poses.len());
-    for c in comments {
-        for l in c.lines() {
-            out += "# ";
-            out += l;
-            out.push('\n');
-        }
-    }
+    let mut out = crate::io::csv::comment_lines(comments);
+    out.reserve(64 * poses.len());
     let mut header: Vec<String> = grid
         .axes
         .iter()

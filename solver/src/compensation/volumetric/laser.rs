@@ -359,14 +359,7 @@ pub fn parse_laser(
 /// decimal that reads back to the same value.
 pub fn format_laser(m: &Machine, meas: &AxisMeasurement, comments: &[String]) -> String {
     let axes = column_axes(m);
-    let mut out = String::new();
-    for c in comments {
-        for l in c.lines() {
-            out += "# ";
-            out += l;
-            out.push('\n');
-        }
-    }
+    let mut out = crate::io::csv::comment_lines(comments);
     let mut header: Vec<String> = axes
         .iter()
         .map(|&a| format!("{}_mm", m.axes[a].name))

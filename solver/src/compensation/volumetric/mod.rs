@@ -54,6 +54,7 @@ pub mod squareness;
 pub mod summary;
 pub mod table;
 
+use crate::io::poses::located;
 pub use compensate::{Corrected, MAX_ITERATIONS, TOLERANCE_MM, correct, correct_within_strokes};
 pub use grid::{GridSpec, format_grid};
 pub use laser::{AxisMeasurement, format_laser, parse_laser, read_laser};
@@ -139,11 +140,4 @@ pub enum VolumetricError {
     /// non-finite value, a correction that does not converge.
     #[error("{0}")]
     Computation(String),
-}
-
-fn located(file: &str, line: usize, column: &Option<(usize, String)>, message: &str) -> String {
-    match column {
-        Some((i, name)) => format!("{file}:{line}: column {i} `{name}`: {message}"),
-        None => format!("{file}:{line}: {message}"),
-    }
 }

@@ -33,7 +33,7 @@ use super::squareness::Squareness;
 use super::table::Table;
 use super::{MAX_TRANSLATION_MM, VolumetricError};
 use model_spec::units::compact;
-use model_spec::{AxisId, AxisKind, Dir, ErrorKind, Link, Machine, Side};
+use model_spec::{AxisId, AxisKind, Dir, ErrorKind, Machine, Side};
 use nalgebra::Vector3;
 
 /// The three axes in chain order, bed outwards.
@@ -94,15 +94,7 @@ impl VolumetricModel {
         measurements: &[AxisMeasurement],
         squareness: &Squareness,
     ) -> Result<VolumetricModel, VolumetricError> {
-        let chain: Vec<AxisId> = m
-            .tool
-            .links
-            .iter()
-            .filter_map(|l| match l {
-                Link::Axis(a) => Some(*a),
-                Link::Fixed { .. } => None,
-            })
-            .collect();
+        let chain: Vec<AxisId> = m.tool.axes().collect();
         let described: Vec<String> = m
             .axes
             .iter()

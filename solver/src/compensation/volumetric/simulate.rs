@@ -25,7 +25,7 @@ use super::{MAX_ANGLE_RAD, MAX_TRANSLATION_MM, VolumetricError};
 use crate::model::BasisContext;
 use crate::simulation::exact::VirtualMachine;
 use crate::simulation::truth::Truth;
-use model_spec::{AxisId, AxisKind, ErrorKind, Link, Machine, Side};
+use model_spec::{AxisId, AxisKind, ErrorKind, Machine, Side};
 use nalgebra::{Matrix6, Rotation3, Vector3, Vector6};
 
 /// One planned laser measurement: the axis, its positions and where the others stand.
@@ -267,15 +267,7 @@ fn squareness_of_lines(
     measurements: &[AxisMeasurement],
     directions: &[Vector3<f64>],
 ) -> Result<(Vec<f64>, Vector3<f64>), VolumetricError> {
-    let chain: Vec<AxisId> = m
-        .tool
-        .links
-        .iter()
-        .filter_map(|l| match l {
-            Link::Axis(a) => Some(*a),
-            Link::Fixed { .. } => None,
-        })
-        .collect();
+    let chain: Vec<AxisId> = m.tool.axes().collect();
     let sq = squareness_errors(m);
     let cannot = || {
         VolumetricError::Setup(format!(

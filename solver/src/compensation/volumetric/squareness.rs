@@ -256,14 +256,7 @@ fn number(v: &Val<'_>, what: &str) -> Result<(f64, String), String> {
 /// errors (µrad) and the reference point (mm), every number the shortest decimal that reads
 /// back to the same value.
 pub fn format_squareness(m: &Machine, sq: &Squareness, comments: &[String]) -> String {
-    let mut out = String::new();
-    for c in comments {
-        for l in c.lines() {
-            out += "# ";
-            out += l;
-            out.push('\n');
-        }
-    }
+    let mut out = crate::io::csv::comment_lines(comments);
     out += &format!("machine = \"{}\"\n", m.name);
     for &(e, v) in &sq.values {
         out += &format!("{} = {}\n", m.catalogue[e].name, format_scaled(v, 6));

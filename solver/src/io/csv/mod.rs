@@ -61,7 +61,7 @@ use model_spec::catalogue::iso_rank;
 use model_spec::{AxisKind, Machine};
 use std::path::Path;
 pub use whole::{parse_csv, read_csv};
-pub use write::format_record;
+pub use write::{comment_lines, format_record};
 
 /// How the readers judge a file: the bounds of what they accept.
 ///

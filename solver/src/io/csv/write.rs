@@ -28,14 +28,7 @@ pub fn format_record(
         )));
     }
     let axes = column_order(m);
-    let mut out = String::new();
-    for c in comments {
-        for l in c.lines() {
-            out += "# ";
-            out += l;
-            out.push('\n');
-        }
-    }
+    let mut out = comment_lines(comments);
     let mut header: Vec<&str> = axes.iter().map(|&a| m.axes[a].name.as_str()).collect();
     if measured {
         header.extend(MEASURED);
@@ -77,4 +70,18 @@ pub fn format_record(
         out.push('\n');
     }
     Ok(out)
+}
+
+/// `comments` as `# ` lines (a comment of several lines gives several), each ending in `\n`:
+/// the head of every CSV and TOML file rtest writes for people to read back.
+pub fn comment_lines(comments: &[String]) -> String {
+    let mut out = String::new();
+    for c in comments {
+        for l in c.lines() {
+            out += "# ";
+            out += l;
+            out.push('\n');
+        }
+    }
+    out
 }

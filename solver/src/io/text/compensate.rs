@@ -2,7 +2,7 @@
 //! remainders, and the lines that need a look.
 
 use super::{header, table};
-use crate::io::report::compensate::CompensationReport;
+use crate::io::report::compensate::{CompensationReport, KinematicsReport};
 use model_spec::units::{fixed, readable};
 
 /// At most this many line numbers are listed in a sentence.
@@ -100,7 +100,15 @@ pub fn compensation(r: &CompensationReport) -> String {
             lines(&r.tilt_uncorrected_lines)
         ));
     }
-    if let Some(k) = &r.kinematics {
+    text.push_str(&kinematics_and_tables(r.kinematics.as_ref(), &r.tables));
+    text
+}
+
+/// The corrected kinematic description (what was folded, what was not) and the tables
+/// written, for people; empty when neither was asked for.
+pub fn kinematics_and_tables(kinematics: Option<&KinematicsReport>, tables: &[String]) -> String {
+    let mut text = String::new();
+    if let Some(k) = kinematics {
         text.push_str(&format!("\nCorrected kinematic description: {}\n", k.file));
         for f in &k.folded {
             text.push_str(&format!("  folded: {f}\n"));
@@ -109,10 +117,10 @@ pub fn compensation(r: &CompensationReport) -> String {
             text.push_str(&format!("  not folded: {f}\n"));
         }
     }
-    if !r.tables.is_empty() {
+    if !tables.is_empty() {
         text.push_str(&format!(
             "\nAxis compensation tables: {}\n",
-            r.tables.join(", ")
+            tables.join(", ")
         ));
     }
     text

@@ -399,3 +399,106 @@ fn bad_input_refused_without_output() {
         assert!(!d.join(f).exists(), "{f} written on failure");
     }
 }
+
+/// The loop in commands: compensate K4, run the compensated path on the machine (the record
+/// labelled with the program's poses, as a compensating controller reports them), identify
+/// again: the compensated errors are gone (within the two identifications' noise), the ball's
+/// set-up is untouched.
+#[test]
+fn identify_after_compensation_finds_the_errors_gone() {
+    let dir = set_up("loop");
+    let d = &dir.0;
+    ok(
+        d,
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--path",
+            "k4.csv",
+            "-o",
+            "k4c.csv",
+        ],
+    );
+    ok(
+        d,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "k4c.csv",
+            "--commanded",
+            "k4.csv",
+            "--truth",
+            "seed-ac-demo",
+            "--seed",
+            "5",
+            "-o",
+            "after.csv",
+        ],
+    );
+    ok(
+        d,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--terms",
+            "ECC@harmonic:2",
+            "--data",
+            "after.csv",
+            "--json",
+            "after.json",
+        ],
+    );
+    let (before, after) = (
+        read_json(&d.join("id.json")),
+        read_json(&d.join("after.json")),
+    );
+    for (b, a) in before["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(after["parameters"].as_array().unwrap())
+    {
+        let name = a["name"].as_str().unwrap();
+        let (vb, sb) = (b["value"].as_f64().unwrap(), b["std"].as_f64().unwrap());
+        let (va, sa) = (a["value"].as_f64().unwrap(), a["std"].as_f64().unwrap());
+        let combined = (sa * sa + sb * sb).sqrt();
+        if name.ends_with("OW") {
+            assert!(
+                (va - vb).abs() < 4.0 * combined,
+                "{name}: set-up {vb} -> {va}"
+            );
+        } else {
+            assert!(
+                va.abs() < 4.0 * combined,
+                "{name}: {vb} -> {va} ± {combined}"
+            );
+            assert!(vb.abs() > 5.0 * combined, "{name} was there before: {vb}");
+        }
+    }
+    // The poses of another program: refused, nothing written.
+    fails(
+        d,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "k4c.csv",
+            "--commanded",
+            "poses.csv",
+            "-o",
+            "x.csv",
+        ],
+        1,
+        &["--commanded", "40 poses", "241 samples"],
+    );
+    assert!(!d.join("x.csv").exists());
+}

@@ -35,7 +35,12 @@ the machine's axes (linear mm, rotary degrees), dx_um,dy_um,dz_um (tool minus wo
 frame, µm) and t_s (s). It is read back before it is written: a simulation whose readings \
 `identify` would refuse (beyond --max-reading-um) is an error (exit code 3) and writes nothing. \
 `-o -` writes the CSV to standard output (the summary then goes to standard error). Prints one \
-line: the samples and the RMS of the readings (µm).";
+line: the samples and the RMS of the readings (µm).
+
+To check a compensation: simulate the compensated path (`rtest compensate -o`) with \
+--commanded set to the path before compensation; the record then holds the program's poses and \
+the readings the compensated machine gives there, as a controller that compensates reports them, \
+and `rtest identify` on it finds the compensated errors near zero.";
 
 /// Flags of `rtest simulate`.
 #[derive(Debug, clap::Args)]
@@ -71,6 +76,11 @@ pub struct SimulateArgs {
     /// Zero the readings at the first sample, as R-test software does (overrides the truth).
     #[arg(long)]
     zeroed: bool,
+    /// The poses the program commanded before compensation (a pose CSV, or the measurement
+    /// the compensated --path came from), written as the record's axes: a controller that
+    /// compensates reports the program's positions, not the corrected ones.
+    #[arg(long, value_name = "FILE")]
+    commanded: Option<std::path::PathBuf>,
     /// The measurement CSV to write (`-`: standard output).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Target,
@@ -120,6 +130,31 @@ fn truth(m: &model_spec::Machine, name: Option<&str>) -> CliResult<Truth> {
     })
 }
 
+/// Writes the poses of the pose file `file` (one per sample of `record`, mm and degrees) as
+/// the record's commands.
+fn relabel(m: &model_spec::Machine, record: &mut solver::record::Record, file: &Path) -> CliResult {
+    let table = solver::io::poses::read_pose_file(file, &solver::io::poses::axis_words(m))
+        .map_err(|e| CliError::input(format!("--commanded: {e}")))?;
+    let poses = table.poses();
+    if poses.len() != record.samples.len() {
+        return Err(CliError::input(format!(
+            "--commanded: {} holds {} poses, the path {} samples: they must be the same poses, before and after compensation",
+            file.display(),
+            poses.len(),
+            record.samples.len()
+        )));
+    }
+    for (sample, pose) in record.samples.iter_mut().zip(poses) {
+        for ((q, &c), a) in sample.commands.iter_mut().zip(&pose.commands).zip(&m.axes) {
+            *q = match a.kind {
+                model_spec::AxisKind::Rotary => c.to_radians(),
+                model_spec::AxisKind::Linear => c,
+            };
+        }
+    }
+    Ok(())
+}
+
 /// Runs `rtest simulate`.
 pub fn run(args: &SimulateArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
@@ -133,6 +168,9 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     }
     if let Some(t) = args.truth.as_deref().map(Path::new).filter(|p| p.exists()) {
         inputs.push(("--truth", t));
+    }
+    if let Some(c) = &args.commanded {
+        inputs.push(("--commanded", c.as_path()));
     }
     check_outputs(&inputs, &[("-o", &args.output)], &[])?;
     let mut truth = truth(&m, args.truth.as_deref())?;
@@ -151,10 +189,13 @@ pub fn run(args: &SimulateArgs) -> CliResult {
         truth.seed = s;
     }
     truth.zeroed |= args.zeroed;
-    let record = simulate(&m, &truth, &path).map_err(|e| match e {
+    let mut record = simulate(&m, &truth, &path).map_err(|e| match e {
         e @ SimulateError::Times { .. } => CliError::input(format!("--path {}: {e}", args.path)),
         e => CliError::computation(format!("--truth: {e}")),
     })?;
+    if let Some(file) = &args.commanded {
+        relabel(&m, &mut record, file)?;
+    }
     let comments = provenance(&m, &args.path, &truth, record.samples.len());
     let csv = format_record(&m, &record, &comments)
         .map_err(|e| CliError::computation(format!("-o: {e}")))?;

@@ -98,14 +98,14 @@ fn library(dir: &Path) -> Vec<Vec<f64>> {
             }
         })
         .collect();
-    let mut values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
+    let values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
     let done = compensate_poses(
         &m,
         errors.errors(),
         m.default_parameters(),
         "poses.csv",
         &poses,
-        &mut values_at,
+        &values_at,
     )
     .unwrap();
     done.poses

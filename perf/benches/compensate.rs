@@ -5,7 +5,10 @@
 //! - `compensate/generated-f32`: the generated single-precision first-order correction (the
 //!   caller's sines and cosines included);
 //! - `compensate/host`: the host's corrected pose (`Compensator::correct`: the IR evaluated in
-//!   process, the check of the remainder, values at the corrected pose).
+//!   process, the check of the remainder, values at the corrected pose);
+//! - `program/iso-1e5`: a 10^5-block ISO program read, every pose corrected (on every core)
+//!   and written back, with the values of the demo truth's recommended model identified on K4:
+//!   what `rtest compensate --nc iso` does between reading and writing its files.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use generated::seed_ac::{PARAMETERS, Params, full};
@@ -64,5 +67,110 @@ fn compensate(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, compensate);
+fn program(c: &mut Criterion) {
+    use solver::compensation::run::{CommandedPose, compensate_poses};
+    use solver::compensation::values::MachineErrors;
+    use solver::fitting::{IdentifyOptions, RefineOptions, identify_refined};
+    use solver::io::nc::{Dialect, WriteOptions, parse_program};
+    use solver::io::poses::axis_words;
+    use solver::io::report::read::parse_identification;
+    use solver::io::report::{IdentificationReport, IdentificationSource, to_json};
+    let m = model_spec::builtin("seed-ac").unwrap().unwrap();
+    let truth = solver::simulation::builtin_truth("seed-ac-demo", &m)
+        .unwrap()
+        .unwrap();
+    let k4 = solver::simulation::builtin_path(&m, "K4").unwrap().unwrap();
+    let record = solver::simulation::simulate(&m, &truth, &k4).unwrap();
+    let mut model = solver::model::Model::of(&m, "reduced").unwrap();
+    model
+        .terms
+        .push(model_spec::terms::Term::parse(&m, "ECC@harmonic:2").unwrap());
+    let (ident, refinement) = identify_refined(
+        &m,
+        &model,
+        &record,
+        &IdentifyOptions::default(),
+        &RefineOptions::default(),
+    )
+    .unwrap();
+    let source = IdentificationSource {
+        data: "k4.csv",
+        label: "extended",
+        base_model: None,
+    };
+    let report = IdentificationReport::new(&m, source, &ident, Some(&refinement)).unwrap();
+    let values = parse_identification("id.json", &to_json(&report).unwrap(), &m).unwrap();
+    let (errors, _) = MachineErrors::from_identified(&m, &values).unwrap();
+    // 10^5 blocks along K4, over and over.
+    let mut text = String::from("%\nO2000 (LONG)\nG21 G90 G94\n");
+    for i in 0..100_000 {
+        let q = &record.samples[i % record.samples.len()].commands;
+        text.push_str(&format!(
+            "N{} G1 X{:.4} Y{:.4} Z{:.4} A{:.4} C{:.4} F2000\n",
+            i + 1,
+            q[0],
+            q[3],
+            q[4],
+            q[1].to_degrees(),
+            q[2].to_degrees()
+        ));
+    }
+    text.push_str("M30\n%\n");
+    let words = axis_words(&m);
+    let params = m.default_parameters();
+    let mut g = c.benchmark_group("program");
+    g.sample_size(10);
+    g.bench_function("iso-1e5", |b| {
+        b.iter(|| {
+            let program = parse_program("long.nc", black_box(&text), Dialect::Iso, &words).unwrap();
+            let poses: Vec<CommandedPose> = program
+                .poses()
+                .iter()
+                .map(|p| CommandedPose {
+                    line: p.line,
+                    commands: p
+                        .commands
+                        .iter()
+                        .zip(&m.axes)
+                        .map(|(&q, a)| match a.kind {
+                            model_spec::AxisKind::Rotary => q.to_radians(),
+                            model_spec::AxisKind::Linear => q,
+                        })
+                        .collect(),
+                })
+                .collect();
+            let values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
+            let done = compensate_poses(
+                &m,
+                errors.errors(),
+                params.clone(),
+                "long.nc",
+                &poses,
+                &values_at,
+            )
+            .unwrap();
+            let corrected: Vec<Vec<f64>> = done
+                .poses
+                .iter()
+                .map(|q| {
+                    q.iter()
+                        .zip(&m.axes)
+                        .map(|(&x, a)| match a.kind {
+                            model_spec::AxisKind::Rotary => x.to_degrees(),
+                            model_spec::AxisKind::Linear => x,
+                        })
+                        .collect()
+                })
+                .collect();
+            program
+                .write(&corrected, &WriteOptions::new())
+                .unwrap()
+                .text
+                .len()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, compensate, program);
 criterion_main!(benches);

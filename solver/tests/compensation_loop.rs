@@ -125,14 +125,14 @@ fn compensated(m: &Machine, errors: &MachineErrors, q: &[f64], params: &[f64]) -
         line: 1,
         commands: q.to_vec(),
     }];
-    let mut values_at = |c: &[f64], out: &mut [f64]| errors.values_at(m, c, out);
+    let values_at = |c: &[f64], out: &mut [f64]| errors.values_at(m, c, out);
     compensate_poses(
         m,
         errors.errors(),
         params.to_vec(),
         "test",
         &commanded,
-        &mut values_at,
+        &values_at,
     )
     .unwrap()
     .poses

@@ -187,9 +187,9 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         };
         let to_rad = |c: &[f64]| convert(c, f64::to_radians);
         let to_deg = |c: &[f64]| convert(c, f64::to_degrees);
-        let mut values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
+        let values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
         let run = |poses: &[solver::io::poses::CommandedPose],
-                   values_at: &mut dyn FnMut(&[f64], &mut [f64])| {
+                   values_at: &(dyn Fn(&[f64], &mut [f64]) + Sync)| {
             let commanded: Vec<CommandedPose> = poses
                 .iter()
                 .map(|p| CommandedPose {
@@ -217,7 +217,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
                 let dialect = Dialect::from_name(name).expect("clap checks the dialect");
                 let program = read_program(path, dialect, &words)
                     .map_err(|e| CliError::input(format!("--path: {e}")))?;
-                let done = run(program.poses(), &mut values_at)?;
+                let done = run(program.poses(), &values_at)?;
                 let corrected: Vec<Vec<f64>> = done.poses.iter().map(|q| to_deg(q)).collect();
                 let options = WriteOptions::with_min_decimals(args.decimals.unwrap_or(0));
                 let written = program
@@ -229,7 +229,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             None => {
                 let table = read_pose_file(path, &words)
                     .map_err(|e| CliError::input(format!("--path: {e}")))?;
-                let done = run(table.poses(), &mut values_at)?;
+                let done = run(table.poses(), &values_at)?;
                 let corrected: Vec<Vec<f64>> = done.poses.iter().map(|q| to_deg(q)).collect();
                 let text = table
                     .write(&corrected)

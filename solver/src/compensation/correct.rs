@@ -124,12 +124,15 @@ impl Compensator {
     /// returns when its caller's sine and cosine are `f64::sin_cos`.
     pub fn fixed_steps(&mut self, commanded: &[f64], values: &[f64]) -> Vec<f64> {
         let target = self.target(commanded);
+        self.steps_towards(commanded, values, &target)
+    }
+
+    /// The fixed steps from `commanded` towards `target` (the commanded pose's own).
+    fn steps_towards(&mut self, commanded: &[f64], values: &[f64], target: &[f64; 6]) -> Vec<f64> {
         let mut q = commanded.to_vec();
         let mut residual = [0.0; RESIDUALS];
         for _ in 0..STEPS {
-            let change = self
-                .step(&q, values, &target, &mut residual, false)
-                .to_vec();
+            let change = self.step(&q, values, target, &mut residual, false);
             for (qi, d) in q.iter_mut().zip(change) {
                 *qi += d;
             }
@@ -154,14 +157,12 @@ impl Compensator {
         let mut values = vec![0.0; self.programs.errors.len()];
         values_at(commanded, &mut values);
         let target = self.target(commanded);
-        let mut q = self.fixed_steps(commanded, &values);
+        let mut q = self.steps_towards(commanded, &values, &target);
         let mut residual = [0.0; RESIDUALS];
         let mut refinements = 0;
         loop {
             values_at(&q, &mut values);
-            let change = self
-                .step(&q, &values, &target, &mut residual, true)
-                .to_vec();
+            let change = self.step(&q, &values, &target, &mut residual, true);
             let remainder = residual[..3].iter().map(|r| r * r).sum::<f64>().sqrt();
             if remainder < POSITION_TOLERANCE {
                 break;

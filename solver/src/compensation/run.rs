@@ -123,7 +123,8 @@ pub struct Compensated {
 
 /// Compensates every pose of `poses` (from the file `file`) with the model errors `errors`
 /// (catalogue ids of `m`), kinematic parameters `params` (mm) and their values at any pose
-/// (`values_at(commands, out)`, mm and rad, one per error).
+/// (`values_at(commands, out)`, mm and rad, one per error). The poses are shared among the
+/// available cores.
 ///
 /// # Errors
 /// [`RunError::Empty`] without poses; [`RunError::NotConverged`] where a pose does not
@@ -134,7 +135,7 @@ pub fn compensate_poses(
     params: Vec<f64>,
     file: &str,
     poses: &[CommandedPose],
-    values_at: &mut dyn FnMut(&[f64], &mut [f64]),
+    values_at: &(dyn Fn(&[f64], &mut [f64]) + Sync),
 ) -> Result<Compensated, RunError> {
     if poses.is_empty() {
         return Err(RunError::Empty {
@@ -148,17 +149,43 @@ pub fn compensate_poses(
             lines: commanded_outside,
         });
     }
-    let mut comp = Compensator::new(m, errors, params)?;
+    let comp = Compensator::new(m, errors, params)?;
+    // Poses are independent: split them over the cores, each with its own buffers. The result
+    // does not depend on the split.
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, 16)
+        .min(poses.len().div_ceil(256));
+    let chunk = poses.len().div_ceil(threads.max(1));
+    let results: Vec<Result<Vec<Corrected>, RunError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = poses
+            .chunks(chunk)
+            .map(|part| {
+                let mut comp = comp.clone();
+                scope.spawn(move || {
+                    let mut values_at = |q: &[f64], out: &mut [f64]| values_at(q, out);
+                    part.iter()
+                        .map(|p| {
+                            comp.correct(&p.commands, &mut values_at).map_err(|r| {
+                                RunError::NotConverged {
+                                    file: file.to_string(),
+                                    line: p.line,
+                                    remainder_um: r * 1e3,
+                                }
+                            })
+                        })
+                        .collect()
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a correction thread does not panic"))
+            .collect()
+    });
     let mut corrected: Vec<Corrected> = Vec::with_capacity(poses.len());
-    for p in poses {
-        let c = comp
-            .correct(&p.commands, values_at)
-            .map_err(|r| RunError::NotConverged {
-                file: file.to_string(),
-                line: p.line,
-                remainder_um: r * 1e3,
-            })?;
-        corrected.push(c);
+    for r in results {
+        corrected.extend(r?);
     }
     let corrected_outside = outside(m, poses, corrected.iter().map(|c| c.commands.as_slice()));
     if !corrected_outside.is_empty() {

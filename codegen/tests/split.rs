@@ -125,3 +125,20 @@ fn every_builtin_machine_compiles_without_warnings() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Machines unlike the built-in ones, compensation module included: no kinematic symbol at all
+/// (its functions read no parameter), one rotary axis about a negative direction.
+#[test]
+fn other_topologies_compile_without_warnings() {
+    let dir = support::scratch("topologies");
+    for (file, text) in [
+        ("no-symbols.toml", include_str!("machines/no-symbols.toml")),
+        ("one-rotary.toml", include_str!("machines/one-rotary.toml")),
+    ] {
+        let m = model_spec::parse_machine(file, text).unwrap();
+        let code = codegen::emit::generate_machine(&m, &[]).unwrap();
+        assert!(code.contains("pub mod compensation"), "{file}");
+        support::check_no_std_lib(&dir, &code);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

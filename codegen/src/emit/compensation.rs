@@ -48,6 +48,16 @@ impl Layout {
     }
 }
 
+/// `params` or, for a program that reads no kinematic parameter, `_params` (no unused
+/// argument in the emitted code).
+fn params_name(p: &Program, layout: &Layout) -> proc_macro2::Ident {
+    let reads = p.ops.iter().any(|op| {
+        matches!(*op, crate::ir::Op::Input(k)
+            if (layout.pose..layout.pose + layout.params).contains(&(k as usize)))
+    });
+    ident(if reads { "params" } else { "_params" })
+}
+
 /// The body of a program: its `let`s, then `out[k] = …` per output (or an array expression
 /// when `array` is set).
 fn body(p: &Program, load: &dyn Fn(usize) -> TokenStream, float: Float) -> TokenStream {
@@ -81,6 +91,11 @@ pub(crate) fn compensation_module(c: &CompensationPrograms) -> TokenStream {
     let target_body = body(&c.target, &|k| layout.structured(&c.target, k), Float::F64);
     let step_body = body(&c.step, &|k| layout.structured(&c.step, k), Float::F64);
     let first_body = body(&c.first_step, &|k| layout.arrays(k), Float::F32);
+    let (tp, sp, fp) = (
+        params_name(&c.target, &layout),
+        params_name(&c.step, &layout),
+        params_name(&c.first_step, &layout),
+    );
     let counts = |p: &Program| p.op_counts().to_string();
     let target_doc = format!(" Straight-line code: {}.", counts(&c.target));
     let step_doc = format!(" Straight-line code: {}.", counts(&c.step));
@@ -135,7 +150,7 @@ pub(crate) fn compensation_module(c: &CompensationPrograms) -> TokenStream {
             /// The target of a commanded pose: the tool point (mm) and the tool axis in the
             /// last frame of the work chain.
             #[doc = #target_doc]
-            pub fn target(pose: &Pose, params: &Params) -> [f64; 6] {
+            pub fn target(pose: &Pose, #tp: &Params) -> [f64; 6] {
                 let mut out = [0.0f64; 6];
                 #target_body
                 out
@@ -147,7 +162,7 @@ pub(crate) fn compensation_module(c: &CompensationPrograms) -> TokenStream {
             #[doc = #step_doc]
             pub fn step(
                 pose: &Pose,
-                params: &Params,
+                #sp: &Params,
                 values: &[f64; N],
                 target: &[f64; 6],
                 out: &mut [f64; #out_len],
@@ -224,7 +239,7 @@ pub(crate) fn compensation_module(c: &CompensationPrograms) -> TokenStream {
             #[doc = #first_doc]
             pub fn first_order_f32(
                 pose: &[f32; #pose_len],
-                params: &[f32; #params_len],
+                #fp: &[f32; #params_len],
                 values: &[f32; N],
                 out: &mut [f32; #out_len],
             ) {

@@ -112,7 +112,7 @@ fn read_flags(args: &(Ident, Ident)) -> (bool, bool) {
 /// One model's module (`pub mod reduced { … }`).
 ///
 /// With `compensation`, the module holds a `compensation` module too
-/// ([`super::compensation`]).
+/// (the corrected pose of a commanded pose, [`crate::compensation`]).
 pub fn model_module(
     module: &str,
     model: &GainModel,

@@ -128,11 +128,11 @@ pub(crate) fn compensation_module(c: &CompensationPrograms) -> TokenStream {
         /// Compensation with this model: the corrected commands of a commanded pose, so that
         /// the predicted tool point and tool axis at the corrected pose (nominal kinematics
         /// plus the model's first-order error) are the nominal ones at the commanded pose,
-        /// in the workpiece's frame. Commands are in machine axis order ([`AXES`]): mm for
-        /// linear axes, rad for rotary ones. Error values are the model's errors at the pose
-        /// ([`super::ERRORS`], mm and rad): constants, and the position-dependent ones from
-        /// the axis compensation tables or the identified terms. Set-up errors, sensor and
-        /// time terms are no machine errors: pass them as zero.
+        /// in the workpiece's frame. Commands are in machine axis order
+        /// ([`compensation::AXES`]): mm for linear axes, rad for rotary ones. Error values are
+        /// the model's errors at the pose ([`ERRORS`], mm and rad): constants, and the
+        /// position-dependent ones from the axis compensation tables or the identified terms.
+        /// Set-up errors, sensor and time terms are no machine errors: pass them as zero.
         pub mod compensation {
             use super::super::{Params, Pose};
             use super::N;

@@ -12,9 +12,10 @@
 //! the table is not the machine's doing, and compensation leaves it alone.
 
 use model_spec::basis::BasisContext;
-use model_spec::{ErrorKind, Machine, builtin};
+use model_spec::{Machine, builtin};
 use solver::compensation::run::{CommandedPose, compensate_poses};
 use solver::compensation::values::MachineErrors;
+use solver::compensation::verify::machine_error_rms;
 use solver::diagnosis::{DiagnoseOptions, diagnose};
 use solver::fitting::{
     IdentifyOptions, RefineOptions, ValidateOptions, identify_refined, validate,
@@ -99,26 +100,6 @@ fn random_path(m: &Machine, n: usize, seed: u64) -> Poses {
     out
 }
 
-/// The true machine errors at a pose (catalogue order), the set-up errors left out.
-fn machine_truth(m: &Machine, truth: &Truth, q: &[f64]) -> Vec<f64> {
-    let motion = vec![1i8; m.axes.len()];
-    let cx = BasisContext {
-        commands: q,
-        motion: &motion,
-        tau: 0.0,
-        elapsed_s: 0.0,
-        velocity: &[],
-        reading: [0.0; 3],
-    };
-    let mut e = truth.error_values(m, &cx);
-    for (i, v) in e.iter_mut().enumerate() {
-        if matches!(m.catalogue[i].kind, ErrorKind::Setup { .. }) {
-            *v = 0.0;
-        }
-    }
-    e
-}
-
 /// The compensated commands of one pose `q` with kinematic parameters `params`.
 fn compensated(m: &Machine, errors: &MachineErrors, q: &[f64], params: &[f64]) -> Vec<f64> {
     let commanded = [CommandedPose {
@@ -147,18 +128,23 @@ fn before_after(
     errors: &MachineErrors,
     poses: &[(Vec<f64>, Vec<f64>)],
 ) -> (f64, f64) {
-    let vm = VirtualMachine::new(m);
-    let (mut before, mut after) = (0.0, 0.0);
-    for (q, params) in poses {
-        let e = vm.error_vector(q, params, &machine_truth(m, truth, q));
-        before += e.position.norm_squared();
-        let qc = &compensated(m, errors, q, params);
-        let e = vm.error_vector(qc, params, &machine_truth(m, truth, qc));
-        after += e.position.norm_squared();
-    }
-    // Over the three directions, as `validate` reports it: √(Σ r² / 3N).
-    let n = 3.0 * poses.len() as f64;
-    ((before / n).sqrt(), (after / n).sqrt())
+    let corrected: Vec<Vec<f64>> = poses
+        .iter()
+        .map(|(q, params)| compensated(m, errors, q, params))
+        .collect();
+    let before: Vec<(&[f64], &[f64])> = poses
+        .iter()
+        .map(|(q, p)| (q.as_slice(), p.as_slice()))
+        .collect();
+    let after: Vec<(&[f64], &[f64])> = corrected
+        .iter()
+        .zip(poses)
+        .map(|(q, (_, p))| (q.as_slice(), p.as_slice()))
+        .collect();
+    (
+        machine_error_rms(m, truth, &before),
+        machine_error_rms(m, truth, &after),
+    )
 }
 
 fn path_poses(m: &Machine, r: &Record) -> Poses {

@@ -7,6 +7,8 @@
 //! - [`kinematics`]: the corrected kinematic description (location errors folded into the
 //!   offsets);
 //! - [`tables`]: axis compensation tables;
+//! - [`verify`]: the machine's own error at poses of the exact virtual machine, before and
+//!   after;
 //! - [`volumetric`]: the three-axis scheme from 6D laser-interferometer measurements (the
 //!   kinematic-parameter independent model and its volumetric grid).
 
@@ -15,4 +17,5 @@ pub mod kinematics;
 pub mod run;
 pub mod tables;
 pub mod values;
+pub mod verify;
 pub mod volumetric;

@@ -1,11 +1,13 @@
 //! The seed's experiment replayed on the virtual seed machine (`seed-ac`) with its documented
 //! demo truth: simulate K4, K1 and K2; identify the reduced model on K4 (refined against the
 //! exact machine); validate it on every path; say what the truth has that the model lacks;
-//! diagnose the reduced model on K4 with K1 and K2 held out; and produce the files people take
-//! away (measurements, reports, generated code, gain table, extended machine description, figure
-//! data). Nothing is written here: the caller writes [`Demo::files`] and draws
+//! diagnose the reduced model on K4 with K1 and K2 held out; compensate K1 and K2 with the
+//! recommended model and measure what is left on the exact machine; and produce the files
+//! people take away (measurements, reports, generated code, gain table, extended machine
+//! description, compensated poses, figure data). Nothing is written here: the caller writes [`Demo::files`] and draws
 //! [`Demo::figures`].
 
+mod compensation;
 mod text;
 
 use crate::diagnosis::figures::{Figures, figures};
@@ -245,6 +247,11 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
     let figures =
         figures(&m, &diagnosis, REDUCED, &opts, &figure_records).map_err(failed("figures"))?;
 
+    // 6. The recommended model put back onto the machine: K1 and K2 compensated.
+    let compensation = compensation::compensate_held_out(
+        &m, &truth, &model, &diagnosis, &runs, &k4_file, &mut files,
+    )?;
+
     // Files people take away.
     let code = codegen::emit::generate_machine(&m, &[]).map_err(failed("code generation"))?;
     let full = codegen::GainModel::derive(&m, &m.errors);
@@ -298,6 +305,7 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
         diagnosis: &diagnosis,
         diagnosis_report: &diagnosis_report,
         operations: &ops,
+        compensation: &compensation,
     });
     Ok(Demo {
         files,

@@ -29,6 +29,8 @@ pub(crate) struct Summary<'a> {
     pub(crate) diagnosis_report: &'a DiagnosisReport,
     /// Per compiled model: name, errors, operation counts.
     pub(crate) operations: &'a [(&'a str, usize, String)],
+    /// The compensation step.
+    pub(crate) compensation: &'a super::compensation::CompensationStep,
 }
 
 /// The whole summary.
@@ -126,9 +128,30 @@ pub(crate) fn summary(s: &Summary) -> String {
         out.push_str(&unexplained(m, s.hidden));
     }
     out.push_str(&diagnosis_text(m, s));
+    out.push_str(&compensation_text(s.compensation));
     out.push_str("\nCompiled straight-line code (per evaluation of all gains):\n");
     for (name, n, ops) in s.operations {
         out.push_str(&format!("  {name:<8} {n:>2} errors: {ops}\n"));
+    }
+    out
+}
+
+/// What compensation left of the machine's error on the held-out paths.
+fn compensation_text(c: &super::compensation::CompensationStep) -> String {
+    let mut out = format!(
+        "\nCompensated (rtest compensate) with {} identified on K4: {} machine error(s) put back onto the machine ({}); set-up, sensor and time terms left out. The machine's own error (the ball's set-up aside), RMS on the exact machine:\n",
+        c.label,
+        c.compensated.len(),
+        c.compensated.join(" ")
+    );
+    for p in &c.paths {
+        out.push_str(&format!(
+            "  {}: {} µm commanded -> {} µm compensated ({:.1} % less)\n",
+            p.name,
+            fixed(p.before * 1e3, 3),
+            fixed(p.after * 1e3, 3),
+            100.0 * (1.0 - p.after / p.before)
+        ));
     }
     out
 }

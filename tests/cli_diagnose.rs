@@ -1,7 +1,7 @@
 //! End-to-end tests of `rtest diagnose` (and the diagnosis in `rtest demo`): the binary run in
 //! temporary directories on measurements simulated by `rtest simulate` on the exact virtual
 //! machine. The demo truth's hidden ECC twice per revolution is found first and named, with the
-//! held-out residual falling by more than half; the JSON has the fields in µm / µrad;
+//! held-out residual falling by more than half; the JSON has its documented fields in µm / µrad;
 //! the extended machine description is accepted by `identify` and `generate`; the figures are
 //! SVG; without a hidden effect there is no finding; bad input gives one line, the right exit
 //! code and no output file.
@@ -110,7 +110,7 @@ fn finds_the_demo_truths_ecc_twice_per_revolution_and_halves_the_held_out_residu
     }
     assert!(!out.contains("  2. "), "one finding only:\n{out}");
 
-    // The JSON: the fields, values in µrad.
+    // The JSON: the documented fields, values in µrad.
     let j = read_json(&dir.join("d.json"));
     assert_eq!(j["base_model"], "reduced");
     let findings = j["findings"].as_array().expect("findings");

@@ -851,9 +851,12 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
     let out = ok(&dir, &["demo"]);
     let elapsed = start.elapsed();
     let files = [
+        "compensate-k1.json",
         "diagnose.json",
         "gains-reduced.md",
+        "identify-recommended.json",
         "identify.json",
+        "k1-compensated.csv",
         "k1-path.svg",
         "k1-spectrum.svg",
         "k1.csv",
@@ -885,9 +888,33 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
         "ECC@harmonic:2",
         "Left unexplained",
         "operations",
+        "Compensated (rtest compensate) with reduced + ECC@harmonic:2",
     ] {
         assert!(out.contains(s), "`{s}` not in:\n{out}");
     }
+    // Compensation with the recommended model leaves under a tenth of the machine's error on
+    // the held-out paths, and its summary is what `compensate --json` writes.
+    for path in ["K1", "K2"] {
+        let line = out
+            .lines()
+            .find(|l| {
+                l.trim_start().starts_with(&format!("{path}: ")) && l.contains("compensated (")
+            })
+            .unwrap_or_else(|| panic!("no compensation line for {path}:\n{out}"));
+        let less: f64 = line
+            .rsplit('(')
+            .next()
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(less >= 90.0, "{line}");
+    }
+    let summary = read_json(&demo.join("compensate-k1.json"));
+    assert_eq!(summary["poses"], 361);
+    assert!(summary["position_remainder_um"].as_f64().unwrap() < 1e-3);
     println!("demo: {:.2} s (debug build)", elapsed.as_secs_f64());
 
     let m = machine();

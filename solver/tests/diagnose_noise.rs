@@ -224,7 +224,7 @@ fn outside_with(
     let mut recs = clean(&m, &["K4", "K1", "K2", "K1R"]);
     add(&mut recs, |r, i| effect(&m, r, i));
     let mut last = None;
-    // Every seed: the "on every seed", three of them.
+    // Every seed, three of them.
     for seed in [7, 8, 9] {
         let noisy = with_ar1(&recs, 0.0, 0.5e-3, seed);
         let d = run(&m, &base, &noisy[..3], o);

@@ -72,7 +72,7 @@ fn program(c: &mut Criterion) {
     use solver::compensation::values::MachineErrors;
     use solver::fitting::{IdentifyOptions, RefineOptions, identify_refined};
     use solver::io::nc::{Dialect, WriteOptions, parse_program};
-    use solver::io::poses::axis_words;
+    use solver::io::poses::{axis_words, from_file_units, to_file_units};
     use solver::io::report::read::parse_identification;
     use solver::io::report::{IdentificationReport, IdentificationSource, to_json};
     let m = model_spec::builtin("seed-ac").unwrap().unwrap();
@@ -128,15 +128,7 @@ fn program(c: &mut Criterion) {
                 .iter()
                 .map(|p| CommandedPose {
                     line: p.line,
-                    commands: p
-                        .commands
-                        .iter()
-                        .zip(&m.axes)
-                        .map(|(&q, a)| match a.kind {
-                            model_spec::AxisKind::Rotary => q.to_radians(),
-                            model_spec::AxisKind::Linear => q,
-                        })
-                        .collect(),
+                    commands: from_file_units(&m, &p.commands),
                 })
                 .collect();
             let values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
@@ -149,19 +141,8 @@ fn program(c: &mut Criterion) {
                 &values_at,
             )
             .unwrap();
-            let corrected: Vec<Vec<f64>> = done
-                .poses
-                .iter()
-                .map(|q| {
-                    q.iter()
-                        .zip(&m.axes)
-                        .map(|(&x, a)| match a.kind {
-                            model_spec::AxisKind::Rotary => x.to_degrees(),
-                            model_spec::AxisKind::Linear => x,
-                        })
-                        .collect()
-                })
-                .collect();
+            let corrected: Vec<Vec<f64>> =
+                done.poses.iter().map(|q| to_file_units(&m, q)).collect();
             program
                 .write(&corrected, &WriteOptions::new())
                 .unwrap()

@@ -13,7 +13,7 @@ use solver::compensation::values::MachineErrors;
 use solver::fitting::hmatrix::parameter_names;
 use solver::fitting::sanity::check_model_values;
 use solver::io::nc::{Dialect, WriteOptions, read_program};
-use solver::io::poses::{axis_words, read_pose_file};
+use solver::io::poses::{axis_words, from_file_units, read_pose_file, to_file_units};
 use solver::io::report::compensate::{
     CompensationReport, CompensationSource, KinematicsReport, LeftOutReport,
 };
@@ -157,13 +157,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             .iter()
             .map(|&e| m.catalogue[e].name.clone())
             .collect(),
-        left_out: left_out
-            .iter()
-            .map(|l| LeftOutReport {
-                term: l.term.clone(),
-                reason: l.reason.clone(),
-            })
-            .collect(),
+        left_out: left_out.iter().map(LeftOutReport::from).collect(),
         rounding: None,
         kinematics: None,
         tables: Vec::new(),
@@ -172,21 +166,8 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     if let (Some(path), Some(out)) = (&args.path, &args.output) {
         let words = axis_words(&m);
         let file = path.display().to_string();
-        // Files hold rotary commands in degrees; the computation takes radians.
-        let rotary: Vec<bool> = m
-            .axes
-            .iter()
-            .map(|a| a.kind == model_spec::AxisKind::Rotary)
-            .collect();
-        let convert = |commands: &[f64], f: fn(f64) -> f64| -> Vec<f64> {
-            commands
-                .iter()
-                .zip(&rotary)
-                .map(|(&q, &r)| if r { f(q) } else { q })
-                .collect()
-        };
-        let to_rad = |c: &[f64]| convert(c, f64::to_radians);
-        let to_deg = |c: &[f64]| convert(c, f64::to_degrees);
+        let to_rad = |c: &[f64]| from_file_units(&m, c);
+        let to_deg = |c: &[f64]| to_file_units(&m, c);
         let values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
         let run = |poses: &[solver::io::poses::CommandedPose],
                    values_at: &(dyn Fn(&[f64], &mut [f64]) + Sync)| {

@@ -145,12 +145,7 @@ fn relabel(m: &model_spec::Machine, record: &mut solver::record::Record, file: &
         )));
     }
     for (sample, pose) in record.samples.iter_mut().zip(poses) {
-        for ((q, &c), a) in sample.commands.iter_mut().zip(&pose.commands).zip(&m.axes) {
-            *q = match a.kind {
-                model_spec::AxisKind::Rotary => c.to_radians(),
-                model_spec::AxisKind::Linear => c,
-            };
-        }
+        sample.commands = solver::io::poses::from_file_units(m, &pose.commands);
     }
     Ok(())
 }

@@ -8,14 +8,14 @@ use crate::compensation::values::MachineErrors;
 use crate::compensation::verify::machine_error_rms;
 use crate::diagnosis::Diagnosis;
 use crate::fitting::{IdentifyOptions, RefineOptions, identify_refined};
-use crate::io::poses::{axis_words, read_pose_csv};
+use crate::io::poses::{axis_words, read_pose_csv, to_file_units};
 use crate::io::report::compensate::{CompensationReport, CompensationSource, LeftOutReport};
 use crate::io::report::read::parse_identification;
 use crate::io::report::{IdentificationReport, IdentificationSource, to_json};
 use crate::model::Model;
 use crate::simulation::truth::Truth;
+use model_spec::Machine;
 use model_spec::units::format_scaled;
-use model_spec::{AxisKind, Machine};
 
 /// What compensation did on one held-out path.
 pub(crate) struct Compensated {
@@ -48,13 +48,9 @@ fn pose_csv(m: &Machine, poses: &[Vec<f64>]) -> String {
         .join(",");
     text.push('\n');
     for q in poses {
-        let row: Vec<String> = q
+        let row: Vec<String> = to_file_units(m, q)
             .iter()
-            .zip(&m.axes)
-            .map(|(&x, a)| match a.kind {
-                AxisKind::Rotary => format_scaled(x.to_degrees(), 0),
-                AxisKind::Linear => format_scaled(x, 0),
-            })
+            .map(|&x| format_scaled(x, 0))
             .collect();
         text.push_str(&row.join(","));
         text.push('\n');
@@ -157,19 +153,7 @@ pub(crate) fn compensate_held_out(
         if r.name == "K1" {
             let table = read_pose_csv(&file, &pose_csv(m, &commanded), &axis_words(m))
                 .map_err(failed("compensation"))?;
-            let degrees: Vec<Vec<f64>> = done
-                .poses
-                .iter()
-                .map(|q| {
-                    q.iter()
-                        .zip(&m.axes)
-                        .map(|(&x, a)| match a.kind {
-                            AxisKind::Rotary => x.to_degrees(),
-                            AxisKind::Linear => x,
-                        })
-                        .collect()
-                })
-                .collect();
+            let degrees: Vec<Vec<f64>> = done.poses.iter().map(|q| to_file_units(m, q)).collect();
             let csv = table.write(&degrees).map_err(failed("compensation"))?;
             let summary = CompensationReport::new(
                 CompensationSource {
@@ -180,13 +164,7 @@ pub(crate) fn compensate_held_out(
                     output: "k1-compensated.csv".into(),
                     format: "csv".into(),
                     compensated: compensated.clone(),
-                    left_out: left_out
-                        .iter()
-                        .map(|l| LeftOutReport {
-                            term: l.term.clone(),
-                            reason: l.reason.clone(),
-                        })
-                        .collect(),
+                    left_out: left_out.iter().map(LeftOutReport::from).collect(),
                     rounding: None,
                     kinematics: None,
                     tables: Vec::new(),

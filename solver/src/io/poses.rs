@@ -23,6 +23,7 @@
 //! shortest decimal that reads back to the same `f64` ([`format_scaled`]); a value equal (bit
 //! for bit) to the one read keeps its text, so unchanged poses give an identical file.
 
+use crate::io::csv::format_located;
 use model_spec::text::{TextError, decode_text};
 use model_spec::units::{format_scaled, parse_scaled};
 use model_spec::{AxisKind, Machine};
@@ -62,6 +63,29 @@ impl AxisWord {
     }
 }
 
+/// Commands as the files hold them (mm, degrees) from commands as the computation takes them
+/// (mm, rad), one per axis of `m`.
+pub fn to_file_units(m: &Machine, commands: &[f64]) -> Vec<f64> {
+    convert(m, commands, f64::to_degrees)
+}
+
+/// Commands as the computation takes them (mm, rad) from commands as the files hold them (mm,
+/// degrees), one per axis of `m`.
+pub fn from_file_units(m: &Machine, commands: &[f64]) -> Vec<f64> {
+    convert(m, commands, f64::to_radians)
+}
+
+fn convert(m: &Machine, commands: &[f64], rotary: fn(f64) -> f64) -> Vec<f64> {
+    commands
+        .iter()
+        .zip(&m.axes)
+        .map(|(&q, a)| match a.kind {
+            AxisKind::Rotary => rotary(q),
+            AxisKind::Linear => q,
+        })
+        .collect()
+}
+
 /// The axis words of machine `m`, in the order of [`Machine::axes`] (the order of every
 /// [`CommandedPose::commands`]).
 pub fn axis_words(m: &Machine) -> Vec<AxisWord> {
@@ -98,7 +122,7 @@ pub struct CommandedPose {
 pub enum PoseCsvError {
     /// The content is malformed; located by line and, where there is one, column (1-based
     /// index and header name).
-    #[error("{}", located(file, *line, column, message))]
+    #[error("{}", format_located(file, *line, column, message))]
     Format {
         /// The file name, as given.
         file: String,
@@ -120,18 +144,6 @@ pub enum PoseCsvError {
     /// The file could not be read as text (too large, not UTF-8, an I/O error).
     #[error(transparent)]
     Text(TextError),
-}
-
-pub(crate) fn located(
-    file: &str,
-    line: usize,
-    column: &Option<(usize, String)>,
-    message: &str,
-) -> String {
-    match column {
-        Some((i, name)) => format!("{file}:{line}: column {i} `{name}`: {message}"),
-        None => format!("{file}:{line}: {message}"),
-    }
 }
 
 /// Where the number of one axis field is in the text.

@@ -54,7 +54,7 @@ pub mod squareness;
 pub mod summary;
 pub mod table;
 
-use crate::io::poses::located;
+use crate::io::csv::format_located;
 pub use compensate::{Corrected, MAX_ITERATIONS, TOLERANCE_MM, correct, correct_within_strokes};
 pub use grid::{GridSpec, format_grid};
 pub use laser::{AxisMeasurement, format_laser, parse_laser, read_laser};
@@ -73,7 +73,7 @@ pub const MAX_ANGLE_RAD: f64 = 0.01;
 #[derive(Debug, thiserror::Error)]
 pub enum VolumetricError {
     /// A malformed or implausible entry of a CSV file: `file:line: column N `NAME`: message`.
-    #[error("{}", located(file, *line, column, message))]
+    #[error("{}", format_located(file, *line, column, message))]
     Format {
         /// The file, as given.
         file: String,

@@ -148,7 +148,9 @@ pub enum CsvError {
     },
 }
 
-fn format_located(
+/// `file:line: column N `NAME`: message`, or `file:line: message` without a column: how every
+/// CSV error of rtest is located.
+pub(crate) fn format_located(
     file: &str,
     line: usize,
     column: &Option<(usize, String)>,

@@ -36,6 +36,15 @@ pub struct LeftOutReport {
     pub reason: String,
 }
 
+impl From<&crate::compensation::values::LeftOut> for LeftOutReport {
+    fn from(l: &crate::compensation::values::LeftOut) -> LeftOutReport {
+        LeftOutReport {
+            term: l.term.clone(),
+            reason: l.reason.clone(),
+        }
+    }
+}
+
 /// An error folded into the corrected kinematic description, or one that could not be.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct KinematicsReport {

@@ -101,17 +101,35 @@ impl AtomTable {
             .collect()
     }
 
-    /// Numeric values of all atoms at a pose: `commands` per axis (linear mm, rotary rad),
-    /// `params` per kinematic symbol (mm).
-    pub fn values(&self, commands: &[f64], params: &[f64]) -> Vec<f64> {
+    /// The number of pose atoms: sines and cosines of the rotary commands and the linear
+    /// commands, which come before the kinematic symbols.
+    pub fn pose_count(&self) -> usize {
         self.kinds
             .iter()
-            .map(|k| match *k {
+            .take_while(|k| !matches!(k, AtomKind::Symbol(_)))
+            .count()
+    }
+
+    /// Writes the values of the pose atoms at `commands` (per axis: linear mm, rotary rad)
+    /// into the first [`AtomTable::pose_count`] entries of `out`, in atom order; the kinematic
+    /// symbols after them are left as they are.
+    pub fn fill_pose(&self, commands: &[f64], out: &mut [f64]) {
+        for (v, k) in out.iter_mut().zip(&self.kinds) {
+            *v = match *k {
                 AtomKind::Sin(a) => commands[a].sin(),
                 AtomKind::Cos(a) => commands[a].cos(),
                 AtomKind::Command(a) => commands[a],
-                AtomKind::Symbol(s) => params[s],
-            })
-            .collect()
+                AtomKind::Symbol(_) => break,
+            };
+        }
+    }
+
+    /// Numeric values of all atoms at a pose: `commands` per axis (linear mm, rotary rad),
+    /// `params` per kinematic symbol (mm).
+    pub fn values(&self, commands: &[f64], params: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.pose_count()];
+        self.fill_pose(commands, &mut out);
+        out.extend_from_slice(params);
+        out
     }
 }

@@ -2,6 +2,7 @@
 //! evaluated in process ([`codegen::Program::eval`]), step for step what the generated
 //! `compensate` function does, then checked and, where needed, refined.
 
+use codegen::atoms::AtomTable;
 use codegen::compensation::{
     CompensationError, CompensationPrograms, RESIDUALS, STEPS, compile_compensation,
 };
@@ -33,11 +34,11 @@ pub struct Corrected {
 #[derive(Clone, Debug)]
 pub struct Compensator {
     programs: CompensationPrograms,
-    rotary: Vec<usize>,
-    linear: Vec<usize>,
-    params: Vec<f64>,
-    scratch: Vec<f64>,
+    atoms: AtomTable,
+    /// The programs' inputs, in their order: pose atoms, kinematic parameters (filled once),
+    /// error values, target. Each program reads the prefix it takes.
     inputs: Vec<f64>,
+    scratch: Vec<f64>,
     out: Vec<f64>,
 }
 
@@ -53,13 +54,14 @@ impl Compensator {
         params: Vec<f64>,
     ) -> Result<Compensator, CompensationError> {
         let programs = compile_compensation(m, errors)?;
+        let mut inputs = vec![0.0; programs.pose_inputs];
+        inputs.extend_from_slice(&params);
+        inputs.resize(inputs.len() + errors.len() + 6, 0.0);
         Ok(Compensator {
-            rotary: m.rotary_axes().collect(),
-            linear: m.linear_axes().collect(),
-            params,
+            atoms: AtomTable::new(m),
+            inputs,
             programs,
             scratch: Vec::new(),
-            inputs: Vec::new(),
             out: Vec::new(),
         })
     }
@@ -69,27 +71,36 @@ impl Compensator {
         &self.programs
     }
 
-    /// Loads pose and parameters into the input buffer (sines and cosines by `f64::sin_cos`,
-    /// as the generated code's caller does on the host).
-    fn load_pose(&mut self, commands: &[f64]) {
-        self.inputs.clear();
-        for &a in &self.rotary {
-            let (s, c) = commands[a].sin_cos();
-            self.inputs.extend([s, c]);
+    /// Loads a pose into the input buffer (the sines and cosines of the rotary commands by
+    /// `f64::sin` and `f64::cos`, as `f64::sin_cos`, the generated code's caller on the host,
+    /// computes them), and the error values and target where given; returns the length of the
+    /// prefix that holds them.
+    fn load(
+        &mut self,
+        commands: &[f64],
+        values: Option<&[f64]>,
+        target: Option<&[f64; 6]>,
+    ) -> usize {
+        self.atoms.fill_pose(commands, &mut self.inputs);
+        let mut end = self.programs.pose_inputs + self.programs.params;
+        if let Some(v) = values {
+            self.inputs[end..end + v.len()].copy_from_slice(v);
+            end += v.len();
         }
-        for &a in &self.linear {
-            self.inputs.push(commands[a]);
+        if let Some(t) = target {
+            self.inputs[end..end + 6].copy_from_slice(t);
+            end += 6;
         }
-        self.inputs.extend_from_slice(&self.params);
+        end
     }
 
     /// The target of a commanded pose: the tool point and the tool axis in the work frame.
     pub fn target(&mut self, commanded: &[f64]) -> [f64; 6] {
-        self.load_pose(commanded);
+        let end = self.load(commanded, None, None);
         let mut t = [0.0; 6];
         self.programs
             .target
-            .eval(&self.inputs, &mut self.scratch, &mut t);
+            .eval(&self.inputs[..end], &mut self.scratch, &mut t);
         t
     }
 
@@ -104,9 +115,7 @@ impl Compensator {
         residual: &mut [f64; RESIDUALS],
         rotary_held: bool,
     ) -> &[f64] {
-        self.load_pose(at);
-        self.inputs.extend_from_slice(values);
-        self.inputs.extend_from_slice(target);
+        let end = self.load(at, Some(values), Some(target));
         let n = self.programs.axis_count();
         self.out.resize(n + RESIDUALS, 0.0);
         let program = if rotary_held {
@@ -114,7 +123,7 @@ impl Compensator {
         } else {
             &self.programs.step
         };
-        program.eval(&self.inputs, &mut self.scratch, &mut self.out);
+        program.eval(&self.inputs[..end], &mut self.scratch, &mut self.out);
         residual.copy_from_slice(&self.out[n..]);
         &self.out[..n]
     }
@@ -187,13 +196,12 @@ impl Compensator {
     /// The first-order correction of `commanded` alone (the generated `f32` function's
     /// computation, in `f64`): the change of every axis (mm, rad).
     pub fn first_order(&mut self, commanded: &[f64], values: &[f64]) -> Vec<f64> {
-        self.load_pose(commanded);
-        self.inputs.extend_from_slice(values);
+        let end = self.load(commanded, Some(values), None);
         let n = self.programs.axis_count();
         let mut out = vec![0.0; n + RESIDUALS];
         self.programs
             .first_step
-            .eval(&self.inputs, &mut self.scratch, &mut out);
+            .eval(&self.inputs[..end], &mut self.scratch, &mut out);
         out.truncate(n);
         out
     }

@@ -32,7 +32,7 @@
 
 use crate::model::{Basis, BasisContext, Effect, Model, Term};
 use crate::record::Record;
-use codegen::atoms::{AtomKind, AtomTable};
+use codegen::atoms::AtomTable;
 use codegen::{GainModel, Program};
 use generated::CompiledModel;
 use model_spec::{ErrorId, FULL_MODEL, Machine};
@@ -203,11 +203,7 @@ impl GainSource {
     fn base(m: &Machine, errors: &[ErrorId], params: &[f64]) -> Result<GainSource, HMatrixError> {
         check_setup(m, errors, params)?;
         let atoms = AtomTable::new(m);
-        let n_pose = atoms
-            .kinds
-            .iter()
-            .filter(|k| !matches!(k, AtomKind::Symbol(_)))
-            .count();
+        let n_pose = atoms.pose_count();
         let mut values = vec![0.0; n_pose];
         values.extend_from_slice(params);
         let mut errs: Vec<ErrorId> = Vec::with_capacity(errors.len());
@@ -384,14 +380,7 @@ impl GainSource {
                 ),
             });
         }
-        for (v, k) in self.values.iter_mut().zip(&self.atoms.kinds) {
-            *v = match *k {
-                AtomKind::Sin(a) => commands[a].sin(),
-                AtomKind::Cos(a) => commands[a].cos(),
-                AtomKind::Command(a) => commands[a],
-                AtomKind::Symbol(_) => break,
-            };
-        }
+        self.atoms.fill_pose(commands, &mut self.values);
         if let Some(c) = &mut self.compiled {
             let (pose, params) = self.values.split_at(self.n_pose);
             (c.model.position_gains)(pose, params, &mut c.out);

@@ -9,14 +9,12 @@ use output::{Outputs, Target};
 use solver::compensation::kinematics::corrected_description;
 use solver::compensation::run::{CommandedPose, compensate_poses};
 use solver::compensation::tables::{Pitch, axis_tables};
-use solver::compensation::values::MachineErrors;
+use solver::compensation::values::{CompensationError, MachineErrors};
 use solver::fitting::hmatrix::parameter_names;
 use solver::fitting::sanity::check_model_values;
 use solver::io::nc::{Dialect, WriteOptions, read_program};
 use solver::io::poses::{axis_words, from_file_units, read_pose_file, to_file_units};
-use solver::io::report::compensate::{
-    CompensationReport, CompensationSource, KinematicsReport, LeftOutReport,
-};
+use solver::io::report::compensate::{CompensationReport, CompensationSource, KinematicsReport};
 use solver::io::report::{read_identification, to_json};
 use solver::io::text::compensate::{compensation, kinematics_and_tables};
 use std::path::PathBuf;
@@ -145,23 +143,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
     let mut files = Outputs::new();
     let params_file = args.params.display().to_string();
-    let mut source = CompensationSource {
-        machine: m.name.clone(),
-        model: id.model_name.clone(),
-        params_file: params_file.clone(),
-        input: String::new(),
-        output: String::new(),
-        format: String::new(),
-        compensated: errors
-            .errors()
-            .iter()
-            .map(|&e| m.catalogue[e].name.clone())
-            .collect(),
-        left_out: left_out.iter().map(LeftOutReport::from).collect(),
-        rounding: None,
-        kinematics: None,
-        tables: Vec::new(),
-    };
+    let mut source = CompensationSource::of(&m, &id.model_name, &params_file, &errors, &left_out);
     let mut summary = None;
     if let (Some(path), Some(out)) = (&args.path, &args.output) {
         let words = axis_words(&m);
@@ -257,15 +239,17 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             linear_mm: args.pitch,
             rotary_deg: args.pitch_deg,
         };
-        let tables = axis_tables(&m, &errors, pitch)
-            .map_err(|e| CliError::usage(format!("--tables: {e}")))?;
+        let tables = axis_tables(&m, &errors, pitch).map_err(|e| match e {
+            CompensationError::Pitch { .. } => CliError::usage(format!("--tables: {e}")),
+            other => CliError::computation(format!("--tables: {other}")),
+        })?;
         for t in &tables {
             let name = t.file_name();
             source.tables.push(dir.join(&name).display().to_string());
             files.add_in_dir("--tables", dir, &name, t.to_csv());
         }
     }
-    let text = match &summary {
+    let mut text = match &summary {
         Some(s) => {
             let report = CompensationReport::new(source, s)
                 .map_err(|e| CliError::computation(format!("--path: {e}")))?;
@@ -284,7 +268,6 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             kinematics_and_tables(source.kinematics.as_ref(), &source.tables)
         ),
     };
-    let mut text = text;
     text.push_str(&wrote(&write(files)?));
     let stdout_taken = [&args.output, &args.kinematics_out, &args.json]
         .iter()

@@ -66,11 +66,6 @@ impl Compensator {
         })
     }
 
-    /// The compiled programs.
-    pub fn programs(&self) -> &CompensationPrograms {
-        &self.programs
-    }
-
     /// Loads a pose into the input buffer (the sines and cosines of the rotary commands by
     /// `f64::sin` and `f64::cos`, as `f64::sin_cos`, the generated code's caller on the host,
     /// computes them), and the error values and target where given; returns the length of the

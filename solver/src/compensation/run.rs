@@ -156,7 +156,7 @@ pub fn compensate_poses(
         .map_or(1, |n| n.get())
         .clamp(1, 16)
         .min(poses.len().div_ceil(256));
-    let chunk = poses.len().div_ceil(threads.max(1));
+    let chunk = poses.len().div_ceil(threads);
     let results: Vec<Result<Vec<Corrected>, RunError>> = std::thread::scope(|scope| {
         let handles: Vec<_> = poses
             .chunks(chunk)

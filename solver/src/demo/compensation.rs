@@ -8,8 +8,8 @@ use crate::compensation::values::MachineErrors;
 use crate::compensation::verify::machine_error_rms;
 use crate::diagnosis::Diagnosis;
 use crate::fitting::{IdentifyOptions, RefineOptions, identify_refined};
-use crate::io::poses::{axis_words, read_pose_csv, to_file_units};
-use crate::io::report::compensate::{CompensationReport, CompensationSource, LeftOutReport};
+use crate::io::poses::to_file_units;
+use crate::io::report::compensate::{CompensationReport, CompensationSource};
 use crate::io::report::read::parse_identification;
 use crate::io::report::{IdentificationReport, IdentificationSource, to_json};
 use crate::model::Model;
@@ -38,7 +38,8 @@ pub(crate) struct CompensationStep {
 }
 
 /// A pose CSV of `poses` (commands in mm and rad) with the machine's axis letters as columns
-/// (mm and degrees, the shortest decimals that read back).
+/// (mm and degrees, the shortest decimals that read back), as `rtest compensate -o` writes a
+/// pose CSV with those columns.
 fn pose_csv(m: &Machine, poses: &[Vec<f64>]) -> String {
     let mut text = m
         .axes
@@ -106,11 +107,6 @@ pub(crate) fn compensate_held_out(
     });
     let params = m.default_parameters();
     let values_at = |q: &[f64], out: &mut [f64]| errors.values_at(m, q, out);
-    let compensated: Vec<String> = errors
-        .errors()
-        .iter()
-        .map(|&e| m.catalogue[e].name.clone())
-        .collect();
     let mut paths = Vec::new();
     for r in &runs[1..] {
         let commanded: Vec<Vec<f64>> = r
@@ -151,27 +147,14 @@ pub(crate) fn compensate_held_out(
             after: pairs(&done.poses),
         });
         if r.name == "K1" {
-            let table = read_pose_csv(&file, &pose_csv(m, &commanded), &axis_words(m))
-                .map_err(failed("compensation"))?;
-            let degrees: Vec<Vec<f64>> = done.poses.iter().map(|q| to_file_units(m, q)).collect();
-            let csv = table.write(&degrees).map_err(failed("compensation"))?;
-            let summary = CompensationReport::new(
-                CompensationSource {
-                    machine: m.name.clone(),
-                    model: label.clone(),
-                    params_file: "identify-recommended.json".into(),
-                    input: "K1".into(),
-                    output: "k1-compensated.csv".into(),
-                    format: "csv".into(),
-                    compensated: compensated.clone(),
-                    left_out: left_out.iter().map(LeftOutReport::from).collect(),
-                    rounding: None,
-                    kinematics: None,
-                    tables: Vec::new(),
-                },
-                &done.summary,
-            )
-            .map_err(failed("compensation"))?;
+            let csv = pose_csv(m, &done.poses);
+            let mut source =
+                CompensationSource::of(m, &label, "identify-recommended.json", &errors, &left_out);
+            source.input = "K1".into();
+            source.output = "k1-compensated.csv".into();
+            source.format = "csv".into();
+            let summary =
+                CompensationReport::new(source, &done.summary).map_err(failed("compensation"))?;
             files.push(DemoFile {
                 name: "k1-compensated.csv".into(),
                 contents: csv,
@@ -186,8 +169,12 @@ pub(crate) fn compensate_held_out(
         }
     }
     Ok(CompensationStep {
+        compensated: errors
+            .errors()
+            .iter()
+            .map(|&e| m.catalogue[e].name.clone())
+            .collect(),
         label,
-        compensated,
         paths,
     })
 }

@@ -126,6 +126,37 @@ pub struct CompensationSource {
     pub tables: Vec<String>,
 }
 
+impl CompensationSource {
+    /// The source of a compensation of machine `m` with the errors `errors` of the model
+    /// `model` read from `params_file`, `left_out` the terms it leaves out; the caller sets
+    /// the input, output and format (and the rounding, description and tables it writes).
+    pub fn of(
+        m: &model_spec::Machine,
+        model: &str,
+        params_file: &str,
+        errors: &crate::compensation::values::MachineErrors,
+        left_out: &[crate::compensation::values::LeftOut],
+    ) -> CompensationSource {
+        CompensationSource {
+            machine: m.name.clone(),
+            model: model.to_string(),
+            params_file: params_file.to_string(),
+            input: String::new(),
+            output: String::new(),
+            format: String::new(),
+            compensated: errors
+                .errors()
+                .iter()
+                .map(|&e| m.catalogue[e].name.clone())
+                .collect(),
+            left_out: left_out.iter().map(LeftOutReport::from).collect(),
+            rounding: None,
+            kinematics: None,
+            tables: Vec::new(),
+        }
+    }
+}
+
 impl CompensationReport {
     /// The report of a compensated file.
     ///

@@ -98,7 +98,7 @@ fn builtin_names_ignore_case_and_others_are_not_builtin() {
     let e = load_path(&m, "K3", &ReadOptions::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "`K3` is neither a built-in path (K1, K2, K4) nor an existing file"
+        "`K3` is neither a test of machine seed-ac (K1, K2, K4, turn-A, turn-C, pair-A-C) nor an existing file"
     );
 }
 
@@ -108,7 +108,7 @@ fn builtin_paths_need_rotary_axes_a_and_c() {
     assert!(matches!(e, PathError::NotAC { .. }));
     assert_eq!(
         e.to_string(),
-        "path K4 is defined only for machines whose rotary axes are A and C (like seed-ac); machine head-table-bc has rotary axes B, C: give the path as a CSV file"
+        "path K4 is defined only for machines whose rotary axes are A and C (like seed-ac); machine head-table-bc has rotary axes B, C: its tests are turn-B, turn-C, pair-B-C, or give the path as a CSV file"
     );
     let e = load_path(&builtin("seed-3axis"), "k1", &ReadOptions::default()).unwrap_err();
     assert_eq!(

@@ -171,7 +171,9 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     let mut truth = truth(&m, args.truth.as_deref())?;
     let read = args.records.read_options();
     let path = load_path(&m, &args.path, &read).map_err(|e| match e {
-        PathError::NotFound(_) | PathError::NotAC { .. } => CliError::usage(format!("--path: {e}")),
+        PathError::NotFound { .. } | PathError::NotAC { .. } => {
+            CliError::usage(format!("--path: {e}"))
+        }
         other => CliError::input(format!("--path: {other}")),
     })?;
     if let Some(n) = noise {

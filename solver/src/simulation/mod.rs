@@ -4,6 +4,8 @@
 //!   nominal tool-centre-point inverse kinematics;
 //! - [`fd`]: error gains by central finite differences of [`exact`], the reference the
 //!   symbolic engine is tested against;
+//! - [`generator`]: the test catalogue of any machine and the generation of its tests within
+//!   strokes, ranges and the clearance rule;
 //! - [`paths`]: the built-in test paths and paths from files, the linear axes following the
 //!   ball;
 //! - [`truth`]: what a virtual machine's errors really are (TOML files and built-in truths);
@@ -12,6 +14,7 @@
 
 pub mod exact;
 pub mod fd;
+pub mod generator;
 pub mod paths;
 pub mod pose;
 pub mod readings;

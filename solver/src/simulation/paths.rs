@@ -1,44 +1,50 @@
-//! Test paths: the built-in `K1`, `K2`, `K4` of machines with rotary axes A and C (`seed-ac`),
-//! paths for any machine from a CSV file, and the nominal tool-centre-point inverse kinematics
-//! that fills the linear commands.
+//! Test paths: the tests of a machine ([`crate::simulation::generator`]: `turn-C`, `pair-A-C`,
+//! …, and the seed's `K1`, `K2`, `K4` on machines whose rotary axes are A and C), paths for any
+//! machine from a CSV file, and the nominal tool-centre-point inverse kinematics that fills the
+//! linear commands.
 //!
-//! Built-in paths (docs/conventions.md; the seed's sample counts, ISO 10791-6 style), sample `i`:
+//! The seed's paths (docs/conventions.md; the seed's sample counts, ISO 10791-6 style), sample
+//! `i`:
 //! - `K1`: `C = i°`, `A = 0°`, `i = 0…360` (361 samples);
 //! - `K2`: `A = (−90 + i)°`, `C = 0°`, `i = 0…120` (121 samples);
 //! - `K4`: `C = 1.5·i°`, `A = −45·(1 − cos C)°`, `i = 0…240` (241 samples; all five axes move).
 //!
-//! The rotary commands are computed in degrees and converted with `to_radians()`; the linear
-//! axes follow the ball by the nominal tool-centre-point inverse kinematics
-//! ([`crate::simulation::exact::VirtualMachine::tool_centre_point_ik`]) with the machine's default kinematic
-//! parameters (what the controller believes). Sample `i` is taken at `t = i·`[`SAMPLE_PERIOD_S`]
-//! (1 s): the R-test samples at rest after each step, so only the order of the samples matters
-//! for `time:K` effects, which are normalised over the record. Directions of motion come from
-//! [`crate::record::motion_directions`].
+//! A built-in path is its test generated with the default options at the machine's default
+//! kinematic parameters (what the controller believes): the rotary commands are computed in
+//! degrees and converted with `to_radians()`; the linear axes follow the ball by the nominal
+//! tool-centre-point inverse kinematics
+//! ([`crate::simulation::exact::VirtualMachine::tool_centre_point_ik`]); every sample is checked
+//! against the strokes, the ranges and the clearance rule. Sample `i` is taken at
+//! `t = i·`[`SAMPLE_PERIOD_S`] (1 s): the R-test samples at rest after each step, so only the
+//! order of the samples matters for `time:K` effects, which are normalised over the record.
+//! Directions of motion come from [`crate::record::motion_directions`].
 //!
 //! A path file is a CSV in the measurement format ([`crate::io::csv`]): rotary columns required
 //! (degrees), linear columns optional (filled by the inverse kinematics), `t_s` optional,
 //! measured columns optional and ignored. It is read by the same bounded line reader and
 //! checked as a measurement file is (nest on the ball when the linear axes are given, strokes
 //! and ranges, and the plausibility of the readings when there are any), under the same
-//! [`ReadOptions`]. The built-in paths lie within the strokes and ranges of `seed-ac`.
+//! [`ReadOptions`].
 
 use crate::io::csv::{CsvError, Need, ReadOptions, read_csv};
 use crate::record::{Record, motion_directions, samples_from};
 use crate::simulation::exact::{ExactError, VirtualMachine};
+use crate::simulation::generator::{self, GeneratorError, GeneratorOptions};
 use model_spec::Machine;
 
 /// Time between two samples of the built-in paths, s.
 pub const SAMPLE_PERIOD_S: f64 = 1.0;
 
-/// Names of the built-in paths (matched without regard to case).
-pub const BUILTIN_PATHS: [&str; 3] = ["K1", "K2", "K4"];
+/// Names of the seed's paths (matched without regard to case), on machines whose rotary axes
+/// are A and C.
+pub const BUILTIN_PATHS: [&str; 3] = generator::SEED_TESTS;
 
 /// Why a path could not be made or read.
 #[derive(Debug, thiserror::Error)]
 pub enum PathError {
-    /// A built-in path asked of a machine whose rotary axes are not A and C.
+    /// One of the seed's paths asked of a machine whose rotary axes are not A and C.
     #[error(
-        "path {path} is defined only for machines whose rotary axes are A and C (like seed-ac); machine {machine} has {has}: give the path as a CSV file"
+        "path {path} is defined only for machines whose rotary axes are A and C (like seed-ac); machine {machine} has {has}: {instead}"
     )]
     NotAC {
         /// The path.
@@ -47,91 +53,76 @@ pub enum PathError {
         machine: String,
         /// What rotary axes it has (`rotary axes B, C`, `no rotary axes`).
         has: String,
+        /// What to use instead (`its tests are turn-B, turn-C, pair-B-C`).
+        instead: String,
     },
-    /// The inverse kinematics failed at a sample of a built-in path.
-    #[error("path {path}, sample {sample}: {source}")]
-    Ik {
+    /// A test of the machine that cannot be generated.
+    #[error("path {path}: {source}")]
+    Generator {
         /// The path.
         path: String,
-        /// The sample (0-based).
-        sample: usize,
         /// Why.
-        source: ExactError,
+        source: GeneratorError,
     },
-    /// Neither a built-in path nor an existing file.
-    #[error("`{0}` is neither a built-in path (K1, K2, K4) nor an existing file")]
-    NotFound(String),
+    /// Neither a test of the machine nor an existing file.
+    #[error("`{name}` is neither a test of machine {machine} ({tests}) nor an existing file")]
+    NotFound {
+        /// The name given.
+        name: String,
+        /// The machine.
+        machine: String,
+        /// Its tests, comma-separated (`no tests: it has no rotary axis`).
+        tests: String,
+    },
     /// The path file is malformed or unreadable.
     #[error("{0}")]
     Csv(#[from] CsvError),
 }
 
-/// The rotary commands `(A, C)` (degrees) of a sample index.
-type RotaryDegrees = fn(usize) -> (f64, f64);
-
-/// The rotary commands (A, C) in degrees of sample `i` of built-in path `name` (`K1`, `K2`,
-/// `K4`, already upper case), and the number of samples.
-fn builtin_degrees(name: &str) -> Option<(usize, RotaryDegrees)> {
-    match name {
-        "K1" => Some((361, |i| (0.0, i as f64))),
-        "K2" => Some((121, |i| (-90.0 + i as f64, 0.0))),
-        "K4" => Some((241, |i| {
-            let c = 1.5 * i as f64;
-            // `+ 0.0` turns the −0 of C = 0° into 0.
-            (-45.0 * (1.0 - c.to_radians().cos()) + 0.0, c)
-        })),
-        _ => None,
-    }
-}
-
-/// The built-in path `name` (`K1`, `K2`, `K4`, any case) of machine `m`; `None` when `name` is
-/// not one of them.
+/// The built-in path `name` (a test of `m`: `K1`, `K2`, `K4`, `turn-C`, `pair-A-C`, …, any
+/// case) generated with the default options at the machine's default kinematic parameters;
+/// `None` when `name` is none of them.
 ///
 /// # Errors
-/// [`PathError::NotAC`] unless the rotary axes of `m` are exactly A and C;
-/// [`PathError::Ik`] when the inverse kinematics has no solution at a sample.
+/// [`PathError::NotAC`] for a seed path on a machine whose rotary axes are not A and C;
+/// [`PathError::Generator`] when a sample cannot be generated within the machine's limits.
 pub fn builtin_path(m: &Machine, name: &str) -> Option<Result<Record, PathError>> {
     let upper = name.trim().to_ascii_uppercase();
-    let (n, degrees) = builtin_degrees(&upper)?;
-    Some(make_builtin(m, &upper, n, degrees))
-}
-
-fn make_builtin(
-    m: &Machine,
-    name: &str,
-    n: usize,
-    degrees: RotaryDegrees,
-) -> Result<Record, PathError> {
-    let rotary: Vec<usize> = m.rotary_axes().collect();
-    let (a, c) = (m.axis_by_name("A"), m.axis_by_name("C"));
-    let (Some(a), Some(c)) = (a, c) else {
-        return Err(not_ac(m, name, &rotary));
+    let tests = generator::tests(m);
+    let Some(spec) = generator::find_test(&tests, name) else {
+        return BUILTIN_PATHS
+            .contains(&upper.as_str())
+            .then(|| Err(not_ac(m, &upper, &tests)));
     };
-    if rotary.len() != 2 || !rotary.contains(&a) || !rotary.contains(&c) {
-        return Err(not_ac(m, name, &rotary));
-    }
-    let mut commands: Vec<Vec<f64>> = (0..n)
-        .map(|i| {
-            let (da, dc) = degrees(i);
-            let mut q = vec![0.0; m.axes.len()];
-            q[a] = da.to_radians();
-            q[c] = dc.to_radians();
-            q
-        })
-        .collect();
-    fill_linear_ik(m, &m.default_parameters(), &mut commands).map_err(|(sample, source)| {
-        PathError::Ik {
-            path: name.to_string(),
-            sample,
+    Some(
+        generator::generate_test(
+            m,
+            spec,
+            &m.default_parameters(),
+            &GeneratorOptions::default(),
+        )
+        .map_err(|source| PathError::Generator {
+            path: spec.name.clone(),
             source,
-        }
-    })?;
-    let times = (0..n).map(|i| i as f64 * SAMPLE_PERIOD_S).collect();
-    Ok(record_from_commands(commands, times))
+        }),
+    )
 }
 
-fn not_ac(m: &Machine, name: &str, rotary: &[usize]) -> PathError {
-    let mut has: Vec<&str> = rotary.iter().map(|&i| m.axes[i].name.as_str()).collect();
+/// The names of `tests`, comma-separated, or why there are none.
+fn test_names(tests: &[generator::TestSpec]) -> String {
+    if tests.is_empty() {
+        "no tests: it has no rotary axis".to_string()
+    } else {
+        tests
+            .iter()
+            .map(|t| t.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+fn not_ac(m: &Machine, name: &str, tests: &[generator::TestSpec]) -> PathError {
+    let mut has: Vec<&str> = m.rotary_axes().map(|i| m.axes[i].name.as_str()).collect();
     has.sort_by_key(|n| model_spec::catalogue::iso_rank(n));
     PathError::NotAC {
         path: name.to_string(),
@@ -141,11 +132,19 @@ fn not_ac(m: &Machine, name: &str, rotary: &[usize]) -> PathError {
         } else {
             format!("rotary axes {}", has.join(", "))
         },
+        instead: if tests.is_empty() {
+            "give the path as a CSV file".into()
+        } else {
+            format!(
+                "its tests are {}, or give the path as a CSV file",
+                test_names(tests)
+            )
+        },
     }
 }
 
-/// A path given by built-in name ([`BUILTIN_PATHS`]) or by the name of a CSV file, read with
-/// `opts` (a built-in path is made, not read: `opts` do not apply to it).
+/// A path given by the name of a test of `m` ([`builtin_path`]) or by the name of a CSV file,
+/// read with `opts` (a built-in path is made, not read: `opts` do not apply to it).
 ///
 /// # Errors
 /// [`PathError::NotFound`] when it is neither; see [`builtin_path`] and [`read_path`].
@@ -156,7 +155,11 @@ pub fn load_path(m: &Machine, name_or_file: &str, opts: &ReadOptions) -> Result<
     let path = std::path::Path::new(name_or_file);
     // Anything that exists and is not a directory is read (a file, a FIFO, a link to one).
     if !path.exists() || path.is_dir() {
-        return Err(PathError::NotFound(name_or_file.to_string()));
+        return Err(PathError::NotFound {
+            name: name_or_file.to_string(),
+            machine: m.name.clone(),
+            tests: test_names(&generator::tests(m)),
+        });
     }
     let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
         file: name_or_file.to_string(),

@@ -18,9 +18,10 @@ Simulates an R-test measurement: the exact virtual machine (exact homogeneous tr
 linearisation) runs a test path with the errors of a truth, and the readings are written as a \
 measurement CSV.
 
-The path is K1 (C 0..360 deg in 1 deg steps, A = 0; 361 samples), K2 (A -90..30 deg, C = 0; 121 \
-samples), K4 (C = 1.5·i deg, A = -45·(1 - cos C) deg, i = 0..240; 241 samples) of a machine \
-whose rotary axes are A and C, or a path CSV file (rotary columns in degrees, linear columns in \
+The path is a test of the machine (`rtest path --machine M --list`: turn-C, pair-A-C, …, \
+generated at the description's default kinematic parameters; on machines whose rotary axes are A \
+and C also K1 (C 0..360 deg in 1 deg steps, A = 0; 361 samples), K2 (A -90..30 deg, C = 0; 121 \
+samples), K4 (C = 1.5·i deg, A = -45·(1 - cos C) deg, i = 0..240; 241 samples)), or a path CSV file (rotary columns in degrees, linear columns in \
 mm optional: they are filled by the nominal tool-centre-point inverse kinematics; poses must be \
 within the strokes and keep the nest on the ball). The truth (docs/truth.md) says the real \
 machine: error values (translational in µm, angular in µrad, constants or position-dependent), \
@@ -53,9 +54,9 @@ pub struct SimulateArgs {
     /// Built-in machine (see `rtest machines`) or path of a machine TOML file.
     #[arg(long, value_name = "NAME|FILE")]
     machine: String,
-    /// Test path: K1, K2, K4 (machines with rotary axes A and C) or a path CSV file (rotary
-    /// axes in degrees, linear axes in mm optional).
-    #[arg(long, value_name = "K1|K2|K4|FILE")]
+    /// Test path: a test of the machine (`turn-C`, `pair-A-C`, K1, K2, K4 …; see `rtest path
+    /// --list`) or a path CSV file (rotary axes in degrees, linear axes in mm optional).
+    #[arg(long, value_name = "TEST|FILE")]
     path: String,
     /// Truth: a built-in name (seed-ac-demo, seed-ac-reduced, …) or a truth TOML file
     /// (docs/truth.md). Default: the machine's demo truth, else the nominal machine.

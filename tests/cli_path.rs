@@ -1,0 +1,302 @@
+//! End-to-end tests of `rtest path`: the list of a machine's tests, a test written as a path
+//! CSV that reads back to the generator's poses bit for bit, `simulate --path NAME` on any
+//! machine, and bad input refused with one stderr line, the right exit code and no file.
+
+use model_spec::Machine;
+use solver::io::csv::ReadOptions;
+use solver::simulation::generator::{GeneratorOptions, generate};
+use solver::simulation::paths::{builtin_path, parse_path};
+
+mod common;
+use common::{entries, fails, ok, read_json, temp_dir_tagged};
+
+fn machine(name: &str) -> Machine {
+    model_spec::builtin(name).unwrap().unwrap()
+}
+
+#[test]
+fn the_list_names_every_test_with_one_line_each() {
+    let dir = temp_dir_tagged("cli-path", "list");
+    let out = ok(&dir, &["path", "--machine", "head-table-bc", "--list"]);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 4, "{out}");
+    assert!(
+        lines[0].starts_with("Tests of machine head-table-bc"),
+        "{out}"
+    );
+    assert!(lines[1].trim_start().starts_with("turn-B"), "{out}");
+    assert!(lines[2].trim_start().starts_with("turn-C"), "{out}");
+    assert!(
+        lines[3].contains("pair-B-C  C turns 0° .. 360° in 1.5° steps, B = -45·(1 − cos C)°"),
+        "{out}"
+    );
+    // A machine without rotary axes says so.
+    let out = ok(&dir, &["path", "--machine", "seed-3axis", "--list"]);
+    assert_eq!(
+        out,
+        "Machine seed-3axis has no rotary axis, so it has no R-test test (the tests turn rotary axes): give a path as a CSV file.\n"
+    );
+    // With a ball position, the tests it puts out of stroke say where.
+    let out = ok(
+        &dir,
+        &[
+            "path",
+            "--machine",
+            "seed-ac",
+            "--list",
+            "--param",
+            "Xw=-450",
+        ],
+    );
+    assert!(
+        out.contains("not generated here: test turn-C, sample 64 of 361 (t = 63 s; A = 0°, C = 63°): Y = -401.079599 mm outside its stroke -400 .. 400 mm"),
+        "{out}"
+    );
+    // The list as JSON.
+    ok(
+        &dir,
+        &[
+            "path",
+            "--machine",
+            "seed-ac",
+            "--list",
+            "--json",
+            "list.json",
+        ],
+    );
+    let json = read_json(&dir.join("list.json"));
+    let tests = json["tests"].as_array().unwrap();
+    let names: Vec<&str> = tests.iter().map(|t| t["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["K1", "K2", "K4", "turn-A", "turn-C", "pair-A-C"]);
+    assert_eq!(tests[5]["follower"]["amplitude_deg"], -45.0);
+    assert_eq!(tests[5]["samples"], 241);
+    assert_eq!(tests[3]["from_deg"], -90.0);
+    assert!(tests.iter().all(|t| t["within_limits"] == true));
+}
+
+#[test]
+fn a_test_written_reads_back_to_the_generators_poses() {
+    let dir = temp_dir_tagged("cli-path", "write");
+    let cases: [(&str, &str, &[&str]); 4] = [
+        ("seed-ac", "K4", &[]),
+        ("seed-ac", "turn-A", &["--param", "Xw=-200,Zw=180"]),
+        ("head-table-bc", "pair-b-c", &["--step-deg", "2.5"]),
+        ("head-table-bc", "turn-B", &["--period-s", "0.25"]),
+    ];
+    for (m_name, test, extra) in cases {
+        let m = machine(m_name);
+        let mut args = vec!["path", "--machine", m_name, "--test", test, "-o", "p.csv"];
+        args.extend_from_slice(extra);
+        let out = ok(&dir, &args);
+        assert!(out.ends_with("Wrote p.csv\n"), "{out}");
+        let text = std::fs::read_to_string(dir.join("p.csv")).unwrap();
+        assert!(text.starts_with("# rtest path: test "), "{text}");
+        let mut read = ReadOptions::default();
+        read.on_ball_tolerance_mm = f64::INFINITY;
+        let back = parse_path("p.csv", &text, &m, &read).unwrap();
+        let mut params = m.default_parameters();
+        let mut opts = GeneratorOptions::default();
+        match extra {
+            ["--param", _] => {
+                params[m.symbol_by_name("Xw").unwrap()] = -200.0;
+                params[m.symbol_by_name("Zw").unwrap()] = 180.0;
+            }
+            ["--step-deg", s] => opts.step_deg = Some(s.parse().unwrap()),
+            ["--period-s", s] => opts.period_s = s.parse().unwrap(),
+            _ => {}
+        }
+        let expected = generate(&m, test, &params, &opts).unwrap();
+        assert_eq!(back, expected, "{m_name} {test} {extra:?}");
+        if extra.is_empty() {
+            assert_eq!(back, builtin_path(&m, test).unwrap().unwrap());
+        }
+    }
+    // A ball away from the description's defaults: the reader of measurements would refuse
+    // the path, and the summary says so.
+    let out = ok(
+        &dir,
+        &[
+            "path",
+            "--machine",
+            "seed-ac",
+            "--test",
+            "turn-C",
+            "--param",
+            "Yw=20",
+            "-o",
+            "q.csv",
+        ],
+    );
+    assert!(out.contains("Note: at the description's default parameters this path leaves the nest up to 20.279 mm off the ball"), "{out}");
+    // `-o -`: the CSV on standard output, the summary on standard error.
+    let o = common::run(
+        Some(&dir),
+        &["path", "--machine", "seed-ac", "--test", "K2", "-o", "-"],
+    );
+    assert!(o.status.success());
+    let text = common::stdout(&o);
+    assert_eq!(text.lines().filter(|l| !l.starts_with('#')).count(), 122);
+    assert!(common::stderr(&o).starts_with("Test K2 of machine seed-ac: 121 samples."));
+}
+
+#[test]
+fn simulate_takes_the_tests_of_any_machine() {
+    let dir = temp_dir_tagged("cli-path", "simulate");
+    let out = ok(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "head-table-bc",
+            "--path",
+            "pair-B-C",
+            "-o",
+            "s.csv",
+        ],
+    );
+    assert!(
+        out.starts_with("simulated pair-B-C on head-table-bc"),
+        "{out}"
+    );
+    let text = std::fs::read_to_string(dir.join("s.csv")).unwrap();
+    assert_eq!(text.lines().filter(|l| !l.starts_with('#')).count(), 242);
+    fails(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "head-table-bc",
+            "--path",
+            "K4",
+            "-o",
+            "s2.csv",
+        ],
+        2,
+        &[
+            "--path: path K4 is defined only for machines whose rotary axes are A and C",
+            "its tests are turn-B, turn-C, pair-B-C",
+        ],
+    );
+    fails(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "turn-X",
+            "-o",
+            "s2.csv",
+        ],
+        2,
+        &[
+            "`turn-X` is neither a test of machine seed-ac (K1, K2, K4, turn-A, turn-C, pair-A-C) nor an existing file",
+        ],
+    );
+    assert_eq!(entries(&dir), ["s.csv"]);
+}
+
+#[test]
+fn bad_input_is_refused_and_writes_nothing() {
+    let dir = temp_dir_tagged("cli-path", "bad");
+    let base = ["path", "--machine", "seed-ac", "-o", "x.csv"];
+    let with = |more: &[&'static str]| -> Vec<&'static str> {
+        let mut v = base.to_vec();
+        v.extend_from_slice(more);
+        v
+    };
+    let cases: [(&[&str], i32, &str); 10] = [
+        (
+            &["--test", "K3"],
+            2,
+            "--test: machine seed-ac has no test `K3` (its tests: K1, K2, K4, turn-A, turn-C, pair-A-C)",
+        ),
+        (
+            &["--test", "K1", "--param", "Q=1"],
+            2,
+            "--param: machine seed-ac has no kinematic symbol `Q`",
+        ),
+        (
+            &["--test", "K1", "--param", "Xw=inf"],
+            2,
+            "--param: `Xw=inf`: the value must be a finite number",
+        ),
+        (
+            &["--test", "K1", "--step-deg", "nan"],
+            2,
+            "--step-deg: step = NaN: the step must be a finite number of degrees above 0",
+        ),
+        (
+            &["--test", "K1", "--period-s", "-1"],
+            2,
+            "--period-s: period = -1",
+        ),
+        (
+            &["--test", "turn-A", "--max-tilt-deg", "200"],
+            2,
+            "--max-tilt-deg: max tilt = 200",
+        ),
+        (
+            &["--test", "turn-A", "--min-ball-height-mm", "300"],
+            2,
+            "--min-ball-height-mm: the ball centre stands 211.537 mm above the face of the C table, less than the 300 mm",
+        ),
+        (
+            &["--test", "turn-C", "--param", "Xw=-450"],
+            2,
+            "--param: test turn-C, sample 64 of 361 (t = 63 s; A = 0°, C = 63°): Y = -401.079599 mm outside its stroke -400 .. 400 mm",
+        ),
+        (
+            &["--test", "K2", "--max-tilt-deg", "80"],
+            2,
+            "--test: test K2, sample 1 of 121 (t = 0 s; A = -90°, C = 0°): the tool axis tilts 90° from the table normal, more than the 80° of the clearance rule",
+        ),
+        (
+            &["--test", "turn-C", "--step-deg", "0.001"],
+            2,
+            "more than 100000 samples",
+        ),
+    ];
+    for (more, code, needle) in cases {
+        fails(&dir, &with(more), code, &[needle]);
+    }
+    fails(
+        &dir,
+        &[
+            "path",
+            "--machine",
+            "seed-3axis",
+            "--test",
+            "turn-C",
+            "-o",
+            "x.csv",
+        ],
+        2,
+        &["--test: machine seed-3axis has no rotary axis, so it has no R-test test"],
+    );
+    // An output that names the machine's file.
+    std::fs::write(
+        dir.join("m.toml"),
+        model_spec::BUILTIN
+            .iter()
+            .find(|(n, _)| *n == "head-table-bc")
+            .unwrap()
+            .1,
+    )
+    .unwrap();
+    fails(
+        &dir,
+        &[
+            "path",
+            "--machine",
+            "m.toml",
+            "--test",
+            "turn-C",
+            "-o",
+            "m.toml",
+        ],
+        2,
+        &["-o: `m.toml` is also the input of --machine"],
+    );
+    assert_eq!(entries(&dir), ["m.toml"]);
+}

@@ -274,6 +274,20 @@ fn bad_input_is_refused_and_writes_nothing() {
         2,
         &["--test: machine seed-3axis has no rotary axis, so it has no R-test test"],
     );
+    fails(
+        &dir,
+        &[
+            "path",
+            "--machine",
+            "head-table-bc",
+            "--test",
+            "K4",
+            "-o",
+            "x.csv",
+        ],
+        2,
+        &["--test: machine head-table-bc has no test `K4` (its tests: turn-B, turn-C, pair-B-C)"],
+    );
     // An output that names the machine's file.
     std::fs::write(
         dir.join("m.toml"),

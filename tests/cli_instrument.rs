@@ -24,7 +24,10 @@ fn presets_are_listed_and_shown() {
         show.contains("σx 0.115 µm, σy 0.115 µm, σz 0.082 µm"),
         "{show}"
     );
-    assert!(show.contains("0.085 µm at 50 µm"), "{show}");
+    assert!(
+        show.contains("at 50 µm: s1 0.085, s2 0.085, s3 0.085 µm"),
+        "{show}"
+    );
     // A file with a bad field: exit code 1, the file, line and column.
     std::fs::write(
         d.join("bad.toml"),

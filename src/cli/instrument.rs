@@ -162,15 +162,23 @@ fn show(i: &Instrument) -> String {
             fixed(corr(1, 2), 2)
         );
     }
-    for s in &i.sensors {
-        if let Tip::Sphere { radius_mm } = s.tip {
-            let lateral_um = 0.05f64.powi(2) / (2.0 * (r + radius_mm)) * 1e3;
-            out += &format!(
-                "sensor {}: a ball tip reads a displacement d⊥ across its axis as −|d⊥|²/(2(R + r)): {} µm at 50 µm (the exact inverse accounts for it)\n",
+    let lateral: Vec<String> = i
+        .sensors
+        .iter()
+        .filter_map(|s| match s.tip {
+            Tip::Sphere { radius_mm } => Some(format!(
+                "{} {}",
                 s.name,
-                fixed(lateral_um, 3)
-            );
-        }
+                fixed(0.05f64.powi(2) / (2.0 * (r + radius_mm)) * 1e3, 3)
+            )),
+            Tip::Flat { .. } => None,
+        })
+        .collect();
+    if !lateral.is_empty() {
+        out += &format!(
+            "ball tips read a displacement d⊥ across their axis as −|d⊥|²/(2(R + r)), at 50 µm: {} µm (the exact inverse accounts for it)\n",
+            lateral.join(", ")
+        );
     }
     out
 }

@@ -38,7 +38,9 @@
 //! the noise model is chosen from its exact residual ([`crate::fitting::choose_noise`]), then
 //! the iteration continues from its solution with every correction the generalized
 //! least-squares one (`Δ = (W·H)⁺·W·r`, [`crate::fitting::least_squares_whitened`]), and the
-//! uncertainties are the whitened fit's.
+//! uncertainties are the whitened fit's. A record with covariances (read through an
+//! instrument) has every correction weighted by them as well
+//! ([`crate::fitting::identify::fit_rows`]).
 
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
 use crate::fitting::identify::{choose_noise_weighted, fit_rows, sample_whitening};

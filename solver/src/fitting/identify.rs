@@ -267,7 +267,7 @@ pub fn sample_whitening(
 /// covariances' or the noise model's σ are right): `None` for an ordinary fit without weights.
 ///
 /// # Errors
-/// As [`super::least_squares`] and [`super::least_squares_whitened`];
+/// As [`super::least_squares()`] and [`super::least_squares_whitened`];
 /// [`EstimateError::Noise`] when the weights do not fit the rows or change the rank.
 #[allow(clippy::too_many_arguments)]
 pub fn fit_rows(

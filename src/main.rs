@@ -46,10 +46,11 @@ enum Verb {
     Compensate(cli::compensate::CompensateArgs),
     Volumetric(cli::volumetric::VolumetricArgs),
     Path(cli::path::PathArgs),
+    Instrument(cli::instrument::InstrumentVerb),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 12] = [
+const VERBS: [&str; 13] = [
     "machines",
     "gains",
     "generate",
@@ -62,6 +63,7 @@ const VERBS: [&str; 12] = [
     "compensate",
     "volumetric",
     "path",
+    "instrument",
 ];
 
 /// A clap error as one line: its message and its hints, without the usage block.
@@ -119,6 +121,7 @@ fn main() -> ExitCode {
         Verb::Compensate(a) => cli::compensate::run(a),
         Verb::Volumetric(a) => cli::volumetric::run(a),
         Verb::Path(a) => cli::path::run(a),
+        Verb::Instrument(a) => cli::instrument::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -833,6 +833,7 @@ fn hidden_bias(m: &Machine, t: &Truth, k4: &Record) -> Vec<f64> {
         samples: k4.samples.clone(),
         measured,
         lines: k4.lines.clone(),
+        ..Default::default()
     };
     let fit = solver::fitting::identify(m, &reduced, &alone, &IdentifyOptions::default())
         .expect("identify");

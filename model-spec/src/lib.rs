@@ -67,6 +67,7 @@ pub mod describe;
 mod error;
 pub mod fingerprint;
 pub mod geometry;
+pub mod instrument;
 pub mod kinematics;
 pub mod limits;
 pub mod locate;

@@ -51,6 +51,7 @@ pub mod compensation;
 pub mod demo;
 pub mod diagnosis;
 pub mod fitting;
+pub mod instrument;
 pub mod io;
 pub mod model;
 pub mod record;

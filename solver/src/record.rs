@@ -30,14 +30,19 @@ pub struct Sample {
 pub struct TimesError(pub String);
 
 /// A record: samples and, when measured, the error vector at each (tool minus workpiece, tool
-/// frame, mm). Two records are equal when their samples and readings are: the lines they were
-/// read from do not count.
+/// frame, mm), with the covariance of each reading when the instrument declares one. Two
+/// records are equal when their samples, readings and covariances are: the lines they were read
+/// from do not count.
 #[derive(Clone, Debug, Default)]
 pub struct Record {
     /// The samples, in the order they were taken.
     pub samples: Vec<Sample>,
     /// The measured error vector per sample (mm); empty for a bare path.
     pub measured: Vec<[f64; 3]>,
+    /// Per sample, the covariance of the error vector read (mm², tool frame): the sensors'
+    /// noise propagated through the instrument's geometry ([`crate::instrument`]). Empty when
+    /// none is declared (a record of error vectors); otherwise one per sample.
+    pub covariance: Vec<[[f64; 3]; 3]>,
     /// The 1-based line of its file each sample was read from; empty when the record was not
     /// read from a file (simulated, or built in memory).
     pub lines: Vec<usize>,
@@ -45,7 +50,9 @@ pub struct Record {
 
 impl PartialEq for Record {
     fn eq(&self, other: &Record) -> bool {
-        self.samples == other.samples && self.measured == other.measured
+        self.samples == other.samples
+            && self.measured == other.measured
+            && self.covariance == other.covariance
     }
 }
 
@@ -59,8 +66,8 @@ impl Record {
         }
     }
 
-    /// The record without the samples `drop` (indices, any order): samples, readings and lines
-    /// of the others, in order.
+    /// The record without the samples `drop` (indices, any order): samples, readings,
+    /// covariances and lines of the others, in order.
     pub fn without(&self, drop: &[usize]) -> Record {
         let keep = |i: &usize| !drop.contains(i);
         let pick =
@@ -71,6 +78,10 @@ impl Record {
                 .map(|i| self.samples[i].clone())
                 .collect(),
             measured: pick(&self.measured),
+            covariance: (0..self.covariance.len())
+                .filter(keep)
+                .map(|i| self.covariance[i])
+                .collect(),
             lines: (0..self.lines.len())
                 .filter(keep)
                 .map(|i| self.lines[i])

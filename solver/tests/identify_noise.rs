@@ -41,8 +41,7 @@ fn static_path(m: &Machine, n: usize) -> Record {
     }
     Record {
         samples,
-        measured: Vec::new(),
-        lines: Vec::new(),
+        ..Default::default()
     }
 }
 

@@ -201,7 +201,7 @@ fn static_record(noise: Vec<[f64; 3]>) -> Record {
             })
             .collect(),
         measured: noise,
-        lines: Vec::new(),
+        ..Default::default()
     }
 }
 

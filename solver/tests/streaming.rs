@@ -20,6 +20,7 @@ fn blocks(r: &Record, size: usize) -> Vec<Result<Record, std::io::Error>> {
                 samples: r.samples[a..b].to_vec(),
                 measured: r.measured[a..b].to_vec(),
                 lines: r.lines.get(a..b).map_or(Vec::new(), <[usize]>::to_vec),
+                ..Default::default()
             })
         })
         .collect()

@@ -50,8 +50,7 @@ fn path(m: &Machine, poses: impl Iterator<Item = (f64, f64)>) -> Record {
                 timed: true,
             })
             .collect(),
-        measured: vec![],
-        lines: vec![],
+        ..Default::default()
     }
 }
 

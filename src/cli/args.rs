@@ -3,6 +3,7 @@
 //! is a usage error (exit code 2).
 
 use super::{CliError, CliResult};
+use model_spec::instrument::{Instrument, InstrumentLoadError, ReadingsFrame, load_instrument};
 use model_spec::units::UM_PER_MM;
 use model_spec::{ErrorId, Machine};
 use solver::fitting::noise::{NoiseChoice, NoiseModel};
@@ -42,16 +43,83 @@ impl NoiseArgs {
         }
     }
 
-    /// The noise choice: `--noise`, or the model of the static record `--noise-record`.
-    pub fn choice(&self, m: &Machine, read: &ReadOptions) -> CliResult<NoiseChoice> {
+    /// The noise choice: `--noise`, or the model of the static record `--noise-record` (read
+    /// through the records' `instrument`, when they have one). A declared model is refused for
+    /// records read through an instrument, whose sensors' σ declare the noise already.
+    pub fn choice(
+        &self,
+        m: &Machine,
+        read: &ReadOptions,
+        instrument: &InstrumentArgs,
+    ) -> CliResult<NoiseChoice> {
         let Some(path) = &self.noise_record else {
-            return self.declared();
+            let declared = self.declared()?;
+            if instrument.instrument.is_some() && matches!(declared, NoiseChoice::Model(_)) {
+                return Err(CliError::usage(
+                    "--noise: the records are read through --instrument, whose sensors' σ give each reading's covariance: a declared noise model would declare the noise a second time; leave --noise out (estimated over time from the rows whitened by the covariances) or give --noise white (the covariances' shape, the residual's scale)",
+                ));
+            }
+            return Ok(declared);
         };
-        let still = super::read_record("--noise-record", m, path, read)?;
+        let still = super::read_record("--noise-record", m, path, read, instrument)?;
         let model = NoiseModel::from_static_record(&still)
             .map_err(|e| CliError::input(format!("--noise-record: {}: {e}", path.display())))?;
         Ok(NoiseChoice::Model(model))
     }
+}
+
+/// The instrument whose sensor readings the records hold. For the verbs that read or write
+/// records.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct InstrumentArgs {
+    /// The R-test instrument of the records: a preset (`rtest instrument list`) or a TOML file
+    /// (docs/instrument.md). The records then hold its sensors' readings (columns s1_um,
+    /// s2_um, … in µm) instead of dx_um,dy_um,dz_um; they are turned into error vectors by its
+    /// exact geometry, each with the covariance of the sensors' noise, which weights the fits.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub instrument: Option<String>,
+    /// The frame of the instrument's displacements, overriding its `frame`: tool (the nest
+    /// turns with the tool) or machine (rotated into the tool frame at each pose).
+    #[arg(long, value_name = "tool|machine", requires = "instrument",
+          value_parser = ["tool", "machine"])]
+    pub readings_frame: Option<String>,
+}
+
+impl InstrumentArgs {
+    /// The input file `--instrument` names, for the check that no output names an input.
+    pub fn input(&self) -> Option<(&'static str, &std::path::Path)> {
+        self.instrument
+            .as_deref()
+            .map(std::path::Path::new)
+            .filter(|p| {
+                p.exists() && model_spec::instrument::preset(&p.to_string_lossy()).is_none()
+            })
+            .map(|p| ("--instrument", p))
+    }
+
+    /// The instrument and the frame of its displacements, when `--instrument` is given.
+    pub fn load(&self) -> CliResult<Option<(Instrument, ReadingsFrame)>> {
+        let Some(name) = &self.instrument else {
+            return Ok(None);
+        };
+        let i = instrument(name, "--instrument")?;
+        let frame = match self.readings_frame.as_deref() {
+            Some(f) => ReadingsFrame::parse(f).ok_or_else(|| {
+                CliError::usage(format!("--readings-frame: `{f}` is not tool or machine"))
+            })?,
+            None => i.frame,
+        };
+        Ok(Some((i, frame)))
+    }
+}
+
+/// The instrument `name` (a preset or a TOML file) given by `flag`: an unknown name is a usage
+/// error, a file that cannot be read or does not validate a bad input.
+pub fn instrument(name: &str, flag: &str) -> CliResult<Instrument> {
+    load_instrument(name).map_err(|e| match e {
+        InstrumentLoadError::NotFound(_) => CliError::usage(format!("{flag}: {e}")),
+        other => CliError::input(format!("{flag}: {other}")),
+    })
 }
 
 /// What a record read must be: plausible readings, poses within the strokes. For the verbs

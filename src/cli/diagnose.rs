@@ -139,6 +139,8 @@ pub struct DiagnoseArgs {
     #[command(flatten)]
     records: RecordLimits,
     #[command(flatten)]
+    instrument: args::InstrumentArgs,
+    #[command(flatten)]
     bounds: ValueBounds,
 }
 
@@ -168,12 +170,12 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     check_outputs(&inputs, &outputs, &dirs)?;
 
     let read = args.records.read_options();
-    let record = super::read_record("--data", &m, &args.data, &read)?;
+    let record = super::read_record("--data", &m, &args.data, &read, &args.instrument)?;
     let mut held = Vec::new();
     for f in &held_files {
         held.push((
             f.display().to_string(),
-            super::read_record("--validate", &m, f, &read)?,
+            super::read_record("--validate", &m, f, &read, &args.instrument)?,
         ));
     }
     let mut opts = DiagnoseOptions::default();
@@ -181,7 +183,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     opts.alpha = args.alpha;
     opts.zeroed = args.zeroed;
     opts.constraint = args::constraint(args.constraint.as_deref())?;
-    opts.noise = args.noise.choice(&m, &read)?;
+    opts.noise = args.noise.choice(&m, &read, &args.instrument)?;
     if let Some(b) = &args.budget {
         opts.budget = solver::diagnosis::plausible::Budget::parse(b)
             .map_err(|e| CliError::usage(format!("--budget: {e}")))?;

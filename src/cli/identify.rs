@@ -120,6 +120,8 @@ pub struct IdentifyArgs {
     #[command(flatten)]
     records: RecordLimits,
     #[command(flatten)]
+    instrument: args::InstrumentArgs,
+    #[command(flatten)]
     bounds: ValueBounds,
 }
 
@@ -144,7 +146,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
     let read = args.records.read_options();
-    let noise = args.noise.choice(&m, &read)?;
+    let noise = args.noise.choice(&m, &read, &args.instrument)?;
     let data = args.data.display().to_string();
     let (ident, refinement, streaming, notes) = if args.stream {
         let (ident, run) = identify_file(&m, &model, &args.data, &opts, args.block as usize, &read)
@@ -164,7 +166,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         };
         (ident, None, Some(streaming), String::new())
     } else {
-        let record = super::read_record("--data", &m, &args.data, &read)?;
+        let record = super::read_record("--data", &m, &args.data, &read, &args.instrument)?;
         super::check_times(
             "--data",
             &args.data,

@@ -11,6 +11,7 @@ pub mod figures;
 pub mod gains;
 pub mod generate;
 pub mod identify;
+pub mod instrument;
 pub mod machines;
 pub mod path;
 pub mod pose_args;
@@ -104,16 +105,24 @@ pub fn load_machine_and_text(name_or_path: &str) -> CliResult<(Machine, String)>
     })
 }
 
-/// The record of a measurement CSV given by `flag` (mm and rad inside), read with `options`;
-/// every problem is a bad input naming the flag, the file and the line.
+/// The record of a measurement CSV given by `flag` (mm and rad inside), read with `options`:
+/// of error vectors, or of the sensor readings of `instrument` when it names one (turned into
+/// error vectors with their covariances, docs/instrument.md). Every problem with the file is a
+/// bad input naming the flag, the file and the line.
 pub fn read_record(
     flag: &str,
     m: &Machine,
     path: &Path,
     options: &ReadOptions,
+    instrument: &args::InstrumentArgs,
 ) -> CliResult<Record> {
-    solver::io::csv::read_measurement(path, m, options)
-        .map_err(|e| CliError::input(format!("{flag}: {e}")))
+    let read = match instrument.load()? {
+        None => solver::io::csv::read_measurement(path, m, options),
+        Some((i, frame)) => {
+            solver::io::sensors::read_sensor_measurement(path, m, &i, frame, options)
+        }
+    };
+    read.map_err(|e| CliError::input(format!("{flag}: {e}")))
 }
 
 /// Refuses `record` (read from `path`, given by `flag`) for `model` when a term needs the real

@@ -41,7 +41,9 @@ line: the samples and the RMS of the readings (µm).
 To check a compensation: simulate the compensated path (`rtest compensate -o`) with \
 --commanded set to the path before compensation; the record then holds the program's poses and \
 the readings the compensated machine gives there, as a controller that compensates reports them, \
-and `rtest identify` on it finds the compensated errors near zero.";
+and `rtest identify` on it finds the compensated errors near zero.
+
+With --instrument NAME|FILE (docs/instrument.md) the CSV holds the readings of the instrument's sensors (columns s1_um, s2_um, … in µm, positive when the plunger is pushed in) instead of dx_um,dy_um,dz_um: the exact forward geometry of the head (flat faces or ball tips, gains, zeros) applied to the exact error vector (rotated into the machine frame first when the instrument reads there), plus each sensor's noise (its noise_um) from the truth's seed. The truth's own noise (--noise-um, --noise-phi) is then the noise of the displacement itself (vibration, drift), added before the sensors read it; --zeroed zeroes the sensors' readings at the first sample. Read it back with --instrument on identify, validate or diagnose.";
 
 /// Flags of `rtest simulate`.
 #[derive(Debug, clap::Args)]
@@ -87,6 +89,8 @@ pub struct SimulateArgs {
     output: Target,
     #[command(flatten)]
     records: RecordLimits,
+    #[command(flatten)]
+    instrument: super::args::InstrumentArgs,
 }
 
 /// Parses `--noise-um` (µm, finite, 0 to [`MAX_NOISE_UM`]) into mm, without double rounding.
@@ -168,6 +172,7 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     if let Some(c) = &args.commanded {
         inputs.push(("--commanded", c.as_path()));
     }
+    inputs.extend(args.instrument.input());
     check_outputs(&inputs, &[("-o", &args.output)], &[])?;
     let mut truth = truth(&m, args.truth.as_deref())?;
     let read = args.records.read_options();
@@ -187,6 +192,9 @@ pub fn run(args: &SimulateArgs) -> CliResult {
         truth.seed = s;
     }
     truth.zeroed |= args.zeroed;
+    if let Some((instrument, frame)) = args.instrument.load()? {
+        return run_instrument(args, &m, &truth, &path, &instrument, frame);
+    }
     let mut record = simulate(&m, &truth, &path).map_err(|e| match e {
         e @ SimulateError::Times { .. } => CliError::input(format!("--path {}: {e}", args.path)),
         e => CliError::computation(format!("--truth: {e}")),
@@ -208,5 +216,73 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     write(files)?;
     let written = args.output.path().map(|p| p.display().to_string());
     let text = simulation(&m, &args.path, &truth, &record, written.as_deref());
+    print_text(&text, matches!(args.output, Target::Stdout))
+}
+
+/// `rtest simulate --instrument`: the sensors' readings instead of the error vectors.
+fn run_instrument(
+    args: &SimulateArgs,
+    m: &model_spec::Machine,
+    truth: &Truth,
+    path: &solver::record::Record,
+    instrument: &model_spec::instrument::Instrument,
+    frame: model_spec::instrument::ReadingsFrame,
+) -> CliResult {
+    use solver::instrument::simulate::{SensorSimulationError, simulate_sensors};
+    use solver::io::sensors::{format_sensor_record, parse_sensor_measurement};
+    let mut sensors = simulate_sensors(m, truth, path, instrument, frame).map_err(|e| match e {
+        SensorSimulationError::Simulate(e @ SimulateError::Times { .. }) => {
+            CliError::input(format!("--path {}: {e}", args.path))
+        }
+        SensorSimulationError::Contact { .. } => CliError::computation(format!(
+            "--instrument {}: {e}: the error vector takes the ball off a sensor",
+            instrument.name
+        )),
+        e => CliError::computation(format!("--truth: {e}")),
+    })?;
+    if let Some(file) = &args.commanded {
+        relabel(m, &mut sensors.record, file)?;
+    }
+    let mut comments = provenance(m, &args.path, truth, sensors.record.samples.len());
+    comments.pop();
+    comments.push(format!(
+        "instrument: {} ({} sensors, displacements in the {} frame); sensor noise σ {} µm from seed {} (the truth's noise is that of the displacement)",
+        instrument.name,
+        instrument.sensors.len(),
+        frame.keyword(),
+        instrument
+            .sensors
+            .iter()
+            .map(|s| format!("{} {}", s.name, model_spec::units::format_scaled(s.noise_mm, 3)))
+            .collect::<Vec<_>>()
+            .join(", "),
+        truth.seed
+    ));
+    comments.push(format!(
+        "units: linear axes mm, rotary axes degrees, {} µm (sensor readings, positive: plunger pushed in), t_s s",
+        instrument.columns().join(" ")
+    ));
+    let csv = format_sensor_record(m, instrument, &sensors, &comments)
+        .map_err(|e| CliError::computation(format!("-o: {e}")))?;
+    let read = args.records.read_options();
+    let record =
+        parse_sensor_measurement(&args.output.to_string(), &csv, m, instrument, frame, &read)
+            .map_err(|e| {
+                CliError::computation(format!(
+                    "-o: the simulated record would not be accepted by identify --instrument, so it is not written: {e}"
+                ))
+            })?;
+    let mut files = Outputs::new();
+    files.add("-o", args.output.clone(), csv);
+    write(files)?;
+    let written = args.output.path().map(|p| p.display().to_string());
+    let mut text = simulation(m, &args.path, truth, &record, written.as_deref());
+    if let Some(at) = text.find("): ") {
+        text.insert_str(at + 1, &format!(" with instrument {}", instrument.name));
+    }
+    let text = text.replace(
+        "RMS of the readings",
+        "RMS of the error vectors the sensors read",
+    );
     print_text(&text, matches!(args.output, Target::Stdout))
 }

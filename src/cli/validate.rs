@@ -68,6 +68,8 @@ pub struct ValidateArgs {
     #[command(flatten)]
     records: RecordLimits,
     #[command(flatten)]
+    instrument: super::args::InstrumentArgs,
+    #[command(flatten)]
     bounds: ValueBounds,
 }
 
@@ -97,7 +99,13 @@ pub fn run(args: &ValidateArgs) -> CliResult {
             args.params.display()
         ))
     })?;
-    let record = super::read_record("--data", &m, &args.data, &args.records.read_options())?;
+    let record = super::read_record(
+        "--data",
+        &m,
+        &args.data,
+        &args.records.read_options(),
+        &args.instrument,
+    )?;
     super::check_times("--data", &args.data, &m, &params.model, &record)?;
     let mut opts = ValidateOptions::default();
     opts.zeroed = args.zeroed;

@@ -65,6 +65,7 @@ pub fn hidden_terms(
         let alone = Record {
             samples: fitted.samples.clone(),
             measured,
+            covariance: fitted.covariance.clone(),
             lines: fitted.lines.clone(),
         };
         Some(

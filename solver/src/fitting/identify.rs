@@ -7,17 +7,24 @@
 //! ([`choose_noise`]: declared, from a static record, or estimated from the ordinary fit's
 //! residual), then the generalized least-squares fit of the whitened rows
 //! ([`super::least_squares_whitened`]), whose uncertainties are honest under correlated noise.
+//!
+//! A record with covariances (read through an instrument) has every sample's rows whitened by
+//! its covariance first ([`SampleWhitening`]: the shape, the mean noise kept as the scale), in
+//! the ordinary fit and under a noise model alike ([`fit_rows`]); the noise model is then
+//! estimated from, or describes, the whitened rows, and a declared one is refused
+//! ([`NoiseError::DeclaredTwice`]). The values, uncertainties and correlations are the whitened
+//! fit's; the residual, σ̂, rank and identifiability those of the readings and the path.
 
 use super::hmatrix::{Backend, GainSource, h_matrix, parameter_names};
 use super::identifiability::{Swallowed, swallowed_by_offsets};
 use super::least_squares::{
     Constraint, EstimateError, Fit, Tolerances, least_squares, least_squares_whitened,
 };
-use super::noise::{NoiseChoice, NoiseModel};
+use super::noise::{NoiseChoice, NoiseError, NoiseModel, NoiseSource, SampleWhitening};
 use crate::model::{Basis, Effect, Model, Term};
 use crate::record::Record;
 use model_spec::{Dir, Machine};
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// The stacked measured error vectors of `record` (mm): `[x₀, y₀, z₀, x₁, …]`.
 ///
@@ -156,8 +163,9 @@ pub struct Identification {
     /// fit ([`crate::fitting::noise::NoiseSource::Residual`]), else the model the rows were
     /// whitened by.
     pub noise: NoiseModel,
-    /// σ̂ of the whitened residual (unitless; about 1 when the noise model's σ is right), for a
-    /// fit whitened by a noise model; `None` for an ordinary fit.
+    /// σ̂ of the whitened residual (unitless; about 1 when the noise model's σ, or the
+    /// covariances' of a record read through an instrument, are right), for a fit whitened by
+    /// a noise model or by covariances; `None` for an ordinary fit.
     pub whitened_sigma: Option<f64>,
 }
 
@@ -229,13 +237,131 @@ pub fn choose_noise(choice: &NoiseChoice, residual: &[f64], sigma: Option<f64>) 
     }
 }
 
-/// As [`identify_with`], under the noise model `noise`: an ordinary fit, the noise model of
-/// [`choose_noise`] from its residual, then generalized least squares
-/// ([`super::least_squares_whitened`]) unless the choice is [`NoiseChoice::Ordinary`].
+/// The whitening of `record`'s covariances, when it has any, with the noise choice checked
+/// against it.
 ///
 /// # Errors
-/// As [`identify_with`]; [`EstimateError::Noise`] when the model cannot whiten or whitening
-/// changes the rank.
+/// [`EstimateError::Noise`]: covariances that cannot whiten ([`SampleWhitening::of`]), or a
+/// declared noise model for a record with covariances ([`NoiseError::DeclaredTwice`]).
+pub fn sample_whitening(
+    record: &Record,
+    noise: &NoiseChoice,
+) -> Result<Option<SampleWhitening>, EstimateError> {
+    let w = SampleWhitening::of(record)?;
+    if w.is_some()
+        && let NoiseChoice::Model(model) = noise
+        && model.source == NoiseSource::Declared
+    {
+        return Err(NoiseError::DeclaredTwice.into());
+    }
+    Ok(w)
+}
+
+/// The fit of the rows `h` (mm per unit of each parameter) and `y` (mm) of records of `layout`
+/// samples: ordinary least squares, or generalized under `noise`
+/// ([`super::least_squares_whitened`]); first whitened per sample by `weights` when the
+/// readings carry covariances. With `weights`, the values, uncertainties, covariance,
+/// correlation and near-confounded pairs are the whitened fit's; the residual, RSS and σ̂ those
+/// of the readings (`y − H·p̂`, mm), the rank and identifiability those of `h`. The second value
+/// is the σ̂ of the whitened residual relative to what the whitening assumed (about 1 when the
+/// covariances' or the noise model's σ are right): `None` for an ordinary fit without weights.
+///
+/// # Errors
+/// As [`super::least_squares()`] and [`super::least_squares_whitened`];
+/// [`EstimateError::Noise`] when the weights do not fit the rows or change the rank.
+#[allow(clippy::too_many_arguments)]
+pub fn fit_rows(
+    h: &DMatrix<f64>,
+    y: &DVector<f64>,
+    names: &[String],
+    constraint: &Constraint,
+    tolerances: &Tolerances,
+    noise: Option<&NoiseModel>,
+    layout: &[usize],
+    weights: Option<&SampleWhitening>,
+) -> Result<(Fit, Option<f64>), EstimateError> {
+    let Some(weights) = weights else {
+        return match noise {
+            None => Ok((least_squares(h, y, names, constraint, tolerances)?, None)),
+            Some(n) => {
+                let w = least_squares_whitened(h, y, names, constraint, tolerances, n, layout)?;
+                Ok((w.fit, w.whitened_sigma))
+            }
+        };
+    };
+    let (mut wh, mut wy) = (h.clone(), y.clone());
+    weights.whiten_matrix(&mut wh)?;
+    weights.whiten_vector(&mut wy)?;
+    let ordinary = least_squares(h, y, names, constraint, tolerances)?;
+    let (weighted, whitened_sigma) = match noise {
+        None => {
+            let f = least_squares(&wh, &wy, names, constraint, tolerances)?;
+            let s = f.sigma.map(|s| s / weights.scale_mm);
+            (f, s)
+        }
+        Some(n) => {
+            let w = least_squares_whitened(&wh, &wy, names, constraint, tolerances, n, layout)?;
+            (w.fit, w.whitened_sigma)
+        }
+    };
+    if weighted.rank != ordinary.rank
+        || weighted.identifiability.determined != ordinary.identifiability.determined
+    {
+        return Err(NoiseError::RankChanged {
+            ordinary: ordinary.rank,
+            whitened: weighted.rank,
+        }
+        .into());
+    }
+    let residual = y - h * DVector::from_column_slice(&weighted.solution);
+    let rss = residual.norm_squared();
+    let sigma = (ordinary.dof > 0).then(|| (rss / ordinary.dof as f64).sqrt());
+    let mut identifiability = ordinary.identifiability;
+    identifiability.near_confounded = weighted.identifiability.near_confounded;
+    Ok((
+        Fit {
+            values: weighted.values,
+            solution: weighted.solution,
+            std: weighted.std,
+            covariance: weighted.covariance,
+            correlation: weighted.correlation,
+            identifiability,
+            residual,
+            rss,
+            sigma,
+            ..ordinary
+        },
+        whitened_sigma,
+    ))
+}
+
+/// [`choose_noise`] for a fit of a record whitened by `weights` (when it has covariances): the
+/// noise model is estimated from the whitened residual, the rows it will whiten.
+///
+/// # Errors
+/// [`EstimateError::Noise`] when the weights do not fit the residual.
+pub fn choose_noise_weighted(
+    choice: &NoiseChoice,
+    fit: &Fit,
+    weights: Option<&SampleWhitening>,
+) -> Result<NoiseModel, EstimateError> {
+    let Some(w) = weights else {
+        return Ok(choose_noise(choice, fit.residual.as_slice(), fit.sigma));
+    };
+    let mut r = fit.residual.clone();
+    w.whiten_vector(&mut r)?;
+    let sigma = (fit.dof > 0).then(|| (r.norm_squared() / fit.dof as f64).sqrt());
+    Ok(choose_noise(choice, r.as_slice(), sigma))
+}
+
+/// As [`identify_with`], under the noise model `noise`: an ordinary fit, the noise model of
+/// [`choose_noise`] from its residual, then generalized least squares
+/// ([`super::least_squares_whitened`]) unless the choice is [`NoiseChoice::Ordinary`]. A record
+/// with covariances is whitened by them first (see the module documentation).
+///
+/// # Errors
+/// As [`identify_with`]; [`EstimateError::Noise`] when the model or the covariances cannot
+/// whiten, whitening changes the rank, or a declared model meets covariances.
 pub fn identify_with_noise(
     m: &Machine,
     model: &Model,
@@ -247,33 +373,39 @@ pub fn identify_with_noise(
     let fitted = opts.fitted_model(model);
     check_readings(record.samples.len(), fitted.width())?;
     let y = measurement_vector(record)?;
+    let weights = sample_whitening(record, noise)?;
     let h = h_matrix(m, &fitted, record, source)?;
     let names = parameter_names(m, &fitted);
-    let ordinary = least_squares(&h, &y, &names, &opts.constraint, &opts.tolerances)?;
     let samples = record.samples.len();
+    let (c, t) = (&opts.constraint, &opts.tolerances);
+    let (ordinary, weighted_sigma) =
+        fit_rows(&h, &y, &names, c, t, None, &[samples], weights.as_ref())?;
     if *noise == NoiseChoice::Ordinary {
-        return Ok(Identification::new(
-            m,
-            fitted,
-            ordinary,
-            samples,
-            opts.zeroed,
-            source.backend(),
-        ));
+        let mut ident =
+            Identification::new(m, fitted, ordinary, samples, opts.zeroed, source.backend());
+        if let (Some(w), Some(s)) = (&weights, weighted_sigma) {
+            ident.noise = NoiseModel::residual(
+                s * w.scale_mm,
+                "ordinary least squares of the rows whitened by each sample's covariance",
+            );
+            ident.whitened_sigma = Some(s);
+        }
+        return Ok(ident);
     }
-    let model_of_noise = choose_noise(noise, ordinary.residual.as_slice(), ordinary.sigma);
-    let w = least_squares_whitened(
+    let model_of_noise = choose_noise_weighted(noise, &ordinary, weights.as_ref())?;
+    let (fit, whitened_sigma) = fit_rows(
         &h,
         &y,
         &names,
-        &opts.constraint,
-        &opts.tolerances,
-        &model_of_noise,
+        c,
+        t,
+        Some(&model_of_noise),
         &[samples],
+        weights.as_ref(),
     )?;
-    let mut ident = Identification::new(m, fitted, w.fit, samples, opts.zeroed, source.backend());
+    let mut ident = Identification::new(m, fitted, fit, samples, opts.zeroed, source.backend());
     ident.noise = model_of_noise;
-    ident.whitened_sigma = w.whitened_sigma;
+    ident.whitened_sigma = whitened_sigma;
     Ok(ident)
 }
 

@@ -38,13 +38,17 @@
 //! the noise model is chosen from its exact residual ([`crate::fitting::choose_noise`]), then
 //! the iteration continues from its solution with every correction the generalized
 //! least-squares one (`Δ = (W·H)⁺·W·r`, [`crate::fitting::least_squares_whitened`]), and the
-//! uncertainties are the whitened fit's.
+//! uncertainties are the whitened fit's. A record with covariances (read through an
+//! instrument) has every correction weighted by them as well
+//! ([`crate::fitting::identify::fit_rows`]).
 
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::identify::{choose_noise_weighted, fit_rows, sample_whitening};
+use crate::fitting::noise::SampleWhitening;
 use crate::fitting::noise::{NoiseChoice, NoiseModel};
 use crate::fitting::{
-    EstimateError, Fit, Identification, IdentifyOptions, Tolerances, choose_noise, gain_source,
-    identify_with, least_squares, least_squares_whitened, measurement_vector,
+    EstimateError, Fit, Identification, IdentifyOptions, Tolerances, gain_source, identify_with,
+    measurement_vector,
 };
 use crate::model::Model;
 use crate::record::Record;
@@ -212,19 +216,24 @@ fn refine_under(
     noise: Option<&NoiseModel>,
 ) -> Result<Refinement, RefineError> {
     let layout = [record.samples.len()];
+    // A record read through an instrument weights every fit by its covariances.
+    let weights = SampleWhitening::of(record).map_err(EstimateError::from)?;
     // The fit of a residual: ordinary, or generalized under the noise model.
     let fit_of = |h: &nalgebra::DMatrix<f64>,
                   r: &DVector<f64>,
                   names: &[String],
                   constraint: &crate::fitting::Constraint|
      -> Result<(Fit, Option<f64>), EstimateError> {
-        match noise {
-            None => Ok((least_squares(h, r, names, constraint, tolerances)?, None)),
-            Some(n) => {
-                let w = least_squares_whitened(h, r, names, constraint, tolerances, n, &layout)?;
-                Ok((w.fit, w.whitened_sigma))
-            }
-        }
+        fit_rows(
+            h,
+            r,
+            names,
+            constraint,
+            tolerances,
+            noise,
+            &layout,
+            weights.as_ref(),
+        )
     };
     let h = h_matrix(m, &ident.model, record, source)?;
     let y = measurement_vector(record)?;
@@ -301,7 +310,7 @@ fn refine_under(
         .collect();
     fit.solution = x;
     ident.fit = fit;
-    if noise.is_some() {
+    if noise.is_some() || weights.is_some() {
         ident.whitened_sigma = whitened_sigma;
     }
     Ok(Refinement {
@@ -391,11 +400,12 @@ pub fn identify_refined_with_noise(
     refine_opts: &RefineOptions,
     noise: &NoiseChoice,
 ) -> Result<(Identification, Refinement), RefineError> {
+    let weights = sample_whitening(record, noise)?;
     let (mut ident, ordinary) = identify_refined_with(m, model, record, source, opts, refine_opts)?;
     if *noise == NoiseChoice::Ordinary {
         return Ok((ident, ordinary));
     }
-    let chosen = choose_noise(noise, ident.fit.residual.as_slice(), ident.fit.sigma);
+    let chosen = choose_noise_weighted(noise, &ident.fit, weights.as_ref())?;
     let r = refine_whitened(
         m,
         record,

@@ -231,7 +231,6 @@ pub fn record_from_commands(commands: Vec<Vec<f64>>, times: Vec<f64>) -> Record 
     let motion = motion_directions(&commands);
     Record {
         samples: samples_from(commands, times, motion),
-        measured: Vec::new(),
-        lines: Vec::new(),
+        ..Default::default()
     }
 }

@@ -149,6 +149,7 @@ pub fn simulate(m: &Machine, truth: &Truth, path: &Record) -> Result<Record, Sim
         samples: path.samples.clone(),
         measured,
         lines: path.lines.clone(),
+        ..Default::default()
     })
 }
 

@@ -227,6 +227,10 @@ pub(super) fn estimate(residuals: &[&[[f64; 3]]]) -> Result<NoiseModel, NoiseErr
 /// bias of the lag-1 autocorrelation removed), clamped to [0, [`MAX_STATIC_PHI`]];
 /// `σ² = (Σ x_t² / n) / (1 − (1+φ)/(n·(1−φ)))` (the variance the removed mean takes away put
 /// back). A record whose correction exceeds one half is too short for its correlation.
+///
+/// A record with covariances (read through an instrument) is first whitened by them
+/// ([`super::SampleWhitening`]): the model then describes the whitened rows, as the fits of a
+/// record with covariances use it.
 pub(super) fn from_static_record(record: &Record) -> Result<NoiseModel, NoiseError> {
     let n = record.measured.len();
     if n == 0 {
@@ -260,12 +264,29 @@ pub(super) fn from_static_record(record: &Record) -> Result<NoiseModel, NoiseErr
             i + 1
         )));
     }
+    let whitened: Vec<[f64; 3]>;
+    let measured: &[[f64; 3]] = match super::SampleWhitening::of(record)? {
+        None => &record.measured,
+        Some(w) => {
+            let mut v = nalgebra::DVector::from_iterator(
+                3 * n,
+                record.measured.iter().flat_map(|r| r.iter().copied()),
+            );
+            w.whiten_vector(&mut v)?;
+            whitened = v
+                .as_slice()
+                .chunks_exact(3)
+                .map(|r| [r[0], r[1], r[2]])
+                .collect();
+            &whitened
+        }
+    };
     let mut sigma_mm = [0.0; 3];
     let mut phi = [0.0; 3];
     let nf = n as f64;
     for d in 0..3 {
-        let mean = record.measured.iter().map(|r| r[d]).sum::<f64>() / nf;
-        let x: Vec<f64> = record.measured.iter().map(|r| r[d] - mean).collect();
+        let mean = measured.iter().map(|r| r[d]).sum::<f64>() / nf;
+        let x: Vec<f64> = measured.iter().map(|r| r[d] - mean).collect();
         let g0: f64 = x.iter().map(|v| v * v).sum();
         if g0 <= 0.0 {
             return Err(NoiseError::Readings(format!(

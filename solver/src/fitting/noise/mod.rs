@@ -24,13 +24,24 @@
 //! direction, divided by σ: noise that follows the model becomes white with unit variance, so
 //! ordinary least squares on whitened rows is the generalized least-squares fit, and every
 //! later F-test, Monte-Carlo null and standard uncertainty is the textbook one.
+//!
+//! A record read through an instrument carries the covariance of each sample's reading (the
+//! sensors' noise through the head's geometry). Its rows are first whitened by those
+//! covariances ([`SampleWhitening`]: the shape of each sample's noise across x, y, z), keeping
+//! the units and the mean size of the noise; the noise model then describes the whitened rows
+//! over time (their σ and φ), estimated or from a static record read through the same
+//! instrument. A declared model (an absolute σ per direction of the error vector) would declare
+//! the noise a second time and is refused ([`NoiseError::DeclaredTwice`]).
 
 use crate::record::Record;
 use nalgebra::{DMatrix, DVector};
 use std::fmt;
 
+mod covariance;
 mod estimate;
 mod spec;
+
+pub use covariance::SampleWhitening;
 
 pub use estimate::{
     MAX_ESTIMATED_PHI, MAX_STATIC_PHI, MIN_STATIC_SAMPLES, NOISE_FLOOR_MM, PHI_GRID_STEP,
@@ -165,6 +176,12 @@ pub enum NoiseError {
     /// other), or the model cannot whiten (σ not positive, φ out of range).
     #[error("whitening: {0}")]
     Whitening(String),
+    /// A noise model declared for a record whose readings already carry their covariance (an
+    /// instrument's sensor noise): the two would declare the reading noise twice.
+    #[error(
+        "the readings carry the covariance of the instrument's sensor noise (each sensor's σ through the head's geometry); a declared noise model would declare the reading noise a second time: leave the declared model out (the noise is then estimated over time from the rows whitened by the covariances) or ask for ordinary least squares (the covariances' shape, the residual's scale)"
+    )]
+    DeclaredTwice,
     /// The whitened fit found another rank or other undetermined parameters than the ordinary
     /// one (a noise model that makes the data numerically singular).
     #[error(

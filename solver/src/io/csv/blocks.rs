@@ -173,6 +173,7 @@ impl<'m, R: Read> MeasurementBlocks<'m, R> {
             samples,
             measured,
             lines,
+            ..Default::default()
         }))
     }
 }

@@ -47,9 +47,9 @@
 //! [`model_spec::units::exact`].
 
 mod blocks;
-mod checks;
-mod lines;
-mod read;
+pub(crate) mod checks;
+pub(crate) mod lines;
+pub(crate) mod read;
 mod whole;
 mod write;
 
@@ -168,6 +168,8 @@ pub(crate) enum Col {
     Axis(usize),
     Time,
     Measured(usize),
+    /// A column a caller asked for beside the machine's (a sensor's readings, µm).
+    Extra(usize),
 }
 
 pub(crate) const MEASURED: [&str; 3] = ["dx_um", "dy_um", "dz_um"];

@@ -24,6 +24,8 @@ pub(crate) struct Header {
     fill_ik: bool,
     /// The three measured columns are present.
     pub(crate) measured: bool,
+    /// The number of extra columns asked for ([`Header::parse`]), all present.
+    extra: usize,
 }
 
 /// One parsed row: commands (mm, rad), time (s, `None` without a `t_s` column) and the
@@ -31,19 +33,30 @@ pub(crate) struct Header {
 pub(crate) type Row = (Vec<f64>, Option<f64>, [f64; 3]);
 
 impl Header {
-    /// Parses the header line `text` (line number `line`).
+    /// Parses the header line `text` (line number `line`), with the columns `extra` (µm,
+    /// matched without regard to case) required beside the machine's: their values are read by
+    /// [`Header::row_with`], in this order.
     pub(crate) fn parse(
         cx: &Ctx,
         line: usize,
         text: &str,
         m: &Machine,
         need: Need,
+        extra: &[String],
     ) -> Result<Header, CsvError> {
-        let expected = expected_columns(m);
+        let mut expected = expected_columns(m);
+        if !extra.is_empty() {
+            expected += &format!("; and {}", extra.join(", "));
+        }
         let names: Vec<String> = text.split(',').map(|n| clean_name(n).to_string()).collect();
         let mut cols: Vec<Col> = Vec::with_capacity(names.len());
         for (i, name) in names.iter().enumerate() {
-            let col = classify(m, name).ok_or_else(|| {
+            let col = extra
+                .iter()
+                .position(|x| x.eq_ignore_ascii_case(name))
+                .map(Col::Extra)
+                .or_else(|| classify(m, name));
+            let col = col.ok_or_else(|| {
                 let what = if name.is_empty() {
                     "empty column name".to_string()
                 } else {
@@ -93,6 +106,20 @@ impl Header {
                 ),
             ));
         }
+        let extra_missing: Vec<&str> = (0..extra.len())
+            .filter(|&k| !has(Col::Extra(k)))
+            .map(|k| extra[k].as_str())
+            .collect();
+        if !extra_missing.is_empty() {
+            return Err(cx.err(
+                line,
+                None,
+                format!(
+                    "missing column(s) {} (sensor readings, µm): every sensor of the instrument needs a column",
+                    extra_missing.join(", ")
+                ),
+            ));
+        }
         let n_measured = (0..3).filter(|&k| has(Col::Measured(k))).count();
         let required = need == Need::Measured || n_measured > 0;
         if required && n_measured < 3 {
@@ -115,6 +142,7 @@ impl Header {
             cols,
             fill_ik: n_linear > 0 && !linear_missing.is_empty(),
             measured: n_measured == 3,
+            extra: extra.len(),
         })
     }
 
@@ -128,6 +156,19 @@ impl Header {
         m: &Machine,
         last_t: &mut Option<(f64, usize)>,
     ) -> Result<Row, CsvError> {
+        self.row_with(cx, line, text, m, last_t).map(|(row, _)| row)
+    }
+
+    /// [`Header::row`], with the values of the extra columns (mm, read from µm), in the order
+    /// they were asked for.
+    pub(crate) fn row_with(
+        &self,
+        cx: &Ctx,
+        line: usize,
+        text: &str,
+        m: &Machine,
+        last_t: &mut Option<(f64, usize)>,
+    ) -> Result<(Row, Vec<f64>), CsvError> {
         let n_fields = text.bytes().filter(|&b| b == b',').count() + 1;
         if n_fields != self.cols.len() {
             return Err(cx.err(
@@ -143,12 +184,19 @@ impl Header {
         let mut c = vec![0.0; m.axes.len()];
         let mut t = None;
         let mut d = [0.0; 3];
+        let mut extra = vec![0.0; self.extra];
         for (i, (field, &col)) in text.split(',').zip(&self.cols).enumerate() {
             let f = field.trim();
             let bad = || self.bad_number(cx, line, i, f, col, m);
             match col {
                 Col::Measured(k) => {
                     d[k] = match parse_scaled(f, -3) {
+                        Some(v) if v.is_finite() => v,
+                        _ => return Err(bad()),
+                    }
+                }
+                Col::Extra(k) => {
+                    extra[k] = match parse_scaled(f, -3) {
                         Some(v) if v.is_finite() => v,
                         _ => return Err(bad()),
                     }
@@ -184,7 +232,7 @@ impl Header {
                 }
             }
         }
-        Ok((c, t, d))
+        Ok(((c, t, d), extra))
     }
 
     /// Why the field `f` of column `i` (holding `col`) on line `line` is not a number that can
@@ -202,7 +250,7 @@ impl Header {
             Col::Axis(a) if m.axes[a].kind == AxisKind::Rotary => "degrees",
             Col::Axis(_) => "mm",
             Col::Time => "s",
-            Col::Measured(_) => "µm",
+            Col::Measured(_) | Col::Extra(_) => "µm",
         };
         let why = match f.parse::<f64>() {
             _ if f.is_empty() => format!("empty field: expected a number ({unit})"),
@@ -281,6 +329,17 @@ pub(crate) fn read_header<R: Read>(
     m: &Machine,
     need: Need,
 ) -> Result<Header, CsvError> {
+    read_header_with(cx, lines, m, need, &[])
+}
+
+/// [`read_header`], with the extra columns `extra` ([`Header::parse`]).
+pub(crate) fn read_header_with<R: Read>(
+    cx: &Ctx,
+    lines: &mut Lines<R>,
+    m: &Machine,
+    need: Need,
+    extra: &[String],
+) -> Result<Header, CsvError> {
     loop {
         let Some((line, text)) = lines.next_line(cx)? else {
             return Err(cx.err(
@@ -293,7 +352,7 @@ pub(crate) fn read_header<R: Read>(
             ));
         };
         if is_data(text) {
-            return Header::parse(cx, line, text, m, need);
+            return Header::parse(cx, line, text, m, need, extra);
         }
     }
 }

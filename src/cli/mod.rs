@@ -13,6 +13,7 @@ pub mod generate;
 pub mod identify;
 pub mod machines;
 pub mod pose_args;
+pub mod segment;
 pub mod simulate;
 pub mod validate;
 pub mod volumetric;

@@ -83,6 +83,8 @@ pub(crate) struct Alignment {
 struct Track {
     placed: Vec<Placed>,
     missing: usize,
+    /// Missing poses that would rest before the log's first row.
+    early: usize,
     anchored: usize,
 }
 
@@ -108,12 +110,16 @@ fn track(rows: &[PlanRow], periods: &[StillPeriod], start: f64, tol: f64, give_u
     let mut t = Track {
         placed: Vec::with_capacity(rows.len()),
         missing: 0,
+        early: 0,
         anchored: 0,
     };
     for r in rows {
         let (a, d) = (r.arrive_s + offset, r.depart_s + offset);
         let Some(j) = best_overlap(periods, a, d) else {
             t.missing += 1;
+            if d < 0.0 {
+                t.early += 1;
+            }
             t.placed.push(Placed {
                 period: None,
                 offset,
@@ -181,11 +187,13 @@ pub(crate) fn align_static(
             short(span)
         ));
     }
-    let key = |t: &Track| (t.missing, n - t.anchored);
+    // A log starts before the program: a placement with poses before its first row is the
+    // least likely, whatever else it explains.
+    let key = |t: &Track| (t.early, t.missing, n - t.anchored);
     let mut best: Option<Track> = None;
     let mut runner_up: Option<Track> = None;
     for &s in &starts {
-        let give_up = best.as_ref().map_or(n, |b| b.missing);
+        let give_up = best.as_ref().map_or(n, |b| b.early + b.missing);
         let t = track(rows, periods, s, tol, give_up);
         if t.placed.len() < n {
             continue;

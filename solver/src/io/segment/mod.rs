@@ -383,14 +383,24 @@ fn static_windows<R: Read>(
     for (i, (a, cut)) in sums.into_iter().zip(&cuts).enumerate() {
         let n = a.n;
         if n < min {
-            return Err(SegmentError::Window {
-                file: file.into(),
-                sample: i + 1,
-                message: format!(
+            let (lo, hi) = cut.planned;
+            let message = if cut.hi <= cut.lo {
+                format!(
+                    "its window {} .. {} s (log clock) lies outside the still period it was placed in: the log has a gap there, or the machine moved",
+                    short(clock.log_time(lo)),
+                    short(clock.log_time(hi))
+                )
+            } else {
+                format!(
                     "{n} log row(s) in its window {} .. {} s (log clock), fewer than {min}: the log is too sparse there, or has a gap",
                     short(clock.log_time(cut.lo)),
                     short(clock.log_time(cut.hi))
-                ),
+                )
+            };
+            return Err(SegmentError::Window {
+                file: file.into(),
+                sample: i + 1,
+                message,
             });
         }
         out.push(Window {

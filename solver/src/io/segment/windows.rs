@@ -62,6 +62,8 @@ pub(crate) struct Cut {
     pub(crate) lo: f64,
     pub(crate) hi: f64,
     pub(crate) clipped: bool,
+    /// The window before it was clipped to its still period.
+    pub(crate) planned: (f64, f64),
 }
 
 /// The cut of every pose of a static plan: its planned window moved by its offset, less
@@ -89,6 +91,7 @@ pub(crate) fn static_cuts(
                 lo: clo,
                 hi: chi,
                 clipped: chi - clo < 0.9 * (hi - lo),
+                planned: (lo, hi),
             }
         })
         .collect()

@@ -9,7 +9,7 @@ use model_spec::{AxisKind, Machine, parse_machine};
 use solver::io::csv::ReadOptions;
 use solver::io::nc::measure::{
     ContinuousTiming, MeasureError, MeasureMode, MeasureOptions, PlanKind, StaticMotion,
-    StaticTiming, TimingPlan, format_plan, measurement_program, parse_plan,
+    StaticTiming, TimingPlan, format_plan, measurement_program, parse_plan, plan_comments,
 };
 use solver::io::nc::{Dialect, parse_program};
 use solver::io::poses::{axis_words, to_file_units};
@@ -444,12 +444,20 @@ fn the_plan_csv_reads_back_exactly() {
     let m = builtin("seed-ac");
     let k4 = builtin_path(&m, "K4").unwrap().unwrap();
     for mode in [static_mode(), continuous_mode()] {
-        let p = measurement_program(&m, &k4, &MeasureOptions::new(&m, Dialect::Iso, mode)).unwrap();
-        let text = format_plan(&m, &p.plan, &["a plan".into()]).unwrap();
-        assert!(text.starts_with("# a plan\nsample,X,Y,Z,A,C,arrive_s,start_s,end_s,depart_s\n1,"));
+        let mut o = MeasureOptions::new(&m, Dialect::Iso, mode);
+        o.test_name = "K4".into();
+        let p = measurement_program(&m, &k4, &o).unwrap();
+        let comments = plan_comments(&m, &o, &p);
+        let text = format_plan(&m, &p.plan, &comments).unwrap();
+        assert!(
+            text.starts_with("# sample-timing plan written by rtest "),
+            "{text}"
+        );
+        assert!(text.contains(" for machine seed-ac, test K4: 241 poses, "));
+        assert!(text.contains("\nsample,X,Y,Z,A,C,arrive_s,start_s,end_s,depart_s\n1,"));
         let back = parse_plan("plan.csv", &text, &m).unwrap();
         assert_eq!(back, p.plan);
-        assert_eq!(format_plan(&m, &back, &["a plan".into()]).unwrap(), text);
+        assert_eq!(format_plan(&m, &back, &comments).unwrap(), text);
     }
 }
 

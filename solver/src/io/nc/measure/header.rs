@@ -3,11 +3,13 @@
 
 use crate::io::nc::Dialect;
 use crate::io::nc::measure::plan::TimingPlan;
-use crate::io::nc::measure::{MeasureMode, MeasureOptions, StaticMotion};
+use crate::io::nc::measure::{MeasureMode, MeasureOptions, MeasurementProgram, StaticMotion};
 use model_spec::units::short;
 use model_spec::{AxisKind, Machine};
 
 /// The header's lines (without comment marks), each short enough for a control's display.
+/// The lines (without comment marks) of the header of the program of `plan`, whose moves leave
+/// the ball by at most `gap_mm` (mm).
 pub(crate) fn lines(
     m: &Machine,
     o: &MeasureOptions,
@@ -102,7 +104,8 @@ pub(crate) fn lines(
         }
     }
     h.push("assumed rates (feed, rapid, acceleration; 0 neglected):".into());
-    for (a, r) in m.axes.iter().zip(&o.rates) {
+    for i in crate::io::csv::column_order(m) {
+        let (a, r) = (&m.axes[i], &o.rates[i]);
         let (u, acc) = match a.kind {
             AxisKind::Linear => ("mm/min", "mm/s2"),
             AxisKind::Rotary => ("deg/min", "deg/s2"),
@@ -132,4 +135,30 @@ fn heidenhain_feed(h: &mut Vec<String>) {
     h.push("moves: L, F in mm/min along the combined move of all".into());
     h.push("axes, degrees counted as mm (no M116): check the run".into());
     h.push("time against the plan in a dry run".into());
+}
+
+/// The comment lines of a plan's CSV (for [`crate::io::nc::measure::format_plan`]): what wrote
+/// it, for which machine, test, dialect and mode, the program clock, the columns' units, and
+/// where the timing assumptions are stated.
+pub fn plan_comments(m: &Machine, o: &MeasureOptions, program: &MeasurementProgram) -> Vec<String> {
+    let test = if o.test_name.is_empty() {
+        String::new()
+    } else {
+        format!(", test {}", o.test_name)
+    };
+    vec![
+        format!(
+            "sample-timing plan written by rtest {} for machine {}{test}: {} poses, {} program in {}",
+            env!("CARGO_PKG_VERSION"),
+            m.name,
+            program.plan.rows.len(),
+            program.plan.kind.name(),
+            o.dialect.name()
+        ),
+        "program clock: t = 0 s at rest at pose 1 after the program's first move".into(),
+        "axes in mm and degrees as the program commands them; times in s: arrive_s at rest (or passing),"
+            .into(),
+        "start_s .. end_s the measuring window (an instant when equal), depart_s the next move".into(),
+        "the timing assumptions are in the program's header (docs/measurement-programs.md)".into(),
+    ]
 }

@@ -241,3 +241,4 @@ pub enum MeasureError {
 }
 
 pub use build::measurement_program;
+pub use header::plan_comments;

@@ -413,7 +413,7 @@ fn a_malformed_log_is_refused_at_its_line_and_column() {
         ),
         (
             "t_s,dx_um\n0,1\n",
-            "log.csv:1: 1 row(s): a log needs at least two",
+            "log.csv: 1 row(s): a log needs at least two",
         ),
         (
             "t_s,dx_um\n0,1\n0.01,1,2\n",

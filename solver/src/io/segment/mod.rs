@@ -29,19 +29,20 @@ pub mod align;
 pub mod log;
 pub mod still;
 pub mod windows;
+mod write;
 
-use crate::io::csv::{CsvError, column_order, comment_lines};
+use crate::io::csv::CsvError;
 use crate::io::nc::measure::{PlanKind, TimingPlan};
 pub use align::Anchor;
-use align::{Alignment, align_continuous, align_static};
+use align::{align_continuous, align_static};
 pub use log::LogClock;
 use log::LogReader;
-use model_spec::units::{degrees_for, format_scaled};
-use model_spec::{AxisKind, Machine};
 use std::io::Read;
 use std::path::Path;
 use still::{Bins, still_periods};
 pub use windows::{Window, WindowFlag};
+use windows::{continuous_windows, static_windows};
+pub use write::{format_segmented, format_windows};
 
 /// How a log is cut. `SegmentOptions::default()` finds everything from the data.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -199,12 +200,10 @@ pub fn segment<R: Read>(
         span = t;
     }
     let Some(clock) = reader.clock().filter(|_| rows >= 2) else {
-        return Err(SegmentError::Csv(CsvError::Format {
+        return Err(SegmentError::Alignment {
             file: file.into(),
-            line: 1,
-            column: None,
             message: format!("{rows} row(s): a log needs at least two"),
-        }));
+        });
     };
     let period = span / (rows - 1) as f64;
     let r_bins = ((shape.sliding_s / (2.0 * bins.h)).round() as usize)
@@ -340,232 +339,4 @@ impl Shape {
             tolerance_s,
         })
     }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn static_windows<R: Read>(
-    file: &str,
-    reader: &mut LogReader<'_, R>,
-    plan: &TimingPlan,
-    al: &Alignment,
-    periods: &[still::StillPeriod],
-    opts: &SegmentOptions,
-    clock: &LogClock,
-    k: usize,
-) -> Result<Vec<Window>, SegmentError> {
-    let margin = |i: usize| {
-        opts.margin_s
-            .unwrap_or(0.1 * (plan.rows[i].end_s - plan.rows[i].start_s))
-    };
-    let cuts = windows::static_cuts(plan, al, periods, &margin);
-    for (i, w) in cuts.windows(2).enumerate() {
-        if w[1].lo < w[0].hi {
-            return Err(SegmentError::Window {
-                file: file.into(),
-                sample: i + 2,
-                message: format!(
-                    "its window ({} .. {} s, log clock) overlaps the one before ({} .. {} s): the offset given or found does not fit the log",
-                    short(clock.log_time(w[1].lo)),
-                    short(clock.log_time(w[1].hi)),
-                    short(clock.log_time(w[0].lo)),
-                    short(clock.log_time(w[0].hi))
-                ),
-            });
-        }
-    }
-    let sums = windows::average(reader, &cuts, k)?;
-    let min = if opts.min_readings == 0 {
-        5
-    } else {
-        opts.min_readings
-    };
-    let mut out = Vec::with_capacity(cuts.len());
-    for (i, (a, cut)) in sums.into_iter().zip(&cuts).enumerate() {
-        let n = a.n;
-        if n < min {
-            let (lo, hi) = cut.planned;
-            let message = if cut.hi <= cut.lo {
-                format!(
-                    "its window {} .. {} s (log clock) lies outside the still period it was placed in: the log has a gap there, or the machine moved",
-                    short(clock.log_time(lo)),
-                    short(clock.log_time(hi))
-                )
-            } else {
-                format!(
-                    "{n} log row(s) in its window {} .. {} s (log clock), fewer than {min}: the log is too sparse there, or has a gap",
-                    short(clock.log_time(cut.lo)),
-                    short(clock.log_time(cut.hi))
-                )
-            };
-            return Err(SegmentError::Window {
-                file: file.into(),
-                sample: i + 1,
-                message,
-            });
-        }
-        out.push(Window {
-            sample: i + 1,
-            log_start_s: clock.log_time(a.first),
-            log_end_s: clock.log_time(a.last),
-            readings: n,
-            t_s: 0.5 * (a.first + a.last) - al.offset,
-            shift_s: al.placed[i].offset - al.offset,
-            anchor: al.placed[i].anchor,
-            mean_mm: a.mean,
-            sd_mm: a.sd,
-            flags: Vec::new(),
-        });
-    }
-    let clipped: Vec<bool> = cuts.iter().map(|c| c.clipped).collect();
-    windows::flag(&mut out, &clipped);
-    Ok(out)
-}
-
-fn continuous_windows<R: Read>(
-    file: &str,
-    reader: &mut LogReader<'_, R>,
-    plan: &TimingPlan,
-    al: &Alignment,
-    period: f64,
-    clock: &LogClock,
-    k: usize,
-) -> Result<Vec<Window>, SegmentError> {
-    let d0 = plan.rows[0].depart_s;
-    let instants: Vec<f64> = plan
-        .rows
-        .iter()
-        .map(|r| al.offset + d0 + al.scale * (r.start_s - d0))
-        .collect();
-    let values =
-        windows::interpolate(reader, &instants, k, 5.0 * period)?.map_err(|(i, why)| {
-            SegmentError::Window {
-                file: file.into(),
-                sample: i + 1,
-                message: format!(
-                    "its instant {} s (log clock) cannot be read: {why}",
-                    short(clock.log_time(instants[i]))
-                ),
-            }
-        })?;
-    Ok(values
-        .into_iter()
-        .zip(&instants)
-        .enumerate()
-        .map(|(i, (mean, &at))| Window {
-            sample: i + 1,
-            log_start_s: clock.log_time(at),
-            log_end_s: clock.log_time(at),
-            readings: 2,
-            t_s: at - al.offset,
-            shift_s: 0.0,
-            anchor: al.placed[i].anchor,
-            mean_mm: mean,
-            sd_mm: vec![0.0; k],
-            flags: Vec::new(),
-        })
-        .collect())
-}
-
-/// The measurement record of `seg` (cut by `plan`, of machine `m`) as CSV text: `comments` as
-/// `# ` lines, the header (the axes as [`column_order`] orders them, the reading columns under
-/// the log's names, `t_s`), one row per pose: axes in mm and degrees, readings in µm, `t_s` in
-/// s, each the shortest decimal that reads back to the same value.
-///
-/// # Errors
-/// [`CsvError::Record`] when `seg` does not have one window per row of `plan`, or a value is
-/// not finite.
-pub fn format_segmented(
-    m: &Machine,
-    plan: &TimingPlan,
-    seg: &Segmented,
-    comments: &[String],
-) -> Result<String, CsvError> {
-    if seg.windows.len() != plan.rows.len() {
-        return Err(CsvError::Record(format!(
-            "{} samples for the {} poses of the plan",
-            seg.windows.len(),
-            plan.rows.len()
-        )));
-    }
-    let axes = column_order(m);
-    let mut out = comment_lines(comments);
-    let mut header: Vec<&str> = axes.iter().map(|&a| m.axes[a].name.as_str()).collect();
-    header.extend(seg.columns.iter().map(String::as_str));
-    header.push("t_s");
-    out += &header.join(",");
-    out.push('\n');
-    for (row, w) in plan.rows.iter().zip(&seg.windows) {
-        let mut fields: Vec<String> = Vec::with_capacity(header.len());
-        for &a in &axes {
-            let q = *row.commands.get(a).unwrap_or(&f64::NAN);
-            fields.push(match m.axes[a].kind {
-                AxisKind::Linear => format_scaled(q, 0),
-                AxisKind::Rotary => format_scaled(degrees_for(q), 0),
-            });
-        }
-        fields.extend(w.mean_mm.iter().map(|&v| format_scaled(v, 3)));
-        fields.push(format_scaled(w.t_s, 0));
-        if row
-            .commands
-            .iter()
-            .chain(&w.mean_mm)
-            .any(|v| !v.is_finite())
-            || !w.t_s.is_finite()
-        {
-            return Err(CsvError::Record(format!(
-                "sample {} has a value that is not finite",
-                w.sample
-            )));
-        }
-        out += &fields.join(",");
-        out.push('\n');
-    }
-    Ok(out)
-}
-
-/// The windows of `seg` as a CSV for people and tools: `sample`, `log_start_s`, `log_end_s`
-/// (the log's clock), `readings`, `t_s` (program clock), `shift_s` (the timing drift),
-/// `anchor`, the standard deviation of each reading column within the window (`<column>_sd`,
-/// µm), and `flags` (`spread`, `motion`, separated by spaces).
-pub fn format_windows(seg: &Segmented) -> String {
-    let mut header = vec![
-        "sample".to_string(),
-        "log_start_s".into(),
-        "log_end_s".into(),
-        "readings".into(),
-        "t_s".into(),
-        "shift_s".into(),
-        "anchor".into(),
-    ];
-    header.extend(seg.columns.iter().map(|c| format!("{c}_sd")));
-    header.push("flags".into());
-    let mut out = header.join(",");
-    out.push('\n');
-    for w in &seg.windows {
-        let mut f = vec![
-            w.sample.to_string(),
-            format_scaled(w.log_start_s, 0),
-            format_scaled(w.log_end_s, 0),
-            w.readings.to_string(),
-            format_scaled(w.t_s, 0),
-            format_scaled(w.shift_s, 0),
-            w.anchor.name().to_string(),
-        ];
-        f.extend(w.sd_mm.iter().map(|&s| format_scaled(s, 3)));
-        f.push(
-            w.flags
-                .iter()
-                .map(|f| f.name())
-                .collect::<Vec<_>>()
-                .join(" "),
-        );
-        out += &f.join(",");
-        out.push('\n');
-    }
-    out
-}
-
-/// A time for messages: at most six decimals, no trailing zeros.
-fn short(x: f64) -> String {
-    model_spec::units::short(x)
 }

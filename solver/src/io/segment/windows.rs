@@ -4,8 +4,10 @@
 use crate::io::csv::CsvError;
 use crate::io::nc::measure::TimingPlan;
 use crate::io::segment::align::{Alignment, Anchor};
-use crate::io::segment::log::LogReader;
+use crate::io::segment::log::{LogClock, LogReader};
 use crate::io::segment::still::{STILL_FLOOR_MM, StillPeriod};
+use crate::io::segment::{SegmentError, SegmentOptions};
+use model_spec::units::short;
 use std::io::Read;
 
 /// Why a window is flagged (the sample is kept; the engineer decides).
@@ -260,4 +262,131 @@ pub(crate) fn flag(windows: &mut [Window], clipped: &[bool]) {
             w.flags.push(WindowFlag::Motion);
         }
     }
+}
+
+#[allow(clippy::too_many_arguments)]
+/// The samples of a static plan: the windows cut (see [`static_cuts`]), averaged, checked for
+/// their number of rows, flagged.
+pub(crate) fn static_windows<R: Read>(
+    file: &str,
+    reader: &mut LogReader<'_, R>,
+    plan: &TimingPlan,
+    al: &Alignment,
+    periods: &[StillPeriod],
+    opts: &SegmentOptions,
+    clock: &LogClock,
+    k: usize,
+) -> Result<Vec<Window>, SegmentError> {
+    let margin = |i: usize| {
+        opts.margin_s
+            .unwrap_or(0.1 * (plan.rows[i].end_s - plan.rows[i].start_s))
+    };
+    let cuts = static_cuts(plan, al, periods, &margin);
+    for (i, w) in cuts.windows(2).enumerate() {
+        if w[1].lo < w[0].hi {
+            return Err(SegmentError::Window {
+                file: file.into(),
+                sample: i + 2,
+                message: format!(
+                    "its window ({} .. {} s, log clock) overlaps the one before ({} .. {} s): the offset given or found does not fit the log",
+                    short(clock.log_time(w[1].lo)),
+                    short(clock.log_time(w[1].hi)),
+                    short(clock.log_time(w[0].lo)),
+                    short(clock.log_time(w[0].hi))
+                ),
+            });
+        }
+    }
+    let sums = average(reader, &cuts, k)?;
+    let min = if opts.min_readings == 0 {
+        5
+    } else {
+        opts.min_readings
+    };
+    let mut out = Vec::with_capacity(cuts.len());
+    for (i, (a, cut)) in sums.into_iter().zip(&cuts).enumerate() {
+        let n = a.n;
+        if n < min {
+            let (lo, hi) = cut.planned;
+            let message = if cut.hi <= cut.lo {
+                format!(
+                    "its window {} .. {} s (log clock) lies outside the still period it was placed in: the log has a gap there, or the machine moved",
+                    short(clock.log_time(lo)),
+                    short(clock.log_time(hi))
+                )
+            } else {
+                format!(
+                    "{n} log row(s) in its window {} .. {} s (log clock), fewer than {min}: the log is too sparse there, or has a gap",
+                    short(clock.log_time(cut.lo)),
+                    short(clock.log_time(cut.hi))
+                )
+            };
+            return Err(SegmentError::Window {
+                file: file.into(),
+                sample: i + 1,
+                message,
+            });
+        }
+        out.push(Window {
+            sample: i + 1,
+            log_start_s: clock.log_time(a.first),
+            log_end_s: clock.log_time(a.last),
+            readings: n,
+            t_s: 0.5 * (a.first + a.last) - al.offset,
+            shift_s: al.placed[i].offset - al.offset,
+            anchor: al.placed[i].anchor,
+            mean_mm: a.mean,
+            sd_mm: a.sd,
+            flags: Vec::new(),
+        });
+    }
+    let clipped: Vec<bool> = cuts.iter().map(|c| c.clipped).collect();
+    flag(&mut out, &clipped);
+    Ok(out)
+}
+
+/// The samples of a continuous plan: the readings at each pose's instant, mapped between the
+/// run's two ends.
+pub(crate) fn continuous_windows<R: Read>(
+    file: &str,
+    reader: &mut LogReader<'_, R>,
+    plan: &TimingPlan,
+    al: &Alignment,
+    period: f64,
+    clock: &LogClock,
+    k: usize,
+) -> Result<Vec<Window>, SegmentError> {
+    let d0 = plan.rows[0].depart_s;
+    let instants: Vec<f64> = plan
+        .rows
+        .iter()
+        .map(|r| al.offset + d0 + al.scale * (r.start_s - d0))
+        .collect();
+    let values = interpolate(reader, &instants, k, 5.0 * period)?.map_err(|(i, why)| {
+        SegmentError::Window {
+            file: file.into(),
+            sample: i + 1,
+            message: format!(
+                "its instant {} s (log clock) cannot be read: {why}",
+                short(clock.log_time(instants[i]))
+            ),
+        }
+    })?;
+    Ok(values
+        .into_iter()
+        .zip(&instants)
+        .enumerate()
+        .map(|(i, (mean, &at))| Window {
+            sample: i + 1,
+            log_start_s: clock.log_time(at),
+            log_end_s: clock.log_time(at),
+            readings: 2,
+            t_s: at - al.offset,
+            shift_s: 0.0,
+            anchor: al.placed[i].anchor,
+            mean_mm: mean,
+            sd_mm: vec![0.0; k],
+            flags: Vec::new(),
+        })
+        .collect())
 }

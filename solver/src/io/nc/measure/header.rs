@@ -46,7 +46,7 @@ pub(crate) fn lines(
         h.push("M129 on controls without FUNCTION TCPM)".into());
         h.push("the active tool must have length 0 and radius 0".into());
     }
-    h.push("the nest's position is in the machine description,".into());
+    h.push("the position of the nest is in the machine description,".into());
     h.push("so no tool length may act on the positions".into());
     h.push("rotary axes: absolute angles, no shortest-path rollover".into());
     if m.symbols.is_empty() {
@@ -97,7 +97,7 @@ pub(crate) fn lines(
             ));
             if iso {
                 h.push("moves: G1 in inverse time (G93: F = 1/min), G64".into());
-                h.push("continuous path, each block's time commanded".into());
+                h.push("continuous path, the time of each block commanded".into());
             } else {
                 heidenhain_feed(&mut h);
             }
@@ -126,7 +126,7 @@ pub(crate) fn lines(
         "planned duration {} s from t = 0",
         short(plan.duration_s())
     ));
-    h.push("the timing plan (CSV) gives each pose's window".into());
+    h.push("the timing plan (CSV) gives the window of each pose".into());
     h
 }
 

@@ -30,14 +30,15 @@
 //! returned), and the plan holds them as written.
 //!
 //! Files: `motion` (move durations, the nest's gap along a move), `text` (the dialects' blocks),
-//! `header` (the assumptions stated in the program), `build` (the program and its plan), `plan`
-//! (the plan, its CSV written and read).
+//! `header` (the assumptions stated in the program), `timing` (the moves' feeds and durations,
+//! the plan's rows), `build` (the program), `plan` (the plan, its CSV written and read).
 
 mod build;
 mod header;
 mod motion;
 mod plan;
 mod text;
+mod timing;
 
 use crate::io::nc::{Dialect, NcError};
 use model_spec::{AxisKind, Machine};

@@ -243,7 +243,7 @@ pub(crate) fn align_static(
         }
     }
     Ok(Alignment {
-        offset: best.placed[0].offset,
+        offset: given.unwrap_or(best.placed[0].offset),
         scale: 1.0,
         anchored: best.anchored,
         runner_up: runner_up.map(|r| (r.placed[0].offset, r.anchored)),

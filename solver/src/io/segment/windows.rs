@@ -46,7 +46,7 @@ pub struct Window {
     /// program's start in the log, s.
     pub t_s: f64,
     /// This pose's offset minus the program start's: how far the machine's timing has drifted
-    /// from the plan by this pose, s.
+    /// from the plan by this pose, s (continuous: the instant found minus the planned one).
     pub shift_s: f64,
     /// How the pose was placed.
     pub anchor: Anchor,
@@ -375,14 +375,15 @@ pub(crate) fn continuous_windows<R: Read>(
     Ok(values
         .into_iter()
         .zip(&instants)
+        .zip(&plan.rows)
         .enumerate()
-        .map(|(i, (mean, &at))| Window {
+        .map(|(i, ((mean, &at), row))| Window {
             sample: i + 1,
             log_start_s: clock.log_time(at),
             log_end_s: clock.log_time(at),
             readings: 2,
             t_s: at - al.offset,
-            shift_s: 0.0,
+            shift_s: at - al.offset - row.start_s,
             anchor: al.placed[i].anchor,
             mean_mm: mean,
             sd_mm: vec![0.0; k],

@@ -50,7 +50,12 @@ enum Verb {
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 13] = [
+const VERBS: [&str; 16] = [
+    Segment(cli::segment::SegmentArgs),
+}
+
+/// The verbs, for the hint of a usage error.
+const VERBS: [&str; 16] = [
     "machines",
     "gains",
     "generate",
@@ -64,6 +69,7 @@ const VERBS: [&str; 13] = [
     "volumetric",
     "path",
     "instrument",
+    "segment",
 ];
 
 /// A clap error as one line: its message and its hints, without the usage block.
@@ -122,6 +128,7 @@ fn main() -> ExitCode {
         Verb::Volumetric(a) => cli::volumetric::run(a),
         Verb::Path(a) => cli::path::run(a),
         Verb::Instrument(a) => cli::instrument::run(a),
+        Verb::Segment(a) => cli::segment::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -15,6 +15,7 @@ pub mod instrument;
 pub mod machines;
 pub mod path;
 pub mod pose_args;
+pub mod segment;
 pub mod simulate;
 pub mod validate;
 pub mod volumetric;

@@ -5,6 +5,8 @@
 //! - [`nc`]: NC programs of commanded poses (ISO G-code, Heidenhain), read and written back;
 //! - [`poses`]: commanded poses, their axis words and their CSV, read and written back;
 //! - [`sensors`]: records of an R-test head's sensor readings, and calibration records;
+//! - [`segment`]: a time-stamped R-test log cut into one sample per pose of a measurement
+//!   program's timing plan;
 //! - [`report`]: the reports (identification, validation, diagnosis, gain tables) as serde
 //!   types, written as JSON; an identification read back;
 //! - [`text`]: the same reports as text for people.
@@ -13,5 +15,6 @@ pub mod csv;
 pub mod nc;
 pub mod poses;
 pub mod report;
+pub mod segment;
 pub mod sensors;
 pub mod text;

@@ -10,7 +10,8 @@
 //!   ball;
 //! - [`truth`]: what a virtual machine's errors really are (TOML files and built-in truths);
 //! - [`readings`]: simulated R-test readings of a truth along a path, with noise and zeroing;
-//! - [`rng`]: the platform-independent noise generator.
+//! - [`rng`]: the platform-independent noise generator;
+//! - [`stream`]: a simulated R-test log of a measurement program's run, streamed row by row.
 
 pub mod exact;
 pub mod fd;
@@ -19,6 +20,7 @@ pub mod paths;
 pub mod pose;
 pub mod readings;
 pub mod rng;
+pub mod stream;
 pub mod truth;
 
 pub use exact::{

@@ -56,6 +56,7 @@ mod write;
 use crate::record::Record;
 pub use blocks::{FIRST_LOOKAHEAD, MeasurementBlocks, time_span};
 pub use checks::LISTED;
+pub(crate) use lines::Lines;
 pub use lines::READ_BUFFER_BYTES;
 use model_spec::catalogue::iso_rank;
 use model_spec::{AxisKind, Machine};

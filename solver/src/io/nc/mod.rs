@@ -50,6 +50,7 @@
 mod error;
 mod heidenhain;
 mod iso;
+pub mod measure;
 mod number;
 mod program;
 mod write;

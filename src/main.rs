@@ -47,15 +47,11 @@ enum Verb {
     Volumetric(cli::volumetric::VolumetricArgs),
     Path(cli::path::PathArgs),
     Instrument(cli::instrument::InstrumentVerb),
-}
-
-/// The verbs, for the hint of a usage error.
-const VERBS: [&str; 16] = [
     Segment(cli::segment::SegmentArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 16] = [
+const VERBS: [&str; 14] = [
     "machines",
     "gains",
     "generate",

@@ -314,3 +314,98 @@ fn bad_input_is_refused_and_writes_nothing() {
     );
     assert_eq!(entries(&dir), ["m.toml"]);
 }
+
+#[test]
+fn the_nc_program_of_a_test_reads_back_to_its_poses_in_both_dialects() {
+    use solver::io::nc::{Dialect, parse_program};
+    use solver::io::poses::axis_words;
+    let dir = temp_dir_tagged("cli-path", "nc");
+    for (machine_name, test, param) in [
+        ("seed-ac", "K4", None),
+        ("head-table-bc", "pair-B-C", Some("Zw=120")),
+    ] {
+        let m = machine(machine_name);
+        let mut params = m.default_parameters();
+        if param.is_some() {
+            let z = m.symbols.iter().position(|s| s.name == "Zw").unwrap();
+            params[z] = 120.0;
+        }
+        let path = generate(&m, test, &params, &GeneratorOptions::default()).unwrap();
+        for (dialect, file) in [(Dialect::Iso, "p.nc"), (Dialect::Heidenhain, "p.h")] {
+            let mut args = vec![
+                "path",
+                "--machine",
+                machine_name,
+                "--test",
+                test,
+                "--nc",
+                dialect.name(),
+                "-o",
+                file,
+            ];
+            if let Some(p) = param {
+                args.extend(["--param", p]);
+            }
+            let out = ok(&dir, &args);
+            assert!(out.contains("Measurement program"), "{out}");
+            let text = std::fs::read_to_string(dir.join(file)).unwrap();
+            let program = parse_program(file, &text, dialect, &axis_words(&m)).unwrap();
+            let poses = program.poses();
+            assert_eq!(poses.len(), path.samples.len(), "{machine_name} {test}");
+            for (p, s) in poses.iter().zip(&path.samples) {
+                for (k, a) in m.axes.iter().enumerate() {
+                    let want = match a.kind {
+                        model_spec::AxisKind::Linear => s.commands[k],
+                        model_spec::AxisKind::Rotary => s.commands[k].to_degrees(),
+                    };
+                    // The program's resolution: 0.0001 mm and 0.0001°.
+                    let rounded = (want * 1e4).round() / 1e4;
+                    assert!(
+                        (p.commands[k] - rounded).abs() < 1e-9,
+                        "{machine_name} {test} {:?}: axis {} {} against {rounded}",
+                        dialect,
+                        a.name,
+                        p.commands[k]
+                    );
+                }
+            }
+            // The timing plan is written beside the program, one row per pose.
+            let plan_file = dir.join(std::path::Path::new(file).with_extension("plan.csv"));
+            let plan = solver::io::nc::measure::read_plan(&plan_file, &m).unwrap();
+            assert_eq!(plan.rows.len(), path.samples.len());
+        }
+    }
+    // A dialect that is not one, and a program to standard output without --plan.
+    fails(
+        &dir,
+        &[
+            "path",
+            "--machine",
+            "seed-ac",
+            "--test",
+            "K4",
+            "--nc",
+            "fanuc",
+            "-o",
+            "x.nc",
+        ],
+        2,
+        &["--nc: `fanuc` is not a dialect"],
+    );
+    fails(
+        &dir,
+        &[
+            "path",
+            "--machine",
+            "seed-ac",
+            "--test",
+            "K4",
+            "--nc",
+            "iso",
+            "-o",
+            "-",
+        ],
+        2,
+        &["--plan FILE"],
+    );
+}

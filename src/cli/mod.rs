@@ -14,6 +14,7 @@ pub mod identify;
 pub mod instrument;
 pub mod machines;
 pub mod path;
+pub mod path_nc;
 pub mod pose_args;
 pub mod segment;
 pub mod simulate;

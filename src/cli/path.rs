@@ -34,6 +34,14 @@ rule: the tool axis within --max-tilt-deg (90) of the table normal, the ball cen
 the first sample, the axis and the limit; nothing is clipped. Where a rotary axis's range (or \
 the tilt rule) is narrower than a full turn, its turn covers what is allowed.
 
+--nc iso|heidenhain -o prog.nc: an NC measurement program of the test instead of the CSV \
+(docs/measurement-programs.md): static (a move, a settle time and a measuring window at each \
+pose; --settle-s, --window-s, --rapid) or --continuous (feed moves through the poses, the R-test \
+sampling at --sample-rate-hz), the assumptions stated in its header (machine coordinates, tool \
+centre point control off, mm and degrees, the kinematic parameters), and its sample-timing plan \
+(CSV, --plan FILE, default the program's name with .plan.csv) that `rtest segment` cuts a \
+streamed log with. The program reads back to the poses to its resolution (--decimals, 4).
+
 `rtest simulate --path NAME` takes the same names at the description's default parameters. \
 `-o -` writes the CSV to standard output (the summary then goes to standard error).";
 
@@ -82,9 +90,11 @@ pub struct PathArgs {
     /// With --list: the list as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE", requires = "list")]
     json: Option<Target>,
-    /// The path CSV to write (`-`: standard output).
+    /// The path CSV to write, or with --nc the NC program (`-`: standard output).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<Target>,
+    #[command(flatten)]
+    nc: super::path_nc::NcArgs,
 }
 
 /// The options of the generator from the flags.
@@ -290,11 +300,19 @@ pub fn run(args: &PathArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     let mut inputs = Vec::new();
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
-    let outputs: Vec<(&str, &Target)> =
-        [("-o", args.output.as_ref()), ("--json", args.json.as_ref())]
-            .into_iter()
-            .filter_map(|(f, t)| t.map(|t| (f, t)))
-            .collect();
+    let dialect = args.nc.dialect()?;
+    let plan_target = match (&dialect, &args.output) {
+        (Some(_), Some(program)) => Some(args.nc.plan_target(program)?),
+        _ => None,
+    };
+    let outputs: Vec<(&str, &Target)> = [
+        ("-o", args.output.as_ref()),
+        ("--json", args.json.as_ref()),
+        ("--plan", plan_target.as_ref()),
+    ]
+    .into_iter()
+    .filter_map(|(f, t)| t.map(|t| (f, t)))
+    .collect();
     check_outputs(&inputs, &outputs, &[])?;
     let params = pose_args::params(&m, args.param.as_deref())?;
     let opts = options(args)?;
@@ -303,9 +321,21 @@ pub fn run(args: &PathArgs) -> CliResult {
     }
     let (spec, record) = poses(args, &m, &params, &opts)?;
     let target = args.output.as_ref().expect("clap requires -o with --test");
-    let csv = csv_text(&m, &spec, &record, &params, &opts, &target.to_string())?;
     let mut files = Outputs::new();
-    files.add("-o", target.clone(), csv);
+    let mut program_note = String::new();
+    match (dialect, plan_target) {
+        (Some(d), Some(plan_target)) => {
+            let (program, plan, note) =
+                super::path_nc::program(&args.nc, d, &m, &spec.name, &record, &params)?;
+            files.add("-o", target.clone(), program);
+            files.add("--plan", plan_target, plan);
+            program_note = note;
+        }
+        _ => {
+            let csv = csv_text(&m, &spec, &record, &params, &opts, &target.to_string())?;
+            files.add("-o", target.clone(), csv);
+        }
+    }
     let written = write(files)?;
     let mut text = format!(
         "Test {} of machine {}: {} samples.\n  {}\n",
@@ -315,6 +345,7 @@ pub fn run(args: &PathArgs) -> CliResult {
         spec.description
     );
     text += &extents(&m, &record);
+    text += &program_note;
     if let Some(c) = changed_params(&m, &params) {
         text +=
             &format!("Kinematic parameters changed from the description's defaults: {c} (mm).\n");

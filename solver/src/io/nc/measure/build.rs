@@ -41,12 +41,12 @@ pub fn measurement_program(
     }
     let (words, written, rounding) = write_poses(m, poses, opts)?;
     let vm = VirtualMachine::new(m);
-    let params = m.default_parameters();
+    let params = &opts.params;
     let internal: Vec<Vec<f64>> = written.iter().map(|w| from_file_units(m, w)).collect();
     let mut widest = 0.0f64;
     for i in 0..internal.len() {
         let next = internal.get(i + 1).unwrap_or(&internal[i]);
-        let gap = largest_gap_mm(&vm, &params, &internal[i], next);
+        let gap = largest_gap_mm(&vm, params, &internal[i], next);
         if gap > opts.max_gap_mm {
             return Err(MeasureError::Move {
                 from: poses.place(i),
@@ -78,6 +78,14 @@ fn check_options(m: &Machine, o: &MeasureOptions) -> Result<(), MeasureError> {
         return bad(format!(
             "{} decimals asked for, at most {MAX_DECIMALS}",
             o.decimals
+        ));
+    }
+    if o.params.len() != m.symbols.len() || o.params.iter().any(|v| !v.is_finite()) {
+        return bad(format!(
+            "{} kinematic parameters for the {} symbols of machine {}, all finite",
+            o.params.len(),
+            m.symbols.len(),
+            m.name
         ));
     }
     if o.rates.len() != m.axes.len() {

@@ -53,8 +53,8 @@ pub(crate) fn lines(
         h.push("kinematic parameters: none".into());
     } else {
         h.push("kinematic parameters (ball and nest), mm:".into());
-        for s in &m.symbols {
-            h.push(format!("  {} = {}", s.name, short(s.default)));
+        for (s, v) in m.symbols.iter().zip(&o.params) {
+            h.push(format!("  {} = {}", s.name, short(*v)));
         }
     }
     h.push("start with the nest on the ball at pose 1: the first".into());

@@ -174,6 +174,10 @@ pub struct MeasureOptions {
     /// The largest distance between the nest and the ball allowed along a move on the nominal
     /// machine, mm. Above 0. Default 0.5 mm.
     pub max_gap_mm: f64,
+    /// The kinematic parameters the poses were planned with (mm, symbol order: the ball
+    /// position among them), stated in the header and used for the nest-ball gap along the
+    /// moves. Default: the machine's defaults.
+    pub params: Vec<f64>,
 }
 
 impl MeasureOptions {
@@ -193,6 +197,7 @@ impl MeasureOptions {
             program_number: 1000,
             approach_feed_mm_min: 500.0,
             max_gap_mm: 0.5,
+            params: m.default_parameters(),
         }
     }
 }

@@ -1,0 +1,146 @@
+//! The NC measurement program of `rtest path --nc`: the flags and the program with its timing
+//! plan, from the record of poses `rtest path` computed (docs/measurement-programs.md).
+
+use super::{CliError, CliResult};
+use model_spec::Machine;
+use output::Target;
+use solver::io::nc::Dialect;
+use solver::io::nc::measure::{
+    ContinuousTiming, MeasureMode, MeasureOptions, StaticMotion, StaticTiming, format_plan,
+    measurement_program, plan_comments,
+};
+use solver::record::Record;
+use std::path::PathBuf;
+
+/// Flags of the measurement program (with `--nc`).
+#[derive(Debug, clap::Args)]
+pub struct NcArgs {
+    /// Write an NC measurement program of the test instead of a path CSV: `iso` (G-code) or
+    /// `heidenhain` (conversational). -o is then the program; --plan its sample-timing plan.
+    #[arg(long, value_name = "iso|heidenhain")]
+    pub nc: Option<String>,
+    /// With --nc: the sample-timing plan (CSV) to write beside the program (default: the
+    /// program's file name with `.plan.csv` in place of its extension).
+    #[arg(long, value_name = "FILE", requires = "nc")]
+    pub plan: Option<Target>,
+    /// With --nc: measure on the fly (feed moves through the poses, the R-test sampling at
+    /// --sample-rate-hz) instead of at rest after each move.
+    #[arg(long, requires = "nc")]
+    pub continuous: bool,
+    /// Static program: settle time at each pose before its measuring window, s.
+    #[arg(long, value_name = "S", requires = "nc", conflicts_with = "continuous")]
+    pub settle_s: Option<f64>,
+    /// Static program: the measuring window at each pose, s.
+    #[arg(long, value_name = "S", requires = "nc", conflicts_with = "continuous")]
+    pub window_s: Option<f64>,
+    /// Static program: rapid moves between the poses (interpolated) instead of feed moves.
+    #[arg(long, requires = "nc", conflicts_with = "continuous")]
+    pub rapid: bool,
+    /// Continuous program: the R-test's sampling rate, Hz.
+    #[arg(long, value_name = "HZ", requires = "continuous")]
+    pub sample_rate_hz: Option<f64>,
+    /// Decimals of the axis words (default 4: 0.0001 mm, 0.0001°).
+    #[arg(long, value_name = "N", requires = "nc")]
+    pub decimals: Option<usize>,
+}
+
+impl NcArgs {
+    /// The dialect of `--nc`, if given.
+    pub fn dialect(&self) -> CliResult<Option<Dialect>> {
+        self.nc
+            .as_deref()
+            .map(|n| {
+                Dialect::from_name(n).ok_or_else(|| {
+                    CliError::usage(format!("--nc: `{n}` is not a dialect (iso or heidenhain)"))
+                })
+            })
+            .transpose()
+    }
+
+    /// The plan's target: --plan, else the program's file with `.plan.csv`.
+    pub fn plan_target(&self, program: &Target) -> CliResult<Target> {
+        if let Some(p) = &self.plan {
+            return Ok(p.clone());
+        }
+        match program {
+            Target::Path(p) => {
+                let mut plan = PathBuf::from(p);
+                plan.set_extension("plan.csv");
+                Ok(Target::Path(plan))
+            }
+            Target::Stdout => Err(CliError::usage(
+                "--nc with -o -: give the timing plan's file with --plan FILE",
+            )),
+        }
+    }
+
+    /// The options of the program for `m` at kinematic parameters `params` (mm).
+    fn options(
+        &self,
+        m: &Machine,
+        dialect: Dialect,
+        test: &str,
+        params: &[f64],
+    ) -> CliResult<MeasureOptions> {
+        let mode = if self.continuous {
+            let mut t = ContinuousTiming::default();
+            if let Some(r) = self.sample_rate_hz {
+                t.sample_rate_hz = r;
+            }
+            MeasureMode::Continuous(t)
+        } else {
+            let mut t = StaticTiming::default();
+            if let Some(s) = self.settle_s {
+                t.settle_s = s;
+            }
+            if let Some(w) = self.window_s {
+                t.window_s = w;
+            }
+            if self.rapid {
+                t.motion = StaticMotion::Rapid;
+            }
+            MeasureMode::Static(t)
+        };
+        let mut o = MeasureOptions::new(m, dialect, mode);
+        o.test_name = test.to_string();
+        o.params = params.to_vec();
+        if let Some(d) = self.decimals {
+            o.decimals = d;
+        }
+        Ok(o)
+    }
+}
+
+/// The measurement program of the poses of `record` (test `test` of `m`, planned at `params`)
+/// and its timing plan's CSV, with a line for people.
+pub fn program(
+    args: &NcArgs,
+    dialect: Dialect,
+    m: &Machine,
+    test: &str,
+    record: &Record,
+    params: &[f64],
+) -> CliResult<(String, String, String)> {
+    let o = args.options(m, dialect, test, params)?;
+    let p = measurement_program(m, record, &o).map_err(|e| match e {
+        solver::io::nc::measure::MeasureError::Options(why) => {
+            CliError::usage(format!("--nc: {why}"))
+        }
+        other => CliError::computation(format!("--nc: {other}")),
+    })?;
+    let plan = format_plan(m, &p.plan, &plan_comments(m, &o, &p))
+        .map_err(|e| CliError::computation(format!("--plan: {e}")))?;
+    let note = format!(
+        "Measurement program ({}, {}): {} poses, planned duration {} s; largest nest-ball gap along a move {} mm (nominal).\n",
+        dialect.name(),
+        if args.continuous {
+            "continuous"
+        } else {
+            "static"
+        },
+        p.plan.rows.len(),
+        model_spec::units::short(p.plan.duration_s()),
+        model_spec::units::short(p.largest_gap_mm)
+    );
+    Ok((p.text, plan, note))
+}

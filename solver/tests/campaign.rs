@@ -301,3 +301,147 @@ fn bad_campaigns_are_refused_naming_the_record() {
     .to_string();
     assert!(e.contains("record `a`"), "{e}");
 }
+
+/// `t` with the ball set-up errors replaced by `setup` (µm).
+fn with_setup(m: &Machine, t: &Truth, setup: [f64; 3]) -> Truth {
+    let mut t = t.clone();
+    for (name, um) in ["XOW", "YOW", "ZOW"].iter().zip(setup) {
+        let term = solver::model::Term::parse(m, name).unwrap();
+        let at: usize = t
+            .model
+            .terms
+            .iter()
+            .take_while(|x| **x != term)
+            .map(|x| x.basis.width())
+            .sum();
+        assert!(t.model.terms.contains(&term), "{name} is in the truth");
+        t.coefficients[at] = um / term.display_factor(m);
+    }
+    t
+}
+
+#[test]
+fn validation_uses_a_fitted_set_up_and_refits_a_new_one() {
+    use solver::fitting::campaign::{CampaignValues, validate_campaign};
+    use solver::fitting::validate::ValidateOptions;
+    let m = machine();
+    let model = reduced(&m);
+    let p = m.default_parameters();
+    let t = truth(&m, "seed-ac-reduced", 0.0, 1, false);
+    let k4 = simulate(&m, &t, &path(&m, "K4")).unwrap();
+    let fitted = Campaign::new(vec![CampaignRecord::new("k4", k4, p.clone(), "a", false)]).unwrap();
+    let (ident, _) = identify_campaign_refined(
+        &m,
+        &model,
+        &fitted,
+        &IdentifyOptions::new(),
+        &RefineOptions::default(),
+        &NoiseChoice::Ordinary,
+    )
+    .unwrap();
+    let values = CampaignValues::of(&ident);
+    // K1 on the same ball, K1 on a ball set up anew (zeroed, so its zero is refitted too).
+    let k1_same = simulate(&m, &t, &path(&m, "K1")).unwrap();
+    let mut moved = with_setup(&m, &t, [40.0, -25.0, 12.0]);
+    moved.zeroed = true;
+    let k1_new = simulate(&m, &moved, &path(&m, "K1")).unwrap();
+    let check = Campaign::new(vec![
+        CampaignRecord::new("k1", k1_same, p.clone(), "a", false),
+        CampaignRecord::new("k1-new", k1_new, p, "b", true),
+    ])
+    .unwrap();
+    let mut opts = ValidateOptions::default();
+    opts.exact = true;
+    let v = validate_campaign(&m, &values, &check, &opts).unwrap();
+    let same = &v.records[0];
+    assert!(same.setup_fitted && same.refitted.is_empty());
+    assert!(
+        same.validation.overall.residual_rms < 1e-9,
+        "{:?}",
+        same.validation.overall
+    );
+    let new = &v.records[1];
+    assert!(!new.setup_fitted);
+    let names: Vec<&str> = new.refitted.iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "XOW[b]",
+            "YOW[b]",
+            "ZOW[b]",
+            "dx0[k1-new]",
+            "dy0[k1-new]",
+            "dz0[k1-new]"
+        ]
+    );
+    assert!(new.validation.overall.measured_rms > 1e-3);
+    assert!(
+        new.validation.overall.residual_rms < 1e-9,
+        "{:?}",
+        new.validation.overall
+    );
+    // Without a refit (the new ball taken for the old one) the prediction is off by the set-up
+    // change.
+    let wrong = Campaign::new(vec![CampaignRecord::new(
+        "k1-new",
+        check.records[1].record.clone(),
+        m.default_parameters(),
+        "a",
+        true,
+    )])
+    .unwrap();
+    let w = validate_campaign(&m, &values, &wrong, &opts).unwrap();
+    assert!(w.records[0].validation.overall.residual_rms > 1e-3);
+}
+
+#[test]
+fn a_drift_on_the_campaign_clock_is_one_drift_over_the_records() {
+    use solver::fitting::campaign::clock::own_clock_terms;
+    let m = machine();
+    let mut model = reduced(&m);
+    let drift = solver::model::Term::parse(&m, "XOC@time:1").unwrap();
+    model.terms.push(drift);
+    let base = truth(&m, "seed-ac-reduced", 0.0, 1, false);
+    // The truth: the reduced errors and XOC drifting by 8 µm over the campaign clock.
+    let mut t = base.clone();
+    t.model.terms.push(drift);
+    t.coefficients.push(8e-3);
+    let records = [("k4", "K4", 0.0), ("k1", "K1", 900.0), ("k2", "K2", 1500.0)];
+    let span = (0.0, 1500.0 + 120.0);
+    let mut rs = Vec::new();
+    for (label, name, start) in records {
+        let p = path(&m, name);
+        let (own, coef) = own_clock_terms(&t.model, &t.coefficients, &p, start, span);
+        let mut local = t.clone();
+        local.model = own;
+        local.coefficients = coef;
+        let measured = simulate(&m, &local, &p).unwrap();
+        rs.push(
+            CampaignRecord::new(label, measured, m.default_parameters(), "ball", false)
+                .starting_at(start),
+        );
+    }
+    let c = Campaign::new(rs).unwrap();
+    let (ident, _) = identify_campaign_refined(
+        &m,
+        &model,
+        &c,
+        &IdentifyOptions::new(),
+        &RefineOptions::default(),
+        &NoiseChoice::Ordinary,
+    )
+    .unwrap();
+    assert_eq!(ident.layout.clock, Some(span));
+    let j = ident
+        .fit
+        .names
+        .iter()
+        .position(|n| n == "XOC@time:1")
+        .unwrap();
+    assert!(
+        (ident.fit.values[j].unwrap() - 8e-3).abs() < 1e-9,
+        "one shared drift: {:?}",
+        ident.fit.values[j]
+    );
+    assert!(ident.fit.residual.amax() < 1e-9);
+}

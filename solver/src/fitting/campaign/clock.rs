@@ -172,3 +172,28 @@ pub fn own_clock_terms(
     }
     (out, coef)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::legendre_affine;
+    use model_spec::basis::legendre;
+
+    #[test]
+    fn affine_legendre_expansions_match_direct_evaluation() {
+        for k in [1u32, 2, 3, 7, 12] {
+            for (a, b) in [(1.0, 0.0), (0.3, -0.4), (0.0, 0.7), (-0.5, 0.25)] {
+                let c = legendre_affine(k, a, b);
+                assert_eq!(c.len(), k as usize + 1);
+                for x in [-1.0, -0.3, 0.0, 0.45, 1.0] {
+                    let direct = legendre(k, a * x + b);
+                    let expanded: f64 = c
+                        .iter()
+                        .enumerate()
+                        .map(|(j, cj)| cj * legendre(j as u32, x))
+                        .sum();
+                    assert!((direct - expanded).abs() < 1e-12, "P{k}({a}x+{b}) at {x}");
+                }
+            }
+        }
+    }
+}

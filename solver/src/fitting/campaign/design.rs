@@ -113,6 +113,24 @@ fn kind(m: &Machine, t: &Term, clock: bool) -> Kind {
     }
 }
 
+/// What the layout needs of a record: its label, set-up, kinematic parameters, zeroing, start
+/// on the campaign clock and number of samples.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordSpec {
+    /// The record's label.
+    pub label: String,
+    /// Its set-up's label.
+    pub setup: String,
+    /// Its kinematic parameters (mm, symbol order).
+    pub params: Vec<f64>,
+    /// Whether its readings were zeroed at the first sample.
+    pub zeroed: bool,
+    /// Its start on the campaign clock (s), if any.
+    pub start_s: Option<f64>,
+    /// Its samples.
+    pub samples: usize,
+}
+
 impl Layout {
     /// The layout of `model` of `m` on `campaign` (checked against `m` first).
     ///
@@ -123,8 +141,6 @@ impl Layout {
         campaign
             .check(m)
             .map_err(|CampaignError(e)| EstimateError::Shape(e))?;
-        check_model(m, model)?;
-        let setups = campaign.setups();
         let clock = span(
             &campaign
                 .records
@@ -132,6 +148,44 @@ impl Layout {
                 .map(|r| (&r.record, r.start_s))
                 .collect::<Vec<_>>(),
         );
+        let specs: Vec<RecordSpec> = campaign
+            .records
+            .iter()
+            .map(|r| RecordSpec {
+                label: r.label.clone(),
+                setup: r.setup.clone(),
+                params: r.params.clone(),
+                zeroed: r.zeroed,
+                start_s: r.start_s,
+                samples: r.record.samples.len(),
+            })
+            .collect();
+        Layout::of_records(m, model, &specs, clock)
+    }
+
+    /// The layout of `model` of `m` on records described by `records` (in campaign order), with
+    /// the campaign clock `clock` (its span, s) or none: what a report read back rebuilds.
+    ///
+    /// # Errors
+    /// A model whose terms do not fit `m`; a clock without a start on every record.
+    pub fn of_records(
+        m: &Machine,
+        model: &Model,
+        records: &[RecordSpec],
+        clock: Option<(f64, f64)>,
+    ) -> Result<Layout, EstimateError> {
+        check_model(m, model)?;
+        if clock.is_some() && records.iter().any(|r| r.start_s.is_none()) {
+            return Err(EstimateError::Shape(
+                "a campaign clock needs a start on every record".into(),
+            ));
+        }
+        let mut setups: Vec<String> = Vec::new();
+        for r in records {
+            if !setups.contains(&r.setup) {
+                setups.push(r.setup.clone());
+            }
+        }
         let on = clock.is_some();
         let mut columns: Vec<Column> = Vec::new();
         let mut push = |t: &Term, owner: Owner, suffix: Option<&str>| {
@@ -160,8 +214,8 @@ impl Layout {
                 push(t, Owner::Setup(s), Some(label));
             }
         }
-        let mut records = Vec::with_capacity(campaign.records.len());
-        for (r, rec) in campaign.records.iter().enumerate() {
+        let mut locals = Vec::with_capacity(records.len());
+        for (r, rec) in records.iter().enumerate() {
             let local = if rec.zeroed {
                 with_offsets(model)
             } else {
@@ -175,15 +229,15 @@ impl Layout {
                 push(t, Owner::Record(r), Some(&rec.label));
             }
             let setup = setups.iter().position(|s| *s == rec.setup).unwrap_or(0);
-            records.push((local, setup));
+            locals.push((local, setup));
         }
         let find = |t: &Term, k: usize, owner: Owner| {
             columns
                 .iter()
                 .position(|c| c.term == *t && c.component == k && c.owner == owner)
         };
-        let mut out = Vec::with_capacity(records.len());
-        for (r, (local, setup)) in records.into_iter().enumerate() {
+        let mut out = Vec::with_capacity(locals.len());
+        for (r, (local, setup)) in locals.into_iter().enumerate() {
             let mut cols = Vec::with_capacity(local.width());
             for (ti, k) in local.columns() {
                 let t = &local.terms[ti];
@@ -196,12 +250,12 @@ impl Layout {
                     EstimateError::Shape(format!(
                         "campaign layout: no column for `{}` of record `{}`",
                         parameter_name(m, t, k),
-                        campaign.records[r].label
+                        records[r].label
                     ))
                 })?;
                 cols.push(c);
             }
-            let rec = &campaign.records[r];
+            let rec = &records[r];
             out.push(RecordColumns {
                 label: rec.label.clone(),
                 setup,
@@ -210,7 +264,7 @@ impl Layout {
                 params: rec.params.clone(),
                 zeroed: rec.zeroed,
                 start_s: rec.start_s,
-                samples: rec.record.samples.len(),
+                samples: rec.samples,
             });
         }
         Ok(Layout {
@@ -219,6 +273,16 @@ impl Layout {
             records: out,
             clock,
         })
+    }
+
+    /// Who owns `term` of this layout's machine: shared, its set-up's or its record's (as the
+    /// module documentation says), for a record on set-up `setup` and record index `record`.
+    pub fn owner_of(&self, m: &Machine, term: &Term, setup: usize, record: usize) -> Owner {
+        match kind(m, term, self.clock.is_some()) {
+            Kind::Shared => Owner::Shared,
+            Kind::Setup => Owner::Setup(setup),
+            Kind::Record => Owner::Record(record),
+        }
     }
 
     /// The column names, in order.
@@ -322,13 +386,30 @@ fn record_block(
     source: &mut GainSource,
 ) -> Result<DMatrix<f64>, EstimateError> {
     let rc = &layout.records[r];
-    let (Some(span), Some(start)) = (layout.clock, rc.start_s) else {
-        return Ok(h_matrix(m, &rc.model, record, source)?);
+    let clock = layout.clock.zip(rc.start_s);
+    block(m, &rc.model, record, source, clock)
+}
+
+/// The H matrix of `model` on `record` (columns in the model's order) with gains from `source`;
+/// with `clock` (`(span, start)`: the campaign clock's span and the record's start on it, s) the
+/// time bases are taken on the campaign clock ([`super::clock`]).
+///
+/// # Errors
+/// As [`h_matrix`].
+pub fn block(
+    m: &Machine,
+    model: &Model,
+    record: &crate::record::Record,
+    source: &mut GainSource,
+    clock: Option<((f64, f64), f64)>,
+) -> Result<DMatrix<f64>, EstimateError> {
+    let Some((span, start)) = clock else {
+        return Ok(h_matrix(m, model, record, source)?);
     };
     // Time bases on the campaign clock: the record's times moved onto it and normalised over the
     // campaign's span; every other term as usual (velocities from the record itself).
     let (timed, other): (Vec<Term>, Vec<Term>) =
-        rc.model.terms.iter().partition(|t| on_clock(t.basis));
+        model.terms.iter().partition(|t| on_clock(t.basis));
     let h_other = h_matrix(m, &Model { terms: other }, record, source)?;
     let h_timed = h_matrix_spanned(
         m,
@@ -337,10 +418,10 @@ fn record_block(
         source,
         Some(span),
     )?;
-    let mut h = DMatrix::zeros(h_other.nrows(), rc.model.width());
+    let mut h = DMatrix::zeros(h_other.nrows(), model.width());
     let (mut a, mut b) = (0, 0);
     let mut at = 0;
-    for t in &rc.model.terms {
+    for t in &model.terms {
         for _ in 0..t.basis.width() {
             if on_clock(t.basis) {
                 h.set_column(at, &h_timed.column(b));

@@ -20,20 +20,27 @@
 //! [`design::Layout`] says which column belongs to whom, [`design::design_matrix`] stacks the
 //! records' H matrices into one, [`fit::identify_campaign`] fits it (first order, ordinary or
 //! generalized least squares), [`refine::identify_campaign_refined`] refines the fit against
-//! the exact machine (each record with its own parameters and set-up values).
+//! the exact machine (each record with its own parameters and set-up values), and
+//! [`validate::validate_campaign`] predicts other records, refitting the set-up errors of a
+//! set-up that was not fitted (and a record's own zero) with the machine's errors held.
 //! `docs/campaigns.md` describes the campaign file and a worked campaign.
 
 pub mod clock;
 pub mod design;
 pub mod fit;
 pub mod refine;
+pub mod validate;
 
-pub use design::{Column, Design, Layout, Owner, RecordColumns, design_matrix};
+pub use design::{Column, Design, Layout, Owner, RecordColumns, RecordSpec, design_matrix};
 pub use fit::{
     CampaignIdentification, RecordFit, choose_campaign_noise, identify_campaign,
     identify_campaign_with,
 };
 pub use refine::{exact_campaign_prediction, identify_campaign_refined, refine_campaign};
+pub use validate::{
+    CampaignValidation, CampaignValues, RecordValidation, Refitted, validate_campaign,
+    validate_record,
+};
 
 use crate::record::Record;
 use model_spec::Machine;
@@ -110,13 +117,17 @@ pub struct Campaign {
 #[error("{0}")]
 pub struct CampaignError(pub String);
 
-/// `true` when `c` may appear in a record or set-up label.
-fn label_char(c: char) -> bool {
+/// `true` when `c` may appear in a record or set-up label: ASCII letters, digits and `- _ . + :`.
+pub fn label_char(c: char) -> bool {
     c.is_ascii_alphanumeric() || "-_.+:".contains(c)
 }
 
-/// Checks a record or set-up label (`what` names it in the message).
-fn check_label(what: &str, label: &str) -> Result<(), CampaignError> {
+/// Checks a record or set-up label (`what` names it in the message): not empty, only
+/// [`label_char`]s.
+///
+/// # Errors
+/// [`CampaignError`] naming `what`, the label and the first character not allowed.
+pub fn check_label(what: &str, label: &str) -> Result<(), CampaignError> {
     if label.is_empty() {
         return Err(CampaignError(format!("{what}: the label is empty")));
     }

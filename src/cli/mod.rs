@@ -4,6 +4,7 @@
 
 pub mod args;
 pub mod bench;
+pub mod campaign;
 pub mod compensate;
 pub mod demo;
 pub mod diagnose;

@@ -56,8 +56,12 @@ pub enum CampaignFileError {
         message: String,
     },
     /// A record's measurement CSV cannot be read (its own file, line and column are named).
-    #[error("record `{label}` ({campaign}:{line}): {error}")]
+    #[error("record `{label}` ({campaign}:{line}): {error}{at}")]
     Record {
+        /// Where the record's kinematic parameters differ from the machine's defaults, what
+        /// they are (the file was read at them): `; read at its kinematic parameters Zw = 300
+        /// mm`; else empty.
+        at: String,
         /// The campaign file.
         campaign: String,
         /// The line of the record's `file` field.
@@ -172,6 +176,27 @@ pub fn read_record_at(
     }
 }
 
+/// `; read at its kinematic parameters Zw = 300 mm (the machine's defaults for the others)`
+/// when `params` differ from `m`'s defaults, else empty: what a message about a record read at
+/// those parameters adds.
+pub fn parameters_note(m: &Machine, params: &[f64]) -> String {
+    let differ: Vec<String> = m
+        .symbols
+        .iter()
+        .zip(params)
+        .filter(|(s, v)| s.default != **v)
+        .map(|(s, v)| format!("{} = {} mm", s.name, model_spec::units::short(*v)))
+        .collect();
+    if differ.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; read at its kinematic parameters {} (the machine's defaults for the others)",
+            differ.join(", ")
+        )
+    }
+}
+
 /// Reads the campaign file at `path` for machine `m` (records not loaded).
 ///
 /// # Errors
@@ -209,6 +234,7 @@ impl CampaignFile {
         for e in &self.records {
             let record = read_record_at(&e.path, m, &e.params, opts).map_err(|error| {
                 CampaignFileError::Record {
+                    at: parameters_note(m, &e.params),
                     campaign: self.file.clone(),
                     line: e.line,
                     label: e.label.clone(),

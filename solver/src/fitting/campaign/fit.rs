@@ -321,6 +321,31 @@ impl CampaignIdentification {
         }
     }
 
+    /// The campaign fit as an [`crate::fitting::Identification`] of the layout's columns (one term
+    /// per column group, named with their owners: `XOW[k4]`), for code that reports a fit:
+    /// samples over every record, zeroed when any record is.
+    pub fn as_identification(&self) -> crate::fitting::Identification {
+        crate::fitting::Identification {
+            machine: self.machine.clone(),
+            model: Model {
+                terms: self
+                    .layout
+                    .columns
+                    .iter()
+                    .filter(|c| c.component == 0)
+                    .map(|c| c.term)
+                    .collect(),
+            },
+            fit: self.fit.clone(),
+            samples: self.records.iter().map(|r| r.samples).sum(),
+            zeroed: self.records.iter().any(|r| r.zeroed),
+            swallowed: self.swallowed.clone(),
+            backend: self.backend,
+            noise: self.noise.clone(),
+            whitened_sigma: self.whitened_sigma,
+        }
+    }
+
     /// The columns owned by `owner`.
     pub fn columns_of(&self, owner: Owner) -> Vec<usize> {
         (0..self.layout.columns.len())

@@ -38,8 +38,8 @@ pub use fit::{
 };
 pub use refine::{exact_campaign_prediction, identify_campaign_refined, refine_campaign};
 pub use validate::{
-    CampaignValidation, CampaignValues, RecordValidation, Refitted, validate_campaign,
-    validate_record,
+    CampaignValidation, CampaignValues, RecordPlan, RecordValidation, Refitted, record_plan,
+    validate_campaign, validate_record,
 };
 
 use crate::record::Record;

@@ -184,27 +184,37 @@ pub fn validate_campaign(
     })
 }
 
-/// Where a column of the validation record's own model takes its value.
-enum Source {
-    /// From the identification's layout column.
-    Known(usize),
-    /// Refitted on the record.
-    Refit,
+/// How a validation record's own model takes its values: the model (with the record's zero
+/// offsets when zeroed), per column the identification's layout column it takes its value
+/// from (`None`: refitted on the record) and its name, whether its set-up and the record itself
+/// were fitted, and the campaign clock `(span, start)` its time bases run on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordPlan {
+    /// The record's own model.
+    pub model: Model,
+    /// Per column: the identification's layout column, or `None` (refitted).
+    pub sources: Vec<Option<usize>>,
+    /// Per column: its name (`XOC`, `XOW[b]`, `dx0[k1]`).
+    pub names: Vec<String>,
+    /// Index of the record's set-up among the identification's, if fitted.
+    pub setup: Option<usize>,
+    /// Index of the record among the identification's, if fitted.
+    pub fitted: Option<usize>,
+    /// The campaign clock's span and the record's start on it, when the identification has one.
+    pub clock: Option<((f64, f64), f64)>,
 }
 
-/// Validates `values` on one record `r` (see the module documentation).
+/// The plan of record `r` under `values` (see [`RecordPlan`]).
 ///
 /// # Errors
-/// A record or model that does not fit `m`; a record on a fitted set-up with other kinematic
-/// parameters; time terms on the identification's campaign clock and a record without a start;
-/// readings missing; parameters without a value under [`Unidentified::Refuse`]; a refit or an
-/// exact prediction that fails.
-pub fn validate_record(
+/// Values that do not match the layout or are not finite; a record on a fitted set-up with
+/// other kinematic parameters; time terms on the campaign clock and a record without a start;
+/// a model that does not fit `m`.
+pub fn record_plan(
     m: &Machine,
     values: &CampaignValues,
     r: &CampaignRecord,
-    opts: &ValidateOptions,
-) -> Result<RecordValidation, ValidateError> {
+) -> Result<RecordPlan, ValidateError> {
     let layout = &values.layout;
     if values.values.len() != layout.columns.len() {
         return Err(ValidateError::Shape(format!(
@@ -255,7 +265,6 @@ pub fn validate_record(
         values.model.clone()
     };
     check_model(m, &model)?;
-    // Where each column's value comes from.
     let mut sources = Vec::with_capacity(model.width());
     let mut names = Vec::with_capacity(model.width());
     for (ti, k) in model.columns() {
@@ -275,35 +284,59 @@ pub fn validate_record(
         };
         let (source, name) = match owner {
             Owner::Shared => match known(Owner::Shared) {
-                Some(c) => (Source::Known(c), base),
+                Some(c) => (Some(c), base),
                 None => {
                     return Err(ValidateError::Shape(format!(
                         "the identification has no shared value for `{base}`"
                     )));
                 }
             },
-            Owner::Setup(s) => {
-                let name = format!("{base}[{}]", r.setup);
-                match (s != usize::MAX).then(|| known(Owner::Setup(s))).flatten() {
-                    Some(c) => (Source::Known(c), name),
-                    None => (Source::Refit, name),
-                }
-            }
-            Owner::Record(x) => {
-                let name = format!("{base}[{}]", r.label);
-                match (x != usize::MAX).then(|| known(Owner::Record(x))).flatten() {
-                    Some(c) => (Source::Known(c), name),
-                    None => (Source::Refit, name),
-                }
-            }
+            Owner::Setup(s) => (
+                (s != usize::MAX).then(|| known(Owner::Setup(s))).flatten(),
+                format!("{base}[{}]", r.setup),
+            ),
+            Owner::Record(x) => (
+                (x != usize::MAX).then(|| known(Owner::Record(x))).flatten(),
+                format!("{base}[{}]", r.label),
+            ),
         };
         sources.push(source);
         names.push(name);
     }
+    Ok(RecordPlan {
+        model,
+        sources,
+        names,
+        setup,
+        fitted,
+        clock,
+    })
+}
+
+/// Validates `values` on one record `r` (see the module documentation).
+///
+/// # Errors
+/// As [`record_plan`]; readings missing; parameters without a value under
+/// [`Unidentified::Refuse`]; a refit or an exact prediction that fails.
+pub fn validate_record(
+    m: &Machine,
+    values: &CampaignValues,
+    r: &CampaignRecord,
+    opts: &ValidateOptions,
+) -> Result<RecordValidation, ValidateError> {
+    let layout = &values.layout;
+    let RecordPlan {
+        model,
+        sources,
+        names,
+        setup,
+        fitted,
+        clock,
+    } = record_plan(m, values, r)?;
     let mut defaulted = Vec::new();
     let mut v = vec![0.0; sources.len()];
     for (k, s) in sources.iter().enumerate() {
-        if let Source::Known(c) = s {
+        if let Some(c) = s {
             match values.values[*c] {
                 Some(x) => v[k] = x,
                 None => defaulted.push(layout.columns[*c].name.clone()),
@@ -314,7 +347,7 @@ pub fn validate_record(
         return Err(ValidateError::Unidentified(defaulted));
     }
     let refit: Vec<usize> = (0..sources.len())
-        .filter(|&k| matches!(sources[k], Source::Refit))
+        .filter(|&k| sources[k].is_none())
         .collect();
     let rec = &r.record;
     if rec.samples.is_empty() {

@@ -61,7 +61,14 @@ impl NoiseArgs {
             }
             return Ok(declared);
         };
-        let still = super::read_record("--noise-record", m, path, read, instrument)?;
+        let still = super::read_record(
+            "--noise-record",
+            m,
+            path,
+            read,
+            instrument,
+            &m.default_parameters(),
+        )?;
         let model = NoiseModel::from_static_record(&still)
             .map_err(|e| CliError::input(format!("--noise-record: {}: {e}", path.display())))?;
         Ok(NoiseChoice::Model(model))

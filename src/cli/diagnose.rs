@@ -3,12 +3,15 @@
 //! accept) and its gain on the fitted and the held-out data.
 
 use super::args::{self, RecordLimits, ValueBounds};
+use super::campaign;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
+use solver::diagnosis::campaign::diagnose_campaign;
 use solver::diagnosis::dictionary::DictionaryOptions;
 use solver::diagnosis::figures::figures;
 use solver::diagnosis::{DiagnoseError, DiagnoseOptions, diagnose};
 use solver::fitting::check_values;
+use solver::io::report::campaign_diagnose::CampaignDiagnosisReport;
 use solver::io::report::{DiagnosisReport, DiagnosisSource, to_json};
 use solver::io::text::diagnose::diagnosis;
 use solver::io::text::validate::zeroed_note;
@@ -87,9 +90,25 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "NAME")]
     model: String,
     /// The measurement CSV the models are fitted on (axes in mm and degrees, dx_um,dy_um,dz_um
-    /// in µm).
+    /// in µm), or a comma list of them: a campaign, each record on its own ball set-up and with
+    /// its own R-test zero, the machine's errors shared (docs/campaigns.md).
+    #[arg(
+        long,
+        value_name = "FILE[,FILE...]",
+        required_unless_present = "campaign"
+    )]
+    data: Option<String>,
+    /// A campaign file (TOML, docs/campaigns.md) whose records are fitted together.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["data", "zeroed", "param"])]
+    campaign: Option<PathBuf>,
+    /// A campaign file of held-out records (their set-ups, ball positions, zeroing), for a
+    /// campaign diagnosis.
     #[arg(long, value_name = "FILE")]
-    data: PathBuf,
+    validate_campaign: Option<PathBuf>,
+    /// Kinematic symbols (mm), `NAME=VALUE,...`, of every --data and --validate record (the
+    /// ball's position), for a campaign diagnosis.
+    #[arg(long, value_name = "NAME=VALUE,...")]
+    param: Option<String>,
     /// Held-out measurement CSVs (comma list) on which the gain is measured; not fitted.
     #[arg(long, value_name = "FILE,FILE")]
     validate: Option<String>,
@@ -160,7 +179,19 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         Some(list) => args::files("--validate", list)?,
         None => Vec::new(),
     };
-    let mut inputs: Vec<(&str, &Path)> = vec![("--data", args.data.as_path())];
+    let files = match &args.data {
+        Some(list) => args::files("--data", list)?,
+        None => Vec::new(),
+    };
+    if args.campaign.is_some()
+        || files.len() > 1
+        || args.validate_campaign.is_some()
+        || args.param.is_some()
+    {
+        return run_campaign(args, &m, &machine_text, &label, &model, &files, &held_files);
+    }
+    let data_path = files[0].as_path();
+    let mut inputs: Vec<(&str, &Path)> = vec![("--data", data_path)];
     inputs.extend(held_files.iter().map(|f| ("--validate", f.as_path())));
     inputs.extend(args.noise.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
@@ -170,12 +201,26 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     check_outputs(&inputs, &outputs, &dirs)?;
 
     let read = args.records.read_options();
-    let record = super::read_record("--data", &m, &args.data, &read, &args.instrument)?;
+    let record = super::read_record(
+        "--data",
+        &m,
+        data_path,
+        &read,
+        &args.instrument,
+        &m.default_parameters(),
+    )?;
     let mut held = Vec::new();
     for f in &held_files {
         held.push((
             f.display().to_string(),
-            super::read_record("--validate", &m, f, &read, &args.instrument)?,
+            super::read_record(
+                "--validate",
+                &m,
+                f,
+                &read,
+                &args.instrument,
+                &m.default_parameters(),
+            )?,
         ));
     }
     let mut opts = DiagnoseOptions::default();
@@ -188,7 +233,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         opts.budget = solver::diagnosis::plausible::Budget::parse(b)
             .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
     }
-    let data = args.data.display().to_string();
+    let data = data_path.display().to_string();
     opts.data_name = data.clone();
     let d = diagnose(&m, &model, &record, &held, &opts).map_err(|e| match e {
         DiagnoseError::Estimate(e)
@@ -251,5 +296,161 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     text.push_str(zeroed_note(&record, args.zeroed));
     let stdout_taken = outputs.iter().any(|(_, t)| matches!(t, Target::Stdout));
     text.push_str(&wrote(&write(files)?));
+    print_text(&text, stdout_taken)
+}
+
+/// The options of a diagnosis from the flags (all but the data).
+fn options(
+    args: &DiagnoseArgs,
+    m: &model_spec::Machine,
+    read: &solver::io::csv::ReadOptions,
+) -> CliResult<DiagnoseOptions> {
+    let mut opts = DiagnoseOptions::default();
+    opts.dictionary = DictionaryOptions::new(args.harmonics, args.poly, args.time);
+    opts.alpha = args.alpha;
+    opts.zeroed = args.zeroed;
+    opts.constraint = args::constraint(args.constraint.as_deref())?;
+    opts.noise = args.noise.choice(m, read, &args.instrument)?;
+    if let Some(b) = &args.budget {
+        opts.budget = solver::diagnosis::plausible::Budget::parse(b)
+            .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
+    }
+    Ok(opts)
+}
+
+/// `rtest diagnose` on a campaign: `--data a.csv,b.csv` or `--campaign FILE`, held out
+/// `--validate` files (each on a set-up of its own) or `--validate-campaign FILE`.
+fn run_campaign(
+    args: &DiagnoseArgs,
+    m: &model_spec::Machine,
+    machine_text: &str,
+    label: &str,
+    model: &solver::model::Model,
+    files: &[PathBuf],
+    held_files: &[PathBuf],
+) -> CliResult {
+    campaign::refuse_instrument(&args.instrument)?;
+    if args.plot.is_some() {
+        return Err(CliError::usage(
+            "--plot draws one fitted record; a campaign diagnosis writes no figures: drop --plot",
+        ));
+    }
+    if args.validate.is_some() && args.validate_campaign.is_some() {
+        return Err(CliError::usage(
+            "--validate and --validate-campaign both give held-out records: give one",
+        ));
+    }
+    let read = args.records.read_options();
+    let params = super::pose_args::params(m, args.param.as_deref())?;
+    let fitted = match &args.campaign {
+        Some(path) => campaign::from_file("--campaign", m, path, &read)?,
+        None => campaign::from_files("--data", m, files, &params, args.zeroed, &read)?,
+    };
+    let held = match &args.validate_campaign {
+        Some(path) => campaign::from_file("--validate-campaign", m, path, &read)?,
+        None if held_files.is_empty() => campaign::Loaded {
+            campaign: solver::fitting::campaign::Campaign {
+                records: Vec::new(),
+            },
+            files: Vec::new(),
+            source: None,
+        },
+        None => campaign::from_files("--validate", m, held_files, &params, args.zeroed, &read)?,
+    };
+    if let Some(r) = held
+        .campaign
+        .records
+        .iter()
+        .find(|r| fitted.campaign.records.iter().any(|f| f.label == r.label))
+    {
+        return Err(CliError::usage(format!(
+            "held-out record `{}` has the label of a fitted record: a held-out record is not fitted (rename one)",
+            r.label
+        )));
+    }
+    let (fitted_inputs, held_inputs) = (fitted.inputs(), held.inputs());
+    let mut inputs: Vec<(&str, &Path)> = fitted_inputs
+        .iter()
+        .map(|p| ("--data", p.as_path()))
+        .collect();
+    inputs.extend(held_inputs.iter().map(|p| ("--validate", p.as_path())));
+    inputs.extend(args.noise.input());
+    inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
+    let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
+    outputs.extend(args.model_out.iter().map(|t| ("--model-out", t)));
+    check_outputs(&inputs, &outputs, &[])?;
+    let flag = if args.campaign.is_some() {
+        "--campaign"
+    } else {
+        "--data"
+    };
+    fitted.check_times(flag, m, model)?;
+    held.check_times("--validate", m, model)?;
+    let mut opts = options(args, m, &read)?;
+    let data = fitted.files.join(",");
+    opts.data_name = data.clone();
+    let (d, part) = diagnose_campaign(m, model, &fitted.campaign, &held.campaign, &opts).map_err(
+        |e| match e {
+            DiagnoseError::Estimate(e)
+            | DiagnoseError::Refine(solver::fitting::RefineError::Estimate(e)) => {
+                super::identify::estimate_error(e)
+            }
+            other => CliError::computation(format!("{flag}: cannot diagnose: {other}")),
+        },
+    )?;
+    for fit in [&d.base_fit, &d.extended_fit] {
+        check_values(m, fit, &args.bounds.values()).map_err(|e| {
+            CliError::computation(format!(
+                "{flag}: implausible result: {e}; the fit does not describe this machine (--max-error-um, --max-error-urad change the bounds)"
+            ))
+        })?;
+    }
+    let mut files_out = Outputs::new();
+    let mut model_out = None;
+    if let Some(target) = &args.model_out {
+        let (name, contents) = d
+            .extended_machine(m, machine_text, label, &format!("rtest diagnose on {data}"))
+            .map_err(|e| CliError::computation(format!("--model-out: {e}")))?;
+        files_out.add("--model-out", target.clone(), contents);
+        model_out = Some((name, target.to_string()));
+    }
+    let held_names: Vec<String> = held
+        .campaign
+        .records
+        .iter()
+        .map(|r| r.label.clone())
+        .collect();
+    let source = DiagnosisSource {
+        machine_source: &args.machine,
+        label,
+        data: &data,
+        samples: fitted.campaign.samples(),
+        held_out: held
+            .campaign
+            .records
+            .iter()
+            .map(|r| (r.label.clone(), r.record.samples.len()))
+            .collect(),
+        opts: &opts,
+        model_out,
+    };
+    let mut report = DiagnosisReport::new(m, &source, &d)
+        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
+    report.campaign = Some(
+        CampaignDiagnosisReport::new(&part, &fitted.files, &held_names)
+            .map_err(|e| CliError::computation(format!("{flag}: {e}")))?,
+    );
+    if let Some(target) = &args.json {
+        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        files_out.add("--json", target.clone(), json);
+    }
+    let mut text = diagnosis(&report);
+    text.push_str(&fitted.zeroed_notes(if args.campaign.is_some() {
+        "say `zeroed = true` for it in the campaign file"
+    } else {
+        "give --zeroed"
+    }));
+    let stdout_taken = outputs.iter().any(|(_, t)| matches!(t, Target::Stdout));
+    text.push_str(&wrote(&write(files_out)?));
     print_text(&text, stdout_taken)
 }

@@ -2,8 +2,10 @@
 //! what the data cannot separate.
 
 use super::args::{self, RecordLimits, ValueBounds};
+use super::campaign;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
+use solver::fitting::campaign::{identify_campaign, identify_campaign_refined};
 use solver::fitting::hmatrix::HMatrixError;
 use solver::fitting::noise::NoiseChoice;
 use solver::fitting::streaming::{StreamingError, identify_file};
@@ -12,7 +14,10 @@ use solver::fitting::{
     identify_refined_noise,
 };
 use solver::io::report::identify::StreamingReport;
-use solver::io::report::{IdentificationReport, IdentificationSource, to_json};
+use solver::io::report::{
+    CampaignReport, CampaignSource, IdentificationReport, IdentificationSource, to_json,
+};
+use solver::io::text::campaign::campaign_identification;
 use solver::io::text::identify::identification;
 use solver::io::text::validate::zeroed_note;
 use std::path::PathBuf;
@@ -88,9 +93,24 @@ pub struct IdentifyArgs {
     /// period:P, step:V, exp:TAU, velocity; instrument terms SXX … SZY).
     #[arg(long, value_name = "LIST")]
     terms: Option<String>,
-    /// The measurement CSV (axes in mm and degrees, dx_um,dy_um,dz_um in µm).
-    #[arg(long, value_name = "FILE")]
-    data: PathBuf,
+    /// The measurement CSV (axes in mm and degrees, dx_um,dy_um,dz_um in µm), or a comma list
+    /// of them: a campaign, each record on its own ball set-up (its own XOW YOW ZOW) and with
+    /// its own R-test zero, the machine's errors shared (docs/campaigns.md).
+    #[arg(
+        long,
+        value_name = "FILE[,FILE...]",
+        required_unless_present = "campaign"
+    )]
+    data: Option<String>,
+    /// A campaign file (TOML: records with their files, labels, set-ups, ball positions,
+    /// zeroing and start times; docs/campaigns.md), fitted together.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["data", "zeroed", "param", "stream"])]
+    campaign: Option<PathBuf>,
+    /// Kinematic symbols (mm), `NAME=VALUE,...`, overriding the machine's defaults for every
+    /// record of --data (the ball's position: Xw=...,Zw=...): the gains and the exact machine
+    /// use them, and the files' linear axes must keep the nest on that ball.
+    #[arg(long, value_name = "NAME=VALUE,...")]
+    param: Option<String>,
     /// The readings were zeroed at the first sample: fit dx0 dy0 dz0 too and say which errors
     /// they swallow.
     #[arg(long)]
@@ -129,9 +149,21 @@ pub struct IdentifyArgs {
 pub fn run(args: &IdentifyArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     let (label, model) = args::model(&m, args.model.as_deref(), args.terms.as_deref())?;
-    let opts = IdentifyOptions::new()
+    let files = match &args.data {
+        Some(list) => args::files("--data", list)?,
+        None => Vec::new(),
+    };
+    if args.campaign.is_some() || files.len() > 1 {
+        return run_campaign(args, &m, &label, &model, &files);
+    }
+    let data_path = files[0].as_path();
+    let params = super::pose_args::params(&m, args.param.as_deref())?;
+    let mut opts = IdentifyOptions::new()
         .zeroed(args.zeroed)
         .constraint(args::constraint(args.constraint.as_deref())?);
+    if args.param.is_some() {
+        opts = opts.params(params.clone());
+    }
     let declared = args.noise.declared()?;
     if args.stream
         && (args.noise.noise_record.is_some() || matches!(declared, NoiseChoice::Model(_)))
@@ -140,16 +172,21 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             "--stream fits by ordinary least squares in one pass; --noise models and --noise-record need the whole record (drop --stream, or use --noise white)",
         ));
     }
-    let mut inputs = vec![("--data", args.data.as_path())];
+    if args.stream && args.param.is_some() {
+        return Err(CliError::usage(
+            "--stream reads the file at the machine's default kinematic parameters; drop --param, or --stream",
+        ));
+    }
+    let mut inputs = vec![("--data", data_path)];
     inputs.extend(args.noise.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
     let read = args.records.read_options();
     let noise = args.noise.choice(&m, &read, &args.instrument)?;
-    let data = args.data.display().to_string();
+    let data = data_path.display().to_string();
     let (ident, refinement, streaming, notes) = if args.stream {
-        let (ident, run) = identify_file(&m, &model, &args.data, &opts, args.block as usize, &read)
+        let (ident, run) = identify_file(&m, &model, data_path, &opts, args.block as usize, &read)
             .map_err(|e| match e {
                 StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
                 e @ StreamingError::ReadTwice(_) => CliError::input(format!("--data: {e}")),
@@ -166,39 +203,27 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         };
         (ident, None, Some(streaming), String::new())
     } else {
-        let record = super::read_record("--data", &m, &args.data, &read, &args.instrument)?;
-        super::check_times(
-            "--data",
-            &args.data,
-            &m,
-            &opts.fitted_model(&model),
-            &record,
-        )?;
+        let record = super::read_record("--data", &m, data_path, &read, &args.instrument, &params)?;
+        super::check_times("--data", data_path, &m, &opts.fitted_model(&model), &record)?;
         let note = zeroed_note(&record, args.zeroed).to_string();
         if args.first_order {
             let ident =
                 identify_noise(&m, &model, &record, &opts, &noise).map_err(estimate_error)?;
             (ident, None, None, note)
         } else {
-            let (ident, r) =
-                identify_refined_noise(&m, &model, &record, &opts, &RefineOptions::default(), &noise)
-                    .map_err(|e| match e {
-                        RefineError::Estimate(e) => estimate_error(e),
-                        e @ RefineError::NotConverged { .. } => CliError::computation(format!(
-                            "--data: {e}: the data do not determine the model well enough for the exact machine (--first-order gives the first-order values)"
-                        )),
-                        other => CliError::computation(format!(
-                            "--data: the refinement against the exact machine failed: {other} (--first-order skips it)"
-                        )),
-                    })?;
+            let (ident, r) = identify_refined_noise(
+                &m,
+                &model,
+                &record,
+                &opts,
+                &RefineOptions::default(),
+                &noise,
+            )
+            .map_err(refine_error)?;
             (ident, Some(r), None, note)
         }
     };
-    check_values(&m, &ident, &args.bounds.values()).map_err(|e| {
-        CliError::computation(format!(
-            "--data: implausible result: {e}; the fit does not describe this machine (too few or unsuitable data, or a model the data cannot determine; --max-error-um, --max-error-urad change the bounds)"
-        ))
-    })?;
+    check_values(&m, &ident, &args.bounds.values()).map_err(|e| implausible(&e))?;
     let source = IdentificationSource {
         data: &data,
         label: &label,
@@ -207,7 +232,19 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let mut report = IdentificationReport::new(&m, source, &ident, refinement.as_ref())
         .map_err(|e| CliError::computation(format!("--data: {e}")))?;
     report.streaming = streaming;
+    if args.param.is_some() {
+        report.notes.push(format!(
+            "kinematic parameters (--param): {}",
+            parameters_text(&m, &params)
+        ));
+    }
     let mut text = identification(&report);
+    if args.param.is_some() {
+        text.push_str(&format!(
+            "Kinematic parameters (--param): {}\n",
+            parameters_text(&m, &params)
+        ));
+    }
     text.push_str(&notes);
     let mut files = Outputs::new();
     if let Some(target) = &args.json {
@@ -216,6 +253,111 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     }
     let stdout_taken = matches!(args.json, Some(Target::Stdout));
     text.push_str(&wrote(&write(files)?));
+    print_text(&text, stdout_taken)
+}
+
+/// `Xw = -217.504 mm, …`: every symbol and its value.
+fn parameters_text(m: &model_spec::Machine, params: &[f64]) -> String {
+    m.symbols
+        .iter()
+        .zip(params)
+        .map(|(s, v)| format!("{} = {} mm", s.name, model_spec::units::short(*v)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// An implausible result as a verb's error.
+fn implausible(e: &solver::fitting::Implausible) -> CliError {
+    CliError::computation(format!(
+        "--data: implausible result: {e}; the fit does not describe this machine (too few or unsuitable data, or a model the data cannot determine; --max-error-um, --max-error-urad change the bounds)"
+    ))
+}
+
+/// A refinement error as a verb's error.
+fn refine_error(e: RefineError) -> CliError {
+    match e {
+        RefineError::Estimate(e) => estimate_error(e),
+        e @ RefineError::NotConverged { .. } => CliError::computation(format!(
+            "--data: {e}: the data do not determine the model well enough for the exact machine (--first-order gives the first-order values)"
+        )),
+        other => CliError::computation(format!(
+            "--data: the refinement against the exact machine failed: {other} (--first-order skips it)"
+        )),
+    }
+}
+
+/// `rtest identify` on a campaign: `--data a.csv,b.csv` or `--campaign FILE`.
+fn run_campaign(
+    args: &IdentifyArgs,
+    m: &model_spec::Machine,
+    label: &str,
+    model: &solver::model::Model,
+    files: &[PathBuf],
+) -> CliResult {
+    if args.stream {
+        return Err(CliError::usage(
+            "--stream reads one long record; a campaign (several --data files) is fitted whole: drop --stream",
+        ));
+    }
+    campaign::refuse_instrument(&args.instrument)?;
+    let read = args.records.read_options();
+    let loaded = match &args.campaign {
+        Some(path) => {
+            check_outputs(&[("--campaign", path.as_path())], &[], &[])?;
+            campaign::from_file("--campaign", m, path, &read)?
+        }
+        None => {
+            let params = super::pose_args::params(m, args.param.as_deref())?;
+            campaign::from_files("--data", m, files, &params, args.zeroed, &read)?
+        }
+    };
+    let flag = if args.campaign.is_some() {
+        "--campaign"
+    } else {
+        "--data"
+    };
+    let all_inputs = loaded.inputs();
+    let mut inputs: Vec<(&str, &std::path::Path)> =
+        all_inputs.iter().map(|p| (flag, p.as_path())).collect();
+    inputs.extend(args.noise.input());
+    inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
+    let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
+    check_outputs(&inputs, &outputs, &[])?;
+    loaded.check_times(flag, m, model)?;
+    let noise = args.noise.choice(m, &read, &args.instrument)?;
+    let opts = IdentifyOptions::new().constraint(args::constraint(args.constraint.as_deref())?);
+    let c = &loaded.campaign;
+    let (ident, refinement) = if args.first_order {
+        let ident = identify_campaign(m, model, c, &opts, &noise).map_err(estimate_error)?;
+        (ident, None)
+    } else {
+        let (ident, r) =
+            identify_campaign_refined(m, model, c, &opts, &RefineOptions::default(), &noise)
+                .map_err(refine_error)?;
+        (ident, Some(r))
+    };
+    campaign::check_campaign_values(m, &ident.layout, &ident.fit.values, &args.bounds.values())
+        .map_err(|e| implausible(&e))?;
+    let source = CampaignSource {
+        label,
+        base_model: args.model.as_deref(),
+        data: &loaded.files,
+    };
+    let report = CampaignReport::new(m, source, &ident, refinement.as_ref())
+        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
+    let mut text = campaign_identification(&report);
+    text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {
+        "say `zeroed = true` for it in the campaign file"
+    } else {
+        "give --zeroed"
+    }));
+    let mut out = Outputs::new();
+    if let Some(target) = &args.json {
+        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        out.add("--json", target.clone(), json);
+    }
+    let stdout_taken = matches!(args.json, Some(Target::Stdout));
+    text.push_str(&wrote(&write(out)?));
     print_text(&text, stdout_taken)
 }
 

@@ -4,6 +4,7 @@
 
 pub mod args;
 pub mod bench;
+pub mod campaign;
 pub mod compensate;
 pub mod demo;
 pub mod diagnose;
@@ -109,7 +110,8 @@ pub fn load_machine_and_text(name_or_path: &str) -> CliResult<(Machine, String)>
 
 /// The record of a measurement CSV given by `flag` (mm and rad inside), read with `options`:
 /// of error vectors, or of the sensor readings of `instrument` when it names one (turned into
-/// error vectors with their covariances, docs/instrument.md). Every problem with the file is a
+/// error vectors with their covariances, docs/instrument.md), planned at the kinematic parameters
+/// `params` (mm: the ball position among them). Every problem with the file is a
 /// bad input naming the flag, the file and the line.
 pub fn read_record(
     flag: &str,
@@ -117,14 +119,21 @@ pub fn read_record(
     path: &Path,
     options: &ReadOptions,
     instrument: &args::InstrumentArgs,
+    params: &[f64],
 ) -> CliResult<Record> {
+    let at = solver::io::campaign::machine_at(m, params);
     let read = match instrument.load()? {
-        None => solver::io::csv::read_measurement(path, m, options),
+        None => solver::io::csv::read_measurement(path, &at, options),
         Some((i, frame)) => {
-            solver::io::sensors::read_sensor_measurement(path, m, &i, frame, options)
+            solver::io::sensors::read_sensor_measurement(path, &at, &i, frame, options)
         }
     };
-    read.map_err(|e| CliError::input(format!("{flag}: {e}")))
+    read.map_err(|e| {
+        CliError::input(format!(
+            "{flag}: {e}{}",
+            solver::io::campaign::parameters_note(m, params)
+        ))
+    })
 }
 
 /// Refuses `record` (read from `path`, given by `flag`) for `model` when a term needs the real

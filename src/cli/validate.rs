@@ -1,14 +1,20 @@
 //! `rtest validate`: identified values (an `identify` JSON) predict another measurement;
 //! residuals before (nominal machine) and after (identified model), per direction.
 
-use super::args::{RecordLimits, ValueBounds};
+use super::args::{self, RecordLimits, ValueBounds};
+use super::campaign;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
+use solver::fitting::campaign::validate_campaign;
 use solver::fitting::hmatrix::parameter_names;
 use solver::fitting::sanity::check_model_values;
 use solver::fitting::validate::Unidentified;
 use solver::fitting::{ValidateError, ValidateOptions, validate};
-use solver::io::report::{ValidationReport, ValidationSource, read_identification, to_json};
+use solver::io::report::{
+    CampaignValidationReport, CampaignValidationSource, ReadValues, ValidationReport,
+    ValidationSource, to_json,
+};
+use solver::io::text::campaign::campaign_validation;
 use solver::io::text::validate::{validation, zeroed_note};
 use std::path::PathBuf;
 
@@ -50,10 +56,30 @@ pub struct ValidateArgs {
     /// The JSON written by `rtest identify --json` (values in µm and µrad).
     #[arg(long, value_name = "FILE")]
     params: PathBuf,
-    /// The measurement CSV to predict (axes in mm and degrees, dx_um,dy_um,dz_um in µm).
-    #[arg(long, value_name = "FILE")]
-    data: PathBuf,
-    /// The readings of --data were zeroed at the first sample: zero the prediction there too.
+    /// The measurement CSV to predict (axes in mm and degrees, dx_um,dy_um,dz_um in µm), or a
+    /// comma list of them (each record labelled by its file's stem).
+    #[arg(
+        long,
+        value_name = "FILE[,FILE...]",
+        required_unless_present = "campaign"
+    )]
+    data: Option<String>,
+    /// A campaign file to predict (TOML: records with their set-ups, ball positions, zeroing;
+    /// docs/campaigns.md): a record on a fitted set-up uses its values, a record on a new
+    /// set-up has its set-up errors (and its zero, when zeroed) refitted.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["data", "zeroed", "param", "setup"])]
+    campaign: Option<PathBuf>,
+    /// The set-up label of every --data record: a set-up of the identification (its set-up
+    /// errors are used) or a new one (refitted on each record). Default: each record its own
+    /// set-up, named by its file's stem.
+    #[arg(long, value_name = "LABEL")]
+    setup: Option<String>,
+    /// Kinematic symbols (mm), `NAME=VALUE,...`, of every --data record (the ball's position),
+    /// overriding the machine's defaults.
+    #[arg(long, value_name = "NAME=VALUE,...")]
+    param: Option<String>,
+    /// The readings of --data were zeroed at the first sample: zero the prediction there too
+    /// (one record and a single identification), or refit each record's zero (a campaign).
     #[arg(long)]
     zeroed: bool,
     /// Predict with the first-order model H·v instead of the exact machine.
@@ -76,54 +102,62 @@ pub struct ValidateArgs {
 /// Runs `rtest validate`.
 pub fn run(args: &ValidateArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
-    let mut inputs = vec![
-        ("--params", args.params.as_path()),
-        ("--data", args.data.as_path()),
-    ];
+    let files = match &args.data {
+        Some(list) => args::files("--data", list)?,
+        None => Vec::new(),
+    };
+    let mut inputs = vec![("--params", args.params.as_path())];
+    inputs.extend(files.iter().map(|f| ("--data", f.as_path())));
+    inputs.extend(args.campaign.iter().map(|f| ("--campaign", f.as_path())));
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
-    let params = read_identification(&args.params, &m)
+    let read_values = solver::io::report::read_values(&args.params, &m)
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
-    let names = parameter_names(&m, &params.model);
+    let single_case =
+        files.len() == 1 && args.campaign.is_none() && args.setup.is_none() && args.param.is_none();
+    match read_values {
+        ReadValues::Single { values, .. } if single_case => run_single(args, &m, &files[0], values),
+        values => run_campaign(args, &m, &files, &values),
+    }
+}
+
+/// One record predicted by a single identification: the prediction as it always was.
+fn run_single(
+    args: &ValidateArgs,
+    m: &model_spec::Machine,
+    data_path: &std::path::Path,
+    params: solver::io::report::IdentifiedValues,
+) -> CliResult {
+    let names = parameter_names(m, &params.model);
     check_model_values(
-        &m,
+        m,
         &params.model,
         &names,
         &params.values,
         &args.bounds.values(),
     )
-    .map_err(|e| {
-        CliError::input(format!(
-            "--params: {}: {e}: these cannot be the errors of a machine tool (--max-error-um, --max-error-urad change the bounds)",
-            args.params.display()
-        ))
-    })?;
+    .map_err(|e| implausible(args, &e))?;
     let record = super::read_record(
         "--data",
-        &m,
-        &args.data,
+        m,
+        data_path,
         &args.records.read_options(),
         &args.instrument,
+        &m.default_parameters(),
     )?;
-    super::check_times("--data", &args.data, &m, &params.model, &record)?;
+    super::check_times("--data", data_path, m, &params.model, &record)?;
     let mut opts = ValidateOptions::default();
     opts.zeroed = args.zeroed;
     opts.exact = !args.first_order;
     if args.refuse_undetermined {
         opts.unidentified = Unidentified::Refuse;
     }
-    let v = validate(&m, &params.model, &params.values, &record, &opts).map_err(|e| match e {
-        ValidateError::Unidentified(names) => CliError::input(format!(
-            "--params: {} gave no value for {} (not determined by the identification) and --refuse-undetermined is set (without it they are set to 0)",
-            args.params.display(),
-            names.join(", ")
-        )),
-        other => CliError::computation(format!("--data: cannot validate: {other}")),
-    })?;
+    let v = validate(m, &params.model, &params.values, &record, &opts)
+        .map_err(|e| validate_error(args, e))?;
     let (params_file, data) = (
         args.params.display().to_string(),
-        args.data.display().to_string(),
+        data_path.display().to_string(),
     );
     let source = ValidationSource {
         machine: &m.name,
@@ -136,11 +170,100 @@ pub fn run(args: &ValidateArgs) -> CliResult {
         .map_err(|e| CliError::computation(format!("--data: {e}")))?;
     let mut text = validation(&report);
     text.push_str(zeroed_note(&record, args.zeroed));
+    finish(args, text, to_json(&report))
+}
+
+/// Writes `json` (the report's JSON, when asked) and prints `text`.
+fn finish(
+    args: &ValidateArgs,
+    mut text: String,
+    json: Result<String, serde_json::Error>,
+) -> CliResult {
     let mut files = Outputs::new();
     if let Some(target) = &args.json {
-        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        let json = json.map_err(|e| CliError::computation(format!("--json: {e}")))?;
         files.add("--json", target.clone(), json);
     }
     text.push_str(&wrote(&write(files)?));
     print_text(&text, matches!(args.json, Some(Target::Stdout)))
+}
+
+/// Values that cannot be a machine's, as a verb's error.
+fn implausible(args: &ValidateArgs, e: &solver::fitting::Implausible) -> CliError {
+    CliError::input(format!(
+        "--params: {}: {e}: these cannot be the errors of a machine tool (--max-error-um, --max-error-urad change the bounds)",
+        args.params.display()
+    ))
+}
+
+/// A validation error as a verb's error.
+fn validate_error(args: &ValidateArgs, e: ValidateError) -> CliError {
+    match e {
+        ValidateError::Unidentified(names) => CliError::input(format!(
+            "--params: {} gave no value for {} (not determined by the identification) and --refuse-undetermined is set (without it they are set to 0)",
+            args.params.display(),
+            names.join(", ")
+        )),
+        other => CliError::computation(format!("--data: cannot validate: {other}")),
+    }
+}
+
+/// Records predicted with a campaign's values (or a single identification seen as a campaign
+/// of one record), each on its set-up.
+fn run_campaign(
+    args: &ValidateArgs,
+    m: &model_spec::Machine,
+    files: &[PathBuf],
+    read_values: &ReadValues,
+) -> CliResult {
+    campaign::refuse_instrument(&args.instrument)?;
+    let (values, model_name) = read_values
+        .as_campaign(m)
+        .map_err(|e| CliError::input(format!("--params: {e}")))?;
+    campaign::check_campaign_values(m, &values.layout, &values.values, &args.bounds.values())
+        .map_err(|e| implausible(args, &e))?;
+    let read = args.records.read_options();
+    let mut loaded = match &args.campaign {
+        Some(path) => campaign::from_file("--campaign", m, path, &read)?,
+        None => {
+            let params = super::pose_args::params(m, args.param.as_deref())?;
+            campaign::from_files("--data", m, files, &params, args.zeroed, &read)?
+        }
+    };
+    if let Some(setup) = &args.setup {
+        solver::fitting::campaign::check_label("--setup", setup)
+            .map_err(|e| CliError::usage(e.to_string()))?;
+        for r in &mut loaded.campaign.records {
+            r.setup = setup.clone();
+        }
+    }
+    let flag = if args.campaign.is_some() {
+        "--campaign"
+    } else {
+        "--data"
+    };
+    loaded.check_times(flag, m, &values.model)?;
+    let mut opts = ValidateOptions::default();
+    opts.exact = !args.first_order;
+    if args.refuse_undetermined {
+        opts.unidentified = Unidentified::Refuse;
+    }
+    let v = validate_campaign(m, &values, &loaded.campaign, &opts)
+        .map_err(|e| validate_error(args, e))?;
+    let params_file = args.params.display().to_string();
+    let source = CampaignValidationSource {
+        model: &model_name,
+        params: &params_file,
+        data: &loaded.files,
+        exact: !args.first_order,
+    };
+    let report = CampaignValidationReport::new(m, source, &v)
+        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
+    let mut text = campaign_validation(&report);
+    text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {
+        "say `zeroed = true` for it in the campaign file"
+    } else {
+        "give --zeroed"
+    }));
+    finish(args, text, to_json(&report))
 }

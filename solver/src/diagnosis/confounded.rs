@@ -49,9 +49,8 @@ pub(super) fn confounded_with(
     // The extended model's columns, scaled to unit norm, with their term indices in `extended`.
     let mut cols: Vec<DVector<f64>> = Vec::new();
     let mut owner: Vec<usize> = Vec::new();
-    for (ti, t) in extended.terms.iter().enumerate() {
+    for ti in 0..extended.terms.len() {
         let all_index = if ti < nb { ti } else { nb + chosen[ti - nb] };
-        debug_assert_eq!(widths[all_index], t.basis.width());
         for k in 0..widths[all_index] {
             let c = h_all.column(starts[all_index] + k).into_owned();
             let norm = c.norm();

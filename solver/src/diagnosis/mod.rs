@@ -16,8 +16,12 @@
 //!    that changes something.
 //! 4. Refit the extended model (refined against the exact machine), and measure the residual
 //!    RMS before and after on the fitted record and on every held-out record.
+//!
+//! [`campaign::diagnose_campaign`] does the same on a campaign (several records, each with its
+//! own set-up and zero).
 
 pub mod adequacy;
+pub mod campaign;
 mod confounded;
 pub mod dictionary;
 pub mod figures;

@@ -269,6 +269,10 @@ pub struct DiagnosisReport {
     pub adequacy_unavailable: Option<String>,
     /// What remains unexplained, per direction the test finds inconsistent with the noise.
     pub unexplained: Vec<UnexplainedReport>,
+    /// The campaign's records and held-out set-ups, for a diagnosis on a campaign; absent for
+    /// one record.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub campaign: Option<super::campaign_diagnose::CampaignDiagnosisReport>,
 }
 
 /// What the report says besides the diagnosis: where things come from and go.
@@ -547,6 +551,7 @@ impl DiagnosisReport {
                 .enumerate()
                 .map(|(i, u)| unexplained(i, u))
                 .collect::<Result<_, _>>()?,
+            campaign: None,
         })
     }
 }

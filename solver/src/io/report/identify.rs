@@ -235,58 +235,13 @@ impl IdentificationReport {
         refinement: Option<&Refinement>,
     ) -> Result<IdentificationReport, NonFinite> {
         let fit = &ident.fit;
-        let id = &fit.identifiability;
         let mut parameters = Vec::with_capacity(fit.names.len());
         for (j, (t, k)) in ident.model.columns().into_iter().enumerate() {
-            let term = ident.model.terms[t];
-            let f = term.display_factor(m);
-            let names = term.basis.column_names();
-            let field = |what: &str| format!("parameters[{j}].{what}");
-            parameters.push(ParameterReport {
-                name: fit.names[j].clone(),
-                error: term.effect.name(m),
-                basis: names.get(k).unwrap_or(&names[0]).clone(),
-                value: finite_opt(|| field("value"), fit.values[j].map(|v| v * f))?,
-                std: finite_opt(|| field("std"), fit.std[j].map(|v| v * f))?,
-                unit: term.unit(m).to_string(),
-                determined: id.determined[j],
-                fixed: fit.fixed[j],
-                over_mm: poly_stroke(m, &term),
-            });
+            parameters.push(parameter_report(m, &ident.model.terms[t], k, fit, j)?);
         }
-        let name = |j: usize| fit.names[j].clone();
-        let refinement = match refinement {
-            Some(r) => RefinementReport {
-                method: "exact".into(),
-                iterations: r.iterations,
-                converged: r.converged,
-                steps_um: r
-                    .steps_mm
-                    .iter()
-                    .enumerate()
-                    .map(|(i, s)| finite(|| format!("refinement.steps_um[{i}]"), s * UM_PER_MM))
-                    .collect::<Result<_, _>>()?,
-                tolerance_um: Some(finite(
-                    || "refinement.tolerance_um".into(),
-                    r.tolerance_mm * UM_PER_MM,
-                )?),
-                first_order_rms_um: finite(
-                    || "refinement.first_order_rms_um".into(),
-                    r.rms_mm.0 * UM_PER_MM,
-                )?,
-            },
-            None => RefinementReport {
-                method: "first-order".into(),
-                iterations: 0,
-                converged: true,
-                steps_um: Vec::new(),
-                tolerance_um: None,
-                first_order_rms_um: finite(
-                    || "refinement.first_order_rms_um".into(),
-                    fit.residual_rms() * UM_PER_MM,
-                )?,
-            },
-        };
+        let refinement = refinement_report(refinement, fit)?;
+        let mut report = fit_report(fit)?;
+        report.notes = notes(fit, &ident.swallowed, &refinement);
         Ok(IdentificationReport {
             machine: m.name.clone(),
             fingerprint: m.fingerprint(),
@@ -295,54 +250,180 @@ impl IdentificationReport {
             base_model: source.base_model.map(str::to_string),
             terms: ident.model.terms.iter().map(|t| t.spelling(m)).collect(),
             parameters,
-            residual_rms_um: finite(|| "residual_rms_um".into(), fit.residual_rms() * UM_PER_MM)?,
-            rank: fit.rank,
-            free_parameters: fit.fixed.iter().filter(|f| !**f).count(),
-            condition: finite_opt(|| "condition".into(), fit.condition)?,
-            confounded: id
-                .confounded
-                .iter()
-                .map(|g| g.iter().map(|&j| name(j)).collect())
-                .collect(),
+            residual_rms_um: report.residual_rms_um,
+            rank: report.rank,
+            free_parameters: report.free_parameters,
+            condition: report.condition,
+            confounded: report.confounded,
             samples: ident.samples,
-            readings: fit.rows(),
-            dof: fit.dof,
+            readings: report.readings,
+            dof: report.dof,
             zeroed: ident.zeroed,
-            constraint: constraint_text(&fit.constraint),
-            sigma_um: finite_opt(|| "sigma_um".into(), fit.sigma.map(|s| s * UM_PER_MM))?,
-            near_confounded: id
-                .near_confounded
-                .iter()
-                .map(|p| {
-                    Ok(NearPairReport {
-                        parameters: [name(p.a), name(p.b)],
-                        correlation: finite(
-                            || "near_confounded.correlation".into(),
-                            p.correlation,
-                        )?,
-                    })
-                })
-                .collect::<Result<_, NonFinite>>()?,
-            swallowed: ident
-                .swallowed
-                .iter()
-                .map(|s: &Swallowed| SwallowedReport {
-                    offsets: s.offsets.clone(),
-                    errors: s.errors.clone(),
-                })
-                .collect(),
+            constraint: report.constraint,
+            sigma_um: report.sigma_um,
+            near_confounded: report.near_confounded,
+            swallowed: FitSummary::swallowed_of(&ident.swallowed),
             gains: backend_name(ident.backend).into(),
-            notes: notes(ident, &refinement),
+            notes: report.notes,
             refinement,
-            noise_model: Some(noise_report(ident)?),
+            noise_model: Some(noise_report(&ident.noise, ident.whitened_sigma)?),
             streaming: None,
         })
     }
 }
 
-/// The noise model of `ident` in µm.
-fn noise_report(ident: &Identification) -> Result<NoiseModelReport, NonFinite> {
-    let n = &ident.noise;
+/// The report of column `j` of `fit`, the component `k` of `term` (in the term's unit).
+///
+/// # Errors
+/// [`NonFinite`] for a value or uncertainty that is not finite.
+pub(crate) fn parameter_report(
+    m: &Machine,
+    term: &crate::model::Term,
+    k: usize,
+    fit: &crate::fitting::Fit,
+    j: usize,
+) -> Result<ParameterReport, NonFinite> {
+    let f = term.display_factor(m);
+    let names = term.basis.column_names();
+    let field = |what: &str| format!("parameters[{j}].{what}");
+    Ok(ParameterReport {
+        name: fit.names[j].clone(),
+        error: term.effect.name(m),
+        basis: names.get(k).unwrap_or(&names[0]).clone(),
+        value: finite_opt(|| field("value"), fit.values[j].map(|v| v * f))?,
+        std: finite_opt(|| field("std"), fit.std[j].map(|v| v * f))?,
+        unit: term.unit(m).to_string(),
+        determined: fit.identifiability.determined[j],
+        fixed: fit.fixed[j],
+        over_mm: poly_stroke(m, term),
+    })
+}
+
+/// What every fit report says of its fit, in report units (the fields of
+/// [`IdentificationReport`] of the same names).
+pub(crate) struct FitSummary {
+    /// `√(RSS / 3N)`, µm.
+    pub residual_rms_um: f64,
+    /// Numerical rank.
+    pub rank: usize,
+    /// Free parameters.
+    pub free_parameters: usize,
+    /// Condition number.
+    pub condition: Option<f64>,
+    /// Confounded groups, by name.
+    pub confounded: Vec<Vec<String>>,
+    /// Readings fitted.
+    pub readings: usize,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// The constraint's text.
+    pub constraint: String,
+    /// σ̂, µm.
+    pub sigma_um: Option<f64>,
+    /// Near-confounded pairs.
+    pub near_confounded: Vec<NearPairReport>,
+    /// Statements for people.
+    pub notes: Vec<String>,
+}
+
+impl FitSummary {
+    /// The swallowed groups as reported.
+    pub(crate) fn swallowed_of(swallowed: &[Swallowed]) -> Vec<SwallowedReport> {
+        swallowed
+            .iter()
+            .map(|s: &Swallowed| SwallowedReport {
+                offsets: s.offsets.clone(),
+                errors: s.errors.clone(),
+            })
+            .collect()
+    }
+}
+
+/// The summary of `fit` (notes left empty).
+///
+/// # Errors
+/// [`NonFinite`] for a statistic that is not finite.
+pub(crate) fn fit_report(fit: &crate::fitting::Fit) -> Result<FitSummary, NonFinite> {
+    let id = &fit.identifiability;
+    let name = |j: usize| fit.names[j].clone();
+    Ok(FitSummary {
+        residual_rms_um: finite(|| "residual_rms_um".into(), fit.residual_rms() * UM_PER_MM)?,
+        rank: fit.rank,
+        free_parameters: fit.fixed.iter().filter(|f| !**f).count(),
+        condition: finite_opt(|| "condition".into(), fit.condition)?,
+        confounded: id
+            .confounded
+            .iter()
+            .map(|g| g.iter().map(|&j| name(j)).collect())
+            .collect(),
+        readings: fit.rows(),
+        dof: fit.dof,
+        constraint: constraint_text(&fit.constraint),
+        sigma_um: finite_opt(|| "sigma_um".into(), fit.sigma.map(|s| s * UM_PER_MM))?,
+        near_confounded: id
+            .near_confounded
+            .iter()
+            .map(|p| {
+                Ok(NearPairReport {
+                    parameters: [name(p.a), name(p.b)],
+                    correlation: finite(|| "near_confounded.correlation".into(), p.correlation)?,
+                })
+            })
+            .collect::<Result<_, NonFinite>>()?,
+        notes: Vec::new(),
+    })
+}
+
+/// The refinement as reported: refined as `refinement` says, or first order (`None`).
+///
+/// # Errors
+/// [`NonFinite`] for a step or RMS that is not finite.
+pub(crate) fn refinement_report(
+    refinement: Option<&Refinement>,
+    fit: &crate::fitting::Fit,
+) -> Result<RefinementReport, NonFinite> {
+    Ok(match refinement {
+        Some(r) => RefinementReport {
+            method: "exact".into(),
+            iterations: r.iterations,
+            converged: r.converged,
+            steps_um: r
+                .steps_mm
+                .iter()
+                .enumerate()
+                .map(|(i, s)| finite(|| format!("refinement.steps_um[{i}]"), s * UM_PER_MM))
+                .collect::<Result<_, _>>()?,
+            tolerance_um: Some(finite(
+                || "refinement.tolerance_um".into(),
+                r.tolerance_mm * UM_PER_MM,
+            )?),
+            first_order_rms_um: finite(
+                || "refinement.first_order_rms_um".into(),
+                r.rms_mm.0 * UM_PER_MM,
+            )?,
+        },
+        None => RefinementReport {
+            method: "first-order".into(),
+            iterations: 0,
+            converged: true,
+            steps_um: Vec::new(),
+            tolerance_um: None,
+            first_order_rms_um: finite(
+                || "refinement.first_order_rms_um".into(),
+                fit.residual_rms() * UM_PER_MM,
+            )?,
+        },
+    })
+}
+
+/// The noise model `n` in µm, with the σ̂ of the whitened residual `whitened`.
+///
+/// # Errors
+/// [`NonFinite`] for a σ that is not finite.
+pub(crate) fn noise_report(
+    n: &crate::fitting::noise::NoiseModel,
+    whitened: Option<f64>,
+) -> Result<NoiseModelReport, NonFinite> {
     let mut sigma_um = [0.0; 3];
     for (d, s) in sigma_um.iter_mut().enumerate() {
         *s = finite(
@@ -354,15 +435,18 @@ fn noise_report(ident: &Identification) -> Result<NoiseModelReport, NonFinite> {
         source: n.source.keyword().into(),
         sigma_um,
         phi: n.phi,
-        whitened_sigma: finite_opt(|| "noise_model.whitened_sigma".into(), ident.whitened_sigma)?,
+        whitened_sigma: finite_opt(|| "noise_model.whitened_sigma".into(), whitened)?,
         text: n.to_string(),
     })
 }
 
 /// The statements for people: what the offsets swallow, what has no value, no uncertainty,
 /// no convergence.
-fn notes(ident: &Identification, refinement: &RefinementReport) -> Vec<String> {
-    let fit = &ident.fit;
+pub(crate) fn notes(
+    fit: &crate::fitting::Fit,
+    swallowed: &[Swallowed],
+    refinement: &RefinementReport,
+) -> Vec<String> {
     let id = &fit.identifiability;
     let mut notes = Vec::new();
     if !refinement.converged {
@@ -372,7 +456,7 @@ fn notes(ident: &Identification, refinement: &RefinementReport) -> Vec<String> {
             refinement.steps_um.last().map_or("?".into(), |s| format!("{s:.3e}"))
         ));
     }
-    for s in &ident.swallowed {
+    for s in swallowed {
         notes.push(format!(
             "zeroed readings: the sensor offset{} {} cannot be told from {} (constant gains)",
             if s.offsets.len() > 1 { "s" } else { "" },

@@ -12,9 +12,16 @@
 //! - **`null` means "undetermined".** A value, an uncertainty or a condition number the data do
 //!   not determine is `null`; nothing else is.
 //!
+//! The campaign reports ([`campaign`], [`campaign_validate`]) give per-record and per-set-up
+//! values and residuals; [`campaign_read::read_values`] reads either kind of identification back.
+//!
 //! [`identify::IdentificationReport`] can be read back ([`read::IdentifiedValues`]): `validate`
 //! takes its model and values, after checking that it belongs to the machine.
 
+pub mod campaign;
+pub mod campaign_diagnose;
+pub mod campaign_read;
+pub mod campaign_validate;
 pub mod compensate;
 pub mod diagnose;
 pub mod gains;
@@ -23,6 +30,9 @@ pub mod read;
 pub mod validate;
 pub mod verdict;
 
+pub use campaign::{CampaignReport, CampaignSource};
+pub use campaign_read::{CampaignRead, ReadValues, read_values};
+pub use campaign_validate::{CampaignValidationReport, CampaignValidationSource};
 pub use diagnose::{DiagnosisReport, DiagnosisSource};
 pub use gains::{GainTableReport, PoseGainsReport};
 pub use identify::{IdentificationReport, IdentificationSource};

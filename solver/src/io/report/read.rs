@@ -139,62 +139,9 @@ pub fn parse_identification(
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let root: Value = serde_json::from_str(text).map_err(|e| json_error(file, text, &e))?;
     let r = Reader { file, m };
-    if !root.is_object() {
-        return Err(r.bad("(top level)", "expected a JSON object".into()));
-    }
-    let machine = r.string(&root, "machine", "machine")?;
-    if machine != m.name {
-        return Err(r.bad(
-            "machine",
-            format!("the values are for machine `{machine}`, not `{}`", m.name),
-        ));
-    }
-    let fingerprint = match root.get("fingerprint") {
-        Some(_) => r.string(&root, "fingerprint", "fingerprint")?,
-        None => {
-            return Err(r.bad(
-                "fingerprint",
-                "missing: the report does not say which machine description it was identified on (identify again with this rtest)".into(),
-            ));
-        }
-    };
-    let own = m.fingerprint();
-    if fingerprint != own {
-        return Err(r.bad(
-            "fingerprint",
-            format!(
-                "`{fingerprint}` is not this description of machine {}'s (`{own}`): the values were identified on a machine with another topology or other kinematic defaults, and do not apply to this one",
-                m.name
-            ),
-        ));
-    }
-    let base = match root.get("base_model") {
-        None | Some(Value::Null) => None,
-        Some(Value::String(base)) => match Model::of(m, base) {
-            Some(model) => Some((base.clone(), model)),
-            None => {
-                return Err(r.bad(
-                    "base_model",
-                    format!(
-                        "machine {} has no model `{base}` (models: {})",
-                        m.name,
-                        m.model_names().join(", ")
-                    ),
-                ));
-            }
-        },
-        Some(other) => {
-            return Err(r.bad("base_model", format!("expected a string, found {other}")));
-        }
-    };
-    if let Some(Value::Object(refinement)) = root.get("refinement")
-        && refinement.get("converged") == Some(&Value::Bool(false))
-    {
-        return Err(r.bad(
-            "refinement.converged",
-            "false: the refinement against the exact machine did not converge, so these values are not an identification".into(),
-        ));
-    }
+    let (machine, fingerprint) = r.header(&root)?;
+    let base = r.base_model(&root)?;
+    r.converged(&root)?;
     let model_name = r.string(&root, "model", "model")?;
     let (model, columns) = r.parameters(&root)?;
     let spelled: Vec<String> = model.terms.iter().map(|t| t.spelling(m)).collect();
@@ -262,18 +209,7 @@ pub fn parse_identification(
             ));
         }
     }
-    let constraint = match root.get("constraint") {
-        None | Some(Value::Null) => "none".to_string(),
-        Some(Value::String(c)) if c == "none" || c == "minimum-norm" || c.starts_with("zero:") => {
-            c.clone()
-        }
-        Some(other) => {
-            return Err(r.bad(
-                "constraint",
-                format!("expected `none`, `minimum-norm` or `zero: NAME, …`, found {other}"),
-            ));
-        }
-    };
+    let constraint = r.constraint(&root)?;
     let Columns {
         values,
         std,
@@ -296,15 +232,19 @@ pub fn parse_identification(
 
 /// What a report says of each model column, in internal units.
 #[derive(Default)]
-struct Columns {
-    values: Vec<Option<f64>>,
-    std: Vec<Option<f64>>,
-    determined: Vec<bool>,
-    fixed: Vec<bool>,
+pub(crate) struct Columns {
+    /// Values.
+    pub(crate) values: Vec<Option<f64>>,
+    /// Standard uncertainties.
+    pub(crate) std: Vec<Option<f64>>,
+    /// Determined.
+    pub(crate) determined: Vec<bool>,
+    /// Fixed by the constraint.
+    pub(crate) fixed: Vec<bool>,
 }
 
 /// A JSON syntax error located in characters: the parser counts columns in bytes.
-fn json_error(file: &str, text: &str, e: &serde_json::Error) -> ReportError {
+pub(crate) fn json_error(file: &str, text: &str, e: &serde_json::Error) -> ReportError {
     let line = e.line().max(1);
     let line_text = text.split('\n').nth(line - 1).unwrap_or("");
     let mut byte = e.column().saturating_sub(1).min(line_text.len());
@@ -325,13 +265,104 @@ fn json_error(file: &str, text: &str, e: &serde_json::Error) -> ReportError {
 }
 
 /// Reads fields of one report, naming its file in errors.
-struct Reader<'a> {
-    file: &'a str,
-    m: &'a Machine,
+pub(crate) struct Reader<'a> {
+    /// The file, as named in messages.
+    pub(crate) file: &'a str,
+    /// The machine.
+    pub(crate) m: &'a Machine,
 }
 
 impl Reader<'_> {
-    fn bad(&self, field: &str, message: String) -> ReportError {
+    /// Checks that `root` is an object for this machine (name and fingerprint): the machine's
+    /// name and fingerprint as written.
+    pub(crate) fn header(&self, root: &Value) -> Result<(String, String), ReportError> {
+        let (r, m) = (self, self.m);
+        if !root.is_object() {
+            return Err(r.bad("(top level)", "expected a JSON object".into()));
+        }
+        let machine = r.string(root, "machine", "machine")?;
+        if machine != m.name {
+            return Err(r.bad(
+                "machine",
+                format!("the values are for machine `{machine}`, not `{}`", m.name),
+            ));
+        }
+        let fingerprint = match root.get("fingerprint") {
+            Some(_) => r.string(root, "fingerprint", "fingerprint")?,
+            None => {
+                return Err(r.bad(
+                    "fingerprint",
+                    "missing: the report does not say which machine description it was identified on (identify again with this rtest)".into(),
+                ));
+            }
+        };
+        let own = m.fingerprint();
+        if fingerprint != own {
+            return Err(r.bad(
+                "fingerprint",
+                format!(
+                    "`{fingerprint}` is not this description of machine {}'s (`{own}`): the values were identified on a machine with another topology or other kinematic defaults, and do not apply to this one",
+                    m.name
+                ),
+            ));
+        }
+        Ok((machine, fingerprint))
+    }
+
+    /// The base model named by `base_model`, if any.
+    pub(crate) fn base_model(&self, root: &Value) -> Result<Option<(String, Model)>, ReportError> {
+        let (r, m) = (self, self.m);
+        Ok(match root.get("base_model") {
+            None | Some(Value::Null) => None,
+            Some(Value::String(base)) => match Model::of(m, base) {
+                Some(model) => Some((base.clone(), model)),
+                None => {
+                    return Err(r.bad(
+                        "base_model",
+                        format!(
+                            "machine {} has no model `{base}` (models: {})",
+                            m.name,
+                            m.model_names().join(", ")
+                        ),
+                    ));
+                }
+            },
+            Some(other) => {
+                return Err(r.bad("base_model", format!("expected a string, found {other}")));
+            }
+        })
+    }
+
+    /// Refuses a report whose refinement did not converge.
+    pub(crate) fn converged(&self, root: &Value) -> Result<(), ReportError> {
+        if let Some(Value::Object(refinement)) = root.get("refinement")
+            && refinement.get("converged") == Some(&Value::Bool(false))
+        {
+            return Err(self.bad(
+                "refinement.converged",
+                "false: the refinement against the exact machine did not converge, so these values are not an identification".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The constraint of the fit as written (`none` without the field).
+    pub(crate) fn constraint(&self, root: &Value) -> Result<String, ReportError> {
+        match root.get("constraint") {
+            None | Some(Value::Null) => Ok("none".to_string()),
+            Some(Value::String(c))
+                if c == "none" || c == "minimum-norm" || c.starts_with("zero:") =>
+            {
+                Ok(c.clone())
+            }
+            Some(other) => Err(self.bad(
+                "constraint",
+                format!("expected `none`, `minimum-norm` or `zero: NAME, …`, found {other}"),
+            )),
+        }
+    }
+
+    pub(crate) fn bad(&self, field: &str, message: String) -> ReportError {
         ReportError::Field {
             file: self.file.to_string(),
             field: field.to_string(),
@@ -340,7 +371,7 @@ impl Reader<'_> {
     }
 
     /// The string field `key` of `v`, named `field` in errors.
-    fn string(&self, v: &Value, key: &str, field: &str) -> Result<String, ReportError> {
+    pub(crate) fn string(&self, v: &Value, key: &str, field: &str) -> Result<String, ReportError> {
         match v.get(key) {
             Some(Value::String(s)) => Ok(s.clone()),
             Some(other) => Err(self.bad(field, format!("expected a string, found {other}"))),
@@ -391,7 +422,6 @@ impl Reader<'_> {
 
     /// The model and values of `parameters`.
     fn parameters(&self, root: &Value) -> Result<(Model, Columns), ReportError> {
-        let m = self.m;
         let params = match root.get("parameters") {
             Some(Value::Array(a)) if !a.is_empty() => a,
             Some(Value::Array(_)) => return Err(self.bad("parameters", "is empty".into())),
@@ -404,6 +434,37 @@ impl Reader<'_> {
         let mut columns = Columns::default();
         let mut i = 0;
         while i < params.len() {
+            let (term, c) = self.term_at(params, i)?;
+            if model.terms.contains(&term) {
+                return Err(self.bad(
+                    &format!("parameters[{i}].error"),
+                    format!(
+                        "`{}` with basis `{}` appears twice",
+                        term.effect.name(self.m),
+                        term.basis
+                    ),
+                ));
+            }
+            columns.values.extend(c.values);
+            columns.std.extend(c.std);
+            columns.determined.extend(c.determined);
+            columns.fixed.extend(c.fixed);
+            model.terms.push(term);
+            i += term.basis.width();
+        }
+        Ok((model, columns))
+    }
+
+    /// The term of `params[i]` (and of `params[i + 1]`, the `sin` column of a harmonic) and
+    /// what the report says of its columns, checked as the module documentation says.
+    pub(crate) fn term_at(
+        &self,
+        params: &[Value],
+        i: usize,
+    ) -> Result<(Term, Columns), ReportError> {
+        let m = self.m;
+        let mut columns = Columns::default();
+        {
             let field = |name: &str| format!("parameters[{i}].{name}");
             let p = &params[i];
             if !p.is_object() {
@@ -435,12 +496,6 @@ impl Reader<'_> {
                 ));
             }
             let term = Term::new(m, effect, basis).map_err(|e| self.bad(&field("basis"), e.0))?;
-            if model.terms.contains(&term) {
-                return Err(self.bad(
-                    &field("error"),
-                    format!("`{error}` with basis `{basis}` appears twice"),
-                ));
-            }
             for k in 0..basis.width() {
                 let j = i + k;
                 let field = |name: &str| format!("parameters[{j}].{name}");
@@ -510,10 +565,8 @@ impl Reader<'_> {
                     .push(determined.unwrap_or(value.is_some()));
                 columns.fixed.push(fixed);
             }
-            model.terms.push(term);
-            i += basis.width();
+            Ok((term, columns))
         }
-        Ok((model, columns))
     }
 
     /// The optional number `key` of the parameter `q` (`null` or absent: `None`), divided by

@@ -73,7 +73,11 @@ pub struct ValidationSource<'a> {
     pub exact: bool,
 }
 
-fn direction(field: &str, s: &Stats) -> Result<DirectionReport, NonFinite> {
+/// The report of `s` (mm) in µm, `field` naming it when a value is not finite.
+///
+/// # Errors
+/// [`NonFinite`].
+pub(crate) fn direction(field: &str, s: &Stats) -> Result<DirectionReport, NonFinite> {
     let um = |what: &str, x: f64| finite(|| format!("{field}.{what}"), x * UM_PER_MM);
     Ok(DirectionReport {
         measured_rms_um: um("measured_rms_um", s.measured_rms)?,

@@ -374,6 +374,9 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
             .collect();
         out.push_str(&format!("Held out (not fitted): {}\n", h.join(", ")));
     }
+    if let Some(c) = &r.campaign {
+        out.push_str(&campaign(c));
+    }
     out.push_str(&outliers(r));
     out.push_str(&format!("Noise model of every test: {}\n", r.noise_model));
     out.push_str(&format!(
@@ -430,5 +433,69 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
     out.push_str(&recommendation(r));
     out.push('\n');
     out.push_str(&next_steps(r));
+    out
+}
+
+/// The records of a campaign diagnosis: set-up, samples, outliers, residual RMS before and after;
+/// the held-out records' set-ups; what differs from one record.
+fn campaign(c: &crate::io::report::campaign_diagnose::CampaignDiagnosisReport) -> String {
+    let head = super::header(&[
+        "record",
+        "set-up",
+        "data",
+        "samples",
+        "outliers",
+        "base RMS µm",
+        "extended RMS µm",
+    ]);
+    let rows: Vec<Vec<String>> = c
+        .records
+        .iter()
+        .map(|r| {
+            vec![
+                r.label.clone(),
+                r.setup.clone(),
+                r.data.clone(),
+                r.samples.to_string(),
+                r.outliers.len().to_string(),
+                value(r.residual_rms_before_um),
+                value(r.residual_rms_after_um),
+            ]
+        })
+        .collect();
+    let mut out = String::from(
+        "Campaign: the machine's errors shared; each record with its own kinematic parameters, its set-up's errors and its own zero.\n",
+    );
+    out.push_str(&super::table(&head, &rows));
+    for r in &c.records {
+        for o in &r.outliers {
+            out.push_str(&format!(
+                "Outlier of record {}: {}, {} {} µm (left out)\n",
+                r.label,
+                o.line
+                    .map_or(format!("sample {}", o.sample + 1), |l| format!(
+                        "{}:{l}",
+                        r.data
+                    )),
+                o.direction,
+                value(o.residual_um)
+            ));
+        }
+    }
+    for h in &c.held_out {
+        out.push_str(&format!(
+            "Held out {}: set-up {}{}\n",
+            h.name,
+            h.setup,
+            if h.setup_fitted {
+                " (fitted: its values predict)"
+            } else {
+                " (new: its set-up errors refitted on it, the machine's values held)"
+            }
+        ));
+    }
+    for n in &c.notes {
+        out.push_str(&format!("Note: {n}.\n"));
+    }
     out
 }

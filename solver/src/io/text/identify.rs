@@ -3,7 +3,7 @@
 //! confounded groups, the nearly confounded pairs and what the zero offsets swallow.
 
 use super::{value, zeroed_text};
-use crate::io::report::identify::IdentificationReport;
+use crate::io::report::identify::{IdentificationReport, ParameterReport};
 use model_spec::units::plural;
 use model_spec::units::{fixed, symbol};
 
@@ -61,7 +61,7 @@ pub fn identification(r: &IdentificationReport) -> String {
 }
 
 /// How the values were computed, one line.
-fn method(r: &IdentificationReport) -> String {
+pub(crate) fn method(r: &IdentificationReport) -> String {
     let gains = match r.gains.as_str() {
         "compiled" => "the compiled (generated) code",
         "evaluator" => "the in-process evaluator",
@@ -98,8 +98,14 @@ fn method(r: &IdentificationReport) -> String {
 
 /// The table of parameters.
 fn parameters(r: &IdentificationReport) -> String {
-    let w = r
-        .parameters
+    let all: Vec<&ParameterReport> = r.parameters.iter().collect();
+    parameter_table(&all, &r.confounded)
+}
+
+/// The table of `params` (value ± std, or why there is none), `confounded` the fit's groups by
+/// name.
+pub(crate) fn parameter_table(params: &[&ParameterReport], confounded: &[Vec<String>]) -> String {
+    let w = params
         .iter()
         .map(|p| p.name.chars().count())
         .max()
@@ -110,10 +116,10 @@ fn parameters(r: &IdentificationReport) -> String {
         "parameter", "value", "std"
     );
     out.push_str(&format!("{}\n", "-".repeat(w + 36)));
-    for p in &r.parameters {
+    for p in params {
         let unit = symbol(&p.unit);
         let name = &p.name;
-        let why = || match confounded_with(r, name) {
+        let why = || match confounded_with(confounded, name) {
             Some(o) if !o.is_empty() => format!("not determined: confounded with {o}"),
             _ => "not determined: these readings do not see it (no gain along this path)".into(),
         };
@@ -147,8 +153,8 @@ fn parameters(r: &IdentificationReport) -> String {
 }
 
 /// The other members of `name`'s confounded group, joined, or `None`.
-fn confounded_with(r: &IdentificationReport, name: &str) -> Option<String> {
-    let g = r.confounded.iter().find(|g| g.iter().any(|n| n == name))?;
+fn confounded_with(confounded: &[Vec<String>], name: &str) -> Option<String> {
+    let g = confounded.iter().find(|g| g.iter().any(|n| n == name))?;
     let others: Vec<&str> = g
         .iter()
         .filter(|n| *n != name)
@@ -158,7 +164,7 @@ fn confounded_with(r: &IdentificationReport, name: &str) -> Option<String> {
 }
 
 /// Rank, condition, residual, σ̂, confounded groups, near pairs, swallowed errors.
-fn summary(r: &IdentificationReport) -> String {
+pub(crate) fn summary(r: &IdentificationReport) -> String {
     let n = r.parameters.len();
     let mut out = format!(
         "rank {} of {}{}; condition number {} (column-scaled H)\n",

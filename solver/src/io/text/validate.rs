@@ -2,7 +2,7 @@
 //! nominal machine) and after (the model).
 
 use super::{header, table, zeroed_text};
-use crate::io::report::validate::ValidationReport;
+use crate::io::report::validate::{DirectionReport, ValidationReport};
 use crate::record::Record;
 use model_spec::units::{fixed, readable};
 
@@ -55,6 +55,15 @@ pub fn defaulted_note(r: &ValidationReport) -> String {
 /// Residual RMS and max per direction and overall (µm), before and after, one block of rows
 /// per validation (name, report).
 pub fn residual_table(rows: &[(&str, &ValidationReport)]) -> String {
+    let blocks: Vec<(String, [(&str, &DirectionReport); 4])> = rows
+        .iter()
+        .map(|(name, r)| (name.to_string(), r.rows()))
+        .collect();
+    residual_table_rows(&blocks)
+}
+
+/// Residual RMS and max (µm), before and after, one block of rows (x, y, z, all) per name.
+pub fn residual_table_rows(blocks: &[(String, [(&str, &DirectionReport); 4])]) -> String {
     let head = header(&[
         "data",
         "dir",
@@ -64,8 +73,8 @@ pub fn residual_table(rows: &[(&str, &ValidationReport)]) -> String {
         "after max µm",
     ]);
     let mut cells = Vec::new();
-    for (name, r) in rows {
-        for (i, (dir, s)) in r.rows().into_iter().enumerate() {
+    for (name, rows) in blocks {
+        for (i, (dir, s)) in rows.iter().enumerate() {
             cells.push(vec![
                 if i == 0 {
                     name.to_string()

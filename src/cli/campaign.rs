@@ -1,0 +1,159 @@
+//! What `identify`, `validate` and `diagnose` share for campaigns: the records of
+//! `--data a.csv,b.csv` (each its own set-up and its own R-test zero) or of `--campaign FILE`,
+//! their checks, and the plausibility of a campaign's values.
+
+use super::{CliError, CliResult};
+use model_spec::Machine;
+use solver::fitting::campaign::{Campaign, CampaignRecord, Layout};
+use solver::fitting::sanity::{ValueLimits, check_model_values};
+use solver::io::campaign::{CampaignFileError, labels_from_files, load_campaign, read_record_at};
+use solver::io::csv::ReadOptions;
+use solver::model::Model;
+use std::path::{Path, PathBuf};
+
+/// Refuses `--instrument` for a campaign: its fit does not weight records by the covariances
+/// sensor readings carry (a record read through an instrument is identified alone).
+pub fn refuse_instrument(instrument: &super::args::InstrumentArgs) -> CliResult<()> {
+    if instrument.instrument.is_some() {
+        return Err(CliError::usage(
+            "--instrument: a campaign (several --data files or --campaign) is fitted without the per-sample covariances of sensor readings, so sensor records are not taken in a campaign yet: identify each sensor record alone",
+        ));
+    }
+    Ok(())
+}
+
+/// A campaign read from the command line, with the file of each record.
+pub struct Loaded {
+    /// The campaign.
+    pub campaign: Campaign,
+    /// Per record, its measurement file as given (for reports).
+    pub files: Vec<String>,
+    /// The campaign file, when the records came from one.
+    pub source: Option<PathBuf>,
+}
+
+/// The records of `files` (given by `flag`), each on a set-up of its own labelled by the
+/// file's stem (made unique), at kinematic parameters `params` (mm), zeroed or not.
+pub fn from_files(
+    flag: &str,
+    m: &Machine,
+    files: &[PathBuf],
+    params: &[f64],
+    zeroed: bool,
+    read: &ReadOptions,
+) -> CliResult<Loaded> {
+    let labels = labels_from_files(files);
+    let mut records = Vec::with_capacity(files.len());
+    for (f, label) in files.iter().zip(&labels) {
+        let record = read_record_at(f, m, params, read).map_err(|e| {
+            CliError::input(format!(
+                "{flag}: {e}{}",
+                solver::io::campaign::parameters_note(m, params)
+            ))
+        })?;
+        records.push(CampaignRecord::new(
+            label.clone(),
+            record,
+            params.to_vec(),
+            label.clone(),
+            zeroed,
+        ));
+    }
+    let campaign = Campaign::new(records).map_err(|e| CliError::usage(format!("{flag}: {e}")))?;
+    Ok(Loaded {
+        campaign,
+        files: files.iter().map(|f| f.display().to_string()).collect(),
+        source: None,
+    })
+}
+
+/// The campaign of the campaign file `path` (given by `flag`), every record's CSV read at its
+/// kinematic parameters.
+pub fn from_file(flag: &str, m: &Machine, path: &Path, read: &ReadOptions) -> CliResult<Loaded> {
+    let (file, campaign) = load_campaign(path, m, read).map_err(|e| match e {
+        e @ CampaignFileError::Text(_) => CliError::input(format!("{flag}: {e}")),
+        e => CliError::input(format!("{flag}: {e}")),
+    })?;
+    Ok(Loaded {
+        campaign,
+        files: file
+            .records
+            .iter()
+            .map(|r| r.path.display().to_string())
+            .collect(),
+        source: Some(path.to_path_buf()),
+    })
+}
+
+impl Loaded {
+    /// Every input file: the campaign file and the records' files, for the check that no
+    /// output names an input.
+    pub fn inputs(&self) -> Vec<PathBuf> {
+        self.source
+            .iter()
+            .cloned()
+            .chain(self.files.iter().map(PathBuf::from))
+            .collect()
+    }
+
+    /// Refuses a record without real times for a term that needs them, naming the record and
+    /// its file.
+    pub fn check_times(&self, flag: &str, m: &Machine, model: &Model) -> CliResult<()> {
+        for (r, f) in self.campaign.records.iter().zip(&self.files) {
+            let mut local = model.clone();
+            if r.zeroed {
+                local = solver::fitting::with_offsets(&local);
+            }
+            super::check_times(
+                &format!("{flag} (record `{}`)", r.label),
+                Path::new(f),
+                m,
+                &local,
+                &r.record,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The note for every record whose first reading is exactly 0 but that is not declared
+    /// zeroed.
+    pub fn zeroed_notes(&self, hint: &str) -> String {
+        self.campaign
+            .records
+            .iter()
+            .filter(|r| r.record.looks_zeroed() && !r.zeroed)
+            .map(|r| {
+                format!(
+                    "Note: the first reading of record `{}` is exactly 0: if its readings were zeroed at the first sample, {hint}.\n",
+                    r.label
+                )
+            })
+            .collect()
+    }
+}
+
+/// The layout's columns as a model (one term per column group, harmonics' two columns once),
+/// for the plausibility check of its values.
+pub fn columns_model(layout: &Layout) -> Model {
+    Model {
+        terms: layout
+            .columns
+            .iter()
+            .filter(|c| c.component == 0)
+            .map(|c| c.term)
+            .collect(),
+    }
+}
+
+/// Checks a campaign's values against the plausibility bounds.
+///
+/// # Errors
+/// The offending parameters, named.
+pub fn check_campaign_values(
+    m: &Machine,
+    layout: &Layout,
+    values: &[Option<f64>],
+    limits: &ValueLimits,
+) -> Result<(), solver::fitting::Implausible> {
+    check_model_values(m, &columns_model(layout), &layout.names(), values, limits)
+}

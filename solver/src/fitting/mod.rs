@@ -15,6 +15,7 @@
 //! - [`mod@validate`]: the identified model's prediction against another record;
 //! - [`distributions`]: the F and t distributions of the significance tests.
 
+pub mod campaign;
 pub mod distributions;
 pub mod hmatrix;
 pub mod identifiability;

@@ -51,7 +51,7 @@ use crate::record::Record;
 use crate::simulation::readings::{SimulateError, simulate};
 use crate::simulation::truth::Truth;
 use model_spec::Machine;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// The rounding floor of a refinement step, in units of `ε·κ·‖y‖∞` (ε the machine epsilon, κ
 /// the condition number of the scaled H, `y` the readings): measured on ill-conditioned fits of
@@ -211,7 +211,79 @@ fn refine_under(
     opts: &RefineOptions,
     noise: Option<&NoiseModel>,
 ) -> Result<Refinement, RefineError> {
-    let layout = [record.samples.len()];
+    let h = h_matrix(m, &ident.model, record, source)?;
+    let y = measurement_vector(record)?;
+    let params = source.params().to_vec();
+    let coordinates = params
+        .iter()
+        .chain(record.samples.iter().flat_map(|s| s.commands.iter()))
+        .fold(1.0f64, |a, v| a.max(v.abs()));
+    let problem = GaussNewton {
+        h: &h,
+        y: &y,
+        layout: &[record.samples.len()],
+        tolerances,
+        noise,
+        coordinates,
+    };
+    let model = ident.model.clone();
+    let mut predict = |x: &[f64]| -> Result<DVector<f64>, RefineError> {
+        let values: Vec<Option<f64>> = x.iter().map(|&v| Some(v)).collect();
+        let p = exact_prediction(m, &model, &values, record, &params)?;
+        Ok(DVector::from_iterator(
+            y.len(),
+            p.iter().flat_map(|r| r.iter().copied()),
+        ))
+    };
+    let (fit, whitened_sigma, refinement) = gauss_newton(&problem, &ident.fit, opts, &mut predict)?;
+    ident.fit = fit;
+    if noise.is_some() {
+        ident.whitened_sigma = whitened_sigma;
+    }
+    Ok(refinement)
+}
+
+/// The exact machine's readings (mm, in the rows of the system) from every parameter's value in
+/// column order (mm, rad).
+pub(crate) type ExactPrediction<'a> = dyn FnMut(&[f64]) -> Result<DVector<f64>, RefineError> + 'a;
+
+/// A Gauss–Newton refinement's system: the first-order H (the Jacobian), the readings, and what
+/// sets the rounding floor.
+pub(crate) struct GaussNewton<'a> {
+    /// The H matrix (mm per unit of each parameter).
+    pub h: &'a DMatrix<f64>,
+    /// The readings (mm).
+    pub y: &'a DVector<f64>,
+    /// Samples per record, in row order (for the whitening).
+    pub layout: &'a [usize],
+    /// Rank and identifiability tolerances.
+    pub tolerances: &'a Tolerances,
+    /// The noise model of generalized corrections; `None`: ordinary least squares.
+    pub noise: Option<&'a NoiseModel>,
+    /// The largest coordinate of the machine and the paths (mm, at least 1): the scale at which
+    /// the exact prediction is rounded.
+    pub coordinates: f64,
+}
+
+/// Refines the first-order fit `start` of `problem` against the exact machine's `predict`ion
+/// (mm, the rows of `problem.y`, from every parameter's value in column order) by Gauss–Newton
+/// iteration (see the module documentation). Returns the final fit (values the refined ones,
+/// determined as in `start`), the σ̂ of the whitened residual under a noise model, and what the
+/// iteration did.
+pub(crate) fn gauss_newton(
+    problem: &GaussNewton,
+    start: &Fit,
+    opts: &RefineOptions,
+    predict: &mut ExactPrediction,
+) -> Result<(Fit, Option<f64>, Refinement), RefineError> {
+    let GaussNewton {
+        h,
+        y,
+        layout,
+        tolerances,
+        noise,
+        coordinates,
+    } = *problem;
     // The fit of a residual: ordinary, or generalized under the noise model.
     let fit_of = |h: &nalgebra::DMatrix<f64>,
                   r: &DVector<f64>,
@@ -221,16 +293,13 @@ fn refine_under(
         match noise {
             None => Ok((least_squares(h, r, names, constraint, tolerances)?, None)),
             Some(n) => {
-                let w = least_squares_whitened(h, r, names, constraint, tolerances, n, &layout)?;
+                let w = least_squares_whitened(h, r, names, constraint, tolerances, n, layout)?;
                 Ok((w.fit, w.whitened_sigma))
             }
         }
     };
-    let h = h_matrix(m, &ident.model, record, source)?;
-    let y = measurement_vector(record)?;
     let rows = y.len().max(1) as f64;
-    let linear_rms = (ident.fit.rss / rows).sqrt();
-    let params = source.params().to_vec();
+    let linear_rms = (start.rss / rows).sqrt();
     // The rounding floor of a correction: relative rounding of the least-squares solution is
     // about ε·κ, so its prediction cannot settle below a multiple of ε·κ·‖y‖∞. A step below
     // the floor is rounding, not a correction.
@@ -244,13 +313,9 @@ fn refine_under(
             .map(|&p| (1.0 + p) / (1.0 - p * p).max(f64::MIN_POSITIVE).sqrt())
             .fold(1.0, f64::max)
     });
-    let kappa = ident.fit.condition.unwrap_or(1.0) * amplification;
+    let kappa = start.condition.unwrap_or(1.0) * amplification;
     // Under a noise model the exact prediction's own rounding (ε times the machine's
     // coordinates, mm) is whitened too, and a correction cannot settle below it.
-    let coordinates = params
-        .iter()
-        .chain(record.samples.iter().flat_map(|s| s.commands.iter()))
-        .fold(1.0f64, |a, v| a.max(v.abs()));
     let prediction_floor = if noise.is_some() {
         ROUNDING_FLOOR_FACTOR * f64::EPSILON * amplification * coordinates
     } else {
@@ -260,22 +325,18 @@ fn refine_under(
     let tolerance = opts.tolerance_mm.max(floor);
     // Iterate on the whole minimum-norm solution, undetermined parameters included: it is what
     // the linear model's prediction is made of. Which values are reported is decided at the end.
-    let mut x = ident.fit.solution.clone();
+    let mut x = start.solution.clone();
     let mut steps = Vec::new();
     let mut converged = false;
-    let residual = |x: &[f64]| -> Result<DVector<f64>, RefineError> {
-        let values: Vec<Option<f64>> = x.iter().map(|&v| Some(v)).collect();
-        let p = exact_prediction(m, &ident.model, &values, record, &params)?;
-        Ok(&y - DVector::from_iterator(y.len(), p.iter().flat_map(|r| r.iter().copied())))
-    };
+    let mut residual = |x: &[f64]| -> Result<DVector<f64>, RefineError> { Ok(y - predict(x)?) };
     for _ in 0..opts.max_iterations {
         let r = residual(&x)?;
-        let (correction, _) = fit_of(&h, &r, &ident.fit.names, &ident.fit.constraint)?;
+        let (correction, _) = fit_of(h, &r, &start.names, &start.constraint)?;
         for (v, d) in x.iter_mut().zip(&correction.solution) {
             *v += d;
         }
         // The largest change of the prediction at any reading.
-        let step = (&h * DVector::from_column_slice(&correction.solution)).amax();
+        let step = (h * DVector::from_column_slice(&correction.solution)).amax();
         if !step.is_finite() || x.iter().any(|v| !v.is_finite()) {
             return Err(RefineError::NotFinite {
                 iterations: steps.len() + 1,
@@ -292,7 +353,7 @@ fn refine_under(
     // exact model. Its own correction is below the tolerance and is not added.
     let r = residual(&x)?;
     let refined_rms = (r.norm_squared() / rows).sqrt();
-    let (mut fit, whitened_sigma) = fit_of(&h, &r, &ident.fit.names, &ident.fit.constraint)?;
+    let (mut fit, whitened_sigma) = fit_of(h, &r, &start.names, &start.constraint)?;
     fit.values = fit
         .values
         .iter()
@@ -300,17 +361,17 @@ fn refine_under(
         .map(|(has, &v)| has.map(|_| v))
         .collect();
     fit.solution = x;
-    ident.fit = fit;
-    if noise.is_some() {
-        ident.whitened_sigma = whitened_sigma;
-    }
-    Ok(Refinement {
-        tolerance_mm: tolerance,
-        iterations: steps.len(),
-        steps_mm: steps,
-        converged,
-        rms_mm: (linear_rms, refined_rms),
-    })
+    Ok((
+        fit,
+        whitened_sigma,
+        Refinement {
+            tolerance_mm: tolerance,
+            iterations: steps.len(),
+            steps_mm: steps,
+            converged,
+            rms_mm: (linear_rms, refined_rms),
+        },
+    ))
 }
 
 /// Identifies `model` on `record` ([`crate::fitting::identify()`], with the gain source it

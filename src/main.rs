@@ -45,10 +45,11 @@ enum Verb {
     Diagnose(cli::diagnose::DiagnoseArgs),
     Compensate(cli::compensate::CompensateArgs),
     Volumetric(cli::volumetric::VolumetricArgs),
+    Plan(cli::plan::PlanArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 11] = [
+const VERBS: [&str; 12] = [
     "machines",
     "gains",
     "generate",
@@ -60,6 +61,7 @@ const VERBS: [&str; 11] = [
     "bench",
     "compensate",
     "volumetric",
+    "plan",
 ];
 
 /// A clap error as one line: its message and its hints, without the usage block.
@@ -116,6 +118,7 @@ fn main() -> ExitCode {
         Verb::Diagnose(a) => cli::diagnose::run(a),
         Verb::Compensate(a) => cli::compensate::run(a),
         Verb::Volumetric(a) => cli::volumetric::run(a),
+        Verb::Plan(a) => cli::plan::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -12,6 +12,7 @@ pub mod gains;
 pub mod generate;
 pub mod identify;
 pub mod machines;
+pub mod plan;
 pub mod pose_args;
 pub mod simulate;
 pub mod validate;

@@ -116,28 +116,13 @@ struct Planned {
 }
 
 fn run_plan(m: &Machine, model: &Model, p: &Plan, noise: &NoiseModel) -> Planned {
-    check_model(m, model).unwrap();
-    let planned = p.campaign(m).unwrap();
-    let design = design_matrix(m, model, &planned.campaign).unwrap();
     let tol = Tolerances::default();
-    let prediction = predict_design(&design, noise, &tol).unwrap();
+    let predicted = p.predict(m, model, noise, &tol).unwrap();
     let set = candidates::candidates(m, p, 100.0).unwrap();
-    let suggestion = suggest(
-        m,
-        model,
-        &planned,
-        &design,
-        &prediction,
-        &set,
-        p.shared_setup,
-        noise,
-        &tol,
-        &Targets::default(),
-    )
-    .unwrap();
+    let suggestion = suggest(m, model, p, &predicted, &set, &Targets::default(), &tol).unwrap();
     Planned {
-        planned,
-        prediction,
+        planned: predicted.planned,
+        prediction: predicted.prediction,
         set,
         suggestion,
     }
@@ -765,4 +750,3 @@ fn bad_plans_are_refused_naming_the_test_and_the_sample() {
     assert!(candidates::candidates(&m, &p, 0.0).is_err());
     assert!(candidates::candidates(&m, &p, f64::NAN).is_err());
 }
-

@@ -8,11 +8,9 @@ use model_spec::units::{UM_PER_MM, compact};
 use output::{Outputs, Target};
 use solver::fitting::EstimateError;
 use solver::fitting::Tolerances;
-use solver::fitting::campaign::design_matrix;
 use solver::fitting::noise::{MAX_PHI, NoiseModel, NoiseSource};
 use solver::fitting::plan::{
-    self, BASE_BALL, BallPosition, Plan, PlanError, PlannedTest, Targets, candidates,
-    predict_design, suggest,
+    self, BASE_BALL, BallPosition, Plan, PlanError, PlannedTest, Targets, candidates, suggest,
 };
 use solver::io::report::plan::{PlanReport, PlanSource};
 use solver::io::report::to_json;
@@ -364,7 +362,6 @@ pub fn run(args: &PlanArgs) -> CliResult {
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
     let fail = |e: PlanError| plan_error(e, args);
-    let planned = plan.campaign(&m).map_err(fail)?;
     let sigma_mm = args.noise_um / UM_PER_MM;
     let noise = if args.noise_phi == 0.0 {
         NoiseModel::white(sigma_mm, NoiseSource::Declared)
@@ -372,35 +369,21 @@ pub fn run(args: &PlanArgs) -> CliResult {
         NoiseModel::ar1(args.noise_phi, sigma_mm, NoiseSource::Declared)
     };
     let tol = Tolerances::default();
-    let design =
-        design_matrix(&m, &model, &planned.campaign).map_err(|e| fail(PlanError::Estimate(e)))?;
-    let prediction = predict_design(&design, &noise, &tol).map_err(|e| fail(e.into()))?;
+    let predicted = plan.predict(&m, &model, &noise, &tol).map_err(fail)?;
     let set = candidates::candidates(&m, &plan, args.ball_step_mm).map_err(fail)?;
     let targets = Targets {
         um: args.target_um,
         urad: args.target_urad,
         ms: args.target_ms,
     };
-    let suggestion = suggest(
-        &m,
-        &model,
-        &planned,
-        &design,
-        &prediction,
-        &set,
-        plan.shared_setup,
-        &noise,
-        &tol,
-        &targets,
-    )
-    .map_err(fail)?;
+    let suggestion = suggest(&m, &model, &plan, &predicted, &set, &targets, &tol).map_err(fail)?;
     let source = PlanSource {
         label: &label,
         base_model: args.model.as_deref(),
         model: &model,
         plan: &plan,
-        planned: &planned,
-        prediction: &prediction,
+        planned: &predicted.planned,
+        prediction: &predicted.prediction,
         candidates: &set,
         suggestion: &suggestion,
         targets: &targets,

@@ -160,13 +160,12 @@ pub fn candidates(m: &Machine, plan: &Plan, step_mm: f64) -> Result<CandidateSet
     let balls = candidate_balls(m, plan, step_mm)?;
     let tests = generator::tests_with(m, &plan.generator.clearance);
     if tests.is_empty() {
-        return Err(PlanError::Generator {
-            test: "(any)".into(),
-            ball: super::BASE_BALL.into(),
-            error: GeneratorError::NoRotaryAxis {
+        return Err(PlanError::Plan(
+            GeneratorError::NoRotaryAxis {
                 machine: m.name.clone(),
-            },
-        });
+            }
+            .to_string(),
+        ));
     }
     let mut set = CandidateSet {
         balls,

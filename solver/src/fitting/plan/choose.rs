@@ -24,11 +24,10 @@
 
 use super::candidates::CandidateSet;
 use super::predict::{Prediction, predict_design};
-use super::{PlanError, PlannedCampaign};
+use super::{Plan, PlanError, PlannedCampaign, Predicted};
 use crate::fitting::campaign::design::{Design, Layout, design_matrix};
 use crate::fitting::campaign::{Campaign, CampaignRecord, Owner};
 use crate::fitting::least_squares::Tolerances;
-use crate::fitting::noise::NoiseModel;
 use crate::model::Model;
 use model_spec::Machine;
 use nalgebra::DMatrix;
@@ -286,33 +285,35 @@ fn with_candidate(
     })
 }
 
-/// Every candidate of `set` added to the planned campaign `planned` (design `plan_design`,
-/// prediction `before`) on its own, predicted under `noise` with `tol`, scored and ranked (see
-/// the module documentation). The candidates at one ball position have their design matrix
-/// computed together ([`design_matrix`], one gain source per position).
+/// Every candidate of `set` added on its own to `plan` as `predicted` (its campaign, design
+/// and prediction, [`Plan::predict`]), predicted under the same noise with `tol`, scored
+/// against `targets` and ranked (see the module documentation). A candidate is zeroed as the
+/// plan is, on its own set-up or, with [`Plan::shared_setup`], on its ball position's. The
+/// candidates at one ball position have their design matrix computed together
+/// ([`design_matrix`], one gain source per position).
 ///
 /// # Errors
 /// Bad targets; a design or prediction that fails (a failed computation).
-#[allow(clippy::too_many_arguments)]
 pub fn suggest(
     m: &Machine,
     model: &Model,
-    planned: &PlannedCampaign,
-    plan_design: &Design,
-    before: &Prediction,
+    plan: &Plan,
+    predicted: &Predicted,
     set: &CandidateSet,
-    shared_setup: bool,
-    noise: &NoiseModel,
-    tol: &Tolerances,
     targets: &Targets,
+    tol: &Tolerances,
 ) -> Result<Suggestion, PlanError> {
     targets.check()?;
+    let before = &predicted.prediction;
+    let planned = &predicted.planned;
+    let plan_design = &predicted.design;
+    let noise = &before.noise;
     let wanted = interest(before);
     let names: Vec<String> = wanted.iter().map(|&j| before.names[j].clone()).collect();
     let baseline = score(m, before, before, &names, targets);
-    let zeroed = planned.campaign.records.first().is_some_and(|r| r.zeroed);
+    let zeroed = plan.zeroed;
     let setup = |ball: usize, label: &str| -> String {
-        if shared_setup {
+        if plan.shared_setup {
             set.balls[ball].name.clone()
         } else {
             label.to_string()

@@ -24,6 +24,9 @@ pub mod candidates;
 pub mod choose;
 pub mod predict;
 
+use crate::fitting::campaign::design::{Design, design_matrix};
+use crate::fitting::least_squares::Tolerances;
+use crate::fitting::noise::NoiseModel;
 pub use candidates::{Candidate, CandidateBall, CandidateSet, Skipped, ball_symbols};
 pub use choose::{Largest, Ranked, Score, Suggestion, Targets, suggest};
 pub use predict::{Prediction, predict, predict_design};
@@ -119,6 +122,17 @@ pub struct PlannedCampaign {
     pub campaign: Campaign,
     /// What each record is, in the same order.
     pub records: Vec<PlannedRecord>,
+}
+
+/// A plan made into a campaign and predicted ([`Plan::predict`]).
+#[derive(Clone, Debug)]
+pub struct Predicted {
+    /// The campaign and what each record is.
+    pub planned: PlannedCampaign,
+    /// Its design matrix.
+    pub design: Design,
+    /// Its prediction.
+    pub prediction: Prediction,
 }
 
 /// `true` for a ball position's name: a letter, then letters, digits, `_`, `-`, `.` or `+`
@@ -306,5 +320,31 @@ impl Plan {
         let campaign = Campaign::new(out)
             .map_err(|e| PlanError::Plan(format!("the planned campaign: {e}")))?;
         Ok(PlannedCampaign { campaign, records })
+    }
+
+    /// The plan of `model` of `m` made into a campaign ([`Plan::campaign`]), its design matrix
+    /// and its prediction under the reading noise `noise` with the tolerances `tol`
+    /// ([`predict_design`]).
+    ///
+    /// # Errors
+    /// A model a plan cannot predict ([`check_model`]), what [`Plan::campaign`] refuses, a
+    /// design or prediction that fails ([`PlanError::Estimate`]; too few readings for the
+    /// parameters among them).
+    pub fn predict(
+        &self,
+        m: &Machine,
+        model: &Model,
+        noise: &NoiseModel,
+        tol: &Tolerances,
+    ) -> Result<Predicted, PlanError> {
+        check_model(m, model)?;
+        let planned = self.campaign(m)?;
+        let design = design_matrix(m, model, &planned.campaign)?;
+        let prediction = predict_design(&design, noise, tol)?;
+        Ok(Predicted {
+            planned,
+            design,
+            prediction,
+        })
     }
 }

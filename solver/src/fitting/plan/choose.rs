@@ -7,7 +7,7 @@
 //!
 //! Every candidate is added to the plan on its own (as one more record: its own set-up, or the
 //! set-up of its ball position with a shared set-up, and its own zero when the readings are
-//! zeroed) and the campaign predicted again ([`super::predict`]). Its [`Score`]:
+//! zeroed) and the campaign predicted again ([`Plan::predict`]). Its [`Score`]:
 //!
 //! 1. **separation**: how many parameters of interest the plan leaves undetermined and the
 //!    plan with the candidate determines (more is better);

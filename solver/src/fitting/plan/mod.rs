@@ -8,7 +8,7 @@
 //! readings will be zeroed, unless the plan shares one set-up per ball position
 //! ([`Plan::shared_setup`]).
 //!
-//! - [`predict`]: the campaign's design matrix ([`crate::fitting::campaign::design_matrix`],
+//! - [`mod@predict`]: the campaign's design matrix ([`crate::fitting::campaign::design_matrix`],
 //!   which needs no readings) and what a fit of it would give for a stated reading noise: rank,
 //!   condition number, confounded groups, the predicted standard uncertainty of every
 //!   determined parameter;

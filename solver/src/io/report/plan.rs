@@ -2,19 +2,28 @@
 //! single addition that helps most (docs/plan.md).
 //!
 //! ```json
-//! {"machine": "seed-ac", "fingerprint": "…", "model": "reduced", "terms": ["XOW", …],
-//!  "noise": {"sigma_um": 0.5, "phi": 0, "text": "white, σ = 0.50 µm (x, y, z), declared"},
+//! {"machine": "seed-ac", "fingerprint": "fa038fe9e24c960a", "model": "reduced", "terms": ["XOW", …],
+//!  "noise": {"sigma_um": [0.5, 0.5, 0.5], "phi": [0.0, 0.0, 0.0],
+//!            "text": "white, σ = 0.50 µm (x, y, z), declared"},
 //!  "zeroed": false, "shared_setup": false, "ball_symbols": ["Xw", "Yw", "Zw"],
-//!  "balls": [{"name": "base", "params_mm": {"Xw": -217.504, …}}],
+//!  "balls": [{"name": "base", "params_mm": {"Xa": 0.0, …, "Zp": 184.67}}],
 //!  "records": [{"label": "K1", "test": "K1", "ball": "base", "setup": "K1", "samples": 361}],
 //!  "parameters": [{"name": "YOA", "error": "YOA", "basis": "const", "owner": "shared",
-//!                  "unit": "um", "determined": true, "std": 0.041}, …],
-//!  "rank": 7, "columns": 11, "condition": 3.2, "confounded": [["XOW[K1]", "COA"], …],
-//!  "targets": {"um": 1, "urad": 5, "ms": 0.1},
-//!  "largest": {"parameter": "BOA", "std": 0.3, "unit": "urad", "relative": 0.06},
-//!  "suggestion": {"criterion": "…", "interest": […], "step_mm": 100, "positions": […],
-//!                 "evaluated": 30, "ranking": [{"place": 1, "test": "K2", "ball": "base", …}],
-//!                 "skipped": [{"test": "K2", "ball": "base.Zw-100", "reason": "…"}]}}
+//!                  "unit": "um", "determined": false, "std": null}, …,
+//!                 {"name": "AOC", …, "determined": true, "std": 0.17134291229456736}, …],
+//!  "rank": 7, "columns": 11, "condition": 3.4624256067636026,
+//!  "confounded": [["YOA", "YOC"], ["ZOA", "ZOW[K1]"], ["BOA", "XOC", "BOC"],
+//!                 ["COA", "XOW[K1]", "YOW[K1]"]],
+//!  "targets": {"um": 1.0, "urad": 5.0, "ms": 0.1},
+//!  "largest": {"parameter": "AOC", "std": 0.17134291229456736, "unit": "urad", …},
+//!  "suggestion": {"criterion": "…", "interest": ["YOA", …], "step_mm": 100.0, "positions": […],
+//!                 "evaluated": 40,
+//!                 "ranking": [{"place": 1, "test": "K4", "ball": "base.Yw+100",
+//!                              "paths_item": "K4:base.Yw+100",
+//!                              "ball_arg": "base.Yw+100:Yw=99.721",
+//!                              "newly_determined": ["YOA", "ZOA", "BOA", "COA", "XOC", "YOC", "BOC"],
+//!                              "rank": 14, "columns": 14, …}, …],
+//!                 "skipped": [{"test": "K4", "ball": "base.Zw+100", "reason": "test K4, sample 170 of 241 …"}, …]}}
 //! ```
 //!
 //! `std` (µm, µrad or ms) is `null` where the plan does not determine the parameter, and the

@@ -50,8 +50,8 @@ how many candidates the ranking shows.
 --json writes the report: {machine, fingerprint, model, terms, noise, zeroed, shared_setup, \
 balls, records, parameters: [{name, error, basis, owner, unit, determined, std}], rank, \
 columns, condition, confounded, near_confounded, targets, largest, suggestion: {criterion, \
-interest, step_mm, positions, evaluated, ranking: [{place, test, ball, paths_item, ball_arg, \
-newly_determined, rank, columns, determined, largest, sum_squares}], skipped: [{test, ball, \
+interest, step_mm, positions, evaluated, ranking: [{place, test, ball, paths_item, samples, \
+ball_arg, newly_determined, rank, columns, determined, largest, sum_squares}], skipped: [{test, ball, \
 reason}]}}; `null` only where the plan does not determine a value.";
 
 /// Flags of `rtest plan`.

@@ -19,7 +19,7 @@
 //!  "suggestion": {"criterion": "…", "interest": ["YOA", …], "step_mm": 100.0, "positions": […],
 //!                 "evaluated": 40,
 //!                 "ranking": [{"place": 1, "test": "K4", "ball": "base.Yw+100",
-//!                              "paths_item": "K4:base.Yw+100",
+//!                              "paths_item": "K4:base.Yw+100", "samples": 241,
 //!                              "ball_arg": "base.Yw+100:Yw=99.721",
 //!                              "newly_determined": ["YOA", "ZOA", "BOA", "COA", "XOC", "YOC", "BOC"],
 //!                              "rank": 14, "columns": 14, …}, …],
@@ -157,6 +157,8 @@ pub struct CandidateReport {
     pub ball: String,
     /// The item to add to `--paths` (`K2`, `K2:high`).
     pub paths_item: String,
+    /// Its samples (as generated: a longer test brings more readings).
+    pub samples: usize,
     /// The `--ball` argument that defines a position the plan does not have
     /// (`base.Zw+100:Zw=311.537`); absent for a planned position.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -355,6 +357,7 @@ impl PlanReport {
                 test: cand.test.clone(),
                 ball: ball.name.clone(),
                 paths_item: crate::fitting::plan::record_label(&cand.test, &ball.name),
+                samples: cand.record.samples.len(),
                 ball_arg: ball
                     .planned
                     .is_none()

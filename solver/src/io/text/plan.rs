@@ -356,6 +356,7 @@ fn suggestion(r: &PlanReport, top: usize) -> String {
             vec![
                 c.place.to_string(),
                 at(c),
+                c.samples.to_string(),
                 c.newly_determined.len().to_string(),
                 format!("{}/{}", c.rank, c.columns),
                 c.largest.as_ref().map_or("-".into(), |l| {
@@ -370,6 +371,7 @@ fn suggestion(r: &PlanReport, top: usize) -> String {
         &header(&[
             "place",
             "candidate",
+            "samples",
             "newly determined",
             "rank",
             "largest std",

@@ -48,10 +48,11 @@ enum Verb {
     Path(cli::path::PathArgs),
     Instrument(cli::instrument::InstrumentVerb),
     Segment(cli::segment::SegmentArgs),
+    Plan(cli::plan::PlanArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 14] = [
+const VERBS: [&str; 15] = [
     "machines",
     "gains",
     "generate",
@@ -66,6 +67,7 @@ const VERBS: [&str; 14] = [
     "path",
     "instrument",
     "segment",
+    "plan",
 ];
 
 /// A clap error as one line: its message and its hints, without the usage block.
@@ -125,6 +127,7 @@ fn main() -> ExitCode {
         Verb::Path(a) => cli::path::run(a),
         Verb::Instrument(a) => cli::instrument::run(a),
         Verb::Segment(a) => cli::segment::run(a),
+        Verb::Plan(a) => cli::plan::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -16,6 +16,7 @@ pub mod instrument;
 pub mod machines;
 pub mod path;
 pub mod path_nc;
+pub mod plan;
 pub mod pose_args;
 pub mod segment;
 pub mod simulate;

@@ -22,6 +22,7 @@ pub mod identifiability;
 pub mod identify;
 pub mod least_squares;
 pub mod noise;
+pub mod plan;
 pub mod refine;
 pub mod sanity;
 pub mod streaming;

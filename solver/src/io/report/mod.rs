@@ -26,6 +26,7 @@ pub mod compensate;
 pub mod diagnose;
 pub mod gains;
 pub mod identify;
+pub mod plan;
 pub mod read;
 pub mod validate;
 pub mod verdict;

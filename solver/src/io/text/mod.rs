@@ -7,6 +7,7 @@ pub mod compensate;
 pub mod diagnose;
 pub mod gains;
 pub mod identify;
+pub mod plan;
 pub mod simulate;
 pub mod validate;
 

@@ -1,0 +1,402 @@
+//! `rtest plan`: what a planned campaign of R-test tests will determine, before measuring, and
+//! the single added test or ball position that would help most.
+
+use super::args::{self, items, positive};
+use super::{CliError, CliResult, EXIT_CODES, check_outputs, pose_args, print_text, write, wrote};
+use model_spec::Machine;
+use model_spec::units::{UM_PER_MM, compact};
+use output::{Outputs, Target};
+use solver::fitting::EstimateError;
+use solver::fitting::Tolerances;
+use solver::fitting::noise::{MAX_PHI, NoiseModel, NoiseSource};
+use solver::fitting::plan::{
+    self, BASE_BALL, BallPosition, Plan, PlanError, PlannedTest, Targets, candidates, suggest,
+};
+use solver::io::report::plan::{PlanReport, PlanSource};
+use solver::io::report::to_json;
+use solver::simulation::generator::{
+    self, Clearance, GeneratorError, GeneratorOptions, SampleProblem,
+};
+
+const LONG_ABOUT: &str = "\
+Predicts, before measuring, what a campaign of R-test tests will determine: the rank and the \
+condition number of its design matrix, the groups of parameters it cannot separate (named as \
+`rtest identify` names them), and the predicted standard uncertainty (µm, µrad) of every \
+parameter it determines, for a reading noise of --noise-um per direction (white, or AR(1) with \
+--noise-phi). No number is given for what the plan cannot determine. Then it suggests the single \
+added test or ball position that helps most, and ranks the candidates (docs/plan.md).
+
+The plan: --paths lists tests of the machine's generator (see `rtest path --list`): `K4,K1`, \
+`turn-C,pair-A-C`. Every test is generated with the linear axes following the ball at the \
+plan's kinematic parameters (--param: the machine's defaults overridden, the ball position \
+among them; this position is called `base`), checked against the strokes, the ranges and the \
+clearance rule at every sample. `TEST:NAME` puts a test at the ball position NAME, defined by \
+--ball NAME:SYMBOL=VALUE,... (mm; the symbols not given as in `base`), e.g. --ball \
+high:Zw=260 --paths K4,K4:high.
+
+Each record is, as in a campaign fit, its own ball set-up (its own XOW YOW ZOW) unless \
+--shared-setup makes the records at one ball position share one; with --zeroed every record has \
+its own R-test zero (dx0 dy0 dz0). The parameters are named as a campaign fit names them: \
+`XOC` (the machine's, shared), `XOW[K4]` (a set-up's), `dx0[K1]` (a record's).
+
+The suggestion: every test of the generator at every planned ball position and at each planned \
+position moved by --ball-step-mm along each of the ball's symbols (down and up), each generated \
+and checked (the refused ones are listed with the generator's reason), is added to the plan on \
+its own. Criterion: first the most parameters of interest (the machine's, shared) newly \
+determined; then the smallest largest predicted uncertainty relative to its target \
+(--target-um, --target-urad, --target-ms); then the smallest sum of (std/target)^2. --top sets \
+how many candidates the ranking shows.
+
+--json writes the report: {machine, fingerprint, model, terms, noise, zeroed, shared_setup, \
+balls, records, parameters: [{name, error, basis, owner, unit, determined, std}], rank, \
+columns, condition, confounded, near_confounded, targets, largest, suggestion: {criterion, \
+interest, step_mm, positions, evaluated, ranking: [{place, test, ball, paths_item, samples, \
+ball_arg, newly_determined, rank, columns, determined, largest, sum_squares}], skipped: [{test, ball, \
+reason}]}}; `null` only where the plan does not determine a value.";
+
+/// Flags of `rtest plan`.
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Predict what a planned campaign of tests will determine, and what to add",
+    long_about = LONG_ABOUT,
+    after_help = EXIT_CODES
+)]
+pub struct PlanArgs {
+    /// Built-in machine (see `rtest machines`) or path of a machine TOML file.
+    #[arg(long, value_name = "NAME|FILE")]
+    machine: String,
+    /// Model of the machine (`reduced`, `full`, …); required unless --terms is given.
+    #[arg(long, value_name = "NAME")]
+    model: Option<String>,
+    /// Terms added to --model or alone: comma list of NAME or NAME@BASIS.
+    #[arg(long, value_name = "LIST")]
+    terms: Option<String>,
+    /// The planned tests, in order: comma list of TEST (at the `base` ball position) or
+    /// TEST:NAME (at the ball position NAME of --ball), e.g. `K4,K1,K4:high`.
+    #[arg(long, value_name = "LIST")]
+    paths: String,
+    /// Kinematic parameters (mm) of the `base` ball position, overriding the machine's
+    /// defaults (`Xw=-200,Zw=180`).
+    #[arg(long, value_name = "SYMBOL=VALUE,...")]
+    param: Option<String>,
+    /// A named ball position: NAME:SYMBOL=VALUE,... (mm; other symbols as `base`). Repeat for
+    /// several.
+    #[arg(long, value_name = "NAME:SYMBOL=VALUE,...")]
+    ball: Vec<String>,
+    /// The readings will be zeroed at each record's first sample: every record's dx0 dy0 dz0
+    /// join the fit.
+    #[arg(long)]
+    zeroed: bool,
+    /// Records at one ball position share one ball set-up (one XOW YOW ZOW).
+    #[arg(long)]
+    shared_setup: bool,
+    /// Standard deviation of one reading, per direction, µm.
+    #[arg(long, value_name = "UM", default_value = "0.5", value_parser = positive)]
+    noise_um: f64,
+    /// Lag-1 autocorrelation of the reading noise (AR(1); 0: white), 0 ≤ F < 0.99.
+    #[arg(long, value_name = "F", default_value = "0", value_parser = phi)]
+    noise_phi: f64,
+    /// Target uncertainty of translational parameters, µm.
+    #[arg(long, value_name = "UM", default_value = "1", value_parser = positive)]
+    target_um: f64,
+    /// Target uncertainty of angular parameters, µrad.
+    #[arg(long, value_name = "URAD", default_value = "5", value_parser = positive)]
+    target_urad: f64,
+    /// Target uncertainty of servo lags (velocity terms), ms.
+    #[arg(long, value_name = "MS", default_value = "0.1", value_parser = positive)]
+    target_ms: f64,
+    /// The step by which the candidate ball positions are moved from the planned ones, mm.
+    #[arg(long, value_name = "MM", default_value = "100", value_parser = positive)]
+    ball_step_mm: f64,
+    /// Candidates shown in the ranking.
+    #[arg(long, value_name = "N", default_value_t = 5,
+          value_parser = clap::value_parser!(u64).range(1..=10_000))]
+    top: u64,
+    /// Step of the turning axis of every test, degrees (default: each test's own).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    step_deg: Option<f64>,
+    /// Time between two samples, s.
+    #[arg(long, value_name = "S", default_value_t = solver::simulation::paths::SAMPLE_PERIOD_S,
+          allow_negative_numbers = true)]
+    period_s: f64,
+    /// Largest angle between the tool axis and the table normal, degrees (0 to 180).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true,
+          default_value_t = generator::clearance::DEFAULT_MAX_TILT_DEG)]
+    max_tilt_deg: f64,
+    /// Least height of the ball centre above the table face, mm: the reach of your nest.
+    #[arg(long, value_name = "MM", allow_negative_numbers = true,
+          default_value_t = generator::clearance::DEFAULT_MIN_BALL_HEIGHT_MM)]
+    min_ball_height_mm: f64,
+    /// Also write the report as JSON to FILE (`-`: standard output).
+    #[arg(long, value_name = "FILE")]
+    json: Option<Target>,
+}
+
+/// A lag-1 autocorrelation: a number from 0 up to, not including, 0.99.
+fn phi(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(x) if (0.0..MAX_PHI).contains(&x) => Ok(x),
+        _ => Err(format!(
+            "`{s}` is not a lag-1 autocorrelation from 0 up to (not including) {MAX_PHI}"
+        )),
+    }
+}
+
+/// The generator's options from the flags.
+fn options(args: &PlanArgs) -> CliResult<GeneratorOptions> {
+    let opts = GeneratorOptions {
+        step_deg: args.step_deg,
+        period_s: args.period_s,
+        clearance: Clearance {
+            max_tilt_deg: args.max_tilt_deg,
+            min_ball_height_mm: args.min_ball_height_mm,
+        },
+    };
+    generator::check_options(&opts).map_err(|e| {
+        let flag = match &e {
+            GeneratorError::Option { option, .. } => match *option {
+                "step" => "--step-deg",
+                "period" => "--period-s",
+                "max tilt" => "--max-tilt-deg",
+                _ => "--min-ball-height-mm",
+            },
+            _ => "--paths",
+        };
+        CliError::usage(format!("{flag}: {e}"))
+    })?;
+    Ok(opts)
+}
+
+/// One `--ball NAME:SYMBOL=VALUE,...`: its name and parameters (`base` overridden).
+fn ball(m: &Machine, text: &str, base: &[f64]) -> CliResult<BallPosition> {
+    let example = "expected NAME:SYMBOL=VALUE,..., e.g. high:Zw=260";
+    let Some((name, list)) = text.split_once(':') else {
+        return Err(CliError::usage(format!(
+            "--ball: `{text}` has no `:` ({example})"
+        )));
+    };
+    let name = name.trim();
+    if name == BASE_BALL || !plan::valid_ball_name(name) {
+        return Err(CliError::usage(format!(
+            "--ball: `{name}` is not a ball position name: a letter, then letters, digits, `_`, `-`, `.` or `+`, and not `{BASE_BALL}` (the position of --param)"
+        )));
+    }
+    let flag = format!("--ball {name}");
+    let mut params = base.to_vec();
+    let mut seen: Vec<&str> = Vec::new();
+    for item in items(&flag, list, example)? {
+        let Some((sym, v)) = item.split_once('=') else {
+            return Err(CliError::usage(format!(
+                "{flag}: `{item}` is not SYMBOL=VALUE"
+            )));
+        };
+        let (sym, v) = (sym.trim(), v.trim());
+        let Some(s) = m.symbol_by_name(sym) else {
+            let names: Vec<&str> = m.symbols.iter().map(|s| s.name.as_str()).collect();
+            return Err(CliError::usage(format!(
+                "{flag}: machine {} has no kinematic symbol `{sym}` (symbols: {})",
+                m.name,
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )));
+        };
+        if seen.contains(&sym) {
+            return Err(CliError::usage(format!("{flag}: `{sym}` is given twice")));
+        }
+        seen.push(sym);
+        let x: f64 = v
+            .parse()
+            .ok()
+            .filter(|x: &f64| x.is_finite())
+            .ok_or_else(|| {
+                CliError::usage(format!("{flag}: `{item}`: `{v}` is not a finite number"))
+            })?;
+        if x.abs() > model_spec::limits::MAX_LENGTH_MM {
+            return Err(CliError::usage(format!(
+                "{flag}: `{sym}` = {} mm is beyond the largest length a machine may have, {} mm",
+                compact(x),
+                model_spec::limits::MAX_LENGTH_MM
+            )));
+        }
+        params[s] = x;
+    }
+    Ok(BallPosition {
+        name: name.to_string(),
+        params,
+    })
+}
+
+/// The plan of the flags.
+fn plan_of(m: &Machine, args: &PlanArgs) -> CliResult<Plan> {
+    let base = pose_args::params(m, args.param.as_deref())?;
+    let mut balls = vec![BallPosition {
+        name: BASE_BALL.to_string(),
+        params: base.clone(),
+    }];
+    for text in &args.ball {
+        let b = ball(m, text, &base)?;
+        if balls.iter().any(|o| o.name == b.name) {
+            return Err(CliError::usage(format!(
+                "--ball: `{}` is given twice",
+                b.name
+            )));
+        }
+        balls.push(b);
+    }
+    let mut tests = Vec::new();
+    let example = "expected a comma list of TEST or TEST:BALL, e.g. K4,K1,K4:high";
+    for item in items("--paths", &args.paths, example)? {
+        let (test, name) = item.split_once(':').unwrap_or((item, BASE_BALL));
+        let (test, name) = (test.trim(), name.trim());
+        let Some(b) = balls.iter().position(|b| b.name == name) else {
+            let named: Vec<&str> = balls[1..].iter().map(|b| b.name.as_str()).collect();
+            return Err(CliError::usage(format!(
+                "--paths: `{item}`: no ball position `{name}` (define it with --ball {name}:SYMBOL=VALUE,...; defined: {})",
+                if named.is_empty() {
+                    "none".to_string()
+                } else {
+                    named.join(", ")
+                }
+            )));
+        };
+        tests.push(PlannedTest {
+            test: test.to_string(),
+            ball: b,
+        });
+    }
+    if let Some(unused) = (1..balls.len()).find(|&b| !tests.iter().any(|t| t.ball == b)) {
+        return Err(CliError::usage(format!(
+            "--ball {}: no test of --paths is at this position (write TEST:{} in --paths)",
+            balls[unused].name, balls[unused].name
+        )));
+    }
+    Ok(Plan {
+        balls,
+        tests,
+        zeroed: args.zeroed,
+        shared_setup: args.shared_setup,
+        generator: options(args)?,
+    })
+}
+
+/// A plan error as a verb's error, naming the flag at fault: usage errors for what the command
+/// line asks (an unknown test, a ball position that puts a test out of a stroke or beyond the
+/// clearance rule), a bad input where the machine cannot follow the ball, a failed computation
+/// otherwise.
+fn plan_error(e: PlanError, args: &PlanArgs) -> CliError {
+    match e {
+        PlanError::Plan(s) => CliError::usage(format!("--paths: {s}")),
+        PlanError::Generator { test, ball, error } => {
+            let ball_flag = if ball != BASE_BALL {
+                format!("--ball {ball}")
+            } else if args.param.is_some() {
+                "--param".to_string()
+            } else {
+                "--paths".to_string()
+            };
+            let at = format!("{test} at ball position `{ball}`");
+            match &error {
+                GeneratorError::UnknownTest { .. } | GeneratorError::NoRotaryAxis { .. } => {
+                    CliError::usage(format!("--paths: {error}"))
+                }
+                GeneratorError::NoRoom { .. } | GeneratorError::TooManySamples { .. } => {
+                    CliError::usage(format!("--paths: {at}: {error}"))
+                }
+                GeneratorError::Option { .. } => CliError::usage(format!("--paths: {error}")),
+                GeneratorError::ParamCount { .. } | GeneratorError::Param { .. } => {
+                    CliError::usage(format!("{ball_flag}: {at}: {error}"))
+                }
+                GeneratorError::BallTooLow { .. } => CliError::usage(format!(
+                    "{ball_flag}: {at}: {error} (or set --min-ball-height-mm to your nest's reach)"
+                )),
+                GeneratorError::Sample(s) => match s.problem {
+                    SampleProblem::Limits(_) => CliError::usage(format!(
+                        "{ball_flag}: {at}: {error}: the linear axes follow the ball; a ball nearer the rotary axes keeps them within their strokes"
+                    )),
+                    SampleProblem::Tilt { .. } => {
+                        CliError::usage(format!("--paths: {at}: {error}"))
+                    }
+                    SampleProblem::Ik(_) => CliError::input(format!("--machine: {at}: {error}")),
+                    SampleProblem::OffBall { .. } | SampleProblem::NotFinite(_) => {
+                        CliError::computation(format!("--paths: {at}: {error}"))
+                    }
+                },
+            }
+        }
+        PlanError::Estimate(e @ EstimateError::TooFewReadings { .. }) => CliError::usage(format!(
+            "--paths: the plan has too few samples for its parameters: {e}"
+        )),
+        PlanError::Estimate(e) => {
+            CliError::computation(format!("--paths: cannot predict the plan: {e}"))
+        }
+    }
+}
+
+/// Runs `rtest plan`.
+pub fn run(args: &PlanArgs) -> CliResult {
+    let m = super::load_machine(&args.machine)?;
+    let (label, model) = args::model(&m, args.model.as_deref(), args.terms.as_deref())?;
+    plan::check_model(&m, &model).map_err(|e| {
+        let flag = if args.terms.is_some() {
+            "--terms"
+        } else {
+            "--model"
+        };
+        CliError::usage(format!("{flag}: {e}"))
+    })?;
+    if args.noise_um > solver::simulation::truth::MAX_NOISE_UM {
+        return Err(CliError::usage(format!(
+            "--noise-um: {} µm is beyond {} µm, the largest reading noise rtest takes",
+            compact(args.noise_um),
+            solver::simulation::truth::MAX_NOISE_UM
+        )));
+    }
+    let plan = plan_of(&m, args)?;
+    let inputs: Vec<_> = super::machine_file(&args.machine)
+        .map(|p| ("--machine", p))
+        .into_iter()
+        .collect();
+    let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
+    check_outputs(&inputs, &outputs, &[])?;
+    let fail = |e: PlanError| plan_error(e, args);
+    let sigma_mm = args.noise_um / UM_PER_MM;
+    let noise = if args.noise_phi == 0.0 {
+        NoiseModel::white(sigma_mm, NoiseSource::Declared)
+    } else {
+        NoiseModel::ar1(args.noise_phi, sigma_mm, NoiseSource::Declared)
+    };
+    let tol = Tolerances::default();
+    let predicted = plan.predict(&m, &model, &noise, &tol).map_err(fail)?;
+    let set = candidates::candidates(&m, &plan, args.ball_step_mm).map_err(fail)?;
+    let targets = Targets {
+        um: args.target_um,
+        urad: args.target_urad,
+        ms: args.target_ms,
+    };
+    let suggestion = suggest(&m, &model, &plan, &predicted, &set, &targets, &tol).map_err(fail)?;
+    let source = PlanSource {
+        label: &label,
+        base_model: args.model.as_deref(),
+        model: &model,
+        plan: &plan,
+        planned: &predicted.planned,
+        prediction: &predicted.prediction,
+        candidates: &set,
+        suggestion: &suggestion,
+        targets: &targets,
+    };
+    let report =
+        PlanReport::new(&m, source).map_err(|e| CliError::computation(format!("plan: {e}")))?;
+    let mut text = solver::io::text::plan::plan(&report, args.top as usize);
+    let mut files = Outputs::new();
+    if let Some(target) = &args.json {
+        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        files.add("--json", target.clone(), json);
+    }
+    let stdout_taken = matches!(args.json, Some(Target::Stdout));
+    text.push_str(&wrote(&write(files)?));
+    print_text(&text, stdout_taken)
+}

@@ -37,6 +37,14 @@ the prediction is zeroed at the first sample too, so constant effects cancel.
 Parameters the identification could not determine (value null) are set to 0 and named; \
 --refuse-undetermined makes that an error instead.
 
+Campaigns (docs/campaigns.md): --params may be a campaign identification, and --data a comma list \
+or --campaign FILE a campaign of records to predict. Shared values come from the \
+identification; a record on a fitted set-up (the same set-up label; --setup LABEL puts every \
+--data record on one) uses that set-up's values; a record on a new set-up has its set-up errors \
+XOW YOW ZOW (and its zero, when zeroed) refitted on it with everything else held, and the \
+report says which parameters were refitted. A single identification is a campaign of one \
+record labelled by the stem of its data file.
+
 --json writes {machine, model, params, data, samples, prediction, measured_rms_um, \
 residual_rms_um, measured_max_um, residual_max_um, per_direction: {x, y, z: {measured_rms_um, \
 measured_max_um, residual_rms_um, residual_max_um}}, zeroed, unidentified_set_to_zero} \

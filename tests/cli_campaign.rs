@@ -516,3 +516,69 @@ fn param_sets_the_ball_position_of_one_record() {
     assert!(j.get("kind").is_none(), "one record: the single report");
     assert!(j["notes"].to_string().contains("Zw = 400 mm"));
 }
+
+#[test]
+fn a_campaign_clock_shares_a_drift_and_the_report_reads_back() {
+    let dir = temp_dir("clock");
+    simulate_seed(&dir, "K4", "k4.csv", "1", &[]);
+    simulate_seed(&dir, "K1", "k1.csv", "2", &[]);
+    simulate_seed(&dir, "K2", "k2.csv", "3", &[]);
+    std::fs::write(
+        dir.join("c.toml"),
+        "[[record]]\nfile = \"k4.csv\"\nsetup = \"ball\"\nstart = 0\n\n[[record]]\nfile = \"k1.csv\"\nsetup = \"ball\"\nstart = 600\n",
+    )
+    .unwrap();
+    ok(
+        &dir,
+        &common::words(
+            "identify --machine seed-ac --model reduced --terms XOC@time:1 --campaign c.toml --json c.json",
+        ),
+    );
+    let j = read_json(&dir.join("c.json"));
+    assert_eq!(j["clock"]["start_s"], 0.0);
+    assert_eq!(j["clock"]["end_s"], 960.0);
+    assert_eq!(j["records"][1]["start_s"], 600.0);
+    assert_eq!(param(&j, "XOC@time:1")["owner"], "shared");
+    assert_eq!(j["setups"][0]["records"].as_array().unwrap().len(), 2);
+    // The report reads back; a record predicted on the clock needs its start.
+    std::fs::write(
+        dir.join("v.toml"),
+        "[[record]]\nfile = \"k2.csv\"\nsetup = \"ball\"\nstart = 1000\n",
+    )
+    .unwrap();
+    let v = ok(
+        &dir,
+        &common::words("validate --machine seed-ac --params c.json --campaign v.toml"),
+    );
+    assert!(v.contains("set-up ball (fitted)"), "{v}");
+    fails(
+        &dir,
+        &common::words("validate --machine seed-ac --params c.json --data k2.csv --setup ball"),
+        1,
+        &["no start on the campaign clock"],
+    );
+    // A report whose parameters do not match its terms and records is refused, naming the field.
+    let text = std::fs::read_to_string(dir.join("c.json")).unwrap();
+    std::fs::write(
+        dir.join("bad.json"),
+        text.replace("\"XOW[ball]\"", "\"XOW[other]\""),
+    )
+    .unwrap();
+    fails(
+        &dir,
+        &common::words("validate --machine seed-ac --params bad.json --campaign v.toml"),
+        1,
+        &["bad.json", "parameters[", ".name", "`XOW[other]`"],
+    );
+    std::fs::write(
+        dir.join("bad.json"),
+        text.replace("\"owner\": \"setup\"", "\"owner\": \"shared\""),
+    )
+    .unwrap();
+    fails(
+        &dir,
+        &common::words("validate --machine seed-ac --params bad.json --campaign v.toml"),
+        1,
+        &["bad.json", ".owner"],
+    );
+}

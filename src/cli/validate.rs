@@ -153,7 +153,7 @@ fn run_single(
         opts.unidentified = Unidentified::Refuse;
     }
     let v = validate(m, &params.model, &params.values, &record, &opts)
-        .map_err(|e| validate_error(args, e))?;
+        .map_err(|e| validate_error(args, e, false))?;
     let (params_file, data) = (
         args.params.display().to_string(),
         data_path.display().to_string(),
@@ -195,14 +195,18 @@ fn implausible(args: &ValidateArgs, e: &solver::fitting::Implausible) -> CliErro
     ))
 }
 
-/// A validation error as a verb's error.
-fn validate_error(args: &ValidateArgs, e: ValidateError) -> CliError {
+/// A validation error as a verb's error; `campaign`: a record that does not fit the
+/// identification's campaign (its set-up, its start) is a bad input.
+fn validate_error(args: &ValidateArgs, e: ValidateError, campaign: bool) -> CliError {
     match e {
         ValidateError::Unidentified(names) => CliError::input(format!(
             "--params: {} gave no value for {} (not determined by the identification) and --refuse-undetermined is set (without it they are set to 0)",
             args.params.display(),
             names.join(", ")
         )),
+        ValidateError::Shape(why) if campaign => {
+            CliError::input(format!("--data: cannot validate: {why}"))
+        }
         other => CliError::computation(format!("--data: cannot validate: {other}")),
     }
 }
@@ -247,7 +251,7 @@ fn run_campaign(
         opts.unidentified = Unidentified::Refuse;
     }
     let v = validate_campaign(m, &values, &loaded.campaign, &opts)
-        .map_err(|e| validate_error(args, e))?;
+        .map_err(|e| validate_error(args, e, true))?;
     let params_file = args.params.display().to_string();
     let source = CampaignValidationSource {
         model: &model_name,

@@ -418,3 +418,167 @@ fn bad_campaign_files_name_file_line_column_and_field() {
     assert!(text.contains("k4-2"), "{text}");
     assert_eq!(entries(&dir), ["c.toml", "k4.csv"]);
 }
+
+#[test]
+fn diagnose_on_a_campaign_finds_the_missing_harmonic() {
+    let dir = temp_dir("diagnose");
+    for (path, out, seed) in [
+        ("K4", "k4.csv", "1"),
+        ("K1", "k1.csv", "2"),
+        ("K2", "k2.csv", "3"),
+    ] {
+        ok(
+            &dir,
+            &[
+                "simulate",
+                "--machine",
+                "seed-ac",
+                "--path",
+                path,
+                "--seed",
+                seed,
+                "-o",
+                out,
+            ],
+        );
+    }
+    let text = ok(
+        &dir,
+        &common::words(
+            "diagnose --machine seed-ac --model reduced --data k4.csv,k1.csv --validate k2.csv \
+             --harmonics 2 --poly 1 --time 1 --json d.json --model-out ext.toml",
+        ),
+    );
+    assert!(
+        text.contains("Campaign: the machine's errors shared"),
+        "{text}"
+    );
+    assert!(text.contains("1. ECC harmonic:2"), "{text}");
+    assert!(text.contains("Held out k2: set-up k2 (new"), "{text}");
+    let j = read_json(&dir.join("d.json"));
+    let c = &j["campaign"];
+    assert_eq!(c["records"].as_array().unwrap().len(), 2);
+    for r in c["records"].as_array().unwrap() {
+        assert!(r["residual_rms_after_um"].as_f64().unwrap() < 0.56, "{r}");
+    }
+    assert_eq!(c["held_out"][0]["setup_fitted"], false);
+    assert!(
+        std::fs::read_to_string(dir.join("ext.toml"))
+            .unwrap()
+            .contains("\"ECC@harmonic:2\"")
+    );
+    // Figures draw one record: refused on a campaign, nothing written.
+    fails(
+        &dir,
+        &common::words(
+            "diagnose --machine seed-ac --model reduced --data k4.csv,k1.csv --plot figs --json e.json",
+        ),
+        2,
+        &["--plot"],
+    );
+    assert!(!dir.join("figs").exists() && !dir.join("e.json").exists());
+}
+
+#[test]
+fn param_sets_the_ball_position_of_one_record() {
+    let dir = temp_dir("param");
+    let (m, machine) = head_head();
+    let mut high = m.default_parameters();
+    high[m.symbol_by_name("Zw").unwrap()] = 400.0;
+    let csv = head_head_record(&m, &high, 30.0, [12.0, -8.0, 5.0], 1);
+    std::fs::write(dir.join("high.csv"), csv).unwrap();
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "identify",
+            "--machine",
+            machine.as_str(),
+            "--terms",
+            "XOW,YOW,ZOW,AOC,BOC",
+            "--data",
+            "high.csv",
+        ];
+        a.extend_from_slice(extra);
+        a.iter().map(|s| s.to_string()).collect::<Vec<String>>()
+    };
+    let without = args(&[]);
+    let without: Vec<&str> = without.iter().map(String::as_str).collect();
+    fails(
+        &dir,
+        &without,
+        1,
+        &["high.csv", "off the nominal workpiece point"],
+    );
+    let with = args(&["--param", "Zw=400", "--json", "h.json"]);
+    let with: Vec<&str> = with.iter().map(String::as_str).collect();
+    let text = ok(&dir, &with);
+    assert!(text.contains("Zw = 400 mm"), "{text}");
+    let j = read_json(&dir.join("h.json"));
+    assert!(j.get("kind").is_none(), "one record: the single report");
+    assert!(j["notes"].to_string().contains("Zw = 400 mm"));
+}
+
+#[test]
+fn a_campaign_clock_shares_a_drift_and_the_report_reads_back() {
+    let dir = temp_dir("clock");
+    simulate_seed(&dir, "K4", "k4.csv", "1", &[]);
+    simulate_seed(&dir, "K1", "k1.csv", "2", &[]);
+    simulate_seed(&dir, "K2", "k2.csv", "3", &[]);
+    std::fs::write(
+        dir.join("c.toml"),
+        "[[record]]\nfile = \"k4.csv\"\nsetup = \"ball\"\nstart = 0\n\n[[record]]\nfile = \"k1.csv\"\nsetup = \"ball\"\nstart = 600\n",
+    )
+    .unwrap();
+    ok(
+        &dir,
+        &common::words(
+            "identify --machine seed-ac --model reduced --terms XOC@time:1 --campaign c.toml --json c.json",
+        ),
+    );
+    let j = read_json(&dir.join("c.json"));
+    assert_eq!(j["clock"]["start_s"], 0.0);
+    assert_eq!(j["clock"]["end_s"], 960.0);
+    assert_eq!(j["records"][1]["start_s"], 600.0);
+    assert_eq!(param(&j, "XOC@time:1")["owner"], "shared");
+    assert_eq!(j["setups"][0]["records"].as_array().unwrap().len(), 2);
+    // The report reads back; a record predicted on the clock needs its start.
+    std::fs::write(
+        dir.join("v.toml"),
+        "[[record]]\nfile = \"k2.csv\"\nsetup = \"ball\"\nstart = 1000\n",
+    )
+    .unwrap();
+    let v = ok(
+        &dir,
+        &common::words("validate --machine seed-ac --params c.json --campaign v.toml"),
+    );
+    assert!(v.contains("set-up ball (fitted)"), "{v}");
+    fails(
+        &dir,
+        &common::words("validate --machine seed-ac --params c.json --data k2.csv --setup ball"),
+        1,
+        &["no start on the campaign clock"],
+    );
+    // A report whose parameters do not match its terms and records is refused, naming the field.
+    let text = std::fs::read_to_string(dir.join("c.json")).unwrap();
+    std::fs::write(
+        dir.join("bad.json"),
+        text.replace("\"XOW[ball]\"", "\"XOW[other]\""),
+    )
+    .unwrap();
+    fails(
+        &dir,
+        &common::words("validate --machine seed-ac --params bad.json --campaign v.toml"),
+        1,
+        &["bad.json", "parameters[", ".name", "`XOW[other]`"],
+    );
+    std::fs::write(
+        dir.join("bad.json"),
+        text.replace("\"owner\": \"setup\"", "\"owner\": \"shared\""),
+    )
+    .unwrap();
+    fails(
+        &dir,
+        &common::words("validate --machine seed-ac --params bad.json --campaign v.toml"),
+        1,
+        &["bad.json", ".owner"],
+    );
+}

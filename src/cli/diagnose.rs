@@ -61,6 +61,12 @@ harmonic is printed as its cos and sin coefficients, its amplitude √(cos² + s
 (cos·cos kθ + sin·sin kθ = amplitude·cos(kθ − φ)). A fit whose refinement does not converge, or \
 whose values are beyond --max-error-um / --max-error-urad, is an error (exit code 3).
 
+Campaigns (docs/campaigns.md, docs/diagnosis.md): --data a.csv,b.csv or --campaign FILE fits \
+the base model on several records together (each its own ball set-up and R-test zero, the \
+machine's errors shared); held-out records come from --validate (each on a new set-up, whose \
+set-up errors are refitted with the machine held) or --validate-campaign FILE. Scanned \
+parameters keep their grid value and --plot is not available on campaigns.
+
 --json writes the report (docs/diagnosis.md): {machine, data, base_model, zeroed, alpha, \
 base_fit, structure, dictionary_size, unexcited, findings: [{error, basis, description, values, \
 stds, unit, amplitude, phase_deg, explained_fraction, f, p_value, correction, candidates_tried, \

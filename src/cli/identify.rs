@@ -66,6 +66,14 @@ Plausibility: readings beyond --max-reading-um and poses outside the strokes are
 their lines; identified values beyond --max-error-um / --max-error-urad are an error (exit code \
 3), not a result.
 
+Campaigns (docs/campaigns.md): --data a.csv,b.csv fits several records together, each on its own \
+ball set-up (its own XOW YOW ZOW, named XOW[a]) and with its own R-test zero (dx0[a] when \
+--zeroed), the machine's errors shared; --param NAME=VALUE,... gives every record the same \
+kinematic parameters (the ball's position). --campaign FILE reads a TOML list of records with \
+their labels, set-ups (records with the same set-up share its errors), ball positions, zeroing \
+and optional start times on one campaign clock. The report gives the shared values, one block \
+per set-up and per record, and each record's residual; its JSON has \"kind\": \"campaign\".
+
 --json writes the report (docs/identification.md): {machine, fingerprint, data, model, \
 base_model, terms, parameters: [{name, error, basis, value, std, unit, determined, fixed}], \
 residual_rms_um, rank, condition, confounded, samples, sigma_um, near_confounded, refinement: \

@@ -37,6 +37,14 @@ the prediction is zeroed at the first sample too, so constant effects cancel.
 Parameters the identification could not determine (value null) are set to 0 and named; \
 --refuse-undetermined makes that an error instead.
 
+Campaigns (docs/campaigns.md): --params may be a campaign identification, and --data a comma list \
+or --campaign FILE a campaign of records to predict. Shared values come from the \
+identification; a record on a fitted set-up (the same set-up label; --setup LABEL puts every \
+--data record on one) uses that set-up's values; a record on a new set-up has its set-up errors \
+XOW YOW ZOW (and its zero, when zeroed) refitted on it with everything else held, and the \
+report says which parameters were refitted. A single identification is a campaign of one \
+record labelled by the stem of its data file.
+
 --json writes {machine, model, params, data, samples, prediction, measured_rms_um, \
 residual_rms_um, measured_max_um, residual_max_um, per_direction: {x, y, z: {measured_rms_um, \
 measured_max_um, residual_rms_um, residual_max_um}}, zeroed, unidentified_set_to_zero} \
@@ -154,7 +162,7 @@ fn run_single(
         opts.unidentified = Unidentified::Refuse;
     }
     let v = validate(m, &params.model, &params.values, &record, &opts)
-        .map_err(|e| validate_error(args, e))?;
+        .map_err(|e| validate_error(args, e, false))?;
     let (params_file, data) = (
         args.params.display().to_string(),
         data_path.display().to_string(),
@@ -196,14 +204,18 @@ fn implausible(args: &ValidateArgs, e: &solver::fitting::Implausible) -> CliErro
     ))
 }
 
-/// A validation error as a verb's error.
-fn validate_error(args: &ValidateArgs, e: ValidateError) -> CliError {
+/// A validation error as a verb's error; `campaign`: a record that does not fit the
+/// identification's campaign (its set-up, its start) is a bad input.
+fn validate_error(args: &ValidateArgs, e: ValidateError, campaign: bool) -> CliError {
     match e {
         ValidateError::Unidentified(names) => CliError::input(format!(
             "--params: {} gave no value for {} (not determined by the identification) and --refuse-undetermined is set (without it they are set to 0)",
             args.params.display(),
             names.join(", ")
         )),
+        ValidateError::Shape(why) if campaign => {
+            CliError::input(format!("--data: cannot validate: {why}"))
+        }
         other => CliError::computation(format!("--data: cannot validate: {other}")),
     }
 }
@@ -249,7 +261,7 @@ fn run_campaign(
         opts.unidentified = Unidentified::Refuse;
     }
     let v = validate_campaign(m, &values, &loaded.campaign, &opts)
-        .map_err(|e| validate_error(args, e))?;
+        .map_err(|e| validate_error(args, e, true))?;
     let params_file = args.params.display().to_string();
     let source = CampaignValidationSource {
         model: &model_name,

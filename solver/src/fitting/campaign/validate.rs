@@ -253,7 +253,7 @@ pub fn record_plan(
                 .any(|t| super::clock::on_clock(t.basis)) =>
         {
             return Err(ValidateError::Shape(format!(
-                "record `{}` has no start on the campaign clock, but the identification's time terms are on it: give the record a start",
+                "record `{}` has no start on the campaign clock, but the identification's time terms are on it: give the record a start (`start` in a campaign file)",
                 r.label
             )));
         }

@@ -21,10 +21,12 @@
 //!   down to the noise";
 //! - the residual structure is that of the records one after the other.
 
+mod heldout;
+
 use super::adequacy;
 use super::confounded::confounded_with;
 use super::dictionary::dictionary;
-use super::heldout::{HeldOut, NEEDS_TOLERANCE};
+use super::heldout::HeldOut;
 use super::outliers::{self, Outlier};
 use super::select::Span;
 use super::{
@@ -32,20 +34,16 @@ use super::{
     unexplained, verdict,
 };
 use crate::fitting::IdentifyOptions;
-use crate::fitting::campaign::design::{block, design_matrix, measurements};
-use crate::fitting::campaign::{
-    Campaign, CampaignIdentification, CampaignRecord, CampaignValues, identify_campaign_refined,
-    record_plan, validate_record,
-};
-use crate::fitting::hmatrix::GainSource;
+use crate::fitting::campaign::design::{design_matrix, measurements};
+use crate::fitting::campaign::{Campaign, CampaignIdentification, identify_campaign_refined};
 use crate::fitting::noise::{self, NoiseChoice, NoiseModel, NoiseSource};
 use crate::fitting::refine::RefineOptions;
-use crate::fitting::validate::{ValidateError, ValidateOptions, Validation, statistics};
 use crate::fitting::with_offsets;
 use crate::model::{Basis, Effect, Model, Term};
 use crate::record::Record;
+use heldout::{needed_groups, predict, rms_without};
 use model_spec::{Dir, Machine};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
 /// One fitted record of a campaign diagnosis.
 #[derive(Clone, Debug, PartialEq)]
@@ -88,109 +86,6 @@ fn fit(
         params: None,
     };
     Ok(identify_campaign_refined(m, model, c, &opts, &RefineOptions::default(), noise)?.0)
-}
-
-/// The values a prediction uses: every column's minimum-norm solution (the fit's values where
-/// it has them; the determined combinations carried where it does not).
-fn estimable(ident: &CampaignIdentification) -> CampaignValues {
-    let mut v = CampaignValues::of(ident);
-    v.values = ident
-        .fit
-        .values
-        .iter()
-        .zip(&ident.fit.solution)
-        .map(|(v, s)| Some(v.unwrap_or(*s)))
-        .collect();
-    v
-}
-
-/// The exact predictions of `ident` on every held-out record.
-fn predict(
-    m: &Machine,
-    ident: &CampaignIdentification,
-    held: &Campaign,
-) -> Result<Vec<Validation>, ValidateError> {
-    let values = estimable(ident);
-    let opts = ValidateOptions {
-        exact: true,
-        ..Default::default()
-    };
-    held.records
-        .iter()
-        .map(|r| validate_record(m, &values, r, &opts).map(|v| v.validation))
-        .collect()
-}
-
-/// The confounded groups of `ident` (by name) the prediction on held-out record `r` needs: a
-/// null direction of the fit that changes the prediction, once the record's refitted columns
-/// have taken what they can.
-fn needed_groups(
-    m: &Machine,
-    ident: &CampaignIdentification,
-    r: &CampaignRecord,
-) -> Result<Vec<Vec<String>>, DiagnoseError> {
-    let fit = &ident.fit;
-    let null = &fit.identifiability.null_space;
-    if null.ncols() == 0 {
-        return Ok(Vec::new());
-    }
-    let values = estimable(ident);
-    let plan = record_plan(m, &values, r)?;
-    let mut source = GainSource::new(m, &plan.model.errors(), &r.params)?;
-    let h = block(m, &plan.model, &r.record, &mut source, plan.clock)?;
-    let rows = h.nrows();
-    let mut b = DMatrix::zeros(rows, fit.names.len());
-    let mut refit = Vec::new();
-    for (k, s) in plan.sources.iter().enumerate() {
-        match s {
-            Some(c) => {
-                let col = h.column(k) / fit.column_norms[*c];
-                let mut target = b.column_mut(*c);
-                target += col;
-            }
-            None => refit.push(k),
-        }
-    }
-    let refit_span = Span::of_groups(rows, 0..refit.len(), &|i| {
-        h.columns(refit[i], 1).into_owned()
-    });
-    let scale = (0..b.ncols())
-        .map(|j| b.column(j).norm())
-        .fold(0.0, f64::max);
-    let mut groups: Vec<usize> = Vec::new();
-    for k in 0..null.ncols() {
-        let n = null.column(k);
-        let moved = refit_span.project_out(&(&b * n));
-        if moved.norm() <= NEEDS_TOLERANCE * scale {
-            continue;
-        }
-        for (g, members) in fit.identifiability.confounded.iter().enumerate() {
-            if members.iter().any(|&j| n[j].abs() > NEEDS_TOLERANCE) && !groups.contains(&g) {
-                groups.push(g);
-            }
-        }
-    }
-    groups.sort_unstable();
-    Ok(groups
-        .iter()
-        .map(|&g| {
-            fit.identifiability.confounded[g]
-                .iter()
-                .map(|&j| fit.names[j].clone())
-                .collect()
-        })
-        .collect())
-}
-
-/// RMS of `residual` without the samples of `drop`, mm.
-fn rms_without(residual: &[[f64; 3]], drop: &[usize]) -> f64 {
-    let kept: Vec<[f64; 3]> = (0..residual.len())
-        .filter(|i| !drop.contains(i))
-        .map(|i| residual[i])
-        .collect();
-    statistics(&kept, &vec![[0.0; 3]; kept.len()])
-        .1
-        .measured_rms
 }
 
 /// The records one after the other as one record (times continued), for the residual

@@ -409,3 +409,72 @@ fn the_nc_program_of_a_test_reads_back_to_its_poses_in_both_dialects() {
         &["--plan FILE"],
     );
 }
+
+#[test]
+fn simulate_and_identify_take_the_ball_position_the_path_was_planned_at() {
+    let dir = temp_dir_tagged("cli-path", "param");
+    let out = ok(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "K4",
+            "--param",
+            "Zw=261.537",
+            "-o",
+            "k4h.csv",
+        ],
+    );
+    assert!(out.contains("wrote k4h.csv"), "{out}");
+    // Read at the ball position it was planned at, it identifies the demo truth's errors.
+    let out = ok(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4h.csv",
+            "--param",
+            "Zw=261.537",
+        ],
+    );
+    assert!(out.contains("rank 11 of 11"), "{out}");
+    // At the description's defaults the nest is 50 mm off the ball: refused, saying so.
+    fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4h.csv",
+        ],
+        1,
+        &["off the nominal workpiece point by more than 0.5 mm"],
+    );
+    // A ball position that puts the test out of stroke is the generator's error.
+    fails(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "seed-ac",
+            "--path",
+            "K4",
+            "--param",
+            "Zw=311.537",
+            "-o",
+            "x.csv",
+        ],
+        1,
+        &["sample 170 of 241", "outside its stroke"],
+    );
+    assert!(!dir.join("x.csv").exists());
+}

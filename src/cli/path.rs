@@ -376,7 +376,7 @@ fn off_default_note(m: &Machine, record: &Record) -> String {
     let tol = solver::simulation::pose::ON_BALL_TOLERANCE_MM;
     if worst > tol {
         format!(
-            "Note: at the description's default parameters this path leaves the nest up to {} mm off the ball, beyond the {} mm the measurement readers accept: put the ball position in the description (its symbols' defaults) to simulate or identify with it.\n",
+            "Note: at the description's default parameters this path leaves the nest up to {} mm off the ball, beyond the {} mm the measurement readers accept: give the same --param to `simulate` and `identify` (or `params` to the record in a campaign file), which then read it at that ball position.\n",
             short(worst),
             short(tol)
         )

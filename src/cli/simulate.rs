@@ -19,7 +19,9 @@ linearisation) runs a test path with the errors of a truth, and the readings are
 measurement CSV.
 
 The path is a test of the machine (`rtest path --machine M --list`: turn-C, pair-A-C, …, \
-generated at the description's default kinematic parameters; on machines whose rotary axes are A \
+generated at the description's default kinematic parameters or at --param Xw=…,Zw=… (the ball \
+position: the path is planned there, the truth's ball stands there with its own deviations, and \
+the record reads back at those parameters, as `identify --param` and campaign files read it); on machines whose rotary axes are A \
 and C also K1 (C 0..360 deg in 1 deg steps, A = 0; 361 samples), K2 (A -90..30 deg, C = 0; 121 \
 samples), K4 (C = 1.5·i deg, A = -45·(1 - cos C) deg, i = 0..240; 241 samples)), or a path CSV file (rotary columns in degrees, linear columns in \
 mm optional: they are filled by the nominal tool-centre-point inverse kinematics; poses must be \
@@ -56,6 +58,11 @@ pub struct SimulateArgs {
     /// Built-in machine (see `rtest machines`) or path of a machine TOML file.
     #[arg(long, value_name = "NAME|FILE")]
     machine: String,
+    /// Kinematic parameters (mm) overriding the description's defaults, the ball position among
+    /// them (`Xw=-200,Zw=180`): the path is planned there and the truth's parameters move by as
+    /// much.
+    #[arg(long, value_name = "SYMBOL=VALUE,...")]
+    param: Option<String>,
     /// Test path: a test of the machine (`turn-C`, `pair-A-C`, K1, K2, K4 …; see `rtest path
     /// --list`) or a path CSV file (rotary axes in degrees, linear axes in mm optional).
     #[arg(long, value_name = "TEST|FILE")]
@@ -175,6 +182,14 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     inputs.extend(args.instrument.input());
     check_outputs(&inputs, &[("-o", &args.output)], &[])?;
     let mut truth = truth(&m, args.truth.as_deref())?;
+    // A ball position on the command line: the machine as planned there, the truth's real
+    // parameters moved by as much as the plan's.
+    let params = super::pose_args::params(&m, args.param.as_deref())?;
+    let defaults = m.default_parameters();
+    for ((real, p), d) in truth.params.iter_mut().zip(&params).zip(&defaults) {
+        *real += p - d;
+    }
+    let m = solver::io::campaign::machine_at(&m, &params);
     let read = args.records.read_options();
     let path = load_path(&m, &args.path, &read).map_err(|e| match e {
         PathError::NotFound { .. } | PathError::NotAC { .. } => {

@@ -4,6 +4,7 @@
 
 use super::{CliError, CliResult};
 use model_spec::Machine;
+use model_spec::instrument::{Instrument, ReadingsFrame};
 use solver::fitting::campaign::{Campaign, CampaignRecord, Layout};
 use solver::fitting::sanity::{ValueLimits, check_model_values};
 use solver::io::campaign::{CampaignFileError, labels_from_files, load_campaign, read_record_at};
@@ -11,12 +12,12 @@ use solver::io::csv::ReadOptions;
 use solver::model::Model;
 use std::path::{Path, PathBuf};
 
-/// Refuses `--instrument` for a campaign: its fit does not weight records by the covariances
-/// sensor readings carry (a record read through an instrument is identified alone).
+/// Refuses `--instrument` for a campaign's validation or diagnosis: they do not weight records
+/// by the covariances sensor readings carry (a campaign's identification does).
 pub fn refuse_instrument(instrument: &super::args::InstrumentArgs) -> CliResult<()> {
     if instrument.instrument.is_some() {
         return Err(CliError::usage(
-            "--instrument: a campaign (several --data files or --campaign) is fitted without the per-sample covariances of sensor readings, so sensor records are not taken in a campaign yet: identify each sensor record alone",
+            "--instrument: the validation and diagnosis of a campaign (several files or --campaign) do not weight records by the per-sample covariances of sensor readings yet: identify the campaign (which does), or validate and diagnose one sensor record at a time",
         ));
     }
     Ok(())
@@ -32,8 +33,12 @@ pub struct Loaded {
     pub source: Option<PathBuf>,
 }
 
+/// The instrument the records are read through (sensor readings), if any.
+pub type Through<'a> = Option<(&'a Instrument, ReadingsFrame)>;
+
 /// The records of `files` (given by `flag`), each on a set-up of its own labelled by the
-/// file's stem (made unique), at kinematic parameters `params` (mm), zeroed or not.
+/// file's stem (made unique), at kinematic parameters `params` (mm), zeroed or not, read
+/// through `instrument` when it is given.
 pub fn from_files(
     flag: &str,
     m: &Machine,
@@ -41,11 +46,12 @@ pub fn from_files(
     params: &[f64],
     zeroed: bool,
     read: &ReadOptions,
+    instrument: Through,
 ) -> CliResult<Loaded> {
     let labels = labels_from_files(files);
     let mut records = Vec::with_capacity(files.len());
     for (f, label) in files.iter().zip(&labels) {
-        let record = read_record_at(f, m, params, read).map_err(|e| {
+        let record = read_record_at(f, m, params, read, instrument).map_err(|e| {
             CliError::input(format!(
                 "{flag}: {e}{}",
                 solver::io::campaign::parameters_note(m, params)
@@ -68,9 +74,15 @@ pub fn from_files(
 }
 
 /// The campaign of the campaign file `path` (given by `flag`), every record's CSV read at its
-/// kinematic parameters.
-pub fn from_file(flag: &str, m: &Machine, path: &Path, read: &ReadOptions) -> CliResult<Loaded> {
-    let (file, campaign) = load_campaign(path, m, read).map_err(|e| match e {
+/// kinematic parameters and through `instrument` when it is given.
+pub fn from_file(
+    flag: &str,
+    m: &Machine,
+    path: &Path,
+    read: &ReadOptions,
+    instrument: Through,
+) -> CliResult<Loaded> {
+    let (file, campaign) = load_campaign(path, m, read, instrument).map_err(|e| match e {
         e @ CampaignFileError::Text(_) => CliError::input(format!("{flag}: {e}")),
         e => CliError::input(format!("{flag}: {e}")),
     })?;

@@ -200,6 +200,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     let mut inputs: Vec<(&str, &Path)> = vec![("--data", data_path)];
     inputs.extend(held_files.iter().map(|f| ("--validate", f.as_path())));
     inputs.extend(args.noise.input());
+    inputs.extend(args.instrument.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     outputs.extend(args.model_out.iter().map(|t| ("--model-out", t)));
@@ -349,11 +350,11 @@ fn run_campaign(
     let read = args.records.read_options();
     let params = super::pose_args::params(m, args.param.as_deref())?;
     let fitted = match &args.campaign {
-        Some(path) => campaign::from_file("--campaign", m, path, &read)?,
-        None => campaign::from_files("--data", m, files, &params, args.zeroed, &read)?,
+        Some(path) => campaign::from_file("--campaign", m, path, &read, None)?,
+        None => campaign::from_files("--data", m, files, &params, args.zeroed, &read, None)?,
     };
     let held = match &args.validate_campaign {
-        Some(path) => campaign::from_file("--validate-campaign", m, path, &read)?,
+        Some(path) => campaign::from_file("--validate-campaign", m, path, &read, None)?,
         None if held_files.is_empty() => campaign::Loaded {
             campaign: solver::fitting::campaign::Campaign {
                 records: Vec::new(),
@@ -361,7 +362,15 @@ fn run_campaign(
             files: Vec::new(),
             source: None,
         },
-        None => campaign::from_files("--validate", m, held_files, &params, args.zeroed, &read)?,
+        None => campaign::from_files(
+            "--validate",
+            m,
+            held_files,
+            &params,
+            args.zeroed,
+            &read,
+            None,
+        )?,
     };
     if let Some(r) = held
         .campaign
@@ -381,6 +390,7 @@ fn run_campaign(
         .collect();
     inputs.extend(held_inputs.iter().map(|p| ("--validate", p.as_path())));
     inputs.extend(args.noise.input());
+    inputs.extend(args.instrument.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     outputs.extend(args.model_out.iter().map(|t| ("--model-out", t)));

@@ -187,6 +187,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     }
     let mut inputs = vec![("--data", data_path)];
     inputs.extend(args.noise.input());
+    inputs.extend(args.instrument.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
@@ -307,16 +308,17 @@ fn run_campaign(
             "--stream reads one long record; a campaign (several --data files) is fitted whole: drop --stream",
         ));
     }
-    campaign::refuse_instrument(&args.instrument)?;
     let read = args.records.read_options();
+    let instrument = args.instrument.load()?;
+    let through = instrument.as_ref().map(|(i, f)| (i, *f));
     let loaded = match &args.campaign {
         Some(path) => {
             check_outputs(&[("--campaign", path.as_path())], &[], &[])?;
-            campaign::from_file("--campaign", m, path, &read)?
+            campaign::from_file("--campaign", m, path, &read, through)?
         }
         None => {
             let params = super::pose_args::params(m, args.param.as_deref())?;
-            campaign::from_files("--data", m, files, &params, args.zeroed, &read)?
+            campaign::from_files("--data", m, files, &params, args.zeroed, &read, through)?
         }
     };
     let flag = if args.campaign.is_some() {
@@ -328,6 +330,7 @@ fn run_campaign(
     let mut inputs: Vec<(&str, &std::path::Path)> =
         all_inputs.iter().map(|p| (flag, p.as_path())).collect();
     inputs.extend(args.noise.input());
+    inputs.extend(args.instrument.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;

@@ -118,6 +118,7 @@ pub fn run(args: &ValidateArgs) -> CliResult {
     inputs.extend(files.iter().map(|f| ("--data", f.as_path())));
     inputs.extend(args.campaign.iter().map(|f| ("--campaign", f.as_path())));
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
+    inputs.extend(args.instrument.input());
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
     let read_values = solver::io::report::read_values(&args.params, &m)
@@ -236,10 +237,10 @@ fn run_campaign(
         .map_err(|e| implausible(args, &e))?;
     let read = args.records.read_options();
     let mut loaded = match &args.campaign {
-        Some(path) => campaign::from_file("--campaign", m, path, &read)?,
+        Some(path) => campaign::from_file("--campaign", m, path, &read, None)?,
         None => {
             let params = super::pose_args::params(m, args.param.as_deref())?;
-            campaign::from_files("--data", m, files, &params, args.zeroed, &read)?
+            campaign::from_files("--data", m, files, &params, args.zeroed, &read, None)?
         }
     };
     if let Some(setup) = &args.setup {

@@ -195,6 +195,9 @@ pub enum DiagnoseError {
     /// The noise model cannot whiten the readings.
     #[error("noise model: {0}")]
     Noise(#[from] NoiseError),
+    /// The campaign cannot be diagnosed as given.
+    #[error("{0}")]
+    Campaign(String),
 }
 
 /// The refined fit of `model` on `record`, by generalized least squares under `noise`.

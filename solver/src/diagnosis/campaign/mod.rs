@@ -129,6 +129,10 @@ pub fn diagnose_campaign(
     held_out: &Campaign,
     o: &DiagnoseOptions,
 ) -> Result<(Diagnosis, CampaignPart), DiagnoseError> {
+    for c in [fitted, held_out] {
+        c.refuse_covariances("a diagnosis")
+            .map_err(|e| DiagnoseError::Campaign(e.0))?;
+    }
     let any_zeroed = fitted.records.iter().any(|r| r.zeroed);
     let base_given = base.clone();
     // The dictionary leaves out what the base model has; with zeroed records the constant zero

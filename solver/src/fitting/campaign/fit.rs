@@ -10,9 +10,9 @@ use super::design::{Design, Layout, Owner, design_matrix, measurements};
 use crate::fitting::IdentifyOptions;
 use crate::fitting::hmatrix::Backend;
 use crate::fitting::identifiability::{NearPair, Swallowed, swallowed_by_offsets};
-use crate::fitting::identify::check_readings;
-use crate::fitting::least_squares::{EstimateError, Fit, least_squares, least_squares_whitened};
-use crate::fitting::noise::{NoiseChoice, NoiseModel};
+use crate::fitting::identify::{check_readings, fit_rows};
+use crate::fitting::least_squares::{EstimateError, Fit};
+use crate::fitting::noise::{NoiseChoice, NoiseModel, SampleWhitening};
 use crate::model::{Effect, Model};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
@@ -187,6 +187,32 @@ pub fn choose_campaign_noise(
     }
 }
 
+/// As [`choose_campaign_noise`] from the residual of `fit` (mm, the records' rows in order),
+/// whitened first per sample by `weights` when the readings carry covariances (the noise model
+/// then describes the whitened rows, as the fits of a record read through an instrument do).
+///
+/// # Errors
+/// [`EstimateError::Noise`] when the weights do not fit the rows.
+pub fn choose_campaign_noise_weighted(
+    choice: &NoiseChoice,
+    fit: &Fit,
+    rows: &[usize],
+    weights: Option<&SampleWhitening>,
+) -> Result<NoiseModel, EstimateError> {
+    let Some(w) = weights else {
+        return Ok(choose_campaign_noise(
+            choice,
+            fit.residual.as_slice(),
+            rows,
+            fit.sigma,
+        ));
+    };
+    let mut r = fit.residual.clone();
+    w.whiten_vector(&mut r)?;
+    let sigma = (fit.dof > 0).then(|| (r.norm_squared() / fit.dof as f64).sqrt());
+    Ok(choose_campaign_noise(choice, r.as_slice(), rows, sigma))
+}
+
 /// Identifies `model` of `m` on `campaign` (first order): the design matrix with the best
 /// gain sources ([`design_matrix`]), then [`identify_campaign_with`].
 ///
@@ -236,33 +262,36 @@ pub fn identify_campaign_with(
     let y = measurements(campaign)?;
     let order = design.layout.solve_order();
     let (h, names) = solve_system(design, &order);
-    let ordinary = least_squares(&h, &y, &names, &opts.constraint, &opts.tolerances)?;
+    let weights = campaign.whitening(noise)?;
+    let (c, t) = (&opts.constraint, &opts.tolerances);
+    let (ordinary, weighted_sigma) =
+        fit_rows(&h, &y, &names, c, t, None, &design.rows, weights.as_ref())?;
     if *noise == NoiseChoice::Ordinary {
-        return Ok(CampaignIdentification::new(
-            m,
-            model,
-            design,
-            to_layout_order(ordinary, &order),
-        ));
+        let mut ident =
+            CampaignIdentification::new(m, model, design, to_layout_order(ordinary, &order));
+        if let (Some(w), Some(s)) = (&weights, weighted_sigma) {
+            ident.noise = NoiseModel::residual(
+                s * w.scale_mm,
+                "ordinary least squares of the rows whitened by each sample's covariance",
+            );
+            ident.whitened_sigma = Some(s);
+        }
+        return Ok(ident);
     }
-    let chosen = choose_campaign_noise(
-        noise,
-        ordinary.residual.as_slice(),
-        &design.rows,
-        ordinary.sigma,
-    );
-    let w = least_squares_whitened(
+    let chosen = choose_campaign_noise_weighted(noise, &ordinary, &design.rows, weights.as_ref())?;
+    let (fit, whitened_sigma) = fit_rows(
         &h,
         &y,
         &names,
-        &opts.constraint,
-        &opts.tolerances,
-        &chosen,
+        c,
+        t,
+        Some(&chosen),
         &design.rows,
+        weights.as_ref(),
     )?;
-    let mut ident = CampaignIdentification::new(m, model, design, to_layout_order(w.fit, &order));
+    let mut ident = CampaignIdentification::new(m, model, design, to_layout_order(fit, &order));
     ident.noise = chosen;
-    ident.whitened_sigma = w.whitened_sigma;
+    ident.whitened_sigma = whitened_sigma;
     Ok(ident)
 }
 

@@ -152,6 +152,68 @@ impl Campaign {
         Ok(c)
     }
 
+    /// The per-sample whitening of the campaign's readings, stacked in record order, when its
+    /// records were read through an instrument (every record carries per-sample covariances,
+    /// [`Record::covariance`]); `None` when none does.
+    ///
+    /// # Errors
+    /// [`EstimateError::Noise`] when some records carry covariances and others do not (their
+    /// rows could not be weighted alike), when a covariance cannot whiten, or when `noise` is a
+    /// declared model (the sensors' σ already declare the noise).
+    pub fn whitening(
+        &self,
+        noise: &crate::fitting::noise::NoiseChoice,
+    ) -> Result<Option<crate::fitting::noise::SampleWhitening>, crate::fitting::EstimateError> {
+        let with: Vec<&str> = self
+            .records
+            .iter()
+            .filter(|r| !r.record.covariance.is_empty())
+            .map(|r| r.label.as_str())
+            .collect();
+        if with.is_empty() {
+            return Ok(None);
+        }
+        if with.len() != self.records.len() {
+            let without: Vec<&str> = self
+                .records
+                .iter()
+                .filter(|r| r.record.covariance.is_empty())
+                .map(|r| r.label.as_str())
+                .collect();
+            return Err(crate::fitting::noise::NoiseError::Whitening(format!(
+                "records {} were read through an instrument (per-sample covariances) and records {} were not: a campaign weights all its records alike, so read every record through the instrument or none",
+                with.join(", "),
+                without.join(", ")
+            ))
+            .into());
+        }
+        let mut all = Record::default();
+        for r in &self.records {
+            all.samples.extend(r.record.samples.iter().cloned());
+            all.covariance.extend(r.record.covariance.iter().copied());
+        }
+        crate::fitting::identify::sample_whitening(&all, noise)
+    }
+
+    /// Refuses a campaign whose records carry per-sample covariances for `what` (a use that
+    /// does not weight its rows by them yet).
+    ///
+    /// # Errors
+    /// [`CampaignError`] naming the first such record.
+    pub fn refuse_covariances(&self, what: &str) -> Result<(), CampaignError> {
+        match self
+            .records
+            .iter()
+            .find(|r| !r.record.covariance.is_empty())
+        {
+            Some(r) => Err(CampaignError(format!(
+                "record `{}` was read through an instrument (per-sample covariances), which {what} does not weight yet: identify the campaign (which does), or validate and diagnose records of error vectors",
+                r.label
+            ))),
+            None => Ok(()),
+        }
+    }
+
     fn check_labels(&self) -> Result<(), CampaignError> {
         if self.records.is_empty() {
             return Err(CampaignError("a campaign needs at least one record".into()));
@@ -162,12 +224,6 @@ impl Campaign {
             if self.records[..i].iter().any(|o| o.label == r.label) {
                 return Err(CampaignError(format!(
                     "record label `{}` is given twice: every record needs its own label",
-                    r.label
-                )));
-            }
-            if !r.record.covariance.is_empty() {
-                return Err(CampaignError(format!(
-                    "record `{}` was read through an instrument (its readings carry per-sample covariances), which a campaign fit does not weight yet: identify sensor records one at a time",
                     r.label
                 )));
             }

@@ -8,7 +8,7 @@ use super::Campaign;
 use super::clock::own_clock_terms;
 use super::design::{Design, design_matrix, measurements};
 use super::fit::{
-    CampaignIdentification, check_options, choose_campaign_noise, identify_campaign_with,
+    CampaignIdentification, check_options, choose_campaign_noise_weighted, identify_campaign_with,
     solve_system, to_layout_order, to_solve_order,
 };
 use crate::fitting::noise::{NoiseChoice, NoiseModel};
@@ -78,6 +78,9 @@ pub fn refine_campaign(
                 .chain(r.record.samples.iter().flat_map(|s| s.commands.iter()))
         })
         .fold(1.0f64, |a, v| a.max(v.abs()));
+    // Records read through an instrument weight every correction by their covariances (a
+    // declared noise model was refused by the first-order fit).
+    let weights = campaign.whitening(&NoiseChoice::Estimate)?;
     let problem = GaussNewton {
         h: &h,
         y: &y,
@@ -85,7 +88,7 @@ pub fn refine_campaign(
         tolerances,
         noise,
         coordinates,
-        weights: None,
+        weights: weights.as_ref(),
     };
     // The first-order fit in solve order: the iteration runs on the system as solved.
     let mut start = ident.fit.clone();
@@ -103,7 +106,7 @@ pub fn refine_campaign(
     ident.fit = to_layout_order(fit, &order);
     let residual = ident.fit.residual.clone();
     ident.set_residual(&residual);
-    if noise.is_some() {
+    if noise.is_some() || weights.is_some() {
         ident.whitened_sigma = whitened_sigma;
     }
     Ok(refinement)
@@ -142,12 +145,8 @@ pub fn identify_campaign_refined(
     if *noise == NoiseChoice::Ordinary {
         return Ok((ident, ordinary));
     }
-    let chosen = choose_campaign_noise(
-        noise,
-        ident.fit.residual.as_slice(),
-        &design.rows,
-        ident.fit.sigma,
-    );
+    let weights = campaign.whitening(noise)?;
+    let chosen = choose_campaign_noise_weighted(noise, &ident.fit, &design.rows, weights.as_ref())?;
     let r = refine_campaign(
         m,
         campaign,

@@ -168,6 +168,9 @@ pub fn validate_campaign(
     opts: &ValidateOptions,
 ) -> Result<CampaignValidation, ValidateError> {
     campaign.check(m).map_err(|e| ValidateError::Shape(e.0))?;
+    campaign
+        .refuse_covariances("a campaign's validation")
+        .map_err(|e| ValidateError::Shape(e.0))?;
     let mut records = Vec::with_capacity(campaign.records.len());
     let (mut measured, mut predicted) = (Vec::new(), Vec::new());
     for r in &campaign.records {

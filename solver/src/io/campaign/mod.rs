@@ -27,6 +27,7 @@ pub use parse::parse_campaign;
 use crate::fitting::campaign::{Campaign, CampaignError, CampaignRecord, label_char};
 use crate::io::csv::{CsvError, ReadOptions, read_measurement};
 use model_spec::Machine;
+use model_spec::instrument::{Instrument, ReadingsFrame};
 use model_spec::text::TextError;
 use std::path::{Path, PathBuf};
 
@@ -160,20 +161,23 @@ pub fn machine_at(m: &Machine, params: &[f64]) -> Machine {
 }
 
 /// Reads the measurement CSV at `path` planned at kinematic parameters `params` (mm): as
-/// [`read_measurement`] with the machine's defaults replaced by `params`.
+/// [`read_measurement`] with the machine's defaults replaced by `params`; with an `instrument`
+/// (and the frame of its readings) a CSV of sensor readings turned into error vectors with
+/// their covariances ([`crate::io::sensors::read_sensor_measurement`]).
 ///
 /// # Errors
-/// As [`read_measurement`].
+/// As [`read_measurement`] and [`crate::io::sensors::read_sensor_measurement`].
 pub fn read_record_at(
     path: &Path,
     m: &Machine,
     params: &[f64],
     opts: &ReadOptions,
+    instrument: Option<(&Instrument, ReadingsFrame)>,
 ) -> Result<crate::record::Record, CsvError> {
-    if params == m.default_parameters().as_slice() {
-        read_measurement(path, m, opts)
-    } else {
-        read_measurement(path, &machine_at(m, params), opts)
+    let at = machine_at(m, params);
+    match instrument {
+        None => read_measurement(path, &at, opts),
+        Some((i, frame)) => crate::io::sensors::read_sensor_measurement(path, &at, i, frame, opts),
     }
 }
 
@@ -218,9 +222,10 @@ pub fn load_campaign(
     path: &Path,
     m: &Machine,
     opts: &ReadOptions,
+    instrument: Option<(&Instrument, ReadingsFrame)>,
 ) -> Result<(CampaignFile, Campaign), CampaignFileError> {
     let f = read_campaign_file(path, m)?;
-    let c = f.load(m, opts)?;
+    let c = f.load(m, opts, instrument)?;
     Ok((f, c))
 }
 
@@ -230,18 +235,24 @@ impl CampaignFile {
     /// # Errors
     /// [`CampaignFileError::Record`] naming the record and the CSV's own line;
     /// [`CampaignFileError::Campaign`] for records that do not make a campaign.
-    pub fn load(&self, m: &Machine, opts: &ReadOptions) -> Result<Campaign, CampaignFileError> {
+    pub fn load(
+        &self,
+        m: &Machine,
+        opts: &ReadOptions,
+        instrument: Option<(&Instrument, ReadingsFrame)>,
+    ) -> Result<Campaign, CampaignFileError> {
         let mut records = Vec::with_capacity(self.records.len());
         for e in &self.records {
-            let record = read_record_at(&e.path, m, &e.params, opts).map_err(|error| {
-                CampaignFileError::Record {
-                    at: parameters_note(m, &e.params),
-                    campaign: self.file.clone(),
-                    line: e.line,
-                    label: e.label.clone(),
-                    error: Box::new(error),
-                }
-            })?;
+            let record =
+                read_record_at(&e.path, m, &e.params, opts, instrument).map_err(|error| {
+                    CampaignFileError::Record {
+                        at: parameters_note(m, &e.params),
+                        campaign: self.file.clone(),
+                        line: e.line,
+                        label: e.label.clone(),
+                        error: Box::new(error),
+                    }
+                })?;
             if e.start_s.is_some() && !record.has_times() {
                 return Err(CampaignFileError::Invalid {
                     file: self.file.clone(),

@@ -157,7 +157,7 @@ impl Campaign {
     /// [`Record::covariance`]); `None` when none does.
     ///
     /// # Errors
-    /// [`EstimateError::Noise`] when some records carry covariances and others do not (their
+    /// [`crate::fitting::EstimateError::Noise`] when some records carry covariances and others do not (their
     /// rows could not be weighted alike), when a covariance cannot whiten, or when `noise` is a
     /// declared model (the sensors' σ already declare the noise).
     pub fn whitening(

@@ -122,14 +122,9 @@ pub fn read_record(
     instrument: &args::InstrumentArgs,
     params: &[f64],
 ) -> CliResult<Record> {
-    let at = solver::io::campaign::machine_at(m, params);
-    let read = match instrument.load()? {
-        None => solver::io::csv::read_measurement(path, &at, options),
-        Some((i, frame)) => {
-            solver::io::sensors::read_sensor_measurement(path, &at, &i, frame, options)
-        }
-    };
-    read.map_err(|e| {
+    let instrument = instrument.load()?;
+    let through = instrument.as_ref().map(|(i, f)| (i, *f));
+    solver::io::campaign::read_record_at(path, m, params, options, through).map_err(|e| {
         CliError::input(format!(
             "{flag}: {e}{}",
             solver::io::campaign::parameters_note(m, params)

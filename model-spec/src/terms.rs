@@ -1,11 +1,22 @@
 //! Terms of a model: an effect (an ISO 230 error of the machine, an R-test sensor zero offset
-//! `dx0 dy0 dz0`, or an R-test instrument term `SXX` … `SZY`) times a basis of the vocabulary
+//! `dx0 dy0 dz0`, an R-test instrument term `SXX` … `SZY`, or a kinematic offset of the
+//! description: one of its `[symbols]`, `Zt`, `Xw`) times a basis of the vocabulary
 //! ([`crate::basis`]). A term gives one H-matrix column, two for `harmonic:K` and `period:P`.
 //! Sub-models of a machine description list terms as `NAME` (constant) or `NAME@BASIS`
 //! (`ECC@harmonic:2`, `dx0@time:1`, `EXX@velocity`).
+//!
+//! **Names.** A term's `NAME` is read, in this order of rules that never overlap:
+//! - `dx0 dy0 dz0` (any case) and `SXX` … `SZY` (upper case): effects of the measurement;
+//! - an error of the machine's catalogue, without regard to case and with the digit-zero alias
+//!   (`xoc`, `X0C` are `XOC`);
+//! - a kinematic symbol, exactly as the description writes it (`Zt`; `zt` is another name).
+//!
+//! The description's validation keeps these apart: a symbol may not be named like an effect of
+//! the measurement, nor like an error of the machine in any spelling that reads as that error
+//! (`XOC`, `xoc`, `X0C`), so every name means one effect.
 
 use crate::basis::{Basis, BasisError, Carrier};
-use crate::{Dir, ErrorId, Machine};
+use crate::{Dir, ErrorId, Machine, SymbolId};
 
 /// Something that moves the measured error vector.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -26,6 +37,13 @@ pub enum Effect {
         /// The direction of the displacement it takes.
         displacement: Dir,
     },
+    /// A kinematic offset of the machine description: the symbol (index into
+    /// `Machine::symbols`) whose value the identification changes. Its coefficient is the
+    /// change from the value the record is modelled with (mm inside, µm for people); its gain is
+    /// the derivative of the tool-minus-workpiece vector (tool frame) with respect to the
+    /// symbol, mm/mm. Constants only: a kinematic offset is one length of the machine's
+    /// geometry.
+    KinematicOffset(SymbolId),
 }
 
 /// The effect names that are no machine error (`dx0 dy0 dz0`, `SXX` … `SZY`): reserved, so a
@@ -35,10 +53,25 @@ pub const MEASUREMENT_EFFECTS: &[&str] = &[
 ];
 
 impl Effect {
-    /// The effect called `name` on `m`: an error name (digit-zero alias accepted),
-    /// `dx0 dy0 dz0` or an instrument term `SXX` … `SZY`.
+    /// The effect called `name` on `m` among the errors and the effects of the measurement: an
+    /// error name (digit-zero alias accepted), `dx0 dy0 dz0` or an instrument term `SXX` …
+    /// `SZY`. Kinematic offsets are not among them (a truth gives a symbol's real value under
+    /// `[parameters]`, not as an error): [`Effect::parse_term`] reads every effect a term may
+    /// have.
     pub fn parse(m: &Machine, name: &str) -> Option<Effect> {
         Effect::parse_measurement(name).or_else(|| m.error_by_name(name).map(Effect::Error))
+    }
+
+    /// The effect a model term called `name` has on `m`: as [`Effect::parse`], or a kinematic
+    /// offset ([`Effect::parse_kinematic`]).
+    pub fn parse_term(m: &Machine, name: &str) -> Option<Effect> {
+        Effect::parse(m, name).or_else(|| Effect::parse_kinematic(m, name))
+    }
+
+    /// The kinematic offset called `name` on `m`: the symbol of that name exactly as the
+    /// description writes it (surrounding blanks ignored), or `None`.
+    pub fn parse_kinematic(m: &Machine, name: &str) -> Option<Effect> {
+        m.symbol_by_name(name.trim()).map(Effect::KinematicOffset)
     }
 
     /// The effect of the measurement (not of the machine) called `name`: a sensor offset
@@ -86,10 +119,11 @@ impl Effect {
         }
     }
 
-    /// Its name (`XOC`, `dx0`).
+    /// Its name (`XOC`, `dx0`, `Zt`).
     pub fn name(self, m: &Machine) -> String {
         match self {
             Effect::Error(e) => m.catalogue[e].name.clone(),
+            Effect::KinematicOffset(s) => m.symbols[s].name.clone(),
             Effect::SensorOffset(d) => format!("d{d}0"),
             Effect::Instrument {
                 reading,
@@ -107,8 +141,9 @@ impl Effect {
         matches!(self, Effect::Error(e) if m.catalogue[e].is_angular())
     }
 
-    /// The unit people see of the effect's value: `um` or `urad`, `1` for an instrument term.
-    /// (A term's coefficient may have another unit: [`Term::unit`].)
+    /// The unit people see of the effect's value: `um` or `urad`, `1` for an instrument term;
+    /// `um` for a kinematic offset (its change; the symbol itself is in mm). (A term's
+    /// coefficient may have another unit: [`Term::unit`].)
     pub fn unit(self, m: &Machine) -> &'static str {
         match self {
             Effect::Instrument { .. } => "1",
@@ -159,7 +194,17 @@ impl Effect {
                 crate::ErrorKind::Component { axis, .. } => Carrier::Axis(axis),
                 _ => Carrier::None,
             },
-            Effect::SensorOffset(_) | Effect::Instrument { .. } => Carrier::None,
+            Effect::SensorOffset(_) | Effect::Instrument { .. } | Effect::KinematicOffset(_) => {
+                Carrier::None
+            }
+        }
+    }
+
+    /// The kinematic symbol of a kinematic offset, or `None`.
+    pub fn symbol(self) -> Option<SymbolId> {
+        match self {
+            Effect::KinematicOffset(s) => Some(s),
+            _ => None,
         }
     }
 }
@@ -184,8 +229,24 @@ impl Term {
     /// Checks that the basis fits the effect ([`Basis::check`]: harmonics of rotary axes'
     /// component errors, polynomials and periods of linear axes', reversal and steps of any
     /// axis's, `exp:TAU` of effects of no axis), that `velocity` multiplies a positioning error
-    /// and that an instrument term is a constant.
+    /// and that an instrument term or a kinematic offset (a symbol of `m`) is a constant.
     pub fn check(&self, m: &Machine) -> Result<(), BasisError> {
+        if let Effect::KinematicOffset(s) = self.effect {
+            if s >= m.symbols.len() {
+                return Err(BasisError(format!(
+                    "symbol #{s} is not a kinematic symbol of machine {} ({} symbols)",
+                    m.name,
+                    m.symbols.len()
+                )));
+            }
+            if self.basis != Basis::Const {
+                return Err(BasisError(format!(
+                    "`{}` is a kinematic offset of the machine (a length of its description, mm): constants only, not `{}`; a length does not change with position, direction of motion or time (what does is an error of an axis or a drift)",
+                    m.symbols[s].name, self.basis
+                )));
+            }
+            return Ok(());
+        }
         if matches!(self.effect, Effect::Instrument { .. }) && self.basis != Basis::Const {
             return Err(BasisError(format!(
                 "`{}` is an instrument term of the R-test: constants only, not `{}`",
@@ -226,19 +287,14 @@ impl Term {
         10f64.powi(self.places(m))
     }
 
-    /// Parses `NAME` (constant) or `NAME@BASIS` (`ECC@harmonic:2`, `dx0@time:1`).
+    /// Parses `NAME` (constant) or `NAME@BASIS` (`ECC@harmonic:2`, `dx0@time:1`, `Zt`): `NAME`
+    /// as [`Effect::parse_term`] reads it.
     pub fn parse(m: &Machine, s: &str) -> Result<Term, BasisError> {
         let (name, basis) = match s.split_once('@') {
             Some((n, b)) => (n, Basis::parse(b)?),
             None => (s, Basis::Const),
         };
-        let effect = Effect::parse(m, name).ok_or_else(|| {
-            BasisError(format!(
-                "`{}` is neither an error of machine {} nor dx0/dy0/dz0 nor an instrument term SXX … SZY",
-                name.trim(),
-                m.name
-            ))
-        })?;
+        let effect = Effect::parse_term(m, name).ok_or_else(|| unknown_effect(m, name))?;
         Term::new(m, effect, basis).map_err(|e| BasisError(format!("{}: {}", name.trim(), e.0)))
     }
 
@@ -253,14 +309,38 @@ impl Term {
     }
 }
 
-/// The machine errors `terms` use, ascending (catalogue order), each once; sensor offsets are
-/// not machine errors.
+/// Why `name` is no effect of `m`: what a name may be; when it is a kinematic symbol's name in
+/// another case, how the symbol is written.
+pub fn unknown_effect(m: &Machine, name: &str) -> BasisError {
+    if let Some(s) = m
+        .symbols
+        .iter()
+        .find(|s| s.name.eq_ignore_ascii_case(name.trim()))
+    {
+        return BasisError(format!(
+            "`{}` is no effect of machine {}; its kinematic symbol is written `{}` (symbols are named exactly as the description writes them)",
+            name.trim(),
+            m.name,
+            s.name
+        ));
+    }
+    BasisError(format!(
+        "`{}` is neither an error of machine {} nor dx0/dy0/dz0 nor an instrument term SXX … SZY",
+        name.trim(),
+        m.name
+    ))
+}
+
+/// The machine errors `terms` use, ascending (catalogue order), each once; sensor offsets,
+/// instrument terms and kinematic offsets are not machine errors.
 pub fn errors_of(terms: &[Term]) -> Vec<ErrorId> {
     let mut errors: Vec<ErrorId> = terms
         .iter()
         .filter_map(|t| match t.effect {
             Effect::Error(e) => Some(e),
-            Effect::SensorOffset(_) | Effect::Instrument { .. } => None,
+            Effect::SensorOffset(_) | Effect::Instrument { .. } | Effect::KinematicOffset(_) => {
+                None
+            }
         })
         .collect();
     errors.sort_unstable();
@@ -269,10 +349,29 @@ pub fn errors_of(terms: &[Term]) -> Vec<ErrorId> {
 }
 
 /// What an effect is, in a machine-tool engineer's words (`angular positioning error of C`,
-/// `straightness of X in y`, `squareness of X to the reference`, `ball set-up error in x`).
+/// `straightness of X in y`, `squareness of X to the reference`, `ball set-up error in x`,
+/// `kinematic offset Zt: z of the offset of the end probe (tool chain)`).
 pub fn describe_effect(m: &Machine, effect: Effect) -> String {
     use crate::{AxisKind, ErrorKind, Motion};
     let e = match effect {
+        Effect::KinematicOffset(s) => {
+            let uses = symbol_uses(m, s);
+            let ball = m.workpiece_symbols().contains(&s);
+            return format!(
+                "{} {}{}",
+                if ball {
+                    "ball position"
+                } else {
+                    "kinematic offset"
+                },
+                m.symbols[s].name,
+                if uses.is_empty() {
+                    " (used in no offset)".to_string()
+                } else {
+                    format!(": {}", uses.join(", "))
+                }
+            );
+        }
         Effect::SensorOffset(d) => return format!("R-test zero offset in {d}"),
         Effect::Instrument {
             reading,
@@ -336,6 +435,39 @@ pub fn describe_effect(m: &Machine, effect: Effect) -> String {
         }
         ErrorKind::Setup { along } => format!("workpiece (ball) set-up error in {along}"),
     }
+}
+
+/// Where the description uses symbol `s`: `z of the offset of the end probe (tool chain)`,
+/// `x of the offset of axis A`, `x of the offset of the link holder`, in chain order (work
+/// chain first, each from the bed outwards).
+pub fn symbol_uses(m: &Machine, s: SymbolId) -> Vec<String> {
+    use crate::{Link, Side, Value};
+    let mut out = Vec::new();
+    let mut add = |offset: &crate::Offset, what: String| {
+        for (k, v) in offset.iter().enumerate() {
+            if *v == Value::Symbol(s) {
+                out.push(format!("{} of the offset of {what}", ["x", "y", "z"][k]));
+            }
+        }
+    };
+    for side in [Side::Work, Side::Tool] {
+        let chain = m.chain(side);
+        let which = match side {
+            Side::Work => "work chain",
+            Side::Tool => "tool chain",
+        };
+        for link in &chain.links {
+            match link {
+                Link::Axis(a) => add(&m.axes[*a].offset, format!("axis {}", m.axes[*a].name)),
+                Link::Fixed { name, offset } => add(offset, format!("the link {name} ({which})")),
+            }
+        }
+        add(
+            &chain.end_offset,
+            format!("the end {} ({which})", chain.end_name),
+        );
+    }
+    out
 }
 
 /// What a basis means for people: `constant`, `twice per revolution`, `linear over the stroke`.

@@ -2,7 +2,7 @@
 //! H-matrix columns are the terms' columns in order.
 
 pub use model_spec::basis::{Basis, BasisContext, Carrier};
-pub use model_spec::terms::{Effect, Term};
+pub use model_spec::terms::{Effect, Term, unknown_effect};
 use model_spec::{ErrorId, Machine};
 
 /// A model: terms in order; its columns are the terms' columns in order.

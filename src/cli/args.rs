@@ -225,15 +225,28 @@ pub fn model(m: &Machine, name: Option<&str>, terms: Option<&str>) -> CliResult<
 }
 
 /// Parses `--terms`: a comma list of `NAME` (constant) or `NAME@BASIS` terms
-/// (`ECC@harmonic:2,dx0@time:1`); each with its text as written (trimmed).
+/// (`ECC@harmonic:2,dx0@time:1`; `NAME` may be a kinematic symbol of the machine, `Zt`, whose
+/// change is identified in µm); each with its text as written (trimmed).
 pub fn parse_terms(m: &Machine, list: &str) -> CliResult<Vec<(String, Term)>> {
     let example = "expected a comma list of NAME or NAME@BASIS, e.g. ECC@harmonic:2,dx0@time:1";
     let mut out = Vec::new();
     for item in items("--terms", list, example)? {
         let term = Term::parse(m, item).map_err(|e| {
             let name = item.split_once('@').map_or(item, |(n, _)| n);
-            let hint = if Effect::parse(m, name).is_none() {
-                format!(" (its errors: `rtest machines --machine {}`)", m.name)
+            let hint = if Effect::parse_term(m, name).is_none() {
+                let symbols: Vec<&str> = m.symbols.iter().map(|s| s.name.as_str()).collect();
+                format!(
+                    " (its errors: `rtest machines --machine {}`{})",
+                    m.name,
+                    if symbols.is_empty() {
+                        String::new()
+                    } else {
+                        format!(
+                            "; its kinematic symbols, whose changes a term may identify too: {}",
+                            symbols.join(" ")
+                        )
+                    }
+                )
             } else {
                 String::new()
             };

@@ -165,7 +165,8 @@ impl Validator<'_> {
     }
 
     /// The terms of a sub-model's list: `NAME` (constant) or `NAME@BASIS`, `NAME` an error of
-    /// the machine's full model or `dx0 dy0 dz0`. Returns the errors used (catalogue order, each
+    /// the machine's full model, an effect of the measurement (`dx0 dy0 dz0`, `SXX` … `SZY`)
+    /// or a kinematic symbol of the machine (`Zt`, written as in `[symbols]`; constants only). Returns the errors used (catalogue order, each
     /// once) and the terms in the order written.
     pub(super) fn term_list(
         &self,
@@ -189,9 +190,23 @@ impl Validator<'_> {
                 Some((n, b)) => (n.trim(), Some(b.trim())),
                 None => (written, None),
             };
-            let effect = match Effect::parse_measurement(name) {
+            let effect = match Effect::parse_measurement(name)
+                .or_else(|| Effect::parse_kinematic(m, name))
+            {
                 Some(e) => e,
                 None => {
+                    if m.error_by_name(name).is_none()
+                        && let Some(sym) =
+                            m.symbols.iter().find(|s| s.name.eq_ignore_ascii_case(name))
+                    {
+                        return self.err(
+                            item.span(),
+                            format!(
+                                "model `{model}`: `{name}` is no error of this machine; the kinematic symbol is written `{}` (symbols are named exactly as [symbols] writes them)",
+                                sym.name
+                            ),
+                        );
+                    }
                     let id = self.error_id_at(name, item.span(), m)?;
                     if !m.errors.contains(&id) {
                         return self.err(

@@ -156,21 +156,31 @@ impl Validator<'_> {
         Ok(())
     }
 
-    /// No symbol takes the name of an error of the machine.
+    /// No symbol takes the name of an error of the machine, in any spelling that reads as that
+    /// error (error names are read without regard to case and with the digit-zero alias:
+    /// `xoc` and `X0C` are `XOC`). A model term, a `--terms` list or a report names an error
+    /// or a kinematic offset by the same word, so the two may never share one.
     pub(super) fn symbols_not_errors(
         &self,
         raw_symbols: &[(&Spanned<String>, &Spanned<Num>)],
         catalogue: &[ErrorTerm],
     ) -> Res<()> {
         for &(k, _) in raw_symbols {
-            if catalogue.iter().any(|e| e.name == *k.get_ref()) {
-                return self.err(
-                    k.span(),
+            let canonical = crate::catalogue::canonical_name(k.get_ref());
+            if let Some(e) = catalogue.iter().find(|e| e.name == canonical) {
+                let message = if e.name == *k.get_ref() {
                     format!(
                         "symbol `{}` has the name of an error of this machine: rename the symbol",
                         k.get_ref()
-                    ),
-                );
+                    )
+                } else {
+                    format!(
+                        "symbol `{}` reads as the error {} of this machine (error names are read without regard to case, with 0 for O): terms name errors and kinematic symbols alike, so rename the symbol",
+                        k.get_ref(),
+                        e.name
+                    )
+                };
+                return self.err(k.span(), message);
             }
         }
         Ok(())

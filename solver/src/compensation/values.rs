@@ -162,6 +162,9 @@ fn left_out_reason(m: &Machine, term: &Term) -> Option<String> {
         (Effect::Instrument { .. }, _) => {
             "an instrument term of the R-test (a sensor's gain or cross-talk), not an error of the machine"
         }
+        (Effect::KinematicOffset(_), _) => {
+            "a kinematic offset of the description (a length, mm): its identified value belongs in the description's [symbols] and the controller's kinematic parameters, not in an error compensation"
+        }
         (Effect::Error(e), _) if matches!(m.catalogue[e].kind, ErrorKind::Setup { .. }) => {
             "a set-up error of the workpiece (where the ball was placed), not an error of the machine"
         }

@@ -80,7 +80,7 @@ fn bases(m: &Machine, effect: Effect, o: &DictionaryOptions) -> Vec<Basis> {
                 .chain((1..=o.time).map(Basis::Time))
                 .collect();
         }
-        Effect::Instrument { .. } => return vec![Basis::Const],
+        Effect::Instrument { .. } | Effect::KinematicOffset(_) => return vec![Basis::Const],
         Effect::Error(e) => &m.catalogue[e],
     };
     match e.kind {

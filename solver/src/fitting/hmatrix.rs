@@ -18,6 +18,9 @@
 //!   (σ_noise / displacement)² relative, negligible when the noise is much smaller than the
 //!   displacements; the refinement against the exact machine (which applies `(I + S)` to the
 //!   displacement exactly) removes the first-order part.
+//! - Kinematic offsets (a symbol of the description, `Zt`): the exact derivative of the
+//!   tool-minus-workpiece vector with respect to the symbol, mm/mm
+//!   ([`crate::fitting::offsets`]); their coefficient is the symbol's change, mm.
 //! - `velocity` terms need the whole record (central differences across samples) and real
 //!   times; `exp:TAU` needs real times: a record whose samples are numbered is refused
 //!   ([`HMatrixError::Times`]).
@@ -456,6 +459,8 @@ enum Gain {
     Unit(usize),
     /// An instrument term: the measured reading of direction `.1` in the row of direction `.0`.
     Reading(usize, usize),
+    /// A kinematic offset: the gain of this symbol.
+    Symbol(usize),
 }
 
 /// The axis velocities of `record` (sample-major, mm/ms or rad/ms) when `model` has a
@@ -574,10 +579,14 @@ pub fn h_matrix_spanned(
                 }
                 Gain::Reading(reading.index(), displacement.index())
             }
+            Effect::KinematicOffset(s) => Gain::Symbol(s),
         };
         cols.push((gain, term.effect.carrier(m), term.basis, k));
     }
     let velocities = times_for(m, model, record, time_span.is_some())?;
+    let offsets = crate::fitting::offsets::has_kinematic_offsets(model)
+        .then(|| crate::fitting::offsets::OffsetGains::new(m));
+    let mut symbol_gains: Vec<[f64; 3]> = Vec::new();
     let n_axes = m.axes.len();
     let n = record.samples.len();
     let mut h = DMatrix::<f64>::zeros(3 * n, cols.len());
@@ -591,6 +600,9 @@ pub fn h_matrix_spanned(
                 HMatrixError::Sample { message, .. } => HMatrixError::Sample { sample: i, message },
                 other => other,
             })?;
+        if let Some(o) = &offsets {
+            symbol_gains = o.gains(&s.commands);
+        }
         let (tau, elapsed_s) = match time_span {
             Some((t0, t1)) if t1 > t0 => (2.0 * (s.t - t0) / (t1 - t0) - 1.0, s.t - t0),
             Some((t0, _)) => (0.0, s.t - t0),
@@ -611,6 +623,7 @@ pub fn h_matrix_spanned(
                 Gain::Slot(slot) => v = g[slot],
                 Gain::Unit(d) => v[d] = 1.0,
                 Gain::Reading(d, j) => v[d] = cx.reading[j],
+                Gain::Symbol(s) => v = symbol_gains[s],
             }
             for d in 0..3 {
                 let x = v[d] * b;

@@ -167,6 +167,10 @@ pub struct Identification {
     /// covariances' of a record read through an instrument, are right), for a fit whitened by
     /// a noise model or by covariances; `None` for an ordinary fit.
     pub whitened_sigma: Option<f64>,
+    /// One entry per parameter: for a kinematic offset, the value of its symbol the change is
+    /// relative to (the kinematic parameter the record was modelled with, mm); `None` for
+    /// every other parameter.
+    pub nominal_mm: Vec<Option<f64>>,
 }
 
 /// Identifies `model` of `m` from the measured `record` (first order), with the best gain
@@ -381,8 +385,7 @@ pub fn identify_with_noise(
     let (ordinary, weighted_sigma) =
         fit_rows(&h, &y, &names, c, t, None, &[samples], weights.as_ref())?;
     if *noise == NoiseChoice::Ordinary {
-        let mut ident =
-            Identification::new(m, fitted, ordinary, samples, opts.zeroed, source.backend());
+        let mut ident = Identification::new(m, fitted, ordinary, samples, opts.zeroed, source);
         if let (Some(w), Some(s)) = (&weights, weighted_sigma) {
             ident.noise = NoiseModel::residual(
                 s * w.scale_mm,
@@ -403,7 +406,7 @@ pub fn identify_with_noise(
         &[samples],
         weights.as_ref(),
     )?;
-    let mut ident = Identification::new(m, fitted, fit, samples, opts.zeroed, source.backend());
+    let mut ident = Identification::new(m, fitted, fit, samples, opts.zeroed, source);
     ident.noise = model_of_noise;
     ident.whitened_sigma = whitened_sigma;
     Ok(ident)
@@ -427,17 +430,20 @@ pub fn identify_with(
 }
 
 impl Identification {
-    /// An identification of `model` (the model fitted, offsets included) by `fit`, with what
-    /// the sensor offsets swallow derived from the fit's confounded groups; an ordinary fit
-    /// (noise model: white with the fit's σ̂).
+    /// An identification of `model` (the model fitted, offsets included) by `fit` with gains
+    /// from `source` (its backend; its kinematic parameters, the values the changes of
+    /// kinematic offsets are relative to), with what the sensor offsets swallow derived from
+    /// the fit's confounded groups; an ordinary fit (noise model: white with the fit's σ̂).
     pub fn new(
         m: &Machine,
         model: Model,
         fit: Fit,
         samples: usize,
         zeroed: bool,
-        backend: Backend,
+        source: &GainSource,
     ) -> Identification {
+        let backend = source.backend();
+        let nominal_mm = crate::fitting::offsets::nominal_of_columns(&model, source.params());
         let is_offset: Vec<bool> = model
             .columns()
             .iter()
@@ -456,6 +462,7 @@ impl Identification {
             backend,
             noise,
             whitened_sigma: None,
+            nominal_mm,
         }
     }
 }

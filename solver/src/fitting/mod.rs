@@ -8,6 +8,8 @@
 //! - [`mod@identify`]: a model identified on a record (first order), with what the sensor
 //!   offsets swallow;
 //! - [`identifiability`]: what the data can and cannot tell apart;
+//! - [`offsets`]: kinematic offsets (symbols of the description) as unknowns: their gains,
+//!   their changes in the exact machine, who owns them in a campaign;
 //! - [`noise`]: the reading noise (white or AR(1) per direction: declared, from a static
 //!   record, or estimated without trusting the model) and the prewhitening that makes it white;
 //! - [`refine`]: Gauss–Newton against the exact machine, removing the second-order bias;
@@ -22,6 +24,7 @@ pub mod identifiability;
 pub mod identify;
 pub mod least_squares;
 pub mod noise;
+pub mod offsets;
 pub mod plan;
 pub mod refine;
 pub mod sanity;

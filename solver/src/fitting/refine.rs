@@ -12,7 +12,7 @@
 //! ```
 //!
 //! where `exact(v)` is the virtual machine ([`crate::simulation::readings`]) with the model's
-//! terms at the values `v`. `v` is the whole minimum-norm solution, undetermined parameters
+//! terms at the values `v` (a kinematic offset's value added to its symbol's length). `v` is the whole minimum-norm solution, undetermined parameters
 //! included (one representative of each confounded group, as in `H·v`); they get no reported
 //! value. The iteration contracts by the ratio of the second-order to the first-order terms
 //! (about 1e-4), so two or three steps reach rounding. With zeroed readings the sensor offsets
@@ -157,7 +157,9 @@ pub enum RefineError {
 
 /// The exact machine's error vector (mm, tool frame) at every sample of `record` with the
 /// model's terms at `values` (mm, rad; `None` as 0) and kinematic parameters `params` (mm).
-/// No noise and no zeroing: sensor offsets in the model add as they are.
+/// No noise and no zeroing: sensor offsets in the model add as they are. A kinematic offset's
+/// value is the change of its symbol: the exact chain runs with `params` plus the changes
+/// ([`crate::fitting::offsets::apply_kinematic_offsets`]).
 pub fn exact_prediction(
     m: &Machine,
     model: &Model,
@@ -165,11 +167,13 @@ pub fn exact_prediction(
     record: &Record,
     params: &[f64],
 ) -> Result<Vec<[f64; 3]>, SimulateError> {
+    let (model, values, params) =
+        crate::fitting::offsets::apply_kinematic_offsets(model, values, params);
     let truth = Truth {
         source: "<identified model>".into(),
         description: String::new(),
-        params: params.to_vec(),
-        model: model.clone(),
+        params,
+        model,
         coefficients: values.iter().map(|v| v.unwrap_or(0.0)).collect(),
         noise_mm: 0.0,
         noise_phi: 0.0,

@@ -228,7 +228,7 @@ pub fn identify_file(
         run.fit.clone(),
         run.samples,
         opts.zeroed,
-        source.backend(),
+        &source,
     );
     Ok((ident, run))
 }

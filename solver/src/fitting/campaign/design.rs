@@ -15,6 +15,12 @@
 //!    record (`dx0[k4]`), and, when the records keep their own clocks, every other term of a
 //!    time basis (`XOC@time:1[k4]`: a drift during that record, on its clock).
 //!
+//! Kinematic offsets ([`crate::fitting::offsets`]): a symbol of the workpiece set-up (`Xw Yw
+//! Zw`, used only in the offset of the work chain's end) is a set-up term (`Xw[high]`: where
+//! that ball was mounted); every other symbol is a length of the machine, shared, and every
+//! record must be modelled with the same value of it
+//! ([`crate::fitting::offsets::check_shared_symbols`]).
+//!
 //! With a campaign clock (every record has a start, [`super::clock`]) terms of a time basis
 //! other than sensor offsets are shared: one drift over the campaign. Instrument terms
 //! (`SXX` … `SZY`, the sensor's gains) are shared: one instrument.
@@ -31,6 +37,7 @@ use crate::fitting::hmatrix::{
     Backend, GainSource, check_model, h_matrix, h_matrix_spanned, parameter_name,
 };
 use crate::fitting::identify::with_offsets;
+use crate::fitting::offsets::{check_shared_symbols, is_setup_symbol};
 use crate::model::{Effect, Model, Term};
 use model_spec::{ErrorKind, Machine};
 use nalgebra::{DMatrix, DVector};
@@ -109,6 +116,7 @@ fn kind(m: &Machine, t: &Term, clock: bool) -> Kind {
         Effect::SensorOffset(_) => Kind::Record,
         _ if on_clock(t.basis) && !clock => Kind::Record,
         Effect::Error(e) if matches!(m.catalogue[e].kind, ErrorKind::Setup { .. }) => Kind::Setup,
+        Effect::KinematicOffset(s) if is_setup_symbol(m, s) => Kind::Setup,
         _ => Kind::Shared,
     }
 }
@@ -167,7 +175,9 @@ impl Layout {
     /// the campaign clock `clock` (its span, s) or none: what a report read back rebuilds.
     ///
     /// # Errors
-    /// A model whose terms do not fit `m`; a clock without a start on every record.
+    /// A model whose terms do not fit `m`; a clock without a start on every record; a shared
+    /// kinematic offset the records are modelled with at different values
+    /// ([`check_shared_symbols`]).
     pub fn of_records(
         m: &Machine,
         model: &Model,
@@ -175,6 +185,11 @@ impl Layout {
         clock: Option<(f64, f64)>,
     ) -> Result<Layout, EstimateError> {
         check_model(m, model)?;
+        let labelled: Vec<(&str, &[f64])> = records
+            .iter()
+            .map(|r| (r.label.as_str(), r.params.as_slice()))
+            .collect();
+        check_shared_symbols(m, model, &labelled).map_err(EstimateError::Shape)?;
         if clock.is_some() && records.iter().any(|r| r.start_s.is_none()) {
             return Err(EstimateError::Shape(
                 "a campaign clock needs a start on every record".into(),
@@ -283,6 +298,24 @@ impl Layout {
             Kind::Setup => Owner::Setup(setup),
             Kind::Record => Owner::Record(record),
         }
+    }
+
+    /// One entry per column: for a kinematic offset, the value of its symbol (mm) its change
+    /// is relative to, the kinematic parameter of its owner's records (shared: every record's,
+    /// one value; a set-up's: its records'); `None` for every other column.
+    pub fn nominal_mm(&self) -> Vec<Option<f64>> {
+        self.columns
+            .iter()
+            .map(|c| {
+                let s = c.term.effect.symbol()?;
+                let record = match c.owner {
+                    Owner::Shared => self.records.first(),
+                    Owner::Setup(k) => self.records.iter().find(|r| r.setup == k),
+                    Owner::Record(r) => self.records.get(r),
+                }?;
+                record.params.get(s).copied()
+            })
+            .collect()
     }
 
     /// The column names, in order.

@@ -372,6 +372,7 @@ impl CampaignIdentification {
             backend: self.backend,
             noise: self.noise.clone(),
             whitened_sigma: self.whitened_sigma,
+            nominal_mm: self.layout.nominal_mm(),
         }
     }
 

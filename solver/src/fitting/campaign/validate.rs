@@ -3,8 +3,11 @@
 //! For every parameter of a validation record's own model (the model with its zero offsets
 //! when its readings were zeroed):
 //!
-//! - **shared** (the machine's errors): the identified value;
-//! - **set-up** (`XOW YOW ZOW`): the identified values of its set-up when that set-up was
+//! - **shared** (the machine's errors): the identified value; for a kinematic offset of the
+//!   machine (`Zt`) the identified length minus the record's value of the symbol (the change
+//!   when the record is modelled with the identification's value);
+//! - **set-up** (`XOW YOW ZOW`, and the changes of the ball's position `Xw Yw Zw` when the
+//!   model has them): the identified values of its set-up when that set-up was
 //!   fitted (the same set-up label: the same ball mounting); otherwise they are **refitted** on
 //!   the record itself, with every other value held: a ball set up anew has new set-up errors,
 //!   which no identification knows;
@@ -338,11 +341,18 @@ pub fn validate_record(
     } = record_plan(m, values, r)?;
     let mut defaulted = Vec::new();
     let mut v = vec![0.0; sources.len()];
+    let nominal = layout.nominal_mm();
     for (k, s) in sources.iter().enumerate() {
         if let Some(c) = s {
             match values.values[*c] {
                 Some(x) => v[k] = x,
                 None => defaulted.push(layout.columns[*c].name.clone()),
+            }
+            // A kinematic offset's value is a change from the identification's value of its
+            // symbol: on a record modelled with another value it is the identified length
+            // minus the record's.
+            if let (Some(sym), Some(n)) = (layout.columns[*c].term.effect.symbol(), nominal[*c]) {
+                v[k] += n - r.params[sym];
             }
         }
     }

@@ -174,6 +174,7 @@ impl CampaignReport {
         let fit = &ident.fit;
         let layout = &ident.layout;
         let mut parameters = Vec::with_capacity(layout.columns.len());
+        let nominal = layout.nominal_mm();
         for (j, c) in layout.columns.iter().enumerate() {
             let (owner, of) = match c.owner {
                 Owner::Shared => ("shared", None),
@@ -183,7 +184,7 @@ impl CampaignReport {
             parameters.push(CampaignParameterReport {
                 owner: owner.into(),
                 of,
-                parameter: parameter_report(m, &c.term, c.component, fit, j)?,
+                parameter: parameter_report(m, &c.term, c.component, fit, j, nominal[j])?,
             });
         }
         let refinement = refinement_report(refinement, fit)?;

@@ -7,7 +7,8 @@
 //!   `clock` (`{"start_s", "end_s"}`), `start_s`;
 //! - the layout these give ([`crate::fitting::campaign::Layout::of_records`]) has exactly the
 //!   columns of `parameters`, in order, with the same names and owners; each parameter is
-//!   checked as in a single report (unit, basis, value, `std`, `determined`, `fixed`).
+//!   checked as in a single report (unit, basis, value, `std`, `determined`, `fixed`); a
+//!   kinematic offset's `nominal_mm` is its owner's records' value of the symbol.
 //!
 //! [`read_values`] reads either kind of report: a single identification becomes a campaign of
 //! one record, labelled by the stem of its `data` file, on the set-up of that label.
@@ -143,6 +144,7 @@ pub fn parse_campaign_report(
         ));
     }
     let mut all = Columns::default();
+    let nominal = layout.nominal_mm();
     let mut j = 0;
     while j < params.len() {
         let c = &layout.columns[j];
@@ -180,6 +182,21 @@ pub fn parse_campaign_report(
                 &field("error"),
                 format!("the terms and records give `{}` here", c.term.spelling(m)),
             ));
+        }
+        // A kinematic offset's change is relative to its owner's records' value of the symbol.
+        for (k, n) in cols.nominal.iter().enumerate() {
+            if let (Some(n), Some(want)) = (n, nominal[j + k])
+                && n.to_bits() != want.to_bits()
+            {
+                return Err(r.bad(
+                    &format!("parameters[{}].nominal_mm", j + k),
+                    format!(
+                        "{} mm, but the records of `{name}` are modelled with {} mm",
+                        model_spec::units::short(*n),
+                        model_spec::units::short(want)
+                    ),
+                ));
+            }
         }
         all.values.extend(cols.values);
         all.std.extend(cols.std);

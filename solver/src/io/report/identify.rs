@@ -53,6 +53,36 @@ pub struct ParameterReport {
     /// (the value means something only over the same stroke); absent for other bases.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub over_mm: Option<[f64; 2]>,
+    /// For a kinematic offset (`error` a symbol of the description): the symbol's value the
+    /// records were modelled with, mm, from which `value` (µm) is the change; absent for other
+    /// parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nominal_mm: Option<f64>,
+    /// For a kinematic offset: the identified value of the symbol, `nominal_mm + value`, mm;
+    /// `null` when the change is not determined; absent for other parameters.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        with = "present_or_null"
+    )]
+    pub identified_mm: Option<Option<f64>>,
+}
+
+/// An optional field whose value may be `null`: absent (`None`), `null` (`Some(None)`) or a
+/// number (`Some(Some(x))`).
+mod present_or_null {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &Option<Option<f64>>, s: S) -> Result<S::Ok, S::Error> {
+        match v {
+            Some(x) => x.serialize(s),
+            None => s.serialize_none(),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Option<f64>>, D::Error> {
+        Option::<f64>::deserialize(d).map(Some)
+    }
 }
 
 /// A pair of determined parameters with a high correlation.
@@ -237,7 +267,15 @@ impl IdentificationReport {
         let fit = &ident.fit;
         let mut parameters = Vec::with_capacity(fit.names.len());
         for (j, (t, k)) in ident.model.columns().into_iter().enumerate() {
-            parameters.push(parameter_report(m, &ident.model.terms[t], k, fit, j)?);
+            let nominal = ident.nominal_mm.get(j).copied().flatten();
+            parameters.push(parameter_report(
+                m,
+                &ident.model.terms[t],
+                k,
+                fit,
+                j,
+                nominal,
+            )?);
         }
         let refinement = refinement_report(refinement, fit)?;
         let mut report = fit_report(fit)?;
@@ -272,7 +310,9 @@ impl IdentificationReport {
     }
 }
 
-/// The report of column `j` of `fit`, the component `k` of `term` (in the term's unit).
+/// The report of column `j` of `fit`, the component `k` of `term` (in the term's unit);
+/// `nominal` (mm) is the value a kinematic offset's change is relative to (`None` for other
+/// terms).
 ///
 /// # Errors
 /// [`NonFinite`] for a value or uncertainty that is not finite.
@@ -282,10 +322,22 @@ pub(crate) fn parameter_report(
     k: usize,
     fit: &crate::fitting::Fit,
     j: usize,
+    nominal: Option<f64>,
 ) -> Result<ParameterReport, NonFinite> {
     let f = term.display_factor(m);
     let names = term.basis.column_names();
     let field = |what: &str| format!("parameters[{j}].{what}");
+    let nominal = match term.effect.symbol() {
+        Some(_) => finite_opt(|| field("nominal_mm"), nominal)?,
+        None => None,
+    };
+    let identified_mm = match nominal {
+        Some(n) => Some(finite_opt(
+            || field("identified_mm"),
+            fit.values[j].map(|v| n + v),
+        )?),
+        None => None,
+    };
     Ok(ParameterReport {
         name: fit.names[j].clone(),
         error: term.effect.name(m),
@@ -296,6 +348,8 @@ pub(crate) fn parameter_report(
         determined: fit.identifiability.determined[j],
         fixed: fit.fixed[j],
         over_mm: poly_stroke(m, term),
+        nominal_mm: nominal,
+        identified_mm,
     })
 }
 

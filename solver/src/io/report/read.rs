@@ -12,6 +12,12 @@
 //! - `terms` lists exactly the terms of the parameters, in order, and holds every term of the
 //!   base model (and the sensor offsets when the readings were zeroed): no parameter is missing;
 //! - a `poly:K` parameter was normalised over the stroke this machine has for its axis;
+//! - a kinematic offset (a symbol of the machine, `Zt`) has `nominal_mm`, the value its change
+//!   is relative to (a finite length in mm). The change of a symbol of the machine (not of the
+//!   workpiece set-up) is re-expressed relative to this machine's default value of the symbol,
+//!   the value `validate` models a record with: `value` becomes the identified length minus
+//!   the default (the change itself when the identification used the default). The change of
+//!   a ball position (`Xw`) is kept, like the set-up errors `XOW YOW ZOW`;
 //! - the refinement, when the report has one, converged (an identification that did not is no
 //!   result);
 //! - what the fit says of each value, when the report says it: `std` (a finite number or
@@ -211,11 +217,21 @@ pub fn parse_identification(
     }
     let constraint = r.constraint(&root)?;
     let Columns {
-        values,
+        mut values,
         std,
         determined,
         fixed,
+        nominal,
     } = columns;
+    // A change of a machine's length, re-expressed from the identification's value of the
+    // symbol to this machine's default (the fingerprint makes the defaults the same).
+    for (j, (t, _)) in model.columns().into_iter().enumerate() {
+        if let (Some(s), Some(n), Some(v)) = (model.terms[t].effect.symbol(), nominal[j], values[j])
+            && !crate::fitting::offsets::is_setup_symbol(m, s)
+        {
+            values[j] = Some(v + (n - m.symbols[s].default));
+        }
+    }
     Ok(IdentifiedValues {
         file: file.to_string(),
         machine,
@@ -241,6 +257,9 @@ pub(crate) struct Columns {
     pub(crate) determined: Vec<bool>,
     /// Fixed by the constraint.
     pub(crate) fixed: Vec<bool>,
+    /// The value of a kinematic offset's symbol its change is relative to (`nominal_mm`, mm);
+    /// `None` for other parameters.
+    pub(crate) nominal: Vec<Option<f64>>,
 }
 
 /// A JSON syntax error located in characters: the parser counts columns in bytes.
@@ -449,6 +468,7 @@ impl Reader<'_> {
             columns.std.extend(c.std);
             columns.determined.extend(c.determined);
             columns.fixed.extend(c.fixed);
+            columns.nominal.extend(c.nominal);
             model.terms.push(term);
             i += term.basis.width();
         }
@@ -471,14 +491,8 @@ impl Reader<'_> {
                 return Err(self.bad(&format!("parameters[{i}]"), "expected an object".into()));
             }
             let error = self.string(p, "error", &field("error"))?;
-            let effect = Effect::parse(m, &error).ok_or_else(|| {
-                self.bad(
-                    &field("error"),
-                    format!(
-                        "`{error}` is neither an error of machine {} nor dx0/dy0/dz0 nor an instrument term SXX … SZY",
-                        m.name
-                    ),
-                )
+            let effect = Effect::parse_term(m, &error).ok_or_else(|| {
+                self.bad(&field("error"), crate::model::unknown_effect(m, &error).0)
             })?;
             let basis_text = self.string(p, "basis", &field("basis"))?;
             let (basis_str, part) = match basis_text.rsplit_once(':') {
@@ -508,7 +522,7 @@ impl Reader<'_> {
                 if k == 1 {
                     let e2 = self.string(q, "error", &field("error"))?;
                     let b2 = self.string(q, "basis", &field("basis"))?;
-                    if Effect::parse(m, &e2) != Some(effect) || b2 != format!("{basis}:sin") {
+                    if Effect::parse_term(m, &e2) != Some(effect) || b2 != format!("{basis}:sin") {
                         return Err(self.bad(
                             &field("basis"),
                             format!(
@@ -558,6 +572,9 @@ impl Reader<'_> {
                             .into(),
                     ));
                 }
+                columns
+                    .nominal
+                    .push(self.nominal(q, &field("nominal_mm"), &term, value)?);
                 columns.values.push(value);
                 columns.std.push(std);
                 columns
@@ -588,6 +605,52 @@ impl Reader<'_> {
                 Err(self.bad(field, format!("expected a number or null, found {other}")))
             }
         }
+    }
+
+    /// The `nominal_mm` of the parameter `q` of `term` (value `value`, mm) when `term` is a
+    /// kinematic offset (required: a finite length in mm; with `identified_mm`, when written,
+    /// `nominal_mm` plus the value), `None` for other terms.
+    fn nominal(
+        &self,
+        q: &Value,
+        field: &str,
+        term: &Term,
+        value: Option<f64>,
+    ) -> Result<Option<f64>, ReportError> {
+        let Some(s) = term.effect.symbol() else {
+            return Ok(None);
+        };
+        let name = &self.m.symbols[s].name;
+        let nominal = match q.get("nominal_mm") {
+            Some(Value::Number(x)) => x
+                .as_f64()
+                .filter(|x| x.is_finite() && x.abs() <= model_spec::limits::MAX_LENGTH_MM),
+            _ => None,
+        }
+        .ok_or_else(|| {
+            self.bad(
+                field,
+                format!(
+                    "missing or not a length in mm: the value of kinematic offset `{name}` is a change from the symbol's value the records were modelled with, which `nominal_mm` gives"
+                ),
+            )
+        })?;
+        if let (Some(Value::Number(x)), Some(v)) = (q.get("identified_mm"), value) {
+            let written = x.as_f64().unwrap_or(f64::NAN);
+            let expected = nominal + v;
+            let off = (written - expected).abs();
+            if off.is_nan() || off > 1e-9 * (1.0 + expected.abs()) {
+                return Err(self.bad(
+                    &field.replace("nominal_mm", "identified_mm"),
+                    format!(
+                        "{} mm is not nominal_mm + value ({} mm) for `{name}`",
+                        short(written),
+                        short(expected)
+                    ),
+                ));
+            }
+        }
+        Ok(Some(nominal))
     }
 
     /// The optional boolean `key` of the parameter `q`; named `field` in errors.

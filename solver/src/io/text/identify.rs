@@ -1,5 +1,6 @@
 //! An identification for people, like the seed's Table 4: one row per parameter (value ± std in
-//! µm or µrad, or why there is none), then rank, condition number, residual RMS, σ̂, the
+//! µm or µrad, or why there is none; a kinematic offset's change in µm with its nominal and
+//! identified lengths in mm), then rank, condition number, residual RMS, σ̂, the
 //! confounded groups, the nearly confounded pairs and what the zero offsets swallow.
 
 use super::{value, zeroed_text};
@@ -130,10 +131,14 @@ pub(crate) fn parameter_table(params: &[&ParameterReport], confounded: &[Vec<Str
             )
         } else {
             match p.value {
-                None => format!("{name:<w$}  {}", why()),
+                None => format!("{name:<w$}  {}{}", why(), length(p)),
                 Some(v) => {
                     let std = p.std.map_or("-".to_string(), value);
-                    let mut l = format!("{name:<w$}  {:>12}  ±  {std:>10}  {unit}", value(v));
+                    let mut l = format!(
+                        "{name:<w$}  {:>12}  ±  {std:>10}  {unit}{}",
+                        value(v),
+                        length(p)
+                    );
                     if !p.determined {
                         l.push_str(&format!(
                             "  ({}; minimum-norm value, a convention, not a measurement)",
@@ -150,6 +155,22 @@ pub(crate) fn parameter_table(params: &[&ParameterReport], confounded: &[Vec<Str
         out.push('\n');
     }
     out
+}
+
+/// For a kinematic offset: `  (change; nominal -250 mm, identified -250.0400 mm)`, the
+/// identified length to 0.1 µm; empty for other parameters.
+fn length(p: &ParameterReport) -> String {
+    let Some(n) = p.nominal_mm else {
+        return String::new();
+    };
+    match p.identified_mm.flatten() {
+        Some(x) => format!(
+            "  (change; nominal {} mm, identified {} mm)",
+            model_spec::units::short(n),
+            fixed(x, 4)
+        ),
+        None => format!("  (nominal {} mm)", model_spec::units::short(n)),
+    }
 }
 
 /// The other members of `name`'s confounded group, joined, or `None`.

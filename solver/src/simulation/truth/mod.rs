@@ -224,7 +224,8 @@ impl Truth {
             match t.effect {
                 Effect::Error(e) => errors[e] += v,
                 Effect::SensorOffset(d) => offsets[d.index()] += v,
-                Effect::Instrument { .. } => {}
+                // The real lengths are `params`: a truth never has a kinematic offset term.
+                Effect::Instrument { .. } | Effect::KinematicOffset(_) => {}
             }
         }
     }

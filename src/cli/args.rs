@@ -233,7 +233,11 @@ pub fn parse_terms(m: &Machine, list: &str) -> CliResult<Vec<(String, Term)>> {
     for item in items("--terms", list, example)? {
         let term = Term::parse(m, item).map_err(|e| {
             let name = item.split_once('@').map_or(item, |(n, _)| n);
-            let hint = if Effect::parse_term(m, name).is_none() {
+            let other_case = m
+                .symbols
+                .iter()
+                .any(|s| s.name.eq_ignore_ascii_case(name.trim()));
+            let hint = if Effect::parse_term(m, name).is_none() && !other_case {
                 let symbols: Vec<&str> = m.symbols.iter().map(|s| s.name.as_str()).collect();
                 format!(
                     " (its errors: `rtest machines --machine {}`{})",

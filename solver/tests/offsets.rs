@@ -643,6 +643,17 @@ fn a_change_identified_at_another_value_is_read_back_against_the_default() {
     let last = back.values[back.model.width() - 1].unwrap();
     assert_eq!(back.model.terms[k], Term::parse(&m, "Zt").unwrap());
     assert!((last + 0.040).abs() < 1e-9, "{last}");
+    // A compensation leaves the length out and says where it belongs.
+    let (errors, left_out) =
+        solver::compensation::values::MachineErrors::from_identified(&m, &back).unwrap();
+    assert!(!errors.errors().is_empty());
+    let zt = left_out.iter().find(|l| l.term == "Zt").unwrap();
+    assert!(
+        zt.reason.contains("kinematic offset") && zt.reason.contains("[symbols]"),
+        "{}",
+        zt.reason
+    );
+    assert_eq!(zt.values, vec![Some(last)]);
 }
 
 #[test]
@@ -770,4 +781,83 @@ errors = ["XOC", "Zt"]
         e,
         "m.toml:37:18: model `with_length`: `zt` is no error of this machine; the kinematic symbol is written `Zt` (symbols are named exactly as [symbols] writes them)"
     );
+}
+
+#[test]
+fn what_every_symbol_is_confounded_with_on_the_test_paths() {
+    // The groups docs/identification.md §15 lists: every symbol of the machine next to the
+    // errors of its model, on the built-in tests (noise-free readings of the nominal machine:
+    // the groups depend on the path only).
+    let cases = [
+        (
+            "seed-ac",
+            "reduced",
+            "Xa,Ya,Za,Zc,Xw,Yw,Zw,Xz,Yz,Zz,Xh,Zh,Zp",
+            "K1",
+            7,
+            vec![
+                "BOA BOC XOC Xa Xh Xz",
+                "COA XOW Xw YOW Yw",
+                "YOA YOC Ya Yz",
+                "ZOA ZOW Za Zc Zh Zp Zw Zz",
+            ],
+        ),
+        (
+            "seed-ac",
+            "reduced",
+            "Xa,Ya,Za,Zc,Xw,Yw,Zw,Xz,Yz,Zz,Xh,Zh,Zp",
+            "K2",
+            7,
+            vec![
+                "AOC BOC XOC XOW Xa Xh Xw Xz YOC YOW Yw ZOW Zc Zw",
+                "YOA Ya Yz",
+                "ZOA Za Zh Zp Zz",
+            ],
+        ),
+        (
+            "head-table-bc",
+            "location",
+            "Xc,Yc,Zc,Xb,Yb,Zb,Zt,Xw,Yw,Zw",
+            "pair-B-C",
+            12,
+            vec![
+                "AOZ YOC Yb Yc",
+                "XOB XOC Xb Xc",
+                "XOW Xw",
+                "YOW Yw",
+                "ZOB ZOW Zb Zc Zw",
+            ],
+        ),
+        (
+            "head-table-bc",
+            "location",
+            "Zt",
+            "turn-C",
+            8,
+            vec!["AOB AOZ YOC", "BOZ XOB XOC", "COB", "ZOB ZOW Zt"],
+        ),
+    ];
+    for (name, base, symbols, path, rank, want) in cases {
+        let m = machine(name);
+        let mut rec = builtin_path(&m, path).unwrap().unwrap();
+        rec.measured = vec![[0.0; 3]; rec.samples.len()];
+        let id = identify(
+            &m,
+            &model(&m, Some(base), symbols),
+            &rec,
+            &IdentifyOptions::new(),
+        )
+        .unwrap();
+        let got: Vec<String> = groups(&id.fit.names, &id.fit.identifiability.confounded)
+            .into_iter()
+            .map(|g| g.join(" "))
+            .collect();
+        println!(
+            "{name} {base} + {symbols} on {path}: rank {} of {}; {got:?}",
+            id.fit.rank,
+            id.fit.names.len()
+        );
+        assert_eq!(id.fit.rank, rank, "{name} {path}");
+        assert_eq!(got, want, "{name} {path}");
+    }
 }

@@ -14,7 +14,10 @@
 //! ordinary fit).
 //! `value` and `std` are `null` where the data do not determine the parameter; `basis` is
 //! `const`, `harmonic:K:cos`, `harmonic:K:sin`, `poly:K`, `reversal` or `time:K`; `unit` is
-//! `um` (translational errors, sensor offsets) or `urad` (angular errors). Readers of the values
+//! `um` (translational errors, sensor offsets, changes of kinematic offsets) or `urad` (angular
+//! errors). A kinematic offset (`"error": "Zt"`, a symbol of the description) also has
+//! `nominal_mm`, the symbol's value its change `value` is from, and `identified_mm`, the
+//! identified length (`null` when the change is not determined). Readers of the values
 //! need `machine`, `fingerprint`, `model`, `base_model`, `terms` and `parameters`
 //! ([`super::read`]).
 

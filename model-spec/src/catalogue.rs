@@ -230,9 +230,9 @@ pub fn build_catalogue(axes: &[Axis], squareness_order: &[AxisId]) -> Vec<ErrorT
         component(i, &mut out);
     }
     if let Some(&first) = squareness_order.first() {
-        let reference = axes[first].direction.dir;
+        let reference = axes[first].direction.own.dir;
         for (rank, &i) in squareness_order.iter().enumerate() {
-            for about in squareness_rotations(rank, axes[i].direction.dir, reference) {
+            for about in squareness_rotations(rank, axes[i].direction.own.dir, reference) {
                 out.push(ErrorTerm {
                     name: location_name(Motion::Rotation(about), &axes[i].name),
                     kind: ErrorKind::Squareness { axis: i, about },
@@ -248,7 +248,7 @@ pub fn build_catalogue(axes: &[Axis], squareness_order: &[AxisId]) -> Vec<ErrorT
     }
     for &i in by_iso.iter().filter(|&&i| axes[i].kind == AxisKind::Rotary) {
         component(i, &mut out);
-        for motion in location_motions(axes[i].direction.dir) {
+        for motion in location_motions(axes[i].direction.own.dir) {
             out.push(ErrorTerm {
                 name: location_name(motion, &axes[i].name),
                 kind: ErrorKind::Location { axis: i, motion },

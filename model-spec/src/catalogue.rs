@@ -15,6 +15,13 @@
 //! - workpiece set-up errors `XOW YOW ZOW` (translations of the workpiece point in the last
 //!   frame of the work chain).
 //!
+//! An inclined axis ([`crate::AxisDirection`]) is described in its own frame `x' y' z'`, where
+//! it moves along (turns about) `z'`; the letters of its errors name the directions of that
+//! frame. An inclined rotary axis B thus has `EXB EYB` (radial), `EZB` (axial), `EAB EBB`
+//! (tilts), `ECB` (angular positioning) and the location errors `XOB YOB AOB BOB`, like a C axis;
+//! an inclined linear axis U has `EZU` as its positioning error. Its errors are translations
+//! along and small rotations about the own axes.
+//!
 //! The digit-zero spelling (`X0C`, `C0X`) is accepted wherever a name is read.
 //!
 //! Translational errors are in mm inside (µm at every boundary a person sees); angular errors are

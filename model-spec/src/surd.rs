@@ -276,7 +276,11 @@ pub fn unit_frame(v: [f64; 3]) -> UnitFrame {
             u[0].times(u[2]).times(inv_len).negated(),
         ];
         // y' = z' × x' = (0, u_z/n, −u_y/n)
-        let y_axis = [Real::ZERO, u[2].times(inv_len), u[1].times(inv_len).negated()];
+        let y_axis = [
+            Real::ZERO,
+            u[2].times(inv_len),
+            u[1].times(inv_len).negated(),
+        ];
         let frame = [x_axis, y_axis, u];
         frame
             .iter()

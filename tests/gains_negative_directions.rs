@@ -49,7 +49,7 @@ fn the_test_machines_have_negative_directions_in_both_chains() {
     let negative = |m: &Machine, side: Side, kind: AxisKind| {
         m.axes
             .iter()
-            .filter(|a| a.side == side && a.kind == kind && a.direction.negative)
+            .filter(|a| a.side == side && a.kind == kind && a.direction.own.negative)
             .map(|a| format!("{}{}", a.name, a.direction))
             .collect::<Vec<_>>()
     };
@@ -159,13 +159,21 @@ fn a_command_and_the_positioning_error_act_along_the_same_coordinate_with_the_si
         for (i, axis) in m.axes.iter().enumerate() {
             let positioning = match axis.kind {
                 AxisKind::Linear => {
-                    format!("E{}{}", axis.direction.dir.translation_letter(), axis.name)
+                    format!(
+                        "E{}{}",
+                        axis.direction.own.dir.translation_letter(),
+                        axis.name
+                    )
                 }
                 AxisKind::Rotary => {
-                    format!("E{}{}", axis.direction.dir.rotation_letter(), axis.name)
+                    format!("E{}{}", axis.direction.own.dir.rotation_letter(), axis.name)
                 }
             };
-            let s = if axis.direction.negative { -1.0 } else { 1.0 };
+            let s = if axis.direction.own.negative {
+                -1.0
+            } else {
+                1.0
+            };
             let (delta, e) = match axis.kind {
                 AxisKind::Linear => (0.05, 0.03),   // mm
                 AxisKind::Rotary => (2e-4, 1.5e-4), // rad

@@ -15,7 +15,7 @@
 use crate::atoms::{AtomKind, AtomTable};
 use crate::poly::{Atom, Poly};
 use crate::rational::Rational;
-use model_spec::kinematics::{Step, chain_steps};
+use model_spec::kinematics::{FrameTurn, Step, chain_steps};
 use model_spec::{AxisKind, ErrorId, Machine, Side, Value};
 use std::collections::BTreeMap;
 
@@ -140,7 +140,7 @@ impl Deriver<'_> {
     }
 
     fn sin_cos(&self, axis: usize) -> (Poly, Poly) {
-        let sign = Rational::int(if self.m.axes[axis].direction.negative {
+        let sign = Rational::int(if self.m.axes[axis].direction.own.negative {
             -1
         } else {
             1
@@ -149,6 +149,29 @@ impl Deriver<'_> {
             Poly::atom(self.atoms.find(AtomKind::Sin(axis))).scale(sign),
             Poly::atom(self.atoms.find(AtomKind::Cos(axis))),
         )
+    }
+
+    /// The rotation of a [`Step::Frame`]: `Fᵀ` into the own frame, `F` back (rows of `F`:
+    /// the axis's own `x' y' z'`).
+    fn frame(&self, axis: usize, turn: FrameTurn) -> [[Poly; 3]; 3] {
+        let inclined = self.m.axes[axis]
+            .direction
+            .inclined
+            .expect("frame steps belong to inclined axes");
+        let f = inclined
+            .frame
+            .axes
+            .map(|row| row.map(|r| self.atoms.real(r)));
+        match turn {
+            FrameTurn::Into => std::array::from_fn(|i| std::array::from_fn(|j| f[j][i].clone())),
+            FrameTurn::Back => f,
+        }
+    }
+
+    /// The canonical form: `cos² = 1 − sin²` and `√p² = p`.
+    fn canonical(&self, p: &Poly) -> Poly {
+        p.reduce(&self.atoms.trig_pairs())
+            .reduce_roots(&self.atoms.root_rules())
     }
 
     /// Applies one step: `v ← S·v`.
@@ -183,17 +206,24 @@ impl Deriver<'_> {
                     }
                 }
             }
+            Step::Frame { axis, turn } => {
+                let r = self.frame(*axis, *turn);
+                v.nominal = mat_vec(&r, &v.nominal).map(|p| self.canonical(&p));
+                for e in v.by_error.values_mut() {
+                    *e = mat_vec(&r, e).map(|p| self.canonical(&p));
+                }
+            }
             Step::Motion {
                 axis,
                 positioning_error,
             } => {
                 let a = &self.m.axes[*axis];
-                let d = a.direction.dir.index();
+                let d = a.direction.own.dir.index();
                 match a.kind {
                     AxisKind::Linear => {
                         if v.kind == Carried::Point {
                             let q = Poly::atom(self.atoms.find(AtomKind::Command(*axis)));
-                            let sign = Rational::int(if a.direction.negative { -1 } else { 1 });
+                            let sign = Rational::int(if a.direction.own.negative { -1 } else { 1 });
                             v.nominal[d] = v.nominal[d].add(&q.scale(sign));
                         }
                     }
@@ -247,17 +277,17 @@ impl Deriver<'_> {
             std::array::from_fn(|j| if i == j { one.clone() } else { Poly::zero() })
         });
         for step in chain_steps(self.m, side) {
-            if let Step::Motion { axis, .. } = step
-                && self.m.axes[axis].kind == AxisKind::Rotary
-            {
-                let (s, c) = self.sin_cos(axis);
-                r = mat_mul(
-                    &r,
-                    &rotation(self.m.axes[axis].direction.dir.index(), &s, &c),
-                );
+            match step {
+                Step::Motion { axis, .. } if self.m.axes[axis].kind == AxisKind::Rotary => {
+                    let (s, c) = self.sin_cos(axis);
+                    let d = self.m.axes[axis].direction.own.dir.index();
+                    r = mat_mul(&r, &rotation(d, &s, &c));
+                }
+                Step::Frame { axis, turn } => r = mat_mul(&r, &self.frame(axis, turn)),
+                _ => {}
             }
         }
-        r
+        r.map(|row| row.map(|p| self.canonical(&p)))
     }
 }
 
@@ -280,7 +310,6 @@ pub fn nominal_pose(m: &Machine) -> NominalPose {
         atoms: &atoms,
         slot: BTreeMap::new(),
     };
-    let pairs = atoms.trig_pairs();
     let tool = d.end(Side::Tool, Carried::Point).nominal;
     // The work frame's origin: the work chain without its end offset (and set-up errors).
     let steps = chain_steps(m, Side::Work);
@@ -301,8 +330,8 @@ pub fn nominal_pose(m: &Machine) -> NominalPose {
     let gap: Vec3 = std::array::from_fn(|k| tool[k].sub(&origin.nominal[k]));
     let rw_t: [[Poly; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| rw[j][i].clone()));
     NominalPose {
-        tool_point_in_work: mat_vec(&rw_t, &gap).map(|p| p.reduce(&pairs)),
-        tool_to_work: mat_mul(&rw_t, &rt).map(|row| row.map(|p| p.reduce(&pairs))),
+        tool_point_in_work: mat_vec(&rw_t, &gap).map(|p| d.canonical(&p)),
+        tool_to_work: mat_mul(&rw_t, &rt).map(|row| row.map(|p| d.canonical(&p))),
     }
 }
 
@@ -324,7 +353,6 @@ pub fn rotation_gains(m: &Machine, errors: &[ErrorId]) -> Vec<Vec3> {
         d.end(Side::Work, Carried::Rotation),
     );
     let r0 = d.tool_rotation();
-    let pairs = atoms.trig_pairs();
     let z = zero3();
     (0..errors.len())
         .map(|i| {
@@ -333,7 +361,7 @@ pub fn rotation_gains(m: &Machine, errors: &[ErrorId]) -> Vec<Vec3> {
                 ww.by_error.get(&i).unwrap_or(&z),
             );
             let v: Vec3 = std::array::from_fn(|k| a[k].sub(&b[k]));
-            mat_t_vec(&r0, &v).map(|p| p.reduce(&pairs))
+            mat_t_vec(&r0, &v).map(|p| d.canonical(&p))
         })
         .collect()
 }
@@ -375,7 +403,6 @@ impl GainModel {
             d.end(Side::Work, Carried::Direction),
         );
         let r0 = d.tool_rotation();
-        let pairs = atoms.trig_pairs();
         let diff = |a: &FirstOrder, b: &FirstOrder, i: usize| -> Vec3 {
             let z = zero3();
             let (va, vb) = (
@@ -383,7 +410,7 @@ impl GainModel {
                 b.by_error.get(&i).unwrap_or(&z),
             );
             let v: Vec3 = std::array::from_fn(|k| va[k].sub(&vb[k]));
-            mat_t_vec(&r0, &v).map(|p| p.reduce(&pairs))
+            mat_t_vec(&r0, &v).map(|p| d.canonical(&p))
         };
         let gains = (0..errors.len())
             .map(|i| {
@@ -412,7 +439,7 @@ impl GainModel {
     /// kinematic symbol (mm). One `[gx, gy, gz, gi, gj, gk]` per error (mm/mm or mm/rad for
     /// position rows, 1/mm or 1/rad for orientation rows).
     pub fn evaluate(&self, commands: &[f64], params: &[f64]) -> Vec<[f64; 6]> {
-        let values = self.atoms.values(commands, params);
+        let values = self.atoms.all_values(commands, params);
         self.gains
             .iter()
             .map(|g| std::array::from_fn(|k| g[k].eval(&values)))

@@ -141,6 +141,22 @@ impl Builder {
     }
 }
 
+/// The value of every atom: an input for pose atoms and kinematic symbols, a constant for the
+/// constant atoms of inclined axes.
+pub(crate) fn atom_vars(b: &mut Builder, atoms: &AtomTable) -> Vec<Var> {
+    let inputs = atoms.input_count();
+    atoms
+        .kinds
+        .iter()
+        .enumerate()
+        .map(|(i, k)| match k.constant_value() {
+            Some(c) => b.constant(c),
+            None if i < inputs => b.push(Op::Input(i as u32)),
+            None => unreachable!("constant atoms come after the inputs"),
+        })
+        .collect()
+}
+
 /// The atom that occurs in the most terms (the first such atom on a tie).
 fn best_atom(p: &Poly) -> Atom {
     let mut counts: HashMap<Atom, usize> = HashMap::new();
@@ -166,6 +182,7 @@ pub(crate) fn inputs_of(m: &Machine, atoms: &AtomTable) -> Vec<Input> {
         .kinds
         .iter()
         .zip(&atoms.names)
+        .take(atoms.input_count())
         .map(|(k, name)| {
             let (field, parameter) = match *k {
                 AtomKind::Sin(a) => (
@@ -178,6 +195,9 @@ pub(crate) fn inputs_of(m: &Machine, atoms: &AtomTable) -> Vec<Input> {
                 ),
                 AtomKind::Command(a) => (m.axes[a].name.to_ascii_lowercase(), false),
                 AtomKind::Symbol(s) => (m.symbols[s].name.clone(), true),
+                AtomKind::Root(_) | AtomKind::Constant(_) => {
+                    unreachable!("constant atoms come after the inputs")
+                }
             };
             Input {
                 name: name.clone(),
@@ -291,9 +311,7 @@ fn compile_polys(m: &Machine, model: &GainModel, polys: &[&Poly]) -> Program {
         memo: HashMap::new(),
         atom_vars: Vec::new(),
     };
-    b.atom_vars = (0..inputs.len())
-        .map(|i| b.push(Op::Input(i as u32)))
-        .collect();
+    b.atom_vars = atom_vars(&mut b, &model.atoms);
     let outputs = polys
         .iter()
         .map(|p| match p.as_constant() {

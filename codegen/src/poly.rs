@@ -242,6 +242,31 @@ impl Poly {
         cur
     }
 
+    /// Rewrites every `√p²` as `p` for each `(atom, p)` rule ([`crate::atoms::AtomTable::root_rules`]).
+    pub fn reduce_roots(&self, rules: &[(Atom, u64)]) -> Poly {
+        if rules.is_empty() {
+            return self.clone();
+        }
+        let mut out = Poly::zero();
+        for (m, &c) in &self.terms {
+            let mut coeff = c;
+            let mut mono = m.clone();
+            for &(a, p) in rules {
+                let e = mono.exponent(a);
+                if e >= 2 {
+                    mono = mono.divide(a, e - e % 2);
+                    for _ in 0..e / 2 {
+                        coeff = coeff
+                            .checked_mul(Rational::int(p as i64))
+                            .expect("bounded coefficients");
+                    }
+                }
+            }
+            add_coeff(&mut out.terms, mono, coeff);
+        }
+        out
+    }
+
     /// The value at `atoms[a]` for every atom `a`.
     pub fn eval(&self, atoms: &[f64]) -> f64 {
         self.terms

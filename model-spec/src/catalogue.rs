@@ -15,6 +15,13 @@
 //! - workpiece set-up errors `XOW YOW ZOW` (translations of the workpiece point in the last
 //!   frame of the work chain).
 //!
+//! An inclined axis ([`crate::AxisDirection`]) is described in its own frame `x' y' z'`, where
+//! it moves along (turns about) `z'`; the letters of its errors name the directions of that
+//! frame. An inclined rotary axis B thus has `EXB EYB` (radial), `EZB` (axial), `EAB EBB`
+//! (tilts), `ECB` (angular positioning) and the location errors `XOB YOB AOB BOB`, like a C axis;
+//! an inclined linear axis U has `EZU` as its positioning error. Its errors are translations
+//! along and small rotations about the own axes.
+//!
 //! The digit-zero spelling (`X0C`, `C0X`) is accepted wherever a name is read.
 //!
 //! Translational errors are in mm inside (µm at every boundary a person sees); angular errors are
@@ -230,9 +237,9 @@ pub fn build_catalogue(axes: &[Axis], squareness_order: &[AxisId]) -> Vec<ErrorT
         component(i, &mut out);
     }
     if let Some(&first) = squareness_order.first() {
-        let reference = axes[first].direction.dir;
+        let reference = axes[first].direction.own.dir;
         for (rank, &i) in squareness_order.iter().enumerate() {
-            for about in squareness_rotations(rank, axes[i].direction.dir, reference) {
+            for about in squareness_rotations(rank, axes[i].direction.own.dir, reference) {
                 out.push(ErrorTerm {
                     name: location_name(Motion::Rotation(about), &axes[i].name),
                     kind: ErrorKind::Squareness { axis: i, about },
@@ -248,7 +255,7 @@ pub fn build_catalogue(axes: &[Axis], squareness_order: &[AxisId]) -> Vec<ErrorT
     }
     for &i in by_iso.iter().filter(|&&i| axes[i].kind == AxisKind::Rotary) {
         component(i, &mut out);
-        for motion in location_motions(axes[i].direction.dir) {
+        for motion in location_motions(axes[i].direction.own.dir) {
             out.push(ErrorTerm {
                 name: location_name(motion, &axes[i].name),
                 kind: ErrorKind::Location { axis: i, motion },

@@ -127,8 +127,14 @@ impl Machine {
                             AxisKind::Linear => b'L',
                             AxisKind::Rotary => b'R',
                         });
-                        h.tag(a.direction.dir.index() as u8);
-                        h.tag(u8::from(a.direction.negative));
+                        h.tag(a.direction.own.dir.index() as u8);
+                        h.tag(u8::from(a.direction.own.negative));
+                        if a.direction.inclined.is_some() {
+                            h.tag(b'i');
+                            for x in a.direction.unit() {
+                                h.number(x);
+                            }
+                        }
                         h.tag(match a.side {
                             Side::Work => b'W',
                             Side::Tool => b'T',

@@ -110,3 +110,102 @@ impl fmt::Display for Direction {
         write!(f, "{}{}", if self.negative { '-' } else { '+' }, self.dir)
     }
 }
+
+/// An inclined axis: the direction as written and the axis's own frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inclined {
+    /// The direction as written in the description (any finite non-zero vector).
+    pub written: [f64; 3],
+    /// The own frame: `z'` along the normalised direction, `x'` the machine x projected
+    /// perpendicular to it, `y' = z' × x'` ([`crate::surd::unit_frame`]), exact where the
+    /// components allow.
+    pub frame: crate::surd::UnitFrame,
+}
+
+/// The direction of an axis: along a signed coordinate direction, or inclined.
+///
+/// An inclined axis is described in its own frame, where it moves along (turns about) `+z'`:
+/// its errors are named with the letters of that frame (`EXB`, `EYB` radial, `EZB` axial,
+/// `EAB`, `EBB` tilts, `ECB` positioning; `XOB YOB AOB BOB` location), so its tables read like
+/// those of a C axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisDirection {
+    /// The direction in the axis's own frame: the coordinate direction itself for an axis along
+    /// x, y or z; `+z` for an inclined axis.
+    pub own: Direction,
+    /// The inclination, for an inclined axis.
+    pub inclined: Option<Inclined>,
+}
+
+impl AxisDirection {
+    /// An axis along a signed coordinate direction.
+    pub fn coordinate(d: Direction) -> AxisDirection {
+        AxisDirection {
+            own: d,
+            inclined: None,
+        }
+    }
+
+    /// The direction of the vector `v`: a signed coordinate direction when only one component
+    /// is non-zero (`[-1, 0, 0]` is `-x`, exactly as `"-x"`), inclined otherwise. `None` for a
+    /// zero or non-finite vector.
+    pub fn from_vector(v: [f64; 3]) -> Option<AxisDirection> {
+        if v.iter().any(|x| !x.is_finite()) || v.iter().all(|&x| x == 0.0) {
+            return None;
+        }
+        let nonzero: Vec<usize> = (0..3).filter(|&i| v[i] != 0.0).collect();
+        if let [i] = nonzero[..] {
+            return Some(AxisDirection::coordinate(Direction {
+                dir: Dir::ALL[i],
+                negative: v[i] < 0.0,
+            }));
+        }
+        Some(AxisDirection {
+            own: Direction {
+                dir: Dir::Z,
+                negative: false,
+            },
+            inclined: Some(Inclined {
+                written: v,
+                frame: crate::surd::unit_frame(v),
+            }),
+        })
+    }
+
+    /// The signed coordinate direction, `None` for an inclined axis.
+    pub fn as_coordinate(&self) -> Option<Direction> {
+        self.inclined.is_none().then_some(self.own)
+    }
+
+    /// The own frame as floating-point rows `[x', y', z']` in machine coordinates (the identity
+    /// for a coordinate axis).
+    pub fn frame(&self) -> [[f64; 3]; 3] {
+        match &self.inclined {
+            Some(i) => i.frame.axes.map(|a| a.map(crate::surd::Real::to_f64)),
+            None => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        }
+    }
+
+    /// The unit vector of motion (linear) or of the rotation vector (rotary) for a positive
+    /// command, in machine coordinates.
+    pub fn unit(&self) -> [f64; 3] {
+        match &self.inclined {
+            Some(i) => i.frame.axes[2].map(crate::surd::Real::to_f64),
+            None => {
+                let mut u = [0.0; 3];
+                u[self.own.dir.index()] = self.own.sign();
+                u
+            }
+        }
+    }
+}
+
+impl fmt::Display for AxisDirection {
+    /// `+x`, or the written vector of an inclined axis (`[0, 1, 1]`).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.inclined {
+            Some(i) => write!(f, "[{}, {}, {}]", i.written[0], i.written[1], i.written[2]),
+            None => write!(f, "{}", self.own),
+        }
+    }
+}

@@ -14,6 +14,12 @@
 //! `Offset · ErrorTranslation(location) · ErrorRotation(location) · ErrorTranslation(EX?,EY?,EZ?)
 //!  · ErrorRotation(the two tilts) · Motion(θ + positioning error)`.
 //!
+//! An inclined axis (see [`crate::AxisDirection`]) is described in its own frame: its steps
+//! are wrapped as `Frame(F) · … · Frame(Fᵀ)`, where the rows of `F` are its own axes
+//! `x' y' z'` in the machine frame and the steps between are those of an axis along `+z'`, so
+//! its errors act along and about its own axes. At command zero the wrap is the identity, so the
+//! offsets of later links stay in machine coordinates.
+//!
 //! The work end adds `Offset · ErrorTranslation(XOW, YOW, ZOW)`; the tool end adds `Offset`.
 //!
 //! An `ErrorRotation(a, b, c)` is, exactly, `Rx(a)·Ry(b)·Rz(c)`, and to first order the seed's
@@ -34,7 +40,15 @@ pub enum Step {
     ErrorTranslation([Option<ErrorId>; 3]),
     /// A small rotation by error terms about x, y, z (`None`: no error there).
     ErrorRotation([Option<ErrorId>; 3]),
-    /// The commanded motion of an axis: a translation along, or rotation about, its direction.
+    /// The constant rotation into (or back out of) an inclined axis's own frame.
+    Frame {
+        /// The inclined axis.
+        axis: AxisId,
+        /// Into the own frame or back.
+        turn: FrameTurn,
+    },
+    /// The commanded motion of an axis: a translation along, or rotation about, its own
+    /// direction ([`crate::AxisDirection::own`]; `+z'` inside an inclined axis's frame).
     Motion {
         /// The axis.
         axis: AxisId,
@@ -45,13 +59,23 @@ pub enum Step {
     },
 }
 
+/// Which way a [`Step::Frame`] turns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameTurn {
+    /// Into the axis's own frame: a vector `v'` in own coordinates is `Fᵀ·v'` in the parent
+    /// frame (the columns of `Fᵀ` are `x' y' z'`).
+    Into,
+    /// Back to the machine-aligned frame: `F·v`.
+    Back,
+}
+
 impl Step {
     /// `true` when the step holds no error and no motion and is the identity (a zero offset).
     pub fn is_identity(&self) -> bool {
         match self {
             Step::Offset(o) => o.iter().all(Value::is_zero),
             Step::ErrorTranslation(e) | Step::ErrorRotation(e) => e.iter().all(Option::is_none),
-            Step::Motion { .. } => false,
+            Step::Motion { .. } | Step::Frame { .. } => false,
         }
     }
 }
@@ -69,6 +93,13 @@ fn axis_steps(m: &Machine, axis: AxisId) -> Vec<Step> {
     let comp = |motion: ErrMotion| find(m, |k| *k == ErrorKind::Component { axis, motion });
     let comp_t = triple(|d| comp(ErrMotion::Translation(d)));
     let mut steps = vec![Step::Offset(a.offset)];
+    let inclined = a.direction.inclined.is_some();
+    if inclined {
+        steps.push(Step::Frame {
+            axis,
+            turn: FrameTurn::Into,
+        });
+    }
     match a.kind {
         AxisKind::Linear => {
             let sq = triple(|d| find(m, |k| *k == ErrorKind::Squareness { axis, about: d }));
@@ -89,7 +120,7 @@ fn axis_steps(m: &Machine, axis: AxisId) -> Vec<Step> {
             })));
             steps.push(Step::ErrorRotation(triple(|d| loc(ErrMotion::Rotation(d)))));
             steps.push(Step::ErrorTranslation(comp_t));
-            let own = a.direction.dir;
+            let own = a.direction.own.dir;
             steps.push(Step::ErrorRotation(triple(|d| {
                 if d == own {
                     None
@@ -102,6 +133,12 @@ fn axis_steps(m: &Machine, axis: AxisId) -> Vec<Step> {
                 positioning_error: comp(ErrMotion::Rotation(own)),
             });
         }
+    }
+    if inclined {
+        steps.push(Step::Frame {
+            axis,
+            turn: FrameTurn::Back,
+        });
     }
     steps
 }

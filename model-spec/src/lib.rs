@@ -74,6 +74,7 @@ pub mod locate;
 pub mod machine;
 pub mod pose;
 mod raw;
+pub mod surd;
 pub mod terms;
 pub mod text;
 pub mod units;
@@ -84,7 +85,7 @@ pub use builtin::{BUILTIN, LoadError, all_builtin, builtin, load_machine, load_m
 pub use catalogue::{ErrorId, ErrorKind, ErrorTerm, Motion, canonical_name};
 pub use catalogue::{build_catalogue, default_squareness_order};
 pub use error::SpecError;
-pub use geometry::{Dir, Direction};
+pub use geometry::{AxisDirection, Dir, Direction, Inclined};
 pub use machine::{
     Axis, AxisId, AxisKind, Chain, FULL_MODEL, Link, Machine, Offset, Side, SubModel, Symbol,
     SymbolId, Value,

@@ -3,7 +3,7 @@
 //! checked.
 
 use crate::catalogue::{ErrorId, ErrorTerm};
-use crate::geometry::Direction;
+use crate::geometry::AxisDirection;
 use std::collections::BTreeMap;
 
 /// Index of a kinematic symbol in [`Machine::symbols`].
@@ -64,8 +64,9 @@ pub struct Axis {
     pub name: String,
     /// Linear or rotary.
     pub kind: AxisKind,
-    /// Direction of motion (linear) or of the rotation vector (rotary) for a positive command.
-    pub direction: Direction,
+    /// Direction of motion (linear) or of the rotation vector (rotary) for a positive command:
+    /// a signed coordinate direction or an inclined direction with its own frame.
+    pub direction: AxisDirection,
     /// Offset of the axis frame from the previous frame of its chain at command zero (mm).
     pub offset: Offset,
     /// Allowed commands `[min, max]`: mm for linear axes, degrees for rotary axes.

@@ -68,6 +68,16 @@ impl<'de> Deserialize<'de> for RawValue {
     }
 }
 
+/// An axis direction as written: `"+x"` … `"-z"`, or a vector `[0, 1, 1]`.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum RawDirection {
+    /// `"+x"`, `"-z"`, ….
+    Text(String),
+    /// Any vector.
+    Vector(Vec<Num>),
+}
+
 /// A whole description file.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -94,7 +104,7 @@ pub struct RawLink {
     pub axis: Option<Spanned<String>>,
     #[serde(rename = "type")]
     pub kind: Option<Spanned<String>>,
-    pub direction: Option<Spanned<String>>,
+    pub direction: Option<Spanned<RawDirection>>,
     pub offset: Option<Spanned<Vec<Spanned<RawValue>>>>,
     pub stroke: Option<Spanned<Vec<Spanned<Num>>>>,
     pub range: Option<Spanned<Vec<Spanned<Num>>>>,

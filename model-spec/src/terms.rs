@@ -179,7 +179,7 @@ impl Effect {
                 let a = &m.axes[axis];
                 match (a.kind, motion) {
                     (AxisKind::Linear, Motion::Translation(d))
-                    | (AxisKind::Rotary, Motion::Rotation(d)) => d == a.direction.dir,
+                    | (AxisKind::Rotary, Motion::Rotation(d)) => d == a.direction.own.dir,
                     _ => false,
                 }
             }
@@ -390,7 +390,7 @@ pub fn describe_effect(m: &Machine, effect: Effect) -> String {
     match e.kind {
         ErrorKind::Component { axis, motion } => {
             let a = &m.axes[axis];
-            let own = a.direction.dir;
+            let own = a.direction.own.dir;
             match (a.kind, motion) {
                 (AxisKind::Linear, Motion::Translation(d)) if d == own => {
                     format!("positioning error of {}", a.name)

@@ -68,7 +68,14 @@ fn seed_ac_axes_symbols_and_chains() {
     let axes: Vec<(&str, AxisKind, Side, Direction)> = m
         .axes
         .iter()
-        .map(|a| (a.name.as_str(), a.kind, a.side, a.direction))
+        .map(|a| {
+            (
+                a.name.as_str(),
+                a.kind,
+                a.side,
+                a.direction.as_coordinate().unwrap(),
+            )
+        })
         .collect();
     let plus = |dir| Direction {
         dir,

@@ -339,16 +339,72 @@ fn bad_direction() {
                 "direction = \"+z\"\noffset",
                 &format!("direction = \"{bad}\"\noffset"),
             ),
-            &format!("m.toml:23:13: axis C: direction `{bad}` is not one of +x -x +y -y +z -z"),
+            &format!(
+                "m.toml:23:13: axis C: direction `{bad}` is not one of +x -x +y -y +z -z (or a vector such as [0, 1, 1])"
+            ),
         );
     }
+}
+
+#[test]
+fn bad_direction_vectors() {
+    for bad in [
+        "[0, 0, 0]",
+        "[1, 1]",
+        "[1, 1, 1, 1]",
+        "[0, nan, 1]",
+        "[inf, 0, 1]",
+    ] {
+        check(
+            &edit(
+                "direction = \"+z\"\noffset",
+                &format!("direction = {bad}\noffset"),
+            ),
+            "m.toml:23:13: axis C: a direction vector needs three finite numbers, not all zero (e.g. [0, 1, 1])",
+        );
+    }
+}
+
+#[test]
+fn direction_vectors_along_an_axis_are_the_signed_letters() {
+    use model_spec::{Dir, Direction};
+    let m = parse_machine(
+        "m.toml",
+        &edit(
+            "direction = \"+z\"\noffset",
+            "direction = [0, 0, -2.5]\noffset",
+        ),
+    )
+    .unwrap();
+    let c = &m.axes[m.axis_by_name("C").unwrap()];
+    assert_eq!(
+        c.direction.as_coordinate(),
+        Some(Direction {
+            dir: Dir::Z,
+            negative: true
+        })
+    );
+    let letters = parse_machine(
+        "m.toml",
+        &edit("direction = \"+z\"\noffset", "direction = \"-z\"\noffset"),
+    )
+    .unwrap();
+    assert_eq!(m.catalogue, letters.catalogue);
+    assert_eq!(m.fingerprint(), letters.fingerprint());
+}
+
+#[test]
+fn inclined_linear_axes_cannot_lead_the_squareness_order() {
+    let text = edit("direction = \"+y\"", "direction = [0, 1, 1]");
+    let err = parse_machine("m.toml", &text).unwrap_err().to_string();
+    assert!(err.contains("linear axis Y is inclined"), "{err}");
 }
 
 #[test]
 fn bad_direction_sign_after_letter() {
     check(
         &edit("direction = \"+z\"\noffset", "direction = \"z+\"\noffset"),
-        "m.toml:23:13: axis C: direction `z+` is not one of +x -x +y -y +z -z",
+        "m.toml:23:13: axis C: direction `z+` is not one of +x -x +y -y +z -z (or a vector such as [0, 1, 1])",
     );
 }
 
@@ -363,7 +419,7 @@ fn directions_are_case_insensitive_and_sign_optional() {
     .unwrap();
     let y = &m.axes[m.axis_by_name("Y").unwrap()];
     assert_eq!(
-        y.direction,
+        y.direction.as_coordinate().unwrap(),
         Direction {
             dir: Dir::Y,
             negative: true
@@ -371,7 +427,7 @@ fn directions_are_case_insensitive_and_sign_optional() {
     );
     let c = &m.axes[m.axis_by_name("C").unwrap()];
     assert_eq!(
-        c.direction,
+        c.direction.as_coordinate().unwrap(),
         Direction {
             dir: Dir::Z,
             negative: false

@@ -5,7 +5,7 @@
 //! against (a generic "first-order HTM product" library), and a third independent check of the
 //! gains.
 
-use model_spec::kinematics::{Step, chain_steps};
+use model_spec::kinematics::{FrameTurn, Step, chain_steps};
 use model_spec::{AxisKind, ErrorId, Machine, Side, Value};
 use nalgebra::{Matrix3, Vector3};
 use solver::simulation::exact::coordinate_rotation;
@@ -96,6 +96,19 @@ impl<'m> FirstOrderChain<'m> {
                         }
                     }
                 }
+                Step::Frame { axis, turn } => {
+                    // Columns x' y' z' (nalgebra reads the rows of `frame()` as columns).
+                    let own = Matrix3::from(self.m.axes[*axis].direction.frame());
+                    let r = match turn {
+                        FrameTurn::Into => own,
+                        FrameTurn::Back => own.transpose(),
+                    };
+                    v.nominal = r * v.nominal;
+                    for p in &mut v.parts {
+                        *p = r * *p;
+                    }
+                    rotation = r * rotation;
+                }
                 Step::Motion {
                     axis,
                     positioning_error,
@@ -104,18 +117,18 @@ impl<'m> FirstOrderChain<'m> {
                     match a.kind {
                         AxisKind::Linear => {
                             if v.point {
-                                v.nominal[a.direction.dir.index()] +=
-                                    a.direction.sign() * commands[*axis];
+                                v.nominal[a.direction.own.dir.index()] +=
+                                    a.direction.own.sign() * commands[*axis];
                             }
                         }
                         AxisKind::Rotary => {
                             if let Some(s) = slot(positioning_error) {
-                                v.parts[s] +=
-                                    Vector3::ith(a.direction.dir.index(), 1.0).cross(&v.nominal);
+                                v.parts[s] += Vector3::ith(a.direction.own.dir.index(), 1.0)
+                                    .cross(&v.nominal);
                             }
                             let r = *coordinate_rotation(
-                                a.direction.dir,
-                                a.direction.sign() * commands[*axis],
+                                a.direction.own.dir,
+                                a.direction.own.sign() * commands[*axis],
                             )
                             .matrix();
                             v.nominal = r * v.nominal;

@@ -339,11 +339,13 @@ fn negative_rotary_direction_and_its_positioning_error() {
     assert!(
         minus.axes[minus.axis_by_name("C").unwrap()]
             .direction
+            .own
             .negative
     );
     assert!(
         !minus.axes[minus.axis_by_name("Z").unwrap()]
             .direction
+            .own
             .negative
     );
     let p = plus.default_parameters();

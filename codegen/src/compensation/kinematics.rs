@@ -52,8 +52,8 @@ pub struct Ingredients {
 fn positioning_error(m: &Machine, axis: usize) -> ErrorId {
     let a = &m.axes[axis];
     let motion = match a.kind {
-        AxisKind::Linear => Motion::Translation(a.direction.dir),
-        AxisKind::Rotary => Motion::Rotation(a.direction.dir),
+        AxisKind::Linear => Motion::Translation(a.direction.own.dir),
+        AxisKind::Rotary => Motion::Rotation(a.direction.own.dir),
     };
     m.catalogue
         .iter()
@@ -74,19 +74,31 @@ fn fresh_name(m: &Machine, base: &str) -> String {
 pub fn check_topology(m: &Machine) -> Result<(), CompensationError> {
     let linear: Vec<usize> = m.linear_axes().collect();
     let rotary = m.rotary_axes().count();
+    // An inclined linear axis counts as a direction of its own (never one of the three).
     let mut dirs: Vec<usize> = linear
         .iter()
-        .map(|&a| m.axes[a].direction.dir.index())
+        .map(|&a| {
+            m.axes[a]
+                .direction
+                .as_coordinate()
+                .map_or(3 + a, |d| d.dir.index())
+        })
         .collect();
     dirs.sort_unstable();
     dirs.dedup();
-    if linear.len() != 3 || dirs.len() != 3 || rotary > 2 {
+    let along_xyz = dirs.iter().all(|&d| d < 3);
+    if linear.len() != 3 || dirs.len() != 3 || !along_xyz || rotary > 2 {
         return Err(CompensationError::Topology {
             machine: m.name.clone(),
             found: format!(
-                "it has {} linear axes along {} directions and {rotary} rotary axes",
+                "it has {} linear axes along {} directions{} and {rotary} rotary axes",
                 linear.len(),
-                dirs.len()
+                dirs.len(),
+                if along_xyz {
+                    ""
+                } else {
+                    ", not all along x, y or z"
+                }
             ),
         });
     }
@@ -139,7 +151,7 @@ impl Ingredients {
             .iter()
             .map(|&a| {
                 let (p, r) = pair(column_rows[a]);
-                if m.axes[a].direction.negative {
+                if m.axes[a].direction.own.negative {
                     (p.map(|x| x.neg()), r.map(|x| x.neg()))
                 } else {
                     (p, r)

@@ -3,7 +3,7 @@
 //! damped least squares for the rotary axes).
 
 use super::kinematics::Ingredients;
-use crate::atoms::AtomTable;
+use crate::atoms::{AtomKind, AtomTable};
 use crate::ir::{Input, Op, Output, Program, Var};
 use crate::lower::{Builder, Signed, inputs_of};
 use crate::poly::Poly;
@@ -161,14 +161,23 @@ pub(crate) enum Kind {
 pub(crate) fn build(ing: &Ingredients, atoms: &AtomTable, kind: Kind) -> Program {
     let machine = &ing.machine;
     let mut inputs: Vec<Input> = inputs_of(machine, atoms);
-    let n_atoms = atoms.kinds.len();
+    let n_inputs = atoms.input_count();
     let mut c = Ctx { b: Builder::new() };
-    let atom_inputs: Vec<Var> = (0..n_atoms)
-        .map(|i| c.b.push(Op::Input(i as u32)))
+    // The polynomials are in the atoms of `ing.machine`: the original machine's atoms with the
+    // three work-point symbols among the kinematic symbols. Those three are computed (first
+    // left unset, then the tool point); every other atom is an input or a constant of the
+    // original machine.
+    let own = AtomTable::new(machine);
+    let work_point = |k: &AtomKind| matches!(k, AtomKind::Symbol(s) if ing.work_point.contains(s));
+    c.b.atom_vars = own
+        .kinds
+        .iter()
+        .map(|k| match k.constant_value() {
+            _ if work_point(k) => Var::MAX,
+            Some(value) => c.b.constant(value),
+            None => c.b.push(Op::Input(u32::from(atoms.find(*k)))),
+        })
         .collect();
-    // The three work-point atoms follow the machine's own atoms; they are computed.
-    c.b.atom_vars = atom_inputs.clone();
-    c.b.atom_vars.extend([Var::MAX; 3]);
     let tip = c.vec3(&ing.tool_point);
     let tip_vars: Vec<Var> = tip
         .iter()
@@ -177,8 +186,10 @@ pub(crate) fn build(ing: &Ingredients, atoms: &AtomTable, kind: Kind) -> Program
             if s.1 { c.b.push(Op::Neg(s.0)) } else { s.0 }
         })
         .collect();
-    c.b.atom_vars.truncate(n_atoms);
-    c.b.atom_vars.extend(tip_vars);
+    for (slot, &symbol) in ing.work_point.iter().enumerate() {
+        let atom = own.find(AtomKind::Symbol(symbol));
+        c.b.atom_vars[atom as usize] = tip_vars[slot];
+    }
     let rot: Vec<[Val; 3]> = ing
         .tool_to_work
         .iter()
@@ -189,7 +200,7 @@ pub(crate) fn build(ing: &Ingredients, atoms: &AtomTable, kind: Kind) -> Program
         let outputs = tip.iter().chain(&axis).map(|&v| c.output(v)).collect();
         return c.b.finish(inputs, outputs);
     }
-    let mut next = n_atoms as u32;
+    let mut next = n_inputs as u32;
     let mut input = |c: &mut Ctx, inputs: &mut Vec<Input>, name: String| {
         inputs.push(Input {
             field: name.clone(),

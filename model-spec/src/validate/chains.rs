@@ -1,8 +1,9 @@
 //! The two kinematic chains and their axes.
 
 use super::{Res, Span, Validator};
-use crate::geometry::Direction;
+use crate::geometry::{AxisDirection, Direction};
 use crate::machine::{Axis, AxisKind, Chain, Link, Offset, Side, Symbol, Value};
+use crate::raw::{Num, RawDirection};
 use crate::raw::{RawLink, RawValue};
 use toml::Spanned;
 
@@ -155,14 +156,34 @@ impl Validator<'_> {
                 ),
             );
         };
-        let Some(direction) = Direction::parse(dir_s.get_ref()) else {
-            return self.err(
-                dir_s.span(),
-                format!(
-                    "axis {n}: direction `{}` is not one of +x -x +y -y +z -z",
-                    dir_s.get_ref()
-                ),
-            );
+        let direction = match dir_s.get_ref() {
+            RawDirection::Text(t) => match Direction::parse(t) {
+                Some(d) => AxisDirection::coordinate(d),
+                None => {
+                    return self.err(
+                        dir_s.span(),
+                        format!(
+                            "axis {n}: direction `{t}` is not one of +x -x +y -y +z -z (or a vector such as [0, 1, 1])"
+                        ),
+                    );
+                }
+            },
+            RawDirection::Vector(v) => {
+                let parsed = <[Num; 3]>::try_from(v.as_slice())
+                    .ok()
+                    .and_then(|v| AxisDirection::from_vector(v.map(|x| x.0)));
+                match parsed {
+                    Some(d) => d,
+                    None => {
+                        return self.err(
+                            dir_s.span(),
+                            format!(
+                                "axis {n}: a direction vector needs three finite numbers, not all zero (e.g. [0, 1, 1])"
+                            ),
+                        );
+                    }
+                }
+            }
         };
         if kind == AxisKind::Rotary && n == "W" {
             return self.err(

@@ -106,7 +106,7 @@ impl Validator<'_> {
         )?;
         self.symbols_not_reserved(&raw_symbols, &axes)?;
 
-        let squareness_order = self.squareness_order(&raw.errors, &axes)?;
+        let squareness_order = self.squareness_order(&raw.errors, &axes, &axis_spans)?;
         let catalogue = build_catalogue(&axes, &squareness_order);
         self.symbols_not_errors(&raw_symbols, &catalogue)?;
         self.symbols_not_measurement_effects(&raw_symbols)?;

@@ -41,7 +41,30 @@ impl Validator<'_> {
         Ok(())
     }
 
-    pub(super) fn squareness_order(&self, raw: &RawErrors, axes: &[Axis]) -> Res<Vec<AxisId>> {
+    pub(super) fn squareness_order(
+        &self,
+        raw: &RawErrors,
+        axes: &[Axis],
+        axis_spans: &[Span],
+    ) -> Res<Vec<AxisId>> {
+        let order = self.squareness_order_as_given(raw, axes)?;
+        // The squareness of the second axis is about the normal of the first two, a coordinate
+        // direction only when both are along coordinate directions.
+        for &i in order.iter().take(2) {
+            if axes[i].direction.inclined.is_some() {
+                return self.err(
+                    axis_spans[i].clone(),
+                    format!(
+                        "linear axis {} is inclined: an inclined linear axis cannot be first or second in the squareness order (put two axes along x, y or z first with `[errors] squareness_order`)",
+                        axes[i].name
+                    ),
+                );
+            }
+        }
+        Ok(order)
+    }
+
+    fn squareness_order_as_given(&self, raw: &RawErrors, axes: &[Axis]) -> Res<Vec<AxisId>> {
         let linear: Vec<AxisId> = (0..axes.len())
             .filter(|&i| axes[i].kind == AxisKind::Linear)
             .collect();

@@ -137,7 +137,7 @@ fn axis_errors(m: &Machine, axis: AxisId, errors: &[ErrorId]) -> (Vec<usize>, Op
         {
             let own = match (a.kind, motion) {
                 (AxisKind::Linear, Motion::Translation(d))
-                | (AxisKind::Rotary, Motion::Rotation(d)) => d == a.direction.dir,
+                | (AxisKind::Rotary, Motion::Rotation(d)) => d == a.direction.own.dir,
                 _ => false,
             };
             if own {
@@ -200,7 +200,7 @@ pub fn axis_tables(
             }
             rows.push(TableRow {
                 position: p,
-                deviation: positioning.map(|k| a.direction.sign() * row[k] + 0.0),
+                deviation: positioning.map(|k| a.direction.own.sign() * row[k] + 0.0),
                 errors: row,
             });
         }
@@ -211,7 +211,7 @@ pub fn axis_tables(
             source: errors.file().to_string(),
             axis: a.name.clone(),
             kind: a.kind,
-            direction: a.direction,
+            direction: a.direction.own,
             pitch: step,
             error_names: ids.iter().map(|&e| m.catalogue[e].name.clone()).collect(),
             angular: ids.iter().map(|&e| m.catalogue[e].is_angular()).collect(),

@@ -88,7 +88,7 @@ fn bases(m: &Machine, effect: Effect, o: &DictionaryOptions) -> Vec<Basis> {
             let a = &m.axes[axis];
             let positioning = match (a.kind, motion) {
                 (AxisKind::Linear, Motion::Translation(d))
-                | (AxisKind::Rotary, Motion::Rotation(d)) => d == a.direction.dir,
+                | (AxisKind::Rotary, Motion::Rotation(d)) => d == a.direction.own.dir,
                 _ => false,
             };
             let mut out: Vec<Basis> = match a.kind {

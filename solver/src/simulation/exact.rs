@@ -27,7 +27,7 @@
 //! Slices of the wrong length are programming errors and panic with a message naming the
 //! machine and the expected length.
 
-use model_spec::kinematics::{Step, chain_steps};
+use model_spec::kinematics::{FrameTurn, Step, chain_steps};
 use model_spec::{AxisKind, Dir, ErrorId, Machine, Offset, Side, Value};
 use nalgebra::{Matrix3, Rotation3, Translation3, Vector3};
 
@@ -206,12 +206,24 @@ impl<'m> VirtualMachine<'m> {
                         * coordinate_rotation(Dir::Y, err(&e[1]))
                         * coordinate_rotation(Dir::Z, err(&e[2])),
                 ),
+                Step::Frame { axis, turn } => {
+                    // nalgebra reads `[[f64; 3]; 3]` as columns: `own` has the columns x' y' z'.
+                    let own = Matrix3::from(self.machine.axes[*axis].direction.frame());
+                    let rows = match turn {
+                        FrameTurn::Into => own,
+                        FrameTurn::Back => own.transpose(),
+                    };
+                    Transform::from_parts(
+                        Translation3::identity(),
+                        Rotation3::from_matrix_unchecked(rows),
+                    )
+                }
                 Step::Motion {
                     axis,
                     positioning_error,
                 } => {
                     let a = &self.machine.axes[*axis];
-                    let (dir, sign) = (a.direction.dir, a.direction.sign());
+                    let (dir, sign) = (a.direction.own.dir, a.direction.own.sign());
                     let q = commands[*axis];
                     match a.kind {
                         AxisKind::Linear => Transform::from_parts(

@@ -114,7 +114,9 @@ impl VolumetricModel {
         let fits = m.axes.len() == N
             && chain.len() == N
             && chain.iter().all(|&a| {
-                let d = m.axes[a].direction.dir.index();
+                let Some(d) = m.axes[a].direction.as_coordinate().map(|d| d.dir.index()) else {
+                    return false;
+                };
                 let fresh = !dirs_seen[d];
                 dirs_seen[d] = true;
                 m.axes[a].kind == AxisKind::Linear && fresh
@@ -162,7 +164,9 @@ impl VolumetricModel {
             }
         }
         let names = chain.map(|a| m.axes[a].name.clone());
-        let coordinate = chain.map(|a| (m.axes[a].direction.dir, m.axes[a].direction.sign()));
+        // Every axis of the chain is along a coordinate direction (checked above).
+        let coordinate =
+            chain.map(|a| (m.axes[a].direction.own.dir, m.axes[a].direction.own.sign()));
         let dirs = coordinate.map(|(d, s)| unit(d) * s);
         let strokes = chain.map(|a| m.axes[a].limits);
         let mut translations = Vec::with_capacity(N);

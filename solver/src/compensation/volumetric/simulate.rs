@@ -191,7 +191,7 @@ pub fn measure(
         .axes
         .iter()
         .map(|a| match a.kind {
-            AxisKind::Linear => unit(a.direction.dir) * a.direction.sign(),
+            AxisKind::Linear => Vector3::from(a.direction.unit()),
             AxisKind::Rotary => Vector3::zeros(),
         })
         .collect();
@@ -285,7 +285,8 @@ fn squareness_of_lines(
     for x in measurements {
         let k = depth(x.axis).ok_or_else(cannot)?;
         let n = directions[x.axis];
-        let along = m.axes[x.axis].direction.dir.index();
+        // The volumetric machines' linear axes are along coordinate directions.
+        let along = m.axes[x.axis].direction.own.dir.index();
         for d in (0..3).filter(|&d| d != along) {
             let t = Table::new(
                 x.positions.clone(),

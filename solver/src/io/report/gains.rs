@@ -46,6 +46,11 @@ pub fn atom_legend(m: &Machine, model: &GainModel) -> Vec<(String, String)> {
                     "kinematic parameter, mm (default {})",
                     short(m.symbols[s].default)
                 ),
+                AtomKind::Root(p) => format!("the square root of {p} (an inclined axis's frame)"),
+                AtomKind::Constant(bits) => format!(
+                    "a numeric entry of an inclined axis's frame ({})",
+                    short(f64::from_bits(bits))
+                ),
             };
             (name.clone(), meaning)
         })

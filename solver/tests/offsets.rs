@@ -36,6 +36,60 @@ fn file_machine(file: &str) -> Machine {
     parse_machine(&path, &text).unwrap()
 }
 
+/// A machine with inclined axes and symbols in the offsets after them: a C table tilted 45°
+/// about x on the work side (the ball on it), a linear U slide along [0, 1, 1] and a B head
+/// about [1, 2, 3] on the tool side, its pivot and tool length symbols.
+fn inclined_machine() -> Machine {
+    let text = r#"
+name = "inclined-offsets"
+[symbols]
+Xc = 10.0
+Zc = 40.0
+Xw = 100.0
+Yw = 20.0
+Zw = 80.0
+Yu = 5.0
+Zb = 150.0
+Lt = 120.0
+[[work]]
+axis = "C"
+type = "rotary"
+direction = [0, -1, 1]
+offset = ["Xc", 0, "Zc"]
+[[work]]
+end = "ball"
+offset = ["Xw", "Yw", "Zw"]
+[[tool]]
+axis = "X"
+type = "linear"
+direction = "+x"
+stroke = [-900.0, 900.0]
+[[tool]]
+axis = "U"
+type = "linear"
+direction = [0, 1, 1]
+offset = [0, "Yu", 0]
+stroke = [-900.0, 900.0]
+[[tool]]
+axis = "Z"
+type = "linear"
+direction = "+z"
+stroke = [-900.0, 900.0]
+[[tool]]
+axis = "B"
+type = "rotary"
+direction = [1, 2, 3]
+offset = [0, "Yu", "Zb"]
+range = [-180.0, 180.0]
+[[tool]]
+end = "probe"
+offset = [0, 0, "Lt"]
+[errors]
+squareness_order = ["X", "Z", "U"]
+"#;
+    parse_machine("inclined-offsets.toml", text).unwrap()
+}
+
 fn symbol(m: &Machine, name: &str) -> usize {
     m.symbol_by_name(name).unwrap()
 }
@@ -124,7 +178,8 @@ fn groups(names: &[String], confounded: &[Vec<usize>]) -> Vec<Vec<String>> {
 #[test]
 fn the_gain_of_every_symbol_is_the_central_difference_of_the_exact_chain() {
     // Built-in machines and test machines with axes in negative directions, a head-head
-    // machine and symbols shared by several offsets; random poses on and off the ball, random
+    // machine, symbols shared by several offsets and inclined axes (linear and rotary, exact
+    // and numeric directions, symbols after them); random poses on and off the ball, random
     // kinematic parameters. The nominal chain is affine in its symbols, so the difference is
     // exact whatever the step: a 0.5 mm and a 20 mm step give the same gain.
     let machines = [
@@ -135,6 +190,7 @@ fn the_gain_of_every_symbol_is_the_central_difference_of_the_exact_chain() {
         file_machine("neg-head.toml"),
         file_machine("head-head-ca.toml"),
         file_machine("shared-offsets.toml"),
+        inclined_machine(),
     ];
     let mut rng = Rng::new(11);
     let mut checked = 0;

@@ -11,7 +11,8 @@
 //! ```
 //!
 //! where `R_k` is the nominal rotation of the chain just before the offset (the product of the
-//! rotary motions between the bed and it, [`model_spec::kinematics::chain_steps`]) and `e_c` the
+//! rotary motions and of the turns into and out of inclined axes' own frames between the bed
+//! and it, [`model_spec::kinematics::chain_steps`]) and `e_c` the
 //! coordinate direction of the offset's entry that names `s`. Offsets only translate and no
 //! rotation depends on a symbol, so the nominal chain is affine in its symbols: this gain is
 //! exact, not a linearisation, at every pose (on or off the ball) and for any size of `δ`.
@@ -32,7 +33,7 @@
 
 use crate::model::{Effect, Model};
 use crate::simulation::exact::coordinate_rotation;
-use model_spec::kinematics::{Step, chain_steps};
+use model_spec::kinematics::{FrameTurn, Step, chain_steps};
 use model_spec::units::short;
 use model_spec::{AxisKind, Machine, Side, SymbolId, Value};
 use nalgebra::{Matrix3, Vector3};
@@ -79,9 +80,20 @@ impl<'m> OffsetGains<'m> {
                 Step::Motion { axis, .. } => {
                     let a = &m.axes[*axis];
                     if a.kind == AxisKind::Rotary {
-                        let q = a.direction.sign() * commands[*axis];
-                        r *= coordinate_rotation(a.direction.dir, q).matrix();
+                        let own = a.direction.own;
+                        let q = own.sign() * commands[*axis];
+                        r *= coordinate_rotation(own.dir, q).matrix();
                     }
+                }
+                // Into (or back out of) an inclined axis's own frame, as the exact chain has
+                // it: nalgebra reads `[[f64; 3]; 3]` as columns, so `own` has the columns
+                // x' y' z'.
+                Step::Frame { axis, turn } => {
+                    let own = Matrix3::from(m.axes[*axis].direction.frame());
+                    r *= match turn {
+                        FrameTurn::Into => own,
+                        FrameTurn::Back => own.transpose(),
+                    };
                 }
                 // Errors are zero in the nominal chain: identity.
                 Step::ErrorTranslation(_) | Step::ErrorRotation(_) => {}

@@ -531,6 +531,29 @@ fn a_campaign_shares_a_machine_length_and_gives_each_set_up_its_ball_position() 
         g.contains(&vec!["XOW[near]".to_string(), "Xw[near]".to_string()]),
         "{g:?}"
     );
+    // The report gives each column's nominal length and reads back only with the records' own.
+    let source = solver::io::report::CampaignSource {
+        label: "location + Zt + Xw",
+        base_model: Some("location"),
+        data: &["near.csv".to_string(), "far.csv".to_string()],
+    };
+    let report = solver::io::report::CampaignReport::new(&m, source, &id, None).unwrap();
+    let json = to_json(&report).unwrap();
+    let root: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let back =
+        solver::io::report::campaign_read::parse_campaign_report("c.json", &root, &m).unwrap();
+    assert_eq!(back.values.values, id.fit.values);
+    let tampered: serde_json::Value =
+        serde_json::from_str(&json.replacen("\"nominal_mm\": 60.0", "\"nominal_mm\": 61.0", 1))
+            .unwrap();
+    let e = solver::io::report::campaign_read::parse_campaign_report("c.json", &tampered, &m)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("nominal_mm")
+            && e.contains("61 mm, but the records of `Xw[far]` are modelled with 60 mm"),
+        "{e}"
+    );
     // Records that disagree on a machine's length cannot share one change of it.
     let mut other = records.clone();
     other[1].params[zt] = -250.01;

@@ -1102,3 +1102,22 @@ fn submodels_take_the_new_vocabulary() {
         );
     }
 }
+
+#[test]
+fn symbol_spelled_like_an_error_and_symbols_in_models() {
+    check(
+        &edit(r#"Xw = -200.0"#, "Xw = -200.0\nx0c = 1.0"),
+        "m.toml:7:1: symbol `x0c` reads as the error XOC of this machine (error names are read without regard to case, with 0 for O): terms name errors and kinematic symbols alike, so rename the symbol",
+    );
+    // A kinematic symbol is a term of a model, constant, written as under [symbols].
+    let m = parse_machine("m.toml", &edit(r#""BOC"]"#, r#""BOC", "Zc"]"#)).unwrap();
+    assert_eq!(m.models["reduced"].terms.len(), 5);
+    check(
+        &edit(r#""BOC"]"#, r#""BOC", "Zc@time:1"]"#),
+        "m.toml:54:39: model `reduced`: Zc: `Zc` is a kinematic offset of the machine (a length of its description, mm): constants only, not `time:1`; a length does not change with position, direction of motion or time (what does is an error of an axis or a drift)",
+    );
+    check(
+        &edit(r#""BOC"]"#, r#""BOC", "zc"]"#),
+        "m.toml:54:39: model `reduced`: `zc` is no error of this machine; the kinematic symbol is written `Zc` (symbols are named exactly as [symbols] writes them)",
+    );
+}

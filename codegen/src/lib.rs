@@ -14,6 +14,7 @@ pub mod poly;
 pub mod rational;
 
 pub use derive::GainModel;
+pub mod build;
 pub mod emit;
 pub mod ir;
 pub mod lower;

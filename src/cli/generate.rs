@@ -1,7 +1,12 @@
-//! `rtest generate`: standalone `no_std` Rust code for a machine's gains.
+//! `rtest generate`: standalone `no_std` Rust code for a machine's gains, as one file or as a
+//! ready crate (`--crate DIR`).
+
+mod crate_files;
 
 use super::{CliError, CliResult, EXIT_CODES, args, check_outputs, write};
+use model_spec::Machine;
 use output::{Outputs, Target};
+use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
 Generates a standalone Rust source file with the error-gain functions of a machine: \
@@ -12,7 +17,11 @@ model whose `pub fn gains(pose, params, out)` writes [gx, gy, gz, gi, gj, gk] pe
 point minus workpiece point in the tool frame, mm per mm of a translational error and mm per rad \
 of an angular error, valid where the nominal tool point is on the workpiece point (every R-test \
 pose). Errors themselves are in mm and rad inside the code (µm and µrad for people). The file \
-has no crate attributes, so it can be `include!`d or used as a module (docs/codegen.md).";
+has no crate attributes, so it can be `include!`d or used as a module (docs/codegen.md). \
+With --crate DIR, writes a ready no_std crate instead: Cargo.toml (its own workspace, no \
+dependencies), src/lib.rs (the code, with crate documentation on the machine, its models, the \
+units and how to call it), README.md and machine.toml (the description it was generated from). \
+DIR must not exist or be empty; the files are written all or none.";
 
 /// Flags of `rtest generate`.
 #[derive(Debug, clap::Args)]
@@ -32,28 +41,98 @@ pub struct GenerateArgs {
     /// Write the code to FILE instead of standard output.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Option<Target>,
+    /// Write a ready no_std crate into DIR (created if missing; refused if not empty):
+    /// Cargo.toml, src/lib.rs, README.md and the machine description as machine.toml.
+    #[arg(long = "crate", value_name = "DIR", conflicts_with = "output")]
+    crate_dir: Option<PathBuf>,
 }
 
 /// Runs `rtest generate`.
 pub fn run(args: &GenerateArgs) -> CliResult {
-    let m = super::load_machine(&args.machine)?;
+    let (m, text) = super::load_machine_and_text(&args.machine)?;
     for (i, name) in args.model.iter().enumerate() {
         args::model_errors(&m, name)?;
         if args.model[..i].contains(name) {
             return Err(CliError::usage(format!("--model: `{name}` is given twice")));
         }
     }
-    let target = args.output.clone().unwrap_or(Target::Stdout);
     let inputs: Vec<_> = super::machine_file(&args.machine)
         .map(|p| ("--machine", p))
         .into_iter()
         .collect();
-    check_outputs(&inputs, &[("-o", &target)], &[])?;
     let models: Vec<&str> = args.model.iter().map(String::as_str).collect();
-    let code = codegen::emit::generate_machine(&m, &models)
-        .map_err(|e| CliError::computation(format!("generate: machine {}: {e}", m.name)))?;
-    let mut files = Outputs::new();
-    files.add("-o", target.clone(), code);
-    // The code may be on standard output: what was written is said on standard error.
-    super::print_text(&super::wrote(&write(files)?), true)
+    match &args.crate_dir {
+        Some(dir) => {
+            refuse_non_empty(dir)?;
+            check_outputs(&inputs, &[], &[("--crate", dir)])?;
+            let code = generate(&m, &models)?;
+            let files = crate_files::files(&m, &text, &models, &code);
+            let mut outputs = Outputs::new();
+            for (relative, contents) in files {
+                let (place, name) = match relative.rsplit_once('/') {
+                    Some((sub, name)) => (dir.join(sub), name),
+                    None => (dir.clone(), relative),
+                };
+                outputs.add_in_dir("--crate", place, name, contents);
+            }
+            let written = write(outputs)?;
+            let built = crate_files::package_name(&m.name);
+            super::print(&format!(
+                "{}Crate `{built}` of machine `{}` in `{}`: `cargo build --release` there, or a \
+                 path dependency of your crate.\n",
+                super::wrote(&written),
+                m.name,
+                dir.display()
+            ))
+        }
+        None => {
+            let target = args.output.clone().unwrap_or(Target::Stdout);
+            check_outputs(&inputs, &[("-o", &target)], &[])?;
+            let code = generate(&m, &models)?;
+            let mut files = Outputs::new();
+            files.add("-o", target.clone(), code);
+            // The code may be on standard output: what was written is said on standard error.
+            super::print_text(&super::wrote(&write(files)?), true)
+        }
+    }
+}
+
+/// The code of the models `models` of `m` (every model when empty).
+fn generate(m: &Machine, models: &[&str]) -> CliResult<String> {
+    codegen::emit::generate_machine(m, models)
+        .map_err(|e| CliError::computation(format!("generate: machine {}: {e}", m.name)))
+}
+
+/// Refuses a crate directory that exists and is not an empty directory: a crate is written
+/// whole into a place of its own, never over or among other files.
+fn refuse_non_empty(dir: &Path) -> CliResult {
+    let shown = dir.display();
+    match std::fs::metadata(dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotADirectory => Err(CliError::input(format!(
+            "--crate: `{shown}`: a directory above it is a file"
+        ))),
+        Err(e) => Err(CliError::input(format!(
+            "--crate: cannot read `{shown}`: {e}"
+        ))),
+        Ok(meta) if !meta.is_dir() => Err(CliError::input(format!(
+            "--crate: `{shown}` exists and is not a directory"
+        ))),
+        Ok(_) => {
+            let mut entries = std::fs::read_dir(dir)
+                .map_err(|e| CliError::input(format!("--crate: cannot read `{shown}`: {e}")))?;
+            match entries.next() {
+                None => Ok(()),
+                Some(entry) => {
+                    let first = entry
+                        .map(|e| format!(" (it holds `{}`)", e.file_name().to_string_lossy()))
+                        .unwrap_or_default();
+                    Err(CliError::input(format!(
+                        "--crate: `{shown}` exists and is not empty{first}: give a new or empty \
+                         directory"
+                    )))
+                }
+            }
+        }
+    }
 }

@@ -5,8 +5,9 @@
 //! rotary commands are inputs, so the code runs on a controller without a maths library (CI
 //! builds it for `thumbv7em-none-eabihf`, a Cortex-M4F).
 //!
-//! Each machine is a module (`seed_ac`, `seed_3axis`, `head_table_bc`) with `Pose`, `Params`
-//! and one module per model (`full`, `reduced`, …) whose `gains(pose, params, out)` writes
+//! Each machine is a module (`seed_ac`, `head_table_bc`, `nutating_head_bc`, …: one per file
+//! of `model-spec/machines/`) with `Pose`, `Params` and one module per model (`full`,
+//! `reduced`, `location`, …) whose `gains(pose, params, out)` writes
 //! `[gx, gy, gz, gi, gj, gk]` per error: the error vector (tool minus workpiece) and the
 //! orientation error in the nominal tool frame per unit of error (mm per mm for translational
 //! errors, mm per rad for angular errors). They are the exact first-order gains where the
@@ -23,6 +24,10 @@
 
 #![no_std]
 #![warn(missing_docs)]
+// The machines with inclined axes hold exact constants such as √2, written as the f64 nearest
+// them (`1.4142135623730951f64`, the bits of `core::f64::consts::SQRT_2`), which clippy takes
+// for approximations of the named constants.
+#![allow(clippy::approx_constant)]
 
 /// `compensate(commanded, params, values, sin_cos, out)` of a compiled model, on slices.
 pub type CompensateFn = fn(&[f64], &[f64], &[f64], fn(f64) -> (f64, f64), &mut [f64]);

@@ -5,13 +5,36 @@ use crate::text::{TextError, read_text};
 use crate::{Machine, SpecError, parse_machine};
 use std::path::Path;
 
-/// Name and TOML text of every built-in machine, in the order `rtest machines` lists them.
+/// Name and TOML text of every built-in machine, in the order `rtest machines` lists them: the
+/// seed's machines and `head-table-bc` first (their places are fixed), then the templates of
+/// the other families: table-table B/C, head-head C/A, the nutating head and the nutating
+/// table (inclined B axes), the four-axis horizontal machine.
 pub const BUILTIN: &[(&str, &str)] = &[
     ("seed-ac", include_str!("../machines/seed-ac.toml")),
     ("seed-3axis", include_str!("../machines/seed-3axis.toml")),
     (
         "head-table-bc",
         include_str!("../machines/head-table-bc.toml"),
+    ),
+    (
+        "table-table-bc",
+        include_str!("../machines/table-table-bc.toml"),
+    ),
+    (
+        "head-head-ca",
+        include_str!("../machines/head-head-ca.toml"),
+    ),
+    (
+        "nutating-head-bc",
+        include_str!("../machines/nutating-head-bc.toml"),
+    ),
+    (
+        "nutating-table-bc",
+        include_str!("../machines/nutating-table-bc.toml"),
+    ),
+    (
+        "horizontal-4axis-b",
+        include_str!("../machines/horizontal-4axis-b.toml"),
     ),
 ];
 

@@ -35,7 +35,16 @@ fn every_builtin_validates() {
     let all = all_builtin();
     assert_eq!(
         all.iter().map(|m| m.name.as_str()).collect::<Vec<_>>(),
-        ["seed-ac", "seed-3axis", "head-table-bc"]
+        [
+            "seed-ac",
+            "seed-3axis",
+            "head-table-bc",
+            "table-table-bc",
+            "head-head-ca",
+            "nutating-head-bc",
+            "nutating-table-bc",
+            "horizontal-4axis-b"
+        ]
     );
     assert!(builtin("no-such-machine").is_none());
 }
@@ -383,7 +392,7 @@ fn load_machine_by_name_and_by_path() {
     let err = load_machine("no/such/file.toml").unwrap_err().to_string();
     assert_eq!(
         err,
-        "no built-in machine and no file called `no/such/file.toml` (built-in: seed-ac, seed-3axis, head-table-bc)"
+        "no built-in machine and no file called `no/such/file.toml` (built-in: seed-ac, seed-3axis, head-table-bc, table-table-bc, head-head-ca, nutating-head-bc, nutating-table-bc, horizontal-4axis-b)"
     );
 
     let dir = std::env::temp_dir().join(format!("model-spec-test-{}", std::process::id()));

@@ -1121,3 +1121,25 @@ fn symbol_spelled_like_an_error_and_symbols_in_models() {
         "m.toml:54:39: model `reduced`: `zc` is no error of this machine; the kinematic symbol is written `Zc` (symbols are named exactly as [symbols] writes them)",
     );
 }
+
+#[test]
+fn an_inclined_linear_axis_leading_the_squareness_order_is_reported_at_the_axis() {
+    check(
+        &edit("direction = \"+y\"", "direction = [0, 1, 1]"),
+        "m.toml:31:8: linear axis Y is inclined: an inclined linear axis cannot be first or second in the squareness order (put two axes along x, y or z first with `[errors] squareness_order`)",
+    );
+    // Third in the order it is accepted, with the squareness errors of its own frame.
+    let m = parse_machine(
+        "m.toml",
+        &edit(
+            "direction = \"+z\"\nstroke",
+            "direction = [0, 1, 4]\nstroke",
+        ),
+    )
+    .unwrap();
+    let z = m.axis_by_name("Z").unwrap();
+    assert!(m.axes[z].direction.inclined.is_some());
+    for name in ["AOZ", "BOZ", "EZZ"] {
+        assert!(m.error_by_name(name).is_some(), "{name}");
+    }
+}

@@ -226,7 +226,10 @@ fn every_test_of_every_machine_is_within_limits_and_clearance_with_the_nest_on_t
             count += 1;
         }
     }
-    assert_eq!(count, 6 + 3 + 6 + 6 + 6 + 1);
+    // Built in: seed-ac 6, head-table-bc 3, table-table-bc 3, head-head-ca 6, the nutating
+    // head and table 3 each, horizontal-4axis-b 1; fixtures: head-head-ca, neg-head, neg-table
+    // 6 each, one-rotary 1.
+    assert_eq!(count, 6 + 3 + 3 + 6 + 3 + 3 + 1 + 6 + 6 + 6 + 1);
 }
 
 #[test]

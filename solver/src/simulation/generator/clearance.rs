@@ -142,9 +142,10 @@ impl<'m> TiltGauge<'m> {
     /// change the tilt or every angle keeps it. `None` when `from_deg` itself tilts too far.
     ///
     /// The tool axis and the table normal are on different chains and the axis turns one of
-    /// them about a fixed direction, so the cosine of the tilt is `α + β·cos q + γ·sin q`
-    /// exactly; the three coefficients come from `q = 0°, 90°, 180°`, and the interval is
-    /// solved in closed form.
+    /// them about a fixed direction (a coordinate direction or an inclined one alike), so the
+    /// cosine of the tilt is `α + β·cos q + γ·sin q` exactly; the three coefficients come from
+    /// `q = 0°, 90°, 180°`, and the interval is solved in closed form for the largest tilt plus
+    /// [`TILT_TOLERANCE_DEG`], the tolerance of the check of every sample.
     pub fn allowed_interval(
         &self,
         commands: &[f64],
@@ -170,7 +171,13 @@ impl<'m> TiltGauge<'m> {
         if self.tilt_deg(&at(from_deg)) > max_tilt_deg + TILT_TOLERANCE_DEG {
             return None;
         }
-        let kappa = max_tilt_deg.to_radians().cos();
+        // The limit with the tolerance of the check: a tilt that reaches the limit exactly (an
+        // A table at ±90°, a 45° nutating head at 180°) is within the rule, and the rounding of
+        // α, β, γ must not cut the interval short of it.
+        let kappa = (max_tilt_deg + TILT_TOLERANCE_DEG)
+            .min(180.0)
+            .to_radians()
+            .cos();
         if rho < 1e-12 || (kappa - alpha) / rho <= -1.0 {
             return Some([f64::NEG_INFINITY, f64::INFINITY]);
         }

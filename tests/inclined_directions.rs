@@ -140,8 +140,8 @@ fn an_exact_frame_keeps_exact_zeros() {
     }
     // In the tool frame, the head's own z' is fixed: EZB is (0, √2/2, √2/2) at every pose.
     let want = ["0", "0.5*√2", "0.5*√2"];
-    for k in 0..3 {
+    for (k, want) in want.iter().enumerate() {
         let text = codegen::table::format_poly(&model.gains[0][k], &model.atoms.names, false);
-        assert_eq!(text, want[k], "row {k}");
+        assert_eq!(text, *want, "row {k}");
     }
 }

@@ -3,8 +3,9 @@
 //! single-precision first-order correction stays within its stated bound of the host's
 //! corrected pose.
 
-use model_spec::{AxisKind, Machine, builtin};
+use model_spec::{AxisKind, Machine, Side, builtin};
 use solver::compensation::correct::Compensator;
+use solver::simulation::exact::chain_transform;
 use solver::simulation::rng::Rng;
 
 /// The host's sine and cosine, as the generated code's caller passes it.
@@ -12,8 +13,48 @@ fn sin_cos(x: f64) -> (f64, f64) {
     x.sin_cos()
 }
 
-/// A random pose within the strokes and ranges, with |tilt| ≥ 15° away from a singular pose.
+/// A random pose within the strokes and ranges, with |tilt| ≥ 15° away from a singular pose:
+/// every rotary command at least 15° from 0°, and the tool axis at least 15° from the plane of
+/// two rotary axes ([`orientation_conditioning`]; the nutating head and table are singular at
+/// B = 180° too).
 fn random_pose(m: &Machine, rng: &mut Rng) -> Vec<f64> {
+    loop {
+        let q = draw_pose(m, rng);
+        if orientation_conditioning(m, &q) >= 15f64.to_radians().sin() {
+            return q;
+        }
+    }
+}
+
+/// For a machine with two rotary axes, `|∂t/∂q₁ × ∂t/∂q₂|` at `q`, `t` the tool axis in the
+/// workpiece frame (nominal machine): the sine of the angle between the tool axis and the plane
+/// of the two rotary axes. Where it vanishes both axes turn the tool axis the same way, a
+/// singular pose (A = 0° on seed-ac: `|sin A|`). 1 for other machines.
+fn orientation_conditioning(m: &Machine, q: &[f64]) -> f64 {
+    let rotary: Vec<usize> = m.rotary_axes().collect();
+    let [a, b] = rotary[..] else {
+        return 1.0;
+    };
+    let (params, zeros) = (m.default_parameters(), vec![0.0; m.catalogue.len()]);
+    let tool_axis = |q: &[f64]| {
+        let tool = chain_transform(m, Side::Tool, q, &params, &zeros);
+        let work = chain_transform(m, Side::Work, q, &params, &zeros);
+        let z = tool.rotation.matrix().column(2).into_owned();
+        work.rotation.inverse_transform_vector(&z)
+    };
+    let derivative = |i: usize| {
+        let h = 1e-6;
+        let (mut up, mut down) = (q.to_vec(), q.to_vec());
+        up[i] += h;
+        down[i] -= h;
+        (tool_axis(&up) - tool_axis(&down)) / (2.0 * h)
+    };
+    derivative(a).cross(&derivative(b)).norm()
+}
+
+/// Rotary commands uniform over their ranges (±180° when unlimited), at least 15° from 0°;
+/// linear commands uniform over their strokes.
+fn draw_pose(m: &Machine, rng: &mut Rng) -> Vec<f64> {
     m.axes
         .iter()
         .map(|a| {

@@ -294,7 +294,8 @@ pub fn unit_frame(v: [f64; 3]) -> UnitFrame {
 fn numeric_frame(v: [f64; 3]) -> UnitFrame {
     let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     let u = v.map(|x| x / norm);
-    let len = (1.0 - u[0] * u[0]).sqrt();
+    // |x'| = √(1 − u_x²) = √(u_y² + u_z²), the second form exact also near x.
+    let len = u[1].hypot(u[2]);
     let x_axis = [len, -u[0] * u[1] / len, -u[0] * u[2] / len];
     let y_axis = [0.0, u[2] / len, -u[1] / len];
     UnitFrame {
@@ -380,6 +381,12 @@ mod tests {
                 assert!((cross[k] - a[2][k]).abs() < 1e-15);
             }
         }
+        // Within rounding of x: the exact form leaves the integer range, the numeric frame is
+        // still orthonormal with x' close to -y.
+        let near_x = unit_frame([1.0, 1e-9, 0.0])
+            .axes
+            .map(|r| r.map(Real::to_f64));
+        assert!((near_x[0][1] + 1.0).abs() < 1e-12, "{near_x:?}");
         let f = unit_frame([0.0, 1.0, 1.0]);
         assert!(f.axes.iter().flatten().all(|r| r.is_exact()));
         assert_eq!(f.axes[2][1].to_string(), "√2/2");

@@ -148,11 +148,21 @@ impl AxisDirection {
 
     /// The direction of the vector `v`: a signed coordinate direction when only one component
     /// is non-zero (`[-1, 0, 0]` is `-x`, exactly as `"-x"`), inclined otherwise. `None` for a
-    /// zero or non-finite vector.
+    /// zero or non-finite vector, or one whose own frame cannot be formed in `f64`.
     pub fn from_vector(v: [f64; 3]) -> Option<AxisDirection> {
         if v.iter().any(|x| !x.is_finite()) || v.iter().all(|&x| x == 0.0) {
             return None;
         }
+        // A vector whose length or whose components' products leave the f64 range is scaled
+        // by a power of two first (exact); ordinary vectors are kept as written, so that their
+        // components are recognised exactly.
+        let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let v = if (1e-100..=1e100).contains(&largest) {
+            v
+        } else {
+            let scale = 2f64.powi(-largest.log2().round() as i32);
+            v.map(|x| x * scale)
+        };
         let nonzero: Vec<usize> = (0..3).filter(|&i| v[i] != 0.0).collect();
         if let [i] = nonzero[..] {
             return Some(AxisDirection::coordinate(Direction {
@@ -160,15 +170,21 @@ impl AxisDirection {
                 negative: v[i] < 0.0,
             }));
         }
-        Some(AxisDirection {
+        let frame = crate::surd::unit_frame(v);
+        // The frame must be orthonormal (it is, unless a component underflows to nothing).
+        let f = frame.axes.map(|a| a.map(crate::surd::Real::to_f64));
+        let orthonormal = (0..3).all(|i| {
+            (0..3).all(|j| {
+                let dot: f64 = (0..3).map(|k| f[i][k] * f[j][k]).sum();
+                (dot - if i == j { 1.0 } else { 0.0 }).abs() < 1e-12
+            })
+        });
+        orthonormal.then_some(AxisDirection {
             own: Direction {
                 dir: Dir::Z,
                 negative: false,
             },
-            inclined: Some(Inclined {
-                written: v,
-                frame: crate::surd::unit_frame(v),
-            }),
+            inclined: Some(Inclined { written: v, frame }),
         })
     }
 

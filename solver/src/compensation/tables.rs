@@ -257,7 +257,7 @@ impl AxisTable {
             self.source.replace(['\n', '\r'], " ")
         );
         out += &format!(
-            "# Position in {}; component errors in rtest's convention (along or about the positive coordinate directions), µm and µrad; absolute values at each position.\n",
+            "# Position in {}; component errors in rtest's convention (along or about the positive coordinate directions; an inclined axis's in its own frame x' y' z'), µm and µrad; absolute values at each position.\n",
             if rotary { "degrees" } else { "mm" }
         );
         if let Some(name) = positioning {

@@ -121,6 +121,10 @@ impl Rational {
 
     /// `self + o`, or an overflow.
     pub fn checked_add(self, o: Rational) -> Result<Rational, Overflow> {
+        if self.den == 1 && o.den == 1 {
+            let num = self.num.checked_add(o.num).ok_or(Overflow)?;
+            return Ok(Rational { num, den: 1 });
+        }
         let g = gcd(self.den, o.den);
         let l = (self.den / g).checked_mul(o.den).ok_or(Overflow)?;
         let a = self.num.checked_mul(l / self.den).ok_or(Overflow)?;
@@ -130,6 +134,10 @@ impl Rational {
 
     /// `self * o`, or an overflow.
     pub fn checked_mul(self, o: Rational) -> Result<Rational, Overflow> {
+        if self.den == 1 && o.den == 1 {
+            let num = self.num.checked_mul(o.num).ok_or(Overflow)?;
+            return Ok(Rational { num, den: 1 });
+        }
         let g1 = gcd(self.num, o.den).max(1);
         let g2 = gcd(o.num, self.den).max(1);
         let n = (self.num / g1).checked_mul(o.num / g2).ok_or(Overflow)?;

@@ -2,6 +2,7 @@
 //! outputs. Inputs are loaded into locals named after their fields, intermediates are `t0`,
 //! `t1`, … ([`super::names`]).
 
+use super::lets;
 use super::names::locals;
 use crate::ir::{Op, Output, Program};
 use proc_macro2::{Ident, Literal, Span, TokenStream};
@@ -86,59 +87,64 @@ pub(crate) enum Float {
 fn lets(p: &Program, locals: &[Ident]) -> TokenStream {
     let load = |k: usize| {
         let input = &p.inputs[k];
-        let f = ident(&input.field);
-        if input.parameter {
-            quote!(params.#f)
-        } else {
-            quote!(pose.#f)
-        }
+        let from = if input.parameter { "params" } else { "pose" };
+        format!("{from}.{}", input.field)
     };
     lets_with(p, locals, &load, Float::F64)
 }
 
-/// One `let` per instruction, inputs loaded by `load(input index)`, literals of type `float`.
+/// The text of a literal as `prettyplease` prints it (`1.5f64`, `-0.25f32`).
+fn literal_text(bits: u64, float: Float) -> String {
+    let x = f64::from_bits(bits);
+    let magnitude = match float {
+        Float::F64 => Literal::f64_suffixed(x.abs()).to_string(),
+        Float::F32 => Literal::f32_suffixed((x as f32).abs()).to_string(),
+    };
+    let negative = match float {
+        Float::F64 => x.is_sign_negative() && x != 0.0,
+        Float::F32 => (x as f32).is_sign_negative() && x as f32 != 0.0,
+    };
+    if negative {
+        format!("-{magnitude}")
+    } else {
+        magnitude
+    }
+}
+
+/// One `let` per instruction, inputs loaded by `load(input index)` (the text of the
+/// expression: `pose.sin_a`, `values[3]`), literals of type `float`. Written as text and
+/// carried in runs ([`super::lets`]); a statement too long for a run goes through `syn`.
 pub(crate) fn lets_with(
     p: &Program,
     locals: &[Ident],
-    load: &dyn Fn(usize) -> TokenStream,
+    load: &dyn Fn(usize) -> String,
     float: Float,
 ) -> TokenStream {
-    let lets = p.ops.iter().zip(locals).map(|(op, dst)| {
-        let l = |v: u32| &locals[v as usize];
+    let names: Vec<String> = locals.iter().map(ToString::to_string).collect();
+    let mut run = lets::Run::default();
+    let mut out = TokenStream::new();
+    for (op, dst) in p.ops.iter().zip(&names) {
+        let l = |v: u32| names[v as usize].as_str();
         let rhs = match *op {
             Op::Input(k) => load(k as usize),
-            Op::Const(bits) => match float {
-                Float::F64 => float_literal(f64::from_bits(bits)),
-                Float::F32 => float_literal_f32(f64::from_bits(bits)),
-            },
-            Op::Add(a, b) => {
-                let (a, b) = (l(a), l(b));
-                quote!(#a + #b)
-            }
-            Op::Sub(a, b) => {
-                let (a, b) = (l(a), l(b));
-                quote!(#a - #b)
-            }
-            Op::Mul(a, b) => {
-                let (a, b) = (l(a), l(b));
-                quote!(#a * #b)
-            }
-            Op::Neg(a) => {
-                let a = l(a);
-                quote!(-#a)
-            }
-            Op::Div(a, b) => {
-                let (a, b) = (l(a), l(b));
-                quote!(#a / #b)
-            }
+            Op::Const(bits) => literal_text(bits, float),
+            Op::Add(a, b) => format!("{} + {}", l(a), l(b)),
+            Op::Sub(a, b) => format!("{} - {}", l(a), l(b)),
+            Op::Mul(a, b) => format!("{} * {}", l(a), l(b)),
+            Op::Neg(a) => format!("-{}", l(a)),
+            Op::Div(a, b) => format!("{} / {}", l(a), l(b)),
         };
-        quote!(let #dst = #rhs;)
-    });
-    quote!(#(#lets)*)
+        run.push(&format!("let {dst} = {rhs};"), &mut out);
+    }
+    run.flush(&mut out);
+    out
 }
 
 /// The statements of a six-row program's body: one `let` per instruction, then one store of
 /// `[gx, gy, gz, gi, gj, gk]` per error.
+///
+/// The runs of `let` statements are carried as `__rtest_lets!("…")` markers: print the
+/// tokens with [`super::pretty`], which writes them out.
 pub fn body(p: &Program, error_consts: &[Ident]) -> TokenStream {
     let locals = locals(p);
     let lets = lets(p, &locals);
@@ -151,6 +157,9 @@ pub fn body(p: &Program, error_consts: &[Ident]) -> TokenStream {
 
 /// The statements of a position program's body ([`crate::compile_position`]): one `let` per
 /// instruction, then one store per direction of the gains of all `n` errors.
+///
+/// The runs of `let` statements are carried as `__rtest_lets!("…")` markers: print the
+/// tokens with [`super::pretty`], which writes them out.
 pub fn position_body(p: &Program, n: usize) -> TokenStream {
     let locals = locals(p);
     let lets = lets(p, &locals);

@@ -304,6 +304,29 @@ mod tests {
     }
 
     #[test]
+    fn identities_hidden_in_intermediates_are_found() {
+        use crate::intermediates::{DeriveOptions, Namer};
+        let m = model_spec::builtin("seed-ac").unwrap().unwrap();
+        let atoms = AtomTable::new(&m);
+        let atom = |k| Poly::atom(atoms.find(k));
+        let (sa, ca) = (atom(AtomKind::Sin(1)), atom(AtomKind::Cos(1)));
+        let (x, y) = (atom(AtomKind::Symbol(0)), atom(AtomKind::Symbol(1)));
+        let mut namer = Namer::new(&atoms, DeriveOptions { max_terms: 1 });
+        // u = Sa·x + Ca·y and v = Ca·x − Sa·y, named: u² + v² − x² − y² vanishes by
+        // sin² + cos² = 1, which the names hide.
+        let u = namer.keep(sa.mul(&x).add(&ca.mul(&y)));
+        let v = namer.keep(ca.mul(&x).sub(&sa.mul(&y)));
+        let inter = namer.finish();
+        assert_eq!(inter.len(), 2);
+        let test = ZeroTest::new(&atoms, &inter).unwrap();
+        let squares = u.mul(&u).add(&v.mul(&v));
+        let hidden = squares.sub(&x.mul(&x)).sub(&y.mul(&y));
+        assert!(!hidden.is_zero() && test.vanishes(&hidden));
+        assert!(!test.vanishes(&squares.sub(&x.mul(&x))));
+        assert!(!test.vanishes(&u.sub(&v)));
+    }
+
+    #[test]
     fn points_lie_on_the_unit_circle() {
         let f = field_for(&[]);
         let mut rng = SplitMix(1);

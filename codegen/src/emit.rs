@@ -122,7 +122,7 @@ fn header(
 
 /// Pretty-prints a token stream as a Rust file, with a header comment (one `// ` line per line
 /// of `header`). The text is `prettyplease`'s; the runs of `let` statements the emitter
-/// carries as text (`__rtest_lets!("…");` markers, see `emit/lets.rs`) are put in at their
+/// carries as text (`__rtest_lets!(r"…");` markers, see `emit/lets.rs`) are put in at their
 /// markers' places, written as `prettyplease` writes them.
 pub fn pretty(header: &str, tokens: TokenStream) -> Result<String, GenerateError> {
     let file: syn::File =

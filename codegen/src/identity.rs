@@ -19,9 +19,11 @@
 //! (a seeded generator): the result is deterministic.
 
 use crate::atoms::{AtomKind, AtomTable};
+use crate::hash::FxHashMap;
 use crate::intermediates::Intermediates;
 use crate::poly::Poly;
 use crate::rational::Rational;
+use std::cell::RefCell;
 
 /// Arithmetic modulo an odd prime `q` below 2⁶³, in Montgomery form (`a` is held as
 /// `a·2⁶⁴ mod q`), so that a product needs no division. Zero is zero in either form.
@@ -110,6 +112,9 @@ impl Field {
 
     /// A rational coefficient, `None` when its denominator is a multiple of `q`.
     fn rational(self, c: Rational) -> Option<u64> {
+        if c.is_one() {
+            return Some(self.one);
+        }
         let n = self.int(c.numer());
         if c.denom() == 1 {
             return Some(n);
@@ -204,6 +209,7 @@ fn point(
     atoms: &AtomTable,
     inter: &Intermediates,
     rng: &mut SplitMix,
+    known: &Coefficients,
 ) -> Option<Vec<u64>> {
     let mut v = vec![0u64; atoms.kinds.len()];
     for (i, k) in atoms.kinds.iter().enumerate() {
@@ -220,7 +226,7 @@ fn point(
         };
     }
     for d in inter.definitions() {
-        let x = eval(f, d, &v)?;
+        let x = eval(f, d, &v, known)?;
         v.push(x);
     }
     Some(v)
@@ -238,11 +244,22 @@ fn circle(f: Field, rng: &mut SplitMix) -> (u64, u64) {
     }
 }
 
-fn eval(f: Field, p: &Poly, values: &[u64]) -> Option<u64> {
+/// The field elements of the rational coefficients met so far (an inverse costs some hundred
+/// multiplications, and few denominators recur).
+type Coefficients = RefCell<FxHashMap<Rational, Option<u64>>>;
+
+fn coefficient(f: Field, c: Rational, known: &Coefficients) -> Option<u64> {
+    if c.denom() == 1 && i64::try_from(c.numer()).is_ok() {
+        return f.rational(c);
+    }
+    *known.borrow_mut().entry(c).or_insert_with(|| f.rational(c))
+}
+
+fn eval(f: Field, p: &Poly, values: &[u64], known: &Coefficients) -> Option<u64> {
     let mut sum = 0;
     for (m, c) in p.terms() {
-        let mut t = f.rational(c)?;
-        for &(a, e) in &m.0 {
+        let mut t = coefficient(f, c, known)?;
+        for &(a, e) in m.factors() {
             let v = values[usize::from(a)];
             t = f.mul(t, if e == 1 { v } else { f.pow(v, u64::from(e)) });
         }
@@ -252,31 +269,55 @@ fn eval(f: Field, p: &Poly, values: &[u64]) -> Option<u64> {
 }
 
 /// The identity test of the polynomials over the atoms and intermediates of one model.
-pub struct ZeroTest {
+#[derive(Debug)]
+pub struct ZeroTest<'a> {
     field: Field,
-    points: Vec<Vec<u64>>,
+    atoms: &'a AtomTable,
+    inter: &'a Intermediates,
+    /// The values at the first point.
+    first: Vec<u64>,
+    /// The generator's state after the first point.
+    rng: u64,
+    /// The values at the second point, computed when a polynomial first vanishes at the first
+    /// (a non-zero value already proves a polynomial non-zero).
+    second: std::cell::OnceCell<Option<Vec<u64>>>,
+    known: Coefficients,
 }
 
-impl ZeroTest {
-    /// The two points for the atoms `atoms` and the intermediates `inter`; `None` when a
-    /// definition cannot be evaluated modulo the prime (a coefficient's denominator is a
-    /// multiple of it: never for the numbers of a machine description).
-    pub fn new(atoms: &AtomTable, inter: &Intermediates) -> Option<ZeroTest> {
+impl<'a> ZeroTest<'a> {
+    /// The test for the atoms `atoms` and the intermediates `inter`; `None` when a definition
+    /// cannot be evaluated modulo the prime (a coefficient's denominator is a multiple of it:
+    /// never for the numbers of a machine description).
+    pub fn new(atoms: &'a AtomTable, inter: &'a Intermediates) -> Option<ZeroTest<'a>> {
         let roots: Vec<u64> = atoms.root_rules().iter().map(|&(_, p)| p).collect();
         let field = field_for(&roots);
         let mut rng = SplitMix(0x5eed_0f2e_207e_5700);
-        let points = (0..2)
-            .map(|_| point(field, atoms, inter, &mut rng))
-            .collect::<Option<Vec<_>>>()?;
-        Some(ZeroTest { field, points })
+        let known = Coefficients::default();
+        let first = point(field, atoms, inter, &mut rng, &known)?;
+        Some(ZeroTest {
+            known,
+            field,
+            atoms,
+            inter,
+            first,
+            rng: rng.0,
+            second: std::cell::OnceCell::new(),
+        })
     }
 
     /// `true` when `p` (over the atoms and intermediates) is identically zero, to the
     /// probability the module documents; `false` when it is not, or cannot be evaluated.
     pub fn vanishes(&self, p: &Poly) -> bool {
-        self.points
-            .iter()
-            .all(|v| eval(self.field, p, v) == Some(0))
+        if eval(self.field, p, &self.first, &self.known) != Some(0) {
+            return false;
+        }
+        let second = self.second.get_or_init(|| {
+            let mut rng = SplitMix(self.rng);
+            point(self.field, self.atoms, self.inter, &mut rng, &self.known)
+        });
+        second
+            .as_ref()
+            .is_some_and(|v| eval(self.field, p, v, &self.known) == Some(0))
     }
 }
 

@@ -121,7 +121,7 @@ impl Intermediates {
     /// `true` when `p` mentions an intermediate.
     pub fn mentioned_in(&self, p: &Poly) -> bool {
         p.terms()
-            .any(|(m, _)| m.0.iter().any(|&(a, _)| a >= self.first))
+            .any(|(m, _)| m.factors().iter().any(|&(a, _)| a >= self.first))
     }
 
     /// Appends the value of every intermediate to `values`, which holds the value of every
@@ -181,7 +181,7 @@ impl Expander<'_> {
         for (m, c) in p.terms() {
             let mut plain = Vec::new();
             let mut term = Poly::constant(Rational::ONE);
-            for &(a, e) in &m.0 {
+            for &(a, e) in m.factors() {
                 if a < first {
                     plain.push((a, e));
                 } else {
@@ -191,7 +191,7 @@ impl Expander<'_> {
                     }
                 }
             }
-            let factor = Poly::term(Monomial(plain), c);
+            let factor = Poly::term(Monomial::new(&plain), c);
             out = out.add(&self.of.rules.canonical(term.mul(&factor)));
         }
         out
@@ -239,23 +239,29 @@ impl Namer {
         if p.len() <= self.max_terms {
             return p;
         }
-        self.name(p)
+        self.name(&p)
     }
 
     /// `c · u` with `u` the intermediate of `p / c`, `c` the leading coefficient of `p`
     /// (`p` itself when it is a constant or a single term).
-    fn name(&mut self, p: Poly) -> Poly {
+    fn name(&mut self, p: &Poly) -> Poly {
         if p.len() <= 1 {
-            return p;
+            return p.clone();
         }
         let lead = p.leading_coefficient();
-        let unit = p.scale(Rational::new(lead.denom(), lead.numer()));
-        let atom = match self.named.get(&unit) {
+        let scaled;
+        let unit = if lead.is_one() {
+            p
+        } else {
+            scaled = p.scale(Rational::new(lead.denom(), lead.numer()));
+            &scaled
+        };
+        let atom = match self.named.get(unit) {
             Some(&a) => a,
             None => {
                 let a = atom_index(usize::from(self.first) + self.definitions.len());
                 self.definitions.push(unit.clone());
-                self.named.insert(unit, a);
+                self.named.insert(unit.clone(), a);
                 a
             }
         };
@@ -268,19 +274,25 @@ impl Namer {
         if a.is_zero() || b.is_zero() {
             return Poly::zero();
         }
-        let (mut a, mut b) = (a.clone(), b.clone());
-        if a.len().saturating_mul(b.len()) > self.max_terms {
-            if a.len() >= b.len() {
-                a = self.name(a);
-            } else {
-                b = self.name(b);
-            }
+        let max = self.max_terms;
+        let too_large = |a: &Poly, b: &Poly| a.len().saturating_mul(b.len()) > max;
+        if !too_large(a, b) {
+            return self.canonical(a.mul(b));
         }
-        if a.len().saturating_mul(b.len()) > self.max_terms {
-            a = self.name(a);
-            b = self.name(b);
+        let (named_a, named_b);
+        let (mut a, mut b) = (a, b);
+        if a.len() >= b.len() {
+            named_a = self.name(a);
+            a = &named_a;
+        } else {
+            named_b = self.name(b);
+            b = &named_b;
         }
-        self.canonical(a.mul(&b))
+        if too_large(a, b) {
+            let (x, y) = (self.name(a), self.name(b));
+            return self.canonical(x.mul(&y));
+        }
+        self.canonical(a.mul(b))
     }
 
     /// The intermediates named so far.

@@ -134,7 +134,7 @@ impl Builder {
     fn monomial(&mut self, m: &Monomial) -> Signed {
         // Powers by repeated multiplication, then the product left to right in atom order.
         let mut acc: Option<Signed> = None;
-        for &(a, e) in &m.0 {
+        for &(a, e) in m.factors() {
             let base = self.atom(a);
             let mut p = base;
             for _ in 1..e {
@@ -214,7 +214,7 @@ pub(crate) fn atom_vars(b: &mut Builder, atoms: &AtomTable) -> Vec<Var> {
 fn best_atom(p: &Poly) -> Atom {
     let mut counts: Vec<(Atom, usize)> = Vec::new();
     for (m, _) in p.terms() {
-        for &(a, _) in &m.0 {
+        for &(a, _) in m.factors() {
             match counts.iter_mut().find(|(x, _)| *x == a) {
                 Some((_, n)) => *n += 1,
                 None => counts.push((a, 1)),

@@ -10,72 +10,156 @@ use crate::rational::Rational;
 /// Index of an atom in the model's [`crate::atoms::AtomTable`].
 pub type Atom = u16;
 
+/// The most factors a monomial holds without a heap allocation: every monomial of a shared
+/// gain, and most of an expanded one.
+const INLINE: usize = 7;
+
+/// The factors of a monomial: up to [`INLINE`] in place, more on the heap.
+#[derive(Clone)]
+enum Factors {
+    Inline(u8, [(Atom, u8); INLINE]),
+    Heap(Vec<(Atom, u8)>),
+}
+
+impl Factors {
+    fn as_slice(&self) -> &[(Atom, u8)] {
+        match self {
+            Factors::Inline(n, items) => &items[..usize::from(*n)],
+            Factors::Heap(v) => v,
+        }
+    }
+
+    /// The factors yielded by `it`, at most `bound` of them.
+    fn collect(bound: usize, it: impl Iterator<Item = (Atom, u8)>) -> Factors {
+        if bound <= INLINE {
+            let mut items = [(0, 0); INLINE];
+            let mut n = 0;
+            for f in it {
+                items[n] = f;
+                n += 1;
+            }
+            Factors::Inline(n as u8, items)
+        } else {
+            let v: Vec<(Atom, u8)> = it.collect();
+            if v.len() <= INLINE {
+                Factors::collect(v.len(), v.into_iter())
+            } else {
+                Factors::Heap(v)
+            }
+        }
+    }
+}
+
 /// A product of atom powers, atoms ascending, exponents ≥ 1.
-#[derive(Clone, Debug, PartialEq, Eq, Hash, Default)]
-pub struct Monomial(pub Vec<(Atom, u8)>);
+#[derive(Clone)]
+pub struct Monomial(Factors);
 
 impl Monomial {
+    /// The monomial of `factors`: `(atom, exponent)`, atoms ascending, exponents ≥ 1.
+    pub fn new(factors: &[(Atom, u8)]) -> Monomial {
+        debug_assert!(
+            factors.windows(2).all(|w| w[0].0 < w[1].0) && factors.iter().all(|f| f.1 >= 1)
+        );
+        Monomial(Factors::collect(factors.len(), factors.iter().copied()))
+    }
+
     /// The monomial 1.
     pub fn one() -> Monomial {
-        Monomial(Vec::new())
+        Monomial(Factors::Inline(0, [(0, 0); INLINE]))
     }
 
     /// A single atom.
     pub fn atom(a: Atom) -> Monomial {
-        Monomial(vec![(a, 1)])
+        Monomial::new(&[(a, 1)])
+    }
+
+    /// The factors `(atom, exponent)`, atoms ascending.
+    pub fn factors(&self) -> &[(Atom, u8)] {
+        self.0.as_slice()
+    }
+
+    /// `true` for the monomial 1.
+    pub fn is_one(&self) -> bool {
+        self.factors().is_empty()
     }
 
     /// Total degree.
     pub fn degree(&self) -> u32 {
-        self.0.iter().map(|&(_, e)| e as u32).sum()
+        self.factors().iter().map(|&(_, e)| e as u32).sum()
     }
 
     /// The exponent of `a`.
     pub fn exponent(&self, a: Atom) -> u8 {
-        self.0.iter().find(|&&(x, _)| x == a).map_or(0, |&(_, e)| e)
+        self.factors()
+            .iter()
+            .find(|&&(x, _)| x == a)
+            .map_or(0, |&(_, e)| e)
     }
 
     /// The product of two monomials.
     pub fn mul(&self, o: &Monomial) -> Monomial {
-        let mut out = Vec::with_capacity(self.0.len() + o.0.len());
+        let (x, y) = (self.factors(), o.factors());
         let (mut i, mut j) = (0, 0);
-        while i < self.0.len() || j < o.0.len() {
-            match (self.0.get(i), o.0.get(j)) {
-                (Some(&(a, ea)), Some(&(b, eb))) if a == b => {
-                    out.push((a, ea + eb));
-                    i += 1;
-                    j += 1;
-                }
-                (Some(&(a, ea)), Some(&(b, _))) if a < b => {
-                    out.push((a, ea));
-                    i += 1;
-                }
-                (Some(_), Some(&(b, eb))) | (None, Some(&(b, eb))) => {
-                    out.push((b, eb));
-                    j += 1;
-                }
-                (Some(&(a, ea)), None) => {
-                    out.push((a, ea));
-                    i += 1;
-                }
-                (None, None) => unreachable!(),
+        let merged = std::iter::from_fn(|| match (x.get(i), y.get(j)) {
+            (Some(&(a, ea)), Some(&(b, eb))) if a == b => {
+                i += 1;
+                j += 1;
+                Some((a, ea + eb))
             }
-        }
-        Monomial(out)
+            (Some(&(a, ea)), Some(&(b, _))) if a < b => {
+                i += 1;
+                Some((a, ea))
+            }
+            (_, Some(&f)) => {
+                j += 1;
+                Some(f)
+            }
+            (Some(&f), None) => {
+                i += 1;
+                Some(f)
+            }
+            (None, None) => None,
+        });
+        Monomial(Factors::collect(x.len() + y.len(), merged))
     }
 
     /// This monomial with the exponent of `a` lowered by `k` (which must be present).
     pub fn divide(&self, a: Atom, k: u8) -> Monomial {
-        Monomial(
-            self.0
-                .iter()
-                .filter_map(|&(x, e)| match x == a {
-                    true if e > k => Some((x, e - k)),
-                    true => None,
-                    false => Some((x, e)),
-                })
-                .collect(),
-        )
+        let f = self.factors();
+        Monomial(Factors::collect(
+            f.len(),
+            f.iter().filter_map(|&(x, e)| match x == a {
+                true if e > k => Some((x, e - k)),
+                true => None,
+                false => Some((x, e)),
+            }),
+        ))
+    }
+}
+
+impl Default for Monomial {
+    fn default() -> Monomial {
+        Monomial::one()
+    }
+}
+
+impl PartialEq for Monomial {
+    fn eq(&self, o: &Monomial) -> bool {
+        self.factors() == o.factors()
+    }
+}
+
+impl Eq for Monomial {}
+
+impl std::hash::Hash for Monomial {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        self.factors().hash(h);
+    }
+}
+
+impl std::fmt::Debug for Monomial {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_tuple("Monomial").field(&self.factors()).finish()
     }
 }
 
@@ -90,7 +174,7 @@ impl Ord for Monomial {
     fn cmp(&self, o: &Self) -> std::cmp::Ordering {
         self.degree()
             .cmp(&o.degree())
-            .then_with(|| self.0.cmp(&o.0))
+            .then_with(|| self.factors().cmp(o.factors()))
     }
 }
 
@@ -181,7 +265,7 @@ impl Poly {
     pub fn as_constant(&self) -> Option<Rational> {
         match self.terms.as_slice() {
             [] => Some(Rational::ZERO),
-            [(m, c)] if m.0.is_empty() => Some(*c),
+            [(m, c)] if m.is_one() => Some(*c),
             _ => None,
         }
     }
@@ -251,6 +335,9 @@ impl Poly {
         if c.is_one() {
             return self.clone();
         }
+        if (-c).is_one() {
+            return self.neg();
+        }
         Poly {
             terms: self
                 .terms
@@ -295,7 +382,7 @@ impl Poly {
                     let power = if i == 0 {
                         rest.clone()
                     } else {
-                        rest.mul(&Monomial(vec![(s, 2 * i)]))
+                        rest.mul(&Monomial::new(&[(s, 2 * i)]))
                     };
                     next.push((power, product(k, Rational::int(sign * binomial))));
                     binomial = binomial * i64::from(j - i) / i64::from(i + 1);
@@ -338,7 +425,7 @@ impl Poly {
         let needed = self
             .terms
             .iter()
-            .any(|(m, _)| m.0.iter().any(|&(a, e)| e >= 2 && reducible(a)));
+            .any(|(m, _)| m.factors().iter().any(|&(a, e)| e >= 2 && reducible(a)));
         if needed {
             self.reduce(trig_pairs).reduce_roots(roots)
         } else {
@@ -351,7 +438,7 @@ impl Poly {
         self.terms
             .iter()
             .map(|(m, c)| {
-                m.0.iter().fold(c.to_f64(), |acc, &(a, e)| {
+                m.factors().iter().fold(c.to_f64(), |acc, &(a, e)| {
                     acc * atoms[a as usize].powi(e as i32)
                 })
             })
@@ -363,7 +450,7 @@ impl Poly {
         let mut v: Vec<Atom> = self
             .terms
             .iter()
-            .flat_map(|(m, _)| m.0.iter().map(|&(a, _)| a))
+            .flat_map(|(m, _)| m.factors().iter().map(|&(a, _)| a))
             .collect();
         v.sort_unstable();
         v.dedup();

@@ -35,14 +35,14 @@ pub fn format_poly(p: &Poly, names: &[String], latex: bool) -> String {
             (_, false) => out.push_str(" + "),
         }
         let mut factors: Vec<String> = Vec::new();
-        if !c.is_one() || m.0.is_empty() {
+        if !c.is_one() || m.is_one() {
             factors.push(if latex {
                 latex_rational(c)
             } else {
                 c.to_string()
             });
         }
-        for &(a, e) in &m.0 {
+        for &(a, e) in m.factors() {
             let n = match names.get(usize::from(a)) {
                 Some(n) => n.clone(),
                 None if latex => format!("u_{{{}}}", usize::from(a) - names.len()),

@@ -3,7 +3,7 @@
 //! evaluation) and the first-order correction in `f32` (for single-precision controllers).
 
 use super::body::{Float, cell_with, float_literal, ident, lets_with};
-use super::names::locals;
+use super::names::local_names;
 use crate::compensation::{CompensationPrograms, DAMPING, RESIDUALS, STEPS};
 use crate::ir::Program;
 use proc_macro2::{Literal, TokenStream};
@@ -58,7 +58,7 @@ fn params_name(p: &Program, layout: &Layout) -> proc_macro2::Ident {
 /// The body of a program: its `let`s, then `out[k] = …` per output (or an array expression
 /// when `array` is set).
 fn body(p: &Program, load: &dyn Fn(usize) -> String, float: Float) -> TokenStream {
-    let locals = locals(p);
+    let locals = local_names(p);
     let lets = lets_with(p, &locals, load, float);
     let stores = p.outputs.iter().enumerate().map(|(k, o)| {
         let k = Literal::usize_unsuffixed(k);

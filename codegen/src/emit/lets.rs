@@ -6,7 +6,7 @@
 //! writes each of these statements as text, exactly as `prettyplease` prints it (a local bound
 //! to an input, a literal, a negated local or a binary operation of two locals), and carries a
 //! run of consecutive statements in the token stream as one marker statement,
-//! `__rtest_lets!("…");`, whose string holds the run. [`crate::emit::pretty`] prints the file
+//! `__rtest_lets!(r"…");`, whose string holds the run. [`crate::emit::pretty`] prints the file
 //! and then replaces each marker line by its statements at the marker's indentation.
 //!
 //! A statement goes into a run only when it is short (at most [`MAX_LINE`] characters) and of
@@ -44,7 +44,6 @@ impl Run {
                 .all(|b| b.is_ascii_alphanumeric() || b" _.[]=;+-*/".contains(&b));
         if plain {
             self.text.push_str(line);
-            self.text.push('\n');
         } else {
             self.flush(out);
             out.extend(
@@ -54,18 +53,22 @@ impl Run {
         }
     }
 
-    /// Ends the run: its marker statement `__rtest_lets!("…");` into `out`.
+    /// Ends the run: its marker statement `__rtest_lets!(r"…");` into `out`.
     pub(crate) fn flush(&mut self, out: &mut TokenStream) {
         if self.text.is_empty() {
             return;
         }
-        let text = std::mem::take(&mut self.text);
+        // A raw string: the statements need no escape (plain ASCII, no quote), and building
+        // it is a copy (a cooked literal escapes character by character).
+        let literal: Literal = format!("r\"{}\"", std::mem::take(&mut self.text))
+            .parse()
+            .expect("a raw string literal of plain ASCII");
         out.extend([
             TokenTree::Ident(Ident::new(MARKER, Span::call_site())),
             TokenTree::Punct(Punct::new('!', Spacing::Alone)),
             TokenTree::Group(Group::new(
                 Delimiter::Parenthesis,
-                TokenTree::Literal(Literal::string(&text)).into(),
+                TokenTree::Literal(literal).into(),
             )),
             TokenTree::Punct(Punct::new(';', Spacing::Alone)),
         ]);
@@ -95,13 +98,13 @@ pub(crate) fn splice(printed: &str) -> String {
                 None => break,
             }
         }
-        // The run is plain ASCII without quotes or backslashes: its only escapes are the line
-        // breaks.
+        // The run, between the quotes of its raw string: statements one after the other, each
+        // ending with its only `;`.
         let run = statement
             .find('"')
             .zip(statement.rfind('"'))
             .map_or("", |(a, b)| &statement[a + 1..b.max(a + 1)]);
-        for s in run.split("\\n").filter(|s| !s.is_empty()) {
+        for s in run.split_inclusive(';') {
             out.push_str(indent);
             out.push_str(s);
             out.push('\n');

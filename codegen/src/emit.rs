@@ -20,6 +20,7 @@ mod body;
 mod compensation;
 mod docs;
 mod items;
+mod lets;
 pub mod names;
 
 pub use body::{body, float_literal, position_body};
@@ -120,7 +121,9 @@ fn header(
 }
 
 /// Pretty-prints a token stream as a Rust file, with a header comment (one `// ` line per line
-/// of `header`).
+/// of `header`). The text is `prettyplease`'s; the runs of `let` statements the emitter
+/// carries as text (`__rtest_lets!(r"…");` markers, see `emit/lets.rs`) are put in at their
+/// markers' places, written as `prettyplease` writes them.
 pub fn pretty(header: &str, tokens: TokenStream) -> Result<String, GenerateError> {
     let file: syn::File =
         syn::parse2(tokens).map_err(|e| GenerateError::Unparsable(e.to_string()))?;
@@ -134,7 +137,7 @@ pub fn pretty(header: &str, tokens: TokenStream) -> Result<String, GenerateError
         out.push('\n');
     }
     out.push('\n');
-    out.push_str(&prettyplease::unparse(&file));
+    out.push_str(&lets::splice(&prettyplease::unparse(&file)));
     Ok(out)
 }
 

@@ -10,14 +10,19 @@
 pub mod atoms;
 pub mod compensation;
 pub mod derive;
+mod hash;
+pub mod identity;
+pub mod intermediates;
 pub mod poly;
 pub mod rational;
 
 pub use derive::GainModel;
+pub use intermediates::DeriveOptions;
 pub mod build;
 pub mod emit;
 pub mod ir;
 pub mod lower;
+mod parts;
 pub mod table;
 
 pub use ir::Program;

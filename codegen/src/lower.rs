@@ -11,11 +11,13 @@
 
 use crate::atoms::{AtomKind, AtomTable};
 use crate::derive::GainModel;
+use crate::hash::FxHashMap;
+use crate::intermediates::Intermediates;
 use crate::ir::{Input, Op, Output, Program, Var};
+pub use crate::parts::{MAX_INSTRUCTIONS, Part, compile_parts};
 use crate::poly::{Atom, Monomial, Poly};
 use crate::rational::Rational;
 use model_spec::Machine;
-use std::collections::HashMap;
 
 /// A value up to sign: `(var, negated)`.
 pub(crate) type Signed = (Var, bool);
@@ -23,22 +25,67 @@ pub(crate) type Signed = (Var, bool);
 /// Builds one program: hash-consed instructions, polynomials memoised up to a constant factor.
 pub(crate) struct Builder {
     ops: Vec<Op>,
-    interned: HashMap<Op, Var>,
-    memo: HashMap<Poly, Signed>,
+    interned: FxHashMap<Op, Var>,
+    memo: FxHashMap<Poly, Signed>,
     /// The value each atom of the polynomials stands for.
     pub(crate) atom_vars: Vec<Var>,
+    /// The intermediates the polynomials may mention (atoms from `intermediates.first()`).
+    intermediates: Intermediates,
+    /// The value of each intermediate, once lowered.
+    intermediate_vars: Vec<Option<Signed>>,
 }
 
 impl Builder {
     /// An empty program whose polynomials will read their atoms from `atom_vars` (set it once
-    /// the inputs are pushed).
+    /// the inputs are pushed) and mention no intermediates.
     pub(crate) fn new() -> Builder {
+        Builder::with(Intermediates::default())
+    }
+
+    /// An empty program whose polynomials may mention `intermediates`: each is lowered from
+    /// its definition the first time a polynomial needs it.
+    fn with(intermediates: Intermediates) -> Builder {
         Builder {
             ops: Vec::new(),
-            interned: HashMap::new(),
-            memo: HashMap::new(),
+            interned: FxHashMap::default(),
+            memo: FxHashMap::default(),
             atom_vars: Vec::new(),
+            intermediate_vars: vec![None; intermediates.len()],
+            intermediates,
         }
+    }
+
+    /// The value of atom `a`: an input, a constant, or an intermediate (lowered now, with the
+    /// intermediates its definition needs, if it was not yet).
+    fn atom(&mut self, a: Atom) -> Signed {
+        let first = self.intermediates.first();
+        if self.intermediates.is_empty() || a < first {
+            return (self.atom_vars[usize::from(a)], false);
+        }
+        let k = usize::from(a - first);
+        if let Some(v) = self.intermediate_vars[k] {
+            return v;
+        }
+        // Every definition needed, found without recursion, then lowered in index order (a
+        // definition mentions only earlier intermediates).
+        let mut needed = std::collections::BTreeSet::from([k]);
+        let mut stack = vec![k];
+        while let Some(j) = stack.pop() {
+            for b in self.intermediates.definitions()[j].atoms() {
+                if b >= first {
+                    let i = usize::from(b - first);
+                    if self.intermediate_vars[i].is_none() && needed.insert(i) {
+                        stack.push(i);
+                    }
+                }
+            }
+        }
+        for j in needed {
+            let definition = self.intermediates.definitions()[j].clone();
+            let v = self.poly(&definition);
+            self.intermediate_vars[j] = Some(v);
+        }
+        self.intermediate_vars[k].expect("just lowered")
     }
 
     /// Appends (or finds) an instruction.
@@ -84,47 +131,53 @@ impl Builder {
         (self.push(Op::Mul(k, v.0)), v.1 ^ c.is_negative())
     }
 
-    fn monomial(&mut self, m: &Monomial) -> Var {
+    fn monomial(&mut self, m: &Monomial) -> Signed {
         // Powers by repeated multiplication, then the product left to right in atom order.
-        let mut acc: Option<Var> = None;
-        for &(a, e) in &m.0 {
-            let base = self.atom_vars[a as usize];
+        let mut acc: Option<Signed> = None;
+        for &(a, e) in m.factors() {
+            let base = self.atom(a);
             let mut p = base;
             for _ in 1..e {
-                p = self.push(Op::Mul(p, base));
+                p = self.mul(p, base);
             }
             acc = Some(match acc {
                 None => p,
-                Some(x) => self.push(Op::Mul(x, p)),
+                Some(x) => self.mul(x, p),
             });
         }
-        acc.unwrap_or_else(|| self.constant(1.0))
+        acc.unwrap_or_else(|| (self.constant(1.0), false))
     }
 
     /// The value of a non-zero polynomial.
     pub(crate) fn poly(&mut self, p: &Poly) -> Signed {
         let lead = p.leading_coefficient();
+        if lead.is_one() {
+            return self.unit(p);
+        }
         let unit = p.scale(Rational::new(lead.denom(), lead.numer()));
-        let v = match self.memo.get(&unit) {
-            Some(&v) => v,
-            None => {
-                let v = self.unit_poly(&unit);
-                self.memo.insert(unit, v);
-                v
-            }
-        };
+        let v = self.unit(&unit);
         self.scale(lead, v)
+    }
+
+    /// The value of a polynomial whose leading coefficient is 1, memoised.
+    fn unit(&mut self, p: &Poly) -> Signed {
+        if let Some(&v) = self.memo.get(p) {
+            return v;
+        }
+        let v = self.unit_poly(p);
+        self.memo.insert(p.clone(), v);
+        v
     }
 
     /// The value of a polynomial whose leading coefficient is 1.
     fn unit_poly(&mut self, p: &Poly) -> Signed {
         if p.len() == 1 {
             let (m, _) = p.terms().next().expect("one term");
-            return (self.monomial(m), false);
+            return self.monomial(m);
         }
         let atom = best_atom(p);
         let (q, r) = p.split_by(atom);
-        let a = (self.atom_vars[atom as usize], false);
+        let a = self.atom(atom);
         let aq = match q.as_constant() {
             Some(c) => self.scale(c, a),
             None => {
@@ -159,15 +212,20 @@ pub(crate) fn atom_vars(b: &mut Builder, atoms: &AtomTable) -> Vec<Var> {
 
 /// The atom that occurs in the most terms (the first such atom on a tie).
 fn best_atom(p: &Poly) -> Atom {
-    let mut counts: HashMap<Atom, usize> = HashMap::new();
+    let mut counts: Vec<(Atom, usize)> = Vec::new();
     for (m, _) in p.terms() {
-        for &(a, _) in &m.0 {
-            *counts.entry(a).or_default() += 1;
+        for &(a, _) in m.factors() {
+            match counts.iter_mut().find(|(x, _)| *x == a) {
+                Some((_, n)) => *n += 1,
+                None => counts.push((a, 1)),
+            }
         }
     }
-    let mut best: Vec<(Atom, usize)> = counts.into_iter().collect();
-    best.sort_by(|x, y| y.1.cmp(&x.1).then(x.0.cmp(&y.0)));
-    best[0].0
+    counts
+        .into_iter()
+        .min_by(|x, y| y.1.cmp(&x.1).then(x.0.cmp(&y.0)))
+        .expect("a polynomial of several terms has atoms")
+        .0
 }
 
 /// The input descriptions of a machine's programs, in atom order: sines and cosines of the
@@ -211,7 +269,7 @@ pub(crate) fn inputs_of(m: &Machine, atoms: &AtomTable) -> Vec<Input> {
 /// Compiles the gains of `model` (derived from `m`) into a straight-line program with six
 /// outputs per error (`gx gy gz gi gj gk`, error after error).
 pub fn compile(m: &Machine, model: &GainModel) -> Program {
-    let polys: Vec<&Poly> = model.gains.iter().flat_map(|g| g.iter()).collect();
+    let polys: Vec<&Poly> = model.gains.shared().iter().flat_map(|g| g.iter()).collect();
     compile_polys(m, model, &polys)
 }
 
@@ -220,97 +278,15 @@ pub fn compile(m: &Machine, model: &GainModel) -> Program {
 /// are not computed.
 pub fn compile_position(m: &Machine, model: &GainModel) -> Program {
     let polys: Vec<&Poly> = (0..3)
-        .flat_map(|d| model.gains.iter().map(move |g| &g[d]))
+        .flat_map(|d| model.gains.shared().iter().map(move |g| &g[d]))
         .collect();
     compile_polys(m, model, &polys)
-}
-
-/// A part of a model compiled on its own: some of its errors, with their gains and position
-/// gains programs.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Part {
-    /// Positions of its errors in the model's error list, ascending.
-    pub rows: Vec<usize>,
-    /// Six outputs per error of the part ([`compile`] of the part).
-    pub gains: Program,
-    /// Position gains, direction-major over the part's errors ([`compile_position`]).
-    pub position: Program,
-}
-
-/// The default bound on the instructions of one generated function.
-pub const MAX_INSTRUCTIONS: usize = 4000;
-
-/// Compiles a model into parts of at most `max_instructions` instructions each (one part when
-/// the whole model fits): the errors are grouped by the axis they belong to (squareness,
-/// set-up and sensor-offset errors by their kind), groups are added to a part while it stays
-/// within the bound, and a group that alone exceeds it is split error by error. Each part has
-/// its own common-subexpression elimination, so sharing across parts is lost: the bound trades
-/// a little arithmetic for a bounded function size and compile time.
-pub fn compile_parts(m: &Machine, model: &GainModel, max_instructions: usize) -> Vec<Part> {
-    let build = |rows: Vec<usize>| {
-        let sub = model.select(&rows);
-        Part {
-            gains: compile(m, &sub),
-            position: compile_position(m, &sub),
-            rows,
-        }
-    };
-    let whole = build((0..model.errors.len()).collect());
-    let size = |p: &Part| p.gains.ops.len().max(p.position.ops.len());
-    if size(&whole) <= max_instructions {
-        return vec![whole];
-    }
-    // Groups of consecutive errors with the same key (catalogue order keeps an axis together).
-    let key = |i: usize| {
-        let e = &m.catalogue[model.errors[i]];
-        (e.axis(), std::mem::discriminant(&e.kind))
-    };
-    let mut groups: Vec<Vec<usize>> = Vec::new();
-    for i in 0..model.errors.len() {
-        match groups.last_mut() {
-            Some(g) if key(g[0]) == key(i) => g.push(i),
-            _ => groups.push(vec![i]),
-        }
-    }
-    let mut parts: Vec<Part> = Vec::new();
-    let mut current: Vec<usize> = Vec::new();
-    for g in groups {
-        let mut trial = current.clone();
-        trial.extend(&g);
-        let candidate = build(trial.clone());
-        if size(&candidate) <= max_instructions || current.is_empty() && g.len() == 1 {
-            current = trial;
-            continue;
-        }
-        if !current.is_empty() {
-            parts.push(build(std::mem::take(&mut current)));
-        }
-        // The group alone, error by error if it does not fit either.
-        for &i in &g {
-            let mut t = current.clone();
-            t.push(i);
-            if current.is_empty() || size(&build(t.clone())) <= max_instructions {
-                current = t;
-            } else {
-                parts.push(build(std::mem::replace(&mut current, vec![i])));
-            }
-        }
-    }
-    if !current.is_empty() {
-        parts.push(build(current));
-    }
-    parts
 }
 
 /// One program with one output per polynomial, in order, sharing common subexpressions.
 fn compile_polys(m: &Machine, model: &GainModel, polys: &[&Poly]) -> Program {
     let inputs = inputs(m, model);
-    let mut b = Builder {
-        ops: Vec::new(),
-        interned: HashMap::new(),
-        memo: HashMap::new(),
-        atom_vars: Vec::new(),
-    };
+    let mut b = Builder::with(model.gains.intermediates().clone());
     b.atom_vars = atom_vars(&mut b, &model.atoms);
     let outputs = polys
         .iter()

@@ -6,78 +6,160 @@
 //!   `1 − sin²`, so two polynomials are equal as functions iff they are equal as data.
 
 use crate::rational::Rational;
-use std::collections::BTreeMap;
-use std::collections::btree_map::Entry;
 
 /// Index of an atom in the model's [`crate::atoms::AtomTable`].
 pub type Atom = u16;
 
+/// The most factors a monomial holds without a heap allocation: every monomial of a shared
+/// gain, and most of an expanded one.
+const INLINE: usize = 7;
+
+/// The factors of a monomial: up to [`INLINE`] in place, more on the heap.
+#[derive(Clone)]
+enum Factors {
+    Inline(u8, [(Atom, u8); INLINE]),
+    Heap(Vec<(Atom, u8)>),
+}
+
+impl Factors {
+    fn as_slice(&self) -> &[(Atom, u8)] {
+        match self {
+            Factors::Inline(n, items) => &items[..usize::from(*n)],
+            Factors::Heap(v) => v,
+        }
+    }
+
+    /// The factors yielded by `it`, at most `bound` of them.
+    fn collect(bound: usize, it: impl Iterator<Item = (Atom, u8)>) -> Factors {
+        if bound <= INLINE {
+            let mut items = [(0, 0); INLINE];
+            let mut n = 0;
+            for f in it {
+                items[n] = f;
+                n += 1;
+            }
+            Factors::Inline(n as u8, items)
+        } else {
+            let v: Vec<(Atom, u8)> = it.collect();
+            if v.len() <= INLINE {
+                Factors::collect(v.len(), v.into_iter())
+            } else {
+                Factors::Heap(v)
+            }
+        }
+    }
+}
+
 /// A product of atom powers, atoms ascending, exponents ≥ 1.
-#[derive(Clone, Debug, PartialEq, Eq, Hash, Default)]
-pub struct Monomial(pub Vec<(Atom, u8)>);
+#[derive(Clone)]
+pub struct Monomial(Factors);
 
 impl Monomial {
+    /// The monomial of `factors`: `(atom, exponent)`, atoms ascending, exponents ≥ 1.
+    pub fn new(factors: &[(Atom, u8)]) -> Monomial {
+        debug_assert!(
+            factors.windows(2).all(|w| w[0].0 < w[1].0) && factors.iter().all(|f| f.1 >= 1)
+        );
+        Monomial(Factors::collect(factors.len(), factors.iter().copied()))
+    }
+
     /// The monomial 1.
     pub fn one() -> Monomial {
-        Monomial(Vec::new())
+        Monomial(Factors::Inline(0, [(0, 0); INLINE]))
     }
 
     /// A single atom.
     pub fn atom(a: Atom) -> Monomial {
-        Monomial(vec![(a, 1)])
+        Monomial::new(&[(a, 1)])
+    }
+
+    /// The factors `(atom, exponent)`, atoms ascending.
+    pub fn factors(&self) -> &[(Atom, u8)] {
+        self.0.as_slice()
+    }
+
+    /// `true` for the monomial 1.
+    pub fn is_one(&self) -> bool {
+        self.factors().is_empty()
     }
 
     /// Total degree.
     pub fn degree(&self) -> u32 {
-        self.0.iter().map(|&(_, e)| e as u32).sum()
+        self.factors().iter().map(|&(_, e)| e as u32).sum()
     }
 
     /// The exponent of `a`.
     pub fn exponent(&self, a: Atom) -> u8 {
-        self.0.iter().find(|&&(x, _)| x == a).map_or(0, |&(_, e)| e)
+        self.factors()
+            .iter()
+            .find(|&&(x, _)| x == a)
+            .map_or(0, |&(_, e)| e)
     }
 
     /// The product of two monomials.
     pub fn mul(&self, o: &Monomial) -> Monomial {
-        let mut out = Vec::with_capacity(self.0.len() + o.0.len());
+        let (x, y) = (self.factors(), o.factors());
         let (mut i, mut j) = (0, 0);
-        while i < self.0.len() || j < o.0.len() {
-            match (self.0.get(i), o.0.get(j)) {
-                (Some(&(a, ea)), Some(&(b, eb))) if a == b => {
-                    out.push((a, ea + eb));
-                    i += 1;
-                    j += 1;
-                }
-                (Some(&(a, ea)), Some(&(b, _))) if a < b => {
-                    out.push((a, ea));
-                    i += 1;
-                }
-                (Some(_), Some(&(b, eb))) | (None, Some(&(b, eb))) => {
-                    out.push((b, eb));
-                    j += 1;
-                }
-                (Some(&(a, ea)), None) => {
-                    out.push((a, ea));
-                    i += 1;
-                }
-                (None, None) => unreachable!(),
+        let merged = std::iter::from_fn(|| match (x.get(i), y.get(j)) {
+            (Some(&(a, ea)), Some(&(b, eb))) if a == b => {
+                i += 1;
+                j += 1;
+                Some((a, ea + eb))
             }
-        }
-        Monomial(out)
+            (Some(&(a, ea)), Some(&(b, _))) if a < b => {
+                i += 1;
+                Some((a, ea))
+            }
+            (_, Some(&f)) => {
+                j += 1;
+                Some(f)
+            }
+            (Some(&f), None) => {
+                i += 1;
+                Some(f)
+            }
+            (None, None) => None,
+        });
+        Monomial(Factors::collect(x.len() + y.len(), merged))
     }
 
     /// This monomial with the exponent of `a` lowered by `k` (which must be present).
     pub fn divide(&self, a: Atom, k: u8) -> Monomial {
-        Monomial(
-            self.0
-                .iter()
-                .filter_map(|&(x, e)| match x == a {
-                    true if e > k => Some((x, e - k)),
-                    true => None,
-                    false => Some((x, e)),
-                })
-                .collect(),
-        )
+        let f = self.factors();
+        Monomial(Factors::collect(
+            f.len(),
+            f.iter().filter_map(|&(x, e)| match x == a {
+                true if e > k => Some((x, e - k)),
+                true => None,
+                false => Some((x, e)),
+            }),
+        ))
+    }
+}
+
+impl Default for Monomial {
+    fn default() -> Monomial {
+        Monomial::one()
+    }
+}
+
+impl PartialEq for Monomial {
+    fn eq(&self, o: &Monomial) -> bool {
+        self.factors() == o.factors()
+    }
+}
+
+impl Eq for Monomial {}
+
+impl std::hash::Hash for Monomial {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        self.factors().hash(h);
+    }
+}
+
+impl std::fmt::Debug for Monomial {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_tuple("Monomial").field(&self.factors()).finish()
     }
 }
 
@@ -92,39 +174,48 @@ impl Ord for Monomial {
     fn cmp(&self, o: &Self) -> std::cmp::Ordering {
         self.degree()
             .cmp(&o.degree())
-            .then_with(|| self.0.cmp(&o.0))
+            .then_with(|| self.factors().cmp(o.factors()))
     }
 }
 
-/// A polynomial: a sum of monomials with non-zero rational coefficients.
+/// A polynomial: a sum of monomials with non-zero rational coefficients, held as its terms in
+/// canonical order (a sorted vector: adding two polynomials is a merge).
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Default)]
 pub struct Poly {
-    terms: BTreeMap<Monomial, Rational>,
+    terms: Vec<(Monomial, Rational)>,
 }
 
-fn add_coeff(terms: &mut BTreeMap<Monomial, Rational>, m: Monomial, c: Rational) {
-    if c.is_zero() {
-        return;
-    }
-    match terms.entry(m) {
-        Entry::Vacant(v) => {
-            v.insert(c);
-        }
-        Entry::Occupied(mut o) => {
-            let sum = o
-                .get()
-                .checked_add(c)
-                .expect("coefficients stay far below the i128 range");
-            if sum.is_zero() {
-                o.remove();
-            } else {
-                *o.get_mut() = sum;
-            }
-        }
-    }
+fn sum(a: Rational, b: Rational) -> Rational {
+    a.checked_add(b)
+        .expect("coefficients stay far below the i128 range")
+}
+
+fn product(a: Rational, b: Rational) -> Rational {
+    a.checked_mul(b).expect("bounded coefficients")
 }
 
 impl Poly {
+    /// The polynomial of `terms` in any order, equal monomials added up, zeros dropped.
+    fn from_terms(mut terms: Vec<(Monomial, Rational)>) -> Poly {
+        terms.sort_by(|x, y| x.0.cmp(&y.0));
+        let mut out: Vec<(Monomial, Rational)> = Vec::with_capacity(terms.len());
+        for (m, c) in terms {
+            match out.last_mut() {
+                Some(last) if last.0 == m => last.1 = sum(last.1, c),
+                _ => {
+                    if out.last().is_some_and(|l| l.1.is_zero()) {
+                        out.pop();
+                    }
+                    out.push((m, c));
+                }
+            }
+        }
+        if out.last().is_some_and(|l| l.1.is_zero()) {
+            out.pop();
+        }
+        Poly { terms: out }
+    }
+
     /// Zero.
     pub fn zero() -> Poly {
         Poly::default()
@@ -132,9 +223,7 @@ impl Poly {
 
     /// A constant.
     pub fn constant(c: Rational) -> Poly {
-        let mut p = Poly::zero();
-        add_coeff(&mut p.terms, Monomial::one(), c);
-        p
+        Poly::term(Monomial::one(), c)
     }
 
     /// A single atom.
@@ -144,9 +233,12 @@ impl Poly {
 
     /// `c · m`.
     pub fn term(m: Monomial, c: Rational) -> Poly {
-        let mut p = Poly::zero();
-        add_coeff(&mut p.terms, m, c);
-        p
+        if c.is_zero() {
+            return Poly::zero();
+        }
+        Poly {
+            terms: vec![(m, c)],
+        }
     }
 
     /// `true` for the zero polynomial.
@@ -171,30 +263,68 @@ impl Poly {
 
     /// The constant value, if the polynomial is a constant.
     pub fn as_constant(&self) -> Option<Rational> {
-        match self.terms.len() {
-            0 => Some(Rational::ZERO),
-            1 => self.terms.get(&Monomial::one()).copied(),
+        match self.terms.as_slice() {
+            [] => Some(Rational::ZERO),
+            [(m, c)] if m.is_one() => Some(*c),
             _ => None,
         }
     }
 
+    /// `self + s·o` with `s = ±1`, by merging.
+    fn merge(&self, o: &Poly, negate: bool) -> Poly {
+        let sign = |c: Rational| if negate { -c } else { c };
+        let mut out = Vec::with_capacity(self.terms.len() + o.terms.len());
+        let (mut i, mut j) = (0, 0);
+        while i < self.terms.len() && j < o.terms.len() {
+            let (a, b) = (&self.terms[i], &o.terms[j]);
+            match a.0.cmp(&b.0) {
+                std::cmp::Ordering::Less => {
+                    out.push(a.clone());
+                    i += 1;
+                }
+                std::cmp::Ordering::Greater => {
+                    out.push((b.0.clone(), sign(b.1)));
+                    j += 1;
+                }
+                std::cmp::Ordering::Equal => {
+                    let c = sum(a.1, sign(b.1));
+                    if !c.is_zero() {
+                        out.push((a.0.clone(), c));
+                    }
+                    i += 1;
+                    j += 1;
+                }
+            }
+        }
+        out.extend_from_slice(&self.terms[i..]);
+        out.extend(o.terms[j..].iter().map(|(m, c)| (m.clone(), sign(*c))));
+        Poly { terms: out }
+    }
+
     /// `self + o`.
     pub fn add(&self, o: &Poly) -> Poly {
-        let mut out = self.clone();
-        for (m, c) in &o.terms {
-            add_coeff(&mut out.terms, m.clone(), *c);
+        if o.is_zero() {
+            return self.clone();
         }
-        out
+        if self.is_zero() {
+            return o.clone();
+        }
+        self.merge(o, false)
     }
 
     /// `self − o`.
     pub fn sub(&self, o: &Poly) -> Poly {
-        self.add(&o.neg())
+        if o.is_zero() {
+            return self.clone();
+        }
+        self.merge(o, true)
     }
 
     /// `−self`.
     pub fn neg(&self) -> Poly {
-        self.scale(-Rational::ONE)
+        Poly {
+            terms: self.terms.iter().map(|(m, c)| (m.clone(), -*c)).collect(),
+        }
     }
 
     /// `c · self`.
@@ -202,44 +332,65 @@ impl Poly {
         if c.is_zero() {
             return Poly::zero();
         }
+        if c.is_one() {
+            return self.clone();
+        }
+        if (-c).is_one() {
+            return self.neg();
+        }
         Poly {
             terms: self
                 .terms
                 .iter()
-                .map(|(m, x)| (m.clone(), x.checked_mul(c).expect("bounded coefficients")))
+                .map(|(m, x)| (m.clone(), product(*x, c)))
                 .collect(),
         }
     }
 
     /// `self · o`, not yet reduced modulo `sin² + cos² = 1`.
     pub fn mul(&self, o: &Poly) -> Poly {
-        let mut out = BTreeMap::new();
+        let mut out = Vec::with_capacity(self.terms.len() * o.terms.len());
         for (ma, ca) in &self.terms {
             for (mb, cb) in &o.terms {
-                add_coeff(
-                    &mut out,
-                    ma.mul(mb),
-                    ca.checked_mul(*cb).expect("bounded coefficients"),
-                );
+                out.push((ma.mul(mb), product(*ca, *cb)));
             }
         }
-        Poly { terms: out }
+        Poly::from_terms(out)
     }
 
     /// Rewrites every `cos²` as `1 − sin²` for each `(sin, cos)` atom pair, giving the canonical
     /// form.
     pub fn reduce(&self, trig_pairs: &[(Atom, Atom)]) -> Poly {
-        let mut cur = self.clone();
+        let mut terms = self.terms.clone();
         for &(s, c) in trig_pairs {
-            while let Some(m) = cur.terms.keys().find(|m| m.exponent(c) >= 2).cloned() {
-                let coeff = cur.terms.remove(&m).expect("present");
-                let rest = m.divide(c, 2);
-                // rest · cos² = rest − rest · sin²
-                add_coeff(&mut cur.terms, rest.clone(), coeff);
-                add_coeff(&mut cur.terms, rest.mul(&Monomial(vec![(s, 2)])), -coeff);
+            if !terms.iter().any(|(m, _)| m.exponent(c) >= 2) {
+                continue;
             }
+            let mut next = Vec::with_capacity(terms.len());
+            for (m, k) in terms {
+                let e = m.exponent(c);
+                if e < 2 {
+                    next.push((m, k));
+                    continue;
+                }
+                // rest · cos^(2j) = rest · (1 − sin²)^j = Σ_i C(j, i) (−1)^i rest · sin^(2i)
+                let j = e / 2;
+                let rest = m.divide(c, 2 * j);
+                let mut binomial: i64 = 1;
+                for i in 0..=j {
+                    let sign = if i % 2 == 0 { 1 } else { -1 };
+                    let power = if i == 0 {
+                        rest.clone()
+                    } else {
+                        rest.mul(&Monomial::new(&[(s, 2 * i)]))
+                    };
+                    next.push((power, product(k, Rational::int(sign * binomial))));
+                    binomial = binomial * i64::from(j - i) / i64::from(i + 1);
+                }
+            }
+            terms = next;
         }
-        cur
+        Poly::from_terms(terms)
     }
 
     /// Rewrites every `√p²` as `p` for each `(atom, p)` rule ([`crate::atoms::AtomTable::root_rules`]).
@@ -247,24 +398,39 @@ impl Poly {
         if rules.is_empty() {
             return self.clone();
         }
-        let mut out = Poly::zero();
-        for (m, &c) in &self.terms {
-            let mut coeff = c;
+        let mut out = Vec::with_capacity(self.terms.len());
+        for (m, c) in &self.terms {
+            let mut coeff = *c;
             let mut mono = m.clone();
             for &(a, p) in rules {
                 let e = mono.exponent(a);
                 if e >= 2 {
                     mono = mono.divide(a, e - e % 2);
                     for _ in 0..e / 2 {
-                        coeff = coeff
-                            .checked_mul(Rational::int(p as i64))
-                            .expect("bounded coefficients");
+                        coeff = product(coeff, Rational::int(p as i64));
                     }
                 }
             }
-            add_coeff(&mut out.terms, mono, coeff);
+            out.push((mono, coeff));
         }
-        out
+        Poly::from_terms(out)
+    }
+
+    /// The canonical form: [`Poly::reduce`] and [`Poly::reduce_roots`], without copying a
+    /// polynomial that has no `cos²` and no `√p²` to rewrite (a product of factors in different
+    /// axes, the common case).
+    pub fn canonical(self, trig_pairs: &[(Atom, Atom)], roots: &[(Atom, u64)]) -> Poly {
+        let reducible =
+            |a: Atom| trig_pairs.iter().any(|&(_, c)| c == a) || roots.iter().any(|&(r, _)| r == a);
+        let needed = self
+            .terms
+            .iter()
+            .any(|(m, _)| m.factors().iter().any(|&(a, e)| e >= 2 && reducible(a)));
+        if needed {
+            self.reduce(trig_pairs).reduce_roots(roots)
+        } else {
+            self
+        }
     }
 
     /// The value at `atoms[a]` for every atom `a`.
@@ -272,7 +438,7 @@ impl Poly {
         self.terms
             .iter()
             .map(|(m, c)| {
-                m.0.iter().fold(c.to_f64(), |acc, &(a, e)| {
+                m.factors().iter().fold(c.to_f64(), |acc, &(a, e)| {
                     acc * atoms[a as usize].powi(e as i32)
                 })
             })
@@ -283,8 +449,8 @@ impl Poly {
     pub fn atoms(&self) -> Vec<Atom> {
         let mut v: Vec<Atom> = self
             .terms
-            .keys()
-            .flat_map(|m| m.0.iter().map(|&(a, _)| a))
+            .iter()
+            .flat_map(|(m, _)| m.factors().iter().map(|&(a, _)| a))
             .collect();
         v.sort_unstable();
         v.dedup();
@@ -293,24 +459,21 @@ impl Poly {
 
     /// Splits into `(q, r)` with `self = a · q + r`, where `r` has no term containing `a`.
     pub fn split_by(&self, a: Atom) -> (Poly, Poly) {
-        let (mut q, mut r) = (Poly::zero(), Poly::zero());
+        let (mut q, mut r) = (Vec::new(), Vec::new());
         for (m, c) in &self.terms {
             if m.exponent(a) > 0 {
-                add_coeff(&mut q.terms, m.divide(a, 1), *c);
+                q.push((m.divide(a, 1), *c));
             } else {
-                add_coeff(&mut r.terms, m.clone(), *c);
+                r.push((m.clone(), *c));
             }
         }
-        (q, r)
+        // Dividing by `a` can change the order of the quotient's monomials; the rest keeps it.
+        (Poly::from_terms(q), Poly { terms: r })
     }
 
     /// The coefficient of the first term (canonical order), or zero.
     pub fn leading_coefficient(&self) -> Rational {
-        self.terms
-            .values()
-            .next()
-            .copied()
-            .unwrap_or(Rational::ZERO)
+        self.terms.first().map_or(Rational::ZERO, |t| t.1)
     }
 }
 

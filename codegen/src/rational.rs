@@ -13,13 +13,52 @@ pub struct Rational {
     den: i128,
 }
 
-fn gcd(mut a: i128, mut b: i128) -> i128 {
-    a = a.abs();
-    b = b.abs();
-    while b != 0 {
-        (a, b) = (b, a % b);
+/// `a / b`, exact, in 64 bits when both fit (a 128-bit division is a slow library call).
+fn div(a: i128, b: i128) -> i128 {
+    match (i64::try_from(a), i64::try_from(b)) {
+        (Ok(x), Ok(y)) if y != -1 => i128::from(x / y),
+        _ => a / b,
     }
-    a
+}
+
+/// The greatest common divisor of `|a|` and `|b|` (binary: shifts and subtractions, no
+/// 128-bit division).
+fn gcd(a: i128, b: i128) -> i128 {
+    let (mut a, mut b) = (a.unsigned_abs(), b.unsigned_abs());
+    if a == 0 || b == 0 {
+        return (a | b) as i128;
+    }
+    if let (Ok(x), Ok(y)) = (u64::try_from(a), u64::try_from(b)) {
+        return i128::from(gcd64(x, y));
+    }
+    let shift = (a | b).trailing_zeros();
+    a >>= a.trailing_zeros();
+    loop {
+        b >>= b.trailing_zeros();
+        if a > b {
+            std::mem::swap(&mut a, &mut b);
+        }
+        b -= a;
+        if b == 0 {
+            return (a << shift) as i128;
+        }
+    }
+}
+
+/// The binary greatest common divisor of two non-zero `u64`.
+fn gcd64(mut a: u64, mut b: u64) -> u64 {
+    let shift = (a | b).trailing_zeros();
+    a >>= a.trailing_zeros();
+    loop {
+        b >>= b.trailing_zeros();
+        if a > b {
+            std::mem::swap(&mut a, &mut b);
+        }
+        b -= a;
+        if b == 0 {
+            return a << shift;
+        }
+    }
 }
 
 /// Arithmetic left the range of `i128` (coefficients of first-order gains stay tiny; this only
@@ -40,8 +79,8 @@ impl Rational {
         let g = gcd(num, den).max(1);
         let s = if den < 0 { -1 } else { 1 };
         Rational {
-            num: s * num / g,
-            den: s * den / g,
+            num: s * div(num, g),
+            den: s * div(den, g),
         }
     }
 
@@ -121,6 +160,10 @@ impl Rational {
 
     /// `self + o`, or an overflow.
     pub fn checked_add(self, o: Rational) -> Result<Rational, Overflow> {
+        if self.den == 1 && o.den == 1 {
+            let num = self.num.checked_add(o.num).ok_or(Overflow)?;
+            return Ok(Rational { num, den: 1 });
+        }
         let g = gcd(self.den, o.den);
         let l = (self.den / g).checked_mul(o.den).ok_or(Overflow)?;
         let a = self.num.checked_mul(l / self.den).ok_or(Overflow)?;
@@ -130,11 +173,21 @@ impl Rational {
 
     /// `self * o`, or an overflow.
     pub fn checked_mul(self, o: Rational) -> Result<Rational, Overflow> {
+        if self.den == 1 && o.den == 1 {
+            let num = self.num.checked_mul(o.num).ok_or(Overflow)?;
+            return Ok(Rational { num, den: 1 });
+        }
+        // Both factors are reduced, so dividing out the cross common factors leaves the
+        // product reduced.
         let g1 = gcd(self.num, o.den).max(1);
         let g2 = gcd(o.num, self.den).max(1);
-        let n = (self.num / g1).checked_mul(o.num / g2).ok_or(Overflow)?;
-        let d = (self.den / g2).checked_mul(o.den / g1).ok_or(Overflow)?;
-        Ok(Rational::new(n, d))
+        let n = div(self.num, g1)
+            .checked_mul(div(o.num, g2))
+            .ok_or(Overflow)?;
+        let d = div(self.den, g2)
+            .checked_mul(div(o.den, g1))
+            .ok_or(Overflow)?;
+        Ok(Rational { num: n, den: d })
     }
 }
 

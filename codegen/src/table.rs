@@ -18,7 +18,8 @@ pub enum Format {
 }
 
 /// Writes a polynomial in the seed's style (`Za + Ca*Zc + Sa*Sc*Xw`), or LaTeX
-/// (`Z_{a} + C_a Z_{c}`) with `latex`.
+/// (`Z_{a} + C_a Z_{c}`) with `latex`. `names` are the names of the atoms; an atom past them is
+/// a named intermediate of the shared form, written `u0`, `u1`, … (`u_{0}` in LaTeX).
 pub fn format_poly(p: &Poly, names: &[String], latex: bool) -> String {
     if p.is_zero() {
         return "0".into();
@@ -34,17 +35,21 @@ pub fn format_poly(p: &Poly, names: &[String], latex: bool) -> String {
             (_, false) => out.push_str(" + "),
         }
         let mut factors: Vec<String> = Vec::new();
-        if !c.is_one() || m.0.is_empty() {
+        if !c.is_one() || m.is_one() {
             factors.push(if latex {
                 latex_rational(c)
             } else {
                 c.to_string()
             });
         }
-        for &(a, e) in &m.0 {
-            let n = &names[a as usize];
+        for &(a, e) in m.factors() {
+            let n = match names.get(usize::from(a)) {
+                Some(n) => n.clone(),
+                None if latex => format!("u_{{{}}}", usize::from(a) - names.len()),
+                None => format!("u{}", usize::from(a) - names.len()),
+            };
             factors.push(match (e, latex) {
-                (1, _) => n.clone(),
+                (1, _) => n,
                 (_, false) => format!("{n}^{e}"),
                 (_, true) => format!("{n}^{{{e}}}"),
             });

@@ -264,3 +264,54 @@ fn colliding_symbol_names_compile_and_equal_the_evaluator() {
     assert!(compiled.next().is_none());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[path = "support/chains.rs"]
+mod chains;
+
+/// The generated text is what `prettyplease` prints for it: the runs of `let` statements the
+/// emitter writes as text (`codegen/src/emit/lets.rs`) are written exactly as `prettyplease`
+/// writes them. Parsing the file (after its `//` header) and printing it again gives the same
+/// text, for every built-in machine, split models, colliding names, a kinematic parameter
+/// whose load is too long to be carried as text, and long synthetic chains.
+#[test]
+fn emitted_files_are_a_fixed_point_of_syn_and_prettyplease() {
+    let long_name = "Xw".to_string() + &"x".repeat(60);
+    let (_, seed_ac) = model_spec::builtin::BUILTIN[0];
+    let long = seed_ac.replace("Xw", &long_name);
+    let mut machines: Vec<Machine> = all_builtin();
+    machines.push(parse_machine("colliding-names.toml", COLLIDING).unwrap());
+    machines.push(parse_machine("long.toml", &long).unwrap());
+    machines.extend([chains::synthetic(2, true), chains::synthetic(12, false)]);
+    let mut files = Vec::new();
+    for m in &machines {
+        files.push((m.name.clone(), generate_machine(m, &[]).unwrap()));
+        files.push((
+            format!("{} split", m.name),
+            generate_machine_with(m, &[], 40).unwrap(),
+        ));
+    }
+    assert!(
+        files
+            .iter()
+            .any(|(_, code)| code.contains(&format!("= params\n            .{long_name};"))),
+        "a load too long for a run goes through syn, which wraps it"
+    );
+    for (name, code) in files {
+        let body: String = code
+            .lines()
+            .skip_while(|l| l.starts_with("//") || l.is_empty())
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let again = prettyplease::unparse(&syn::parse_file(&body).unwrap());
+        assert!(!body.contains("__rtest_lets"), "{name}: a marker is left");
+        if again != body {
+            let (a, b) = (again.lines(), body.lines());
+            let (i, (x, y)) = a
+                .zip(b)
+                .enumerate()
+                .find(|(_, (x, y))| x != y)
+                .expect("texts of different lengths");
+            panic!("{name}, line {i}: prettyplease prints\n{x}\nwhere the emitter wrote\n{y}");
+        }
+    }
+}

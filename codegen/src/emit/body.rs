@@ -2,7 +2,8 @@
 //! outputs. Inputs are loaded into locals named after their fields, intermediates are `t0`,
 //! `t1`, … ([`super::names`]).
 
-use super::names::locals;
+use super::lets;
+use super::names::local_names;
 use crate::ir::{Op, Output, Program};
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::quote;
@@ -24,19 +25,19 @@ pub(crate) fn ident(name: &str) -> Ident {
 }
 
 /// One output cell: a value, a negated value or a literal.
-fn cell(locals: &[Ident], o: &Output) -> TokenStream {
+fn cell(locals: &[String], o: &Output) -> TokenStream {
     cell_with(locals, o, Float::F64)
 }
 
 /// One output cell, literals of type `float`.
-pub(crate) fn cell_with(locals: &[Ident], o: &Output, float: Float) -> TokenStream {
+pub(crate) fn cell_with(locals: &[String], o: &Output, float: Float) -> TokenStream {
     match *o {
         Output::Var(v) => {
-            let v = &locals[v as usize];
+            let v = ident(&locals[v as usize]);
             quote!(#v)
         }
         Output::Neg(v) => {
-            let v = &locals[v as usize];
+            let v = ident(&locals[v as usize]);
             quote!(-#v)
         }
         Output::Const(c) => match float {
@@ -83,64 +84,72 @@ pub(crate) enum Float {
 }
 
 /// One `let` per instruction: `let zc = params.Zc;`, `let t3 = t1 * zc;`.
-fn lets(p: &Program, locals: &[Ident]) -> TokenStream {
+fn lets(p: &Program, locals: &[String]) -> TokenStream {
     let load = |k: usize| {
         let input = &p.inputs[k];
-        let f = ident(&input.field);
-        if input.parameter {
-            quote!(params.#f)
-        } else {
-            quote!(pose.#f)
-        }
+        let from = if input.parameter { "params" } else { "pose" };
+        format!("{from}.{}", input.field)
     };
     lets_with(p, locals, &load, Float::F64)
 }
 
-/// One `let` per instruction, inputs loaded by `load(input index)`, literals of type `float`.
+/// The text of a literal as `prettyplease` prints it (`1.5f64`, `-0.25f32`).
+fn literal_text(bits: u64, float: Float) -> String {
+    let x = f64::from_bits(bits);
+    let magnitude = match float {
+        Float::F64 => Literal::f64_suffixed(x.abs()).to_string(),
+        Float::F32 => Literal::f32_suffixed((x as f32).abs()).to_string(),
+    };
+    let negative = match float {
+        Float::F64 => x.is_sign_negative() && x != 0.0,
+        Float::F32 => (x as f32).is_sign_negative() && x as f32 != 0.0,
+    };
+    if negative {
+        format!("-{magnitude}")
+    } else {
+        magnitude
+    }
+}
+
+/// One `let` per instruction, inputs loaded by `load(input index)` (the text of the
+/// expression: `pose.sin_a`, `values[3]`), literals of type `float`. Written as text and
+/// carried in runs ([`super::lets`]); a statement too long for a run goes through `syn`.
 pub(crate) fn lets_with(
     p: &Program,
-    locals: &[Ident],
-    load: &dyn Fn(usize) -> TokenStream,
+    names: &[String],
+    load: &dyn Fn(usize) -> String,
     float: Float,
 ) -> TokenStream {
-    let lets = p.ops.iter().zip(locals).map(|(op, dst)| {
-        let l = |v: u32| &locals[v as usize];
-        let rhs = match *op {
-            Op::Input(k) => load(k as usize),
-            Op::Const(bits) => match float {
-                Float::F64 => float_literal(f64::from_bits(bits)),
-                Float::F32 => float_literal_f32(f64::from_bits(bits)),
-            },
-            Op::Add(a, b) => {
-                let (a, b) = (l(a), l(b));
-                quote!(#a + #b)
-            }
-            Op::Sub(a, b) => {
-                let (a, b) = (l(a), l(b));
-                quote!(#a - #b)
-            }
-            Op::Mul(a, b) => {
-                let (a, b) = (l(a), l(b));
-                quote!(#a * #b)
-            }
-            Op::Neg(a) => {
-                let a = l(a);
-                quote!(-#a)
-            }
-            Op::Div(a, b) => {
-                let (a, b) = (l(a), l(b));
-                quote!(#a / #b)
-            }
+    use std::fmt::Write;
+    let mut run = lets::Run::default();
+    let mut out = TokenStream::new();
+    let mut line = String::new();
+    for (op, dst) in p.ops.iter().zip(names) {
+        let l = |v: u32| names[v as usize].as_str();
+        line.clear();
+        // Writing to a `String` cannot fail.
+        let _ = match *op {
+            Op::Input(k) => write!(line, "let {dst} = {};", load(k as usize)),
+            Op::Const(bits) => write!(line, "let {dst} = {};", literal_text(bits, float)),
+            Op::Add(a, b) => write!(line, "let {dst} = {} + {};", l(a), l(b)),
+            Op::Sub(a, b) => write!(line, "let {dst} = {} - {};", l(a), l(b)),
+            Op::Mul(a, b) => write!(line, "let {dst} = {} * {};", l(a), l(b)),
+            Op::Neg(a) => write!(line, "let {dst} = -{};", l(a)),
+            Op::Div(a, b) => write!(line, "let {dst} = {} / {};", l(a), l(b)),
         };
-        quote!(let #dst = #rhs;)
-    });
-    quote!(#(#lets)*)
+        run.push(&line, &mut out);
+    }
+    run.flush(&mut out);
+    out
 }
 
 /// The statements of a six-row program's body: one `let` per instruction, then one store of
 /// `[gx, gy, gz, gi, gj, gk]` per error.
+///
+/// The runs of `let` statements are carried as `__rtest_lets!(r"…")` markers: print the
+/// tokens with [`super::pretty`], which writes them out.
 pub fn body(p: &Program, error_consts: &[Ident]) -> TokenStream {
-    let locals = locals(p);
+    let locals = local_names(p);
     let lets = lets(p, &locals);
     let stores = p.outputs.chunks(6).zip(error_consts).map(|(row, name)| {
         let cells = row.iter().map(|o| cell(&locals, o));
@@ -151,8 +160,11 @@ pub fn body(p: &Program, error_consts: &[Ident]) -> TokenStream {
 
 /// The statements of a position program's body ([`crate::compile_position`]): one `let` per
 /// instruction, then one store per direction of the gains of all `n` errors.
+///
+/// The runs of `let` statements are carried as `__rtest_lets!(r"…")` markers: print the
+/// tokens with [`super::pretty`], which writes them out.
 pub fn position_body(p: &Program, n: usize) -> TokenStream {
-    let locals = locals(p);
+    let locals = local_names(p);
     let lets = lets(p, &locals);
     let stores = p.outputs.chunks(n.max(1)).enumerate().map(|(d, row)| {
         let d = Literal::usize_unsuffixed(d);
@@ -165,7 +177,7 @@ pub fn position_body(p: &Program, n: usize) -> TokenStream {
 /// The body of one part of a split position program: its `let`s, then one store per cell
 /// `out[d][ERROR] = …` (the part's errors only).
 pub(crate) fn position_part_body(p: &Program, error_consts: &[Ident]) -> TokenStream {
-    let locals = locals(p);
+    let locals = local_names(p);
     let lets = lets(p, &locals);
     let n = error_consts.len().max(1);
     let stores = p.outputs.chunks(n).enumerate().flat_map(|(d, row)| {

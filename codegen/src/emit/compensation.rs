@@ -3,7 +3,7 @@
 //! evaluation) and the first-order correction in `f32` (for single-precision controllers).
 
 use super::body::{Float, cell_with, float_literal, ident, lets_with};
-use super::names::locals;
+use super::names::local_names;
 use crate::compensation::{CompensationPrograms, DAMPING, RESIDUALS, STEPS};
 use crate::ir::Program;
 use proc_macro2::{Literal, TokenStream};
@@ -19,32 +19,29 @@ struct Layout {
 impl Layout {
     /// The load of input `k` from the arguments of a struct-taking function (`pose.sin_a`,
     /// `params.Zc`, `values[3]`, `target[1]`).
-    fn structured(&self, p: &Program, k: usize) -> TokenStream {
-        let field = ident(&p.inputs[k].field);
+    fn structured(&self, p: &Program, k: usize) -> String {
+        let field = &p.inputs[k].field;
         if k < self.pose {
-            quote!(pose.#field)
+            format!("pose.{field}")
         } else if k < self.pose + self.params {
-            quote!(params.#field)
+            format!("params.{field}")
         } else if k < self.pose + self.params + self.values {
-            let i = Literal::usize_unsuffixed(k - self.pose - self.params);
-            quote!(values[#i])
+            format!("values[{}]", k - self.pose - self.params)
         } else {
-            let i = Literal::usize_unsuffixed(k - self.pose - self.params - self.values);
-            quote!(target[#i])
+            format!("target[{}]", k - self.pose - self.params - self.values)
         }
     }
 
     /// The load of input `k` from the arrays of the `f32` function.
-    fn arrays(&self, k: usize) -> TokenStream {
+    fn arrays(&self, k: usize) -> String {
         let (array, i) = if k < self.pose {
-            (quote!(pose), k)
+            ("pose", k)
         } else if k < self.pose + self.params {
-            (quote!(params), k - self.pose)
+            ("params", k - self.pose)
         } else {
-            (quote!(values), k - self.pose - self.params)
+            ("values", k - self.pose - self.params)
         };
-        let i = Literal::usize_unsuffixed(i);
-        quote!(#array[#i])
+        format!("{array}[{i}]")
     }
 }
 
@@ -60,8 +57,8 @@ fn params_name(p: &Program, layout: &Layout) -> proc_macro2::Ident {
 
 /// The body of a program: its `let`s, then `out[k] = …` per output (or an array expression
 /// when `array` is set).
-fn body(p: &Program, load: &dyn Fn(usize) -> TokenStream, float: Float) -> TokenStream {
-    let locals = locals(p);
+fn body(p: &Program, load: &dyn Fn(usize) -> String, float: Float) -> TokenStream {
+    let locals = local_names(p);
     let lets = lets_with(p, &locals, load, float);
     let stores = p.outputs.iter().enumerate().map(|(k, o)| {
         let k = Literal::usize_unsuffixed(k);

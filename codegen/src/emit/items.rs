@@ -113,6 +113,9 @@ fn read_flags(args: &(Ident, Ident)) -> (bool, bool) {
 ///
 /// With `compensation`, the module holds a `compensation` module too
 /// (the corrected pose of a commanded pose, [`crate::compensation`]).
+///
+/// The runs of `let` statements are carried as `__rtest_lets!(r"…")` markers: print the
+/// tokens with [`super::pretty`], which writes them out.
 pub fn model_module(
     module: &str,
     model: &GainModel,
@@ -330,7 +333,10 @@ pub struct ModelCode<'a> {
 }
 
 /// The code of one machine: its `Pose`, `Params` and one module per model, as a token stream
-/// (the content of a module; no crate attributes, so it can be `include!`d).
+/// (the content of a module; no crate attributes, so it can be `include!`d once printed).
+///
+/// The runs of `let` statements are carried as `__rtest_lets!(r"…")` markers: print the
+/// tokens with [`super::pretty`], which writes them out.
 pub fn machine_tokens(m: &Machine, models: &[ModelCode<'_>]) -> TokenStream {
     let inputs = crate::lower::inputs(m, models.first().expect("at least one model").model);
     let structs = input_structs(m, &inputs);

@@ -80,15 +80,23 @@ pub fn input_locals(inputs: &[Input]) -> Vec<String> {
 /// The local of every instruction of `p`, indexed by [`crate::ir::Var`]: the input's name for an
 /// input load, `t0`, `t1`, … for the others in order.
 pub fn locals(p: &Program) -> Vec<Ident> {
+    local_names(p)
+        .iter()
+        .map(|n| Ident::new(n, Span::call_site()))
+        .collect()
+}
+
+/// The names of [`locals`], as text.
+pub(crate) fn local_names(p: &Program) -> Vec<String> {
     let inputs = input_locals(&p.inputs);
     let mut next = 0usize;
     p.ops
         .iter()
         .map(|op| match *op {
-            Op::Input(k) => Ident::new(&inputs[k as usize], Span::call_site()),
+            Op::Input(k) => inputs[k as usize].clone(),
             _ => {
                 next += 1;
-                Ident::new(&format!("t{}", next - 1), Span::call_site())
+                format!("t{}", next - 1)
             }
         })
         .collect()

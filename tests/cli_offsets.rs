@@ -249,7 +249,7 @@ fn a_campaign_shares_the_pivot_length_and_refuses_records_that_disagree_on_it() 
             "--json",
             "bad.json",
         ],
-        3,
+        1,
         &[
             "kinematic offset `Zt` is one length of the machine",
             "records `near` and `far`",

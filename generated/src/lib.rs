@@ -24,10 +24,6 @@
 
 #![no_std]
 #![warn(missing_docs)]
-// The machines with inclined axes hold exact constants such as √2, written as the f64 nearest
-// them (`1.4142135623730951f64`, the bits of `core::f64::consts::SQRT_2`), which clippy takes
-// for approximations of the named constants.
-#![allow(clippy::approx_constant)]
 
 /// `compensate(commanded, params, values, sin_cos, out)` of a compiled model, on slices.
 pub type CompensateFn = fn(&[f64], &[f64], &[f64], fn(f64) -> (f64, f64), &mut [f64]);

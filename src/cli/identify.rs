@@ -338,6 +338,15 @@ fn run_campaign(
     let noise = args.noise.choice(m, &read, &args.instrument)?;
     let opts = IdentifyOptions::new().constraint(args::constraint(args.constraint.as_deref())?);
     let c = &loaded.campaign;
+    // Records modelled with different values of a machine length cannot share its change: a
+    // bad input, said before any fitting.
+    let labelled: Vec<(&str, &[f64])> = c
+        .records
+        .iter()
+        .map(|r| (r.label.as_str(), r.params.as_slice()))
+        .collect();
+    solver::fitting::offsets::check_shared_symbols(m, model, &labelled)
+        .map_err(|e| CliError::input(format!("{flag}: {e}")))?;
     let (ident, refinement) = if args.first_order {
         let ident = identify_campaign(m, model, c, &opts, &noise).map_err(estimate_error)?;
         (ident, None)

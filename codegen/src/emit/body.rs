@@ -11,6 +11,10 @@ use quote::quote;
 /// An exact `f64` literal (shortest round-trip decimal, `f64` suffix), negative values as a
 /// unary minus.
 pub fn float_literal(x: f64) -> TokenStream {
+    if named_constant(x, Float::F64).is_some() {
+        let text = literal_text(x.to_bits(), Float::F64);
+        return text.parse().expect("a path to a core constant");
+    }
     let lit = Literal::f64_suffixed(x.abs());
     if x.is_sign_negative() && x != 0.0 {
         quote!(-#lit)
@@ -22,6 +26,28 @@ pub fn float_literal(x: f64) -> TokenStream {
 /// An identifier (a field, module or constant name that the machine description made valid).
 pub(crate) fn ident(name: &str) -> Ident {
     Ident::new(name, Span::call_site())
+}
+
+/// The `core` constant whose value `|x|` is in the type `float`, for the constants an exact
+/// inclined direction brings (`√2`, written as a literal Clippy reads as an approximation of
+/// `SQRT_2`).
+fn named_constant(x: f64, float: Float) -> Option<&'static str> {
+    match float {
+        Float::F64 => {
+            let a = x.abs();
+            (a == core::f64::consts::SQRT_2)
+                .then_some("core::f64::consts::SQRT_2")
+                .or((a == core::f64::consts::FRAC_1_SQRT_2)
+                    .then_some("core::f64::consts::FRAC_1_SQRT_2"))
+        }
+        Float::F32 => {
+            let a = (x as f32).abs();
+            (a == core::f32::consts::SQRT_2)
+                .then_some("core::f32::consts::SQRT_2")
+                .or((a == core::f32::consts::FRAC_1_SQRT_2)
+                    .then_some("core::f32::consts::FRAC_1_SQRT_2"))
+        }
+    }
 }
 
 /// One output cell: a value, a negated value or a literal.
@@ -65,6 +91,10 @@ pub fn reads(p: &Program) -> (bool, bool) {
 /// An exact `f32` literal of `x` rounded to single precision (shortest round-trip decimal,
 /// `f32` suffix), negative values as a unary minus.
 pub fn float_literal_f32(x: f64) -> TokenStream {
+    if named_constant(x, Float::F32).is_some() {
+        let text = literal_text(x.to_bits(), Float::F32);
+        return text.parse().expect("a path to a core constant");
+    }
     let x = x as f32;
     let lit = Literal::f32_suffixed(x.abs());
     if x.is_sign_negative() && x != 0.0 {
@@ -96,9 +126,10 @@ fn lets(p: &Program, locals: &[String]) -> TokenStream {
 /// The text of a literal as `prettyplease` prints it (`1.5f64`, `-0.25f32`).
 fn literal_text(bits: u64, float: Float) -> String {
     let x = f64::from_bits(bits);
-    let magnitude = match float {
-        Float::F64 => Literal::f64_suffixed(x.abs()).to_string(),
-        Float::F32 => Literal::f32_suffixed((x as f32).abs()).to_string(),
+    let magnitude = match (named_constant(x, float), float) {
+        (Some(name), _) => name.to_string(),
+        (None, Float::F64) => Literal::f64_suffixed(x.abs()).to_string(),
+        (None, Float::F32) => Literal::f32_suffixed((x as f32).abs()).to_string(),
     };
     let negative = match float {
         Float::F64 => x.is_sign_negative() && x != 0.0,

@@ -1,8 +1,9 @@
 //! Models too large for one function, compiled in parts of bounded size.
 //!
 //! The whole model is compiled once. When it exceeds the bound, the instructions each error's
-//! outputs depend on in the whole program (its closure) tell how large a part holding a set
-//! of errors will be: about the size of the union of their closures. The errors are grouped
+//! outputs depend on in the whole gains program (its closure; the closure of its three
+//! position outputs for the position program) tell how large a part holding a set of errors
+//! will be: about the size of the union of their closures. The errors are grouped
 //! by axis (catalogue order keeps an axis together) and the groups packed into parts on that
 //! estimate; each part is then compiled once, and a part that still exceeds the bound (its
 //! own common-subexpression elimination came out larger than the estimate) is halved until it
@@ -29,13 +30,13 @@ pub struct Part {
 pub const MAX_INSTRUCTIONS: usize = 4000;
 
 /// The instructions of `p` each group of outputs depends on: `group(o)` is the group of
-/// output `o`, `groups` their number. Each closure is ascending.
-fn closures(p: &Program, groups: usize, group: impl Fn(usize) -> usize) -> Vec<Vec<u32>> {
+/// output `o` (`None`: not counted), `groups` their number. Each closure is ascending.
+fn closures(p: &Program, groups: usize, group: impl Fn(usize) -> Option<usize>) -> Vec<Vec<u32>> {
     let mut stamp = vec![usize::MAX; p.ops.len()];
     let mut roots: Vec<Vec<u32>> = vec![Vec::new(); groups];
     for (o, out) in p.outputs.iter().enumerate() {
-        if let Output::Var(v) | Output::Neg(v) = out {
-            roots[group(o)].push(*v);
+        if let (Output::Var(v) | Output::Neg(v), Some(g)) = (out, group(o)) {
+            roots[g].push(*v);
         }
     }
     roots
@@ -64,8 +65,9 @@ fn closures(p: &Program, groups: usize, group: impl Fn(usize) -> usize) -> Vec<V
         .collect()
 }
 
-/// The estimated size of a part: the union of its errors' closures in the whole gains and
-/// position programs (the larger of the two).
+/// The estimated size of a part: the union of its errors' closures in the whole gains
+/// program, of all six outputs for the part's gains program and of the three position outputs
+/// for its position program (the larger of the two).
 struct Estimate {
     gains: Vec<Vec<u32>>,
     position: Vec<Vec<u32>>,
@@ -75,12 +77,12 @@ struct Estimate {
 }
 
 impl Estimate {
-    fn new(whole: &Part, n: usize) -> Estimate {
+    fn new(whole: &Program, n: usize) -> Estimate {
         Estimate {
-            gains: closures(&whole.gains, n, |o| o / 6),
-            position: closures(&whole.position, n, |o| o % n.max(1)),
-            in_gains: vec![false; whole.gains.ops.len()],
-            in_position: vec![false; whole.position.ops.len()],
+            gains: closures(whole, n, |o| Some(o / 6)),
+            position: closures(whole, n, |o| (o % 6 < 3).then_some(o / 6)),
+            in_gains: vec![false; whole.ops.len()],
+            in_position: vec![false; whole.ops.len()],
             size: [0, 0],
         }
     }
@@ -141,10 +143,17 @@ pub fn compile_parts(m: &Machine, model: &GainModel, max_instructions: usize) ->
         }
     };
     let n = model.errors.len();
-    let whole = build((0..n).collect());
     let size = |p: &Part| p.gains.ops.len().max(p.position.ops.len());
-    if size(&whole) <= max_instructions {
-        return vec![whole];
+    let whole = compile(m, model);
+    if whole.ops.len() <= max_instructions {
+        let position = compile_position(m, model);
+        if position.ops.len() <= max_instructions {
+            return vec![Part {
+                rows: (0..n).collect(),
+                gains: whole,
+                position,
+            }];
+        }
     }
     // Groups of consecutive errors with the same key (catalogue order keeps an axis together).
     let key = |i: usize| {

@@ -152,6 +152,18 @@ fn legend(m: &Machine) -> String {
     s
 }
 
+/// `c` padded with spaces to `width` characters. By hand: the width of `format!` is limited to
+/// 65 535, and a cell of a long chain's expanded table is longer.
+fn pad(c: &str, width: usize) -> String {
+    let mut s = String::with_capacity(width.max(c.len()));
+    s.push_str(c);
+    s.extend(std::iter::repeat_n(
+        ' ',
+        width.saturating_sub(c.chars().count()),
+    ));
+    s
+}
+
 fn text(title: &str, rows: &[(String, String, Vec<String>)], legend: &str) -> String {
     let mut widths = [0usize; 8];
     let header: Vec<String> = ["group", "error"]
@@ -174,11 +186,7 @@ fn text(title: &str, rows: &[(String, String, Vec<String>)], legend: &str) -> St
     }
     let mut out = format!("{title}\n{legend}\n");
     for (i, r) in all.iter().enumerate() {
-        let line: Vec<String> = r
-            .iter()
-            .zip(&widths)
-            .map(|(c, w)| format!("{c:<w$}", w = *w))
-            .collect();
+        let line: Vec<String> = r.iter().zip(&widths).map(|(c, w)| pad(c, *w)).collect();
         out.push_str(line.join("  ").trim_end());
         out.push('\n');
         if i == 0 {
@@ -262,4 +270,14 @@ fn latex_table(title: &str, rows: &[(String, String, Vec<String>)]) -> String {
     }
     out.push_str("\\hline\n\\end{longtable}\n");
     out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn cells_pad_beyond_the_width_limit_of_format() {
+        assert_eq!(super::pad("ΔX", 4), "ΔX  ");
+        assert_eq!(super::pad("long", 2), "long");
+        assert_eq!(super::pad("a", 70_000).len(), 70_000);
+    }
 }

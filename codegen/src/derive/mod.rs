@@ -59,8 +59,9 @@ pub struct NominalPose {
 /// (canonical polynomials in the machine's atoms).
 pub fn nominal_pose(m: &Machine) -> NominalPose {
     let atoms = AtomTable::new(m);
-    let mut w = Walk::new(m, &atoms, Namer::new(&atoms, DeriveOptions::default()), &[]);
-    let nominal = w.run();
+    let mut w =
+        Walk::new(m, &atoms, Namer::new(&atoms, DeriveOptions::default()), &[]).with_nominal_pose();
+    let nominal = w.run().expect("the walk was asked for the nominal pose");
     let (_, inter) = w.finish();
     let mut x = inter.expander();
     NominalPose {

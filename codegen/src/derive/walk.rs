@@ -111,6 +111,8 @@ pub(crate) struct Walk<'a> {
     slot: BTreeMap<ErrorId, usize>,
     /// One contribution per requested error.
     out: Vec<Contribution>,
+    /// Whether to carry the tool point for the nominal pose.
+    nominal: bool,
 }
 
 impl<'a> Walk<'a> {
@@ -133,7 +135,15 @@ impl<'a> Walk<'a> {
                     rotation: zero3(),
                 })
                 .collect(),
+            nominal: false,
         }
+    }
+
+    /// The walk that also carries the tool point to the work frame ([`Walk::run`] then returns
+    /// the nominal pose).
+    pub(crate) fn with_nominal_pose(mut self) -> Walk<'a> {
+        self.nominal = true;
+        self
     }
 
     /// The contributions of the requested errors, in order, and the intermediates they are
@@ -208,13 +218,22 @@ impl<'a> Walk<'a> {
 
     /// `Σ_j a_j · b_j`, each product through the namer, the sum kept.
     fn dot<'p>(&mut self, pairs: impl IntoIterator<Item = (&'p Poly, &'p Poly)>) -> Poly {
+        let sum = self.sum_of_products(pairs);
+        self.namer.keep(sum)
+    }
+
+    /// `Σ_j a_j · b_j`, each product through the namer (a gain: not kept).
+    fn sum_of_products<'p>(
+        &mut self,
+        pairs: impl IntoIterator<Item = (&'p Poly, &'p Poly)>,
+    ) -> Poly {
         let mut sum = Poly::zero();
         for (a, b) in pairs {
             if !a.is_zero() && !b.is_zero() {
                 sum = sum.add(&self.namer.mul(a, b));
             }
         }
-        self.namer.keep(sum)
+        sum
     }
 
     /// `a · b` (matrices).
@@ -246,13 +265,22 @@ impl<'a> Walk<'a> {
         out
     }
 
-    /// `a × b`.
+    /// `a × b` (a gain: not kept).
     fn cross(&mut self, a: &Vec3, b: &Vec3) -> Vec3 {
         let mut out = zero3();
         for (i, cell) in out.iter_mut().enumerate() {
             let (j, k) = ((i + 1) % 3, (i + 2) % 3);
             let (p, q) = (self.namer.mul(&a[j], &b[k]), self.namer.mul(&a[k], &b[j]));
-            *cell = self.namer.keep(p.sub(&q));
+            *cell = p.sub(&q);
+        }
+        out
+    }
+
+    /// `m · v`, a gain: not kept.
+    fn gain(&mut self, m: &Mat3, v: &Vec3) -> Vec3 {
+        let mut out = zero3();
+        for (i, cell) in out.iter_mut().enumerate() {
+            *cell = self.sum_of_products((0..3).map(|k| (&m[i][k], &v[k])));
         }
         out
     }
@@ -283,8 +311,8 @@ impl<'a> Walk<'a> {
     /// An error rotation about `e_k` of the work chain, where the frame seen from the tool
     /// frame is `m` and the workpiece point and z axis in it are `w` and `z`.
     fn work_rotation_error(&mut self, slot: usize, k: usize, m: &Mat3, (w, z): &(Vec3, Vec3)) {
-        let position = self.mat_vec(m, &cross_unit(k, w)).map(|p| p.neg());
-        let orientation = self.mat_vec(m, &cross_unit(k, z)).map(|p| p.neg());
+        let position = self.gain(m, &cross_unit(k, w)).map(|p| p.neg());
+        let orientation = self.gain(m, &cross_unit(k, z)).map(|p| p.neg());
         let rotation = std::array::from_fn(|i| m[i][k].neg());
         self.add(slot, |c| &mut c.position, &position);
         self.add(slot, |c| &mut c.orientation, &orientation);
@@ -292,7 +320,8 @@ impl<'a> Walk<'a> {
     }
 
     /// Walks the tool chain from its end: records every tool error, and returns the tool
-    /// frame's rotation in the bed frame and the tool point in bed coordinates.
+    /// frame's rotation in the bed frame and (for the nominal pose) the tool point in bed
+    /// coordinates.
     fn tool_chain(&mut self) -> (Mat3, Vec3) {
         let mut q = identity();
         let mut lever = zero3();
@@ -330,12 +359,16 @@ impl<'a> Walk<'a> {
                 let moved = self.mat_t_vec(&q, &t);
                 for k in 0..3 {
                     lever[k] = self.namer.keep(lever[k].add(&moved[k]));
-                    point[k] = self.namer.keep(point[k].add(&t[k]));
+                    if self.nominal {
+                        point[k] = self.namer.keep(point[k].add(&t[k]));
+                    }
                 }
             }
             if let Some(r) = self.rotation(step) {
                 q = self.mat_mul(&r, &q);
-                point = self.mat_vec(&r, &point);
+                if self.nominal {
+                    point = self.mat_vec(&r, &point);
+                }
             }
         }
         (q, point)
@@ -364,8 +397,9 @@ impl<'a> Walk<'a> {
     }
 
     /// Walks both chains, recording every tracked error; returns the nominal pose of the tool
-    /// relative to the last frame of the work chain.
-    pub(crate) fn run(&mut self) -> Nominal {
+    /// relative to the last frame of the work chain when asked for
+    /// ([`Walk::with_nominal_pose`]).
+    pub(crate) fn run(&mut self) -> Option<Nominal> {
         let (tool_rotation, tool_point) = self.tool_chain();
         let steps = chain_steps(self.m, Side::Work);
         let levers = self.work_levers(&steps);
@@ -405,7 +439,7 @@ impl<'a> Walk<'a> {
             }
             if let Some(r) = self.rotation(step) {
                 m = self.mat_mul(&m, &r);
-                if i < end {
+                if self.nominal && i < end {
                     tip = self.mat_t_vec(&r, &tip);
                 }
             }
@@ -420,9 +454,9 @@ impl<'a> Walk<'a> {
                 self.work_rotation_error(slot, d, &m, &levers[i]);
             }
         }
-        Nominal {
+        self.nominal.then(|| Nominal {
             tool_point_in_work: tip,
             tool_to_work: std::array::from_fn(|i| std::array::from_fn(|j| m[j][i].clone())),
-        }
+        })
     }
 }

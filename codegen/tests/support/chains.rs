@@ -2,26 +2,22 @@
 //! the tests of long chains: a serial arm on the tool side and a rotary table stack on the work
 //! side, with every offset a kinematic symbol.
 //!
-//! `rotary` rotary axes in all: the arm gets the first half (rounded up), the table the rest.
-//! Counted over both chains, the axes turn about x, z, y and an inclined direction in turn: the
-//! arm's inclined axes about `[0, 1, 1]` (frame entries in `√2`), the table's about
-//! `[1, 1, 1]` (`√2`, `√3`). With `linear`, the tool chain starts with X, Y and Z slides (so that
-//! the tool-centre-point inverse kinematics puts the tool on the ball); a machine has at most 16
-//! axes, so `linear` allows at most 13 rotary axes.
+//! `rotary` rotary axes in all, taken in turn by the arm (axes 0, 2, 4, …, from its base to the
+//! tool) and the table (axes 1, 3, 5, …, from the bed to the workpiece), so that each machine
+//! is the one before with one more axis at the end of one chain. Along the arm the axes turn
+//! about x, z, −y and `[0, 1, 1]` in turn (an inclined axis, frame entries in `√2`), along the
+//! table about z, x, `[1, 1, 1]` (`√2`, `√3`) and −y. With `linear`, the tool chain starts with
+//! X, Y and Z slides (so that the tool-centre-point inverse kinematics puts the tool on the
+//! ball); a machine has at most 16 axes, so `linear` allows at most 13 rotary axes.
 
 /// The letters of the rotary axes, in order (no E, O or W; X, Y and Z are the slides).
 const LETTERS: &[u8] = b"ABCDFGHIJKLMNPQRSTUV";
 
-/// The direction of the `i`-th rotary axis (counted over both chains) on the tool side (`arm`)
-/// or the work side.
-fn direction(i: usize, arm: bool) -> &'static str {
-    match (i % 4, arm) {
-        (0, _) => "\"+x\"",
-        (1, _) => "\"+z\"",
-        (2, _) => "\"-y\"",
-        (_, true) => "[0, 1, 1]",
-        (_, false) => "[1, 1, 1]",
-    }
+/// The direction of the `k`-th rotary axis of the arm (`arm`) or the table.
+fn direction(k: usize, arm: bool) -> &'static str {
+    const ARM: [&str; 4] = ["\"+x\"", "\"+z\"", "\"-y\"", "[0, 1, 1]"];
+    const TABLE: [&str; 4] = ["\"+z\"", "\"+x\"", "[1, 1, 1]", "\"-y\""];
+    if arm { ARM[k % 4] } else { TABLE[k % 4] }
 }
 
 /// The description of the synthetic machine with `rotary` rotary axes (1 to 16; at most 13
@@ -51,10 +47,10 @@ pub fn synthetic_machine(rotary: usize, linear: bool) -> String {
             "[[{side}]]\naxis = \"{letter}\"\ntype = \"rotary\"\ndirection = {dir}\n\
              offset = [\"{letter}x\", \"{letter}y\", \"{letter}z\"]\n\n",
             side = if arm { "tool" } else { "work" },
-            dir = direction(i, arm),
+            dir = direction(i / 2, arm),
         ));
     };
-    for i in arm..rotary {
+    for i in (1..rotary).step_by(2) {
         axis(&mut work, &mut symbols, i, false);
     }
     symbols.push_str("wx = 30.0\nwy = -20.0\nwz = 60.0\ntx = 0.0\nty = 0.0\ntz = -120.0\n");
@@ -68,7 +64,7 @@ pub fn synthetic_machine(rotary: usize, linear: bool) -> String {
             ));
         }
     }
-    for i in 0..arm {
+    for i in (0..rotary).step_by(2) {
         axis(&mut tool, &mut symbols, i, true);
     }
     tool.push_str("[[tool]]\nend = \"probe\"\noffset = [\"tx\", \"ty\", \"tz\"]\n");

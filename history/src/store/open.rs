@@ -127,16 +127,41 @@ fn header_note(path: &Path) -> String {
             "; its header counts {pages} pages of {page} bytes ({} bytes) but the file has {len} bytes: it was truncated",
             pages * u64::from(page)
         )
-    } else if page >= 512 && len % u64::from(page) != 0 {
+    } else if page >= 512 && !len.is_multiple_of(u64::from(page)) {
         format!("; its length ({len} bytes) is not a whole number of its {page}-byte pages")
     } else {
         String::new()
     }
 }
 
+/// The path of SQLite's file `suffix` (`-wal`, `-shm`) beside the database at `path`.
+fn beside(path: &Path, suffix: &str) -> PathBuf {
+    let mut side = path.as_os_str().to_owned();
+    side.push(suffix);
+    PathBuf::from(side)
+}
+
 /// Checks, through a read-only connection, that the file is an rtest history database that is
-/// not damaged and whose version this rtest can read.
+/// not damaged and whose version this rtest can read. A refused file is left as it was: the
+/// empty write-ahead log and the shared-memory file that SQLite makes beside a WAL database
+/// when it opens one are removed again if they were not there before.
 fn check_contents(path: &Path) -> Res<()> {
+    let (wal, shm) = (beside(path, "-wal"), beside(path, "-shm"));
+    let (had_wal, had_shm) = (wal.exists(), shm.exists());
+    let checked = read_only_checks(path);
+    if checked.is_err() {
+        if !had_wal && std::fs::metadata(&wal).is_ok_and(|m| m.len() == 0) {
+            let _ = std::fs::remove_file(&wal);
+        }
+        if !had_shm && !wal.exists() {
+            let _ = std::fs::remove_file(&shm);
+        }
+    }
+    checked
+}
+
+/// The checks of [`check_contents`], on a connection closed when this returns.
+fn read_only_checks(path: &Path) -> Res<()> {
     let damaged = |e: rusqlite::Error| match HistoryError::sqlite(path, e) {
         HistoryError::NotHistory { file, reason } => HistoryError::NotHistory {
             file,
@@ -265,9 +290,7 @@ fn temporary_beside(path: &Path) -> PathBuf {
 fn remove_temporary(tmp: &Path) {
     let _ = std::fs::remove_file(tmp);
     for suffix in ["-wal", "-shm", "-journal"] {
-        let mut side = tmp.as_os_str().to_owned();
-        side.push(suffix);
-        let _ = std::fs::remove_file(PathBuf::from(side));
+        let _ = std::fs::remove_file(beside(tmp, suffix));
     }
 }
 

@@ -12,13 +12,13 @@
 //!   reproducibility of the set-up between checks;
 //! - **trend**: the weighted least-squares line `v = a + b·t` (weights `1/σ²`, `t` in days)
 //!   through the checks from the baseline up to this one (at least 3 checks at 2 times or
-//!   more). Its slope's standard error is the larger of the one the recorded uncertainties
-//!   give, `√(1/Σw(t − t̄)²)`, and that one times the Birge ratio `√(χ²/(n − 2))` of the
-//!   checks' scatter about the line. The flag fires when `|b|/SE` exceeds Student's
-//!   two-sided quantile of `alpha` with `n − 2` degrees of freedom. When the recorded
-//!   uncertainties are right the test is conservative; when the checks scatter more than they
-//!   say (set-up, temperature), the scatter sets the standard error and Student's t makes
-//!   the level right for few checks.
+//!   more). The weights give the checks' relative precision; the scale comes from the
+//!   checks' own scatter about the line: the slope's standard error is
+//!   `√(1/Σw(t − t̄)²)` times the Birge ratio `√(χ²/(n − 2))`, and the flag fires when
+//!   `|b|/SE` exceeds Student's two-sided quantile of `alpha` with `n − 2` degrees of freedom.
+//!   The level is exactly `alpha` when the checks' variances are proportional to their
+//!   recorded `σ²` (right, or all understated by one factor, as when the set-up's
+//!   reproducibility adds to every check alike), whatever the number of checks.
 //!
 //! Each row's flags use only that check and the checks before it (a later check never changes
 //! an earlier row); the trend over the whole series is [`Assessment::trend`].
@@ -152,7 +152,8 @@ pub struct Slope {
     pub checks: usize,
     /// The slope, unit per day.
     pub per_day: f64,
-    /// Its standard error, unit per day.
+    /// Its standard error, unit per day: the one the recorded uncertainties give, times the
+    /// scatter ratio.
     pub std_per_day: f64,
     /// The Birge ratio `√(χ²/(n − 2))` of the checks about the line: how much more they
     /// scatter than their uncertainties say (about 1 when those are right).
@@ -230,7 +231,15 @@ pub fn slope(points: &[Point], alpha: f64) -> Option<Slope> {
         .sum();
     let dof = n - 2;
     let scatter_ratio = (chi2 / dof as f64).sqrt();
-    let se = (1.0 / sxx).sqrt() * scatter_ratio.max(1.0);
+    // Checks on a line to rounding (noise-free data: a ratio below 1e-6, which noisy checks
+    // reach with a probability below 1e-6) have no scatter to scale by: then the recorded
+    // uncertainties give the standard error.
+    let scale = if scatter_ratio >= 1e-6 {
+        scatter_ratio
+    } else {
+        1.0
+    };
+    let se = (1.0 / sxx).sqrt() * scale;
     let t = b / se;
     let critical = student_two_sided(alpha, dof);
     let values = [b, se, t, scatter_ratio];

@@ -34,8 +34,10 @@ pub struct Parameter {
     /// Its basis column (`const`, `harmonic:2:cos`, …).
     pub basis: String,
     /// In a campaign: `shared`, `setup` or `record`; `None` in a single identification.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub owner: Option<String>,
     /// In a campaign: the set-up's or record's label of a `setup` or `record` parameter.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub of: Option<String>,
     /// The estimate, in `unit`; `None` when the data did not determine it.
     pub value: Option<f64>,

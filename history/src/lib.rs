@@ -15,13 +15,15 @@
 //!   record at once; a damaged or foreign file is refused with its name and never changed.
 //! - [`trend`] selects one error's comparable checks of one machine and flags them: beyond
 //!   tolerance ([`tolerance`]), changed against a baseline, drifting (a weighted least-squares
-//!   slope and Student's t, [`stats`]).
+//!   slope and Student's t, [`stats`]); [`report`] writes the listing and the trend for
+//!   people, as CSV and as JSON.
 //!
 //! Values are kept in the unit the reports give them: µm for translational errors, µrad for
 //! angular ones.
 
 pub mod check;
 pub mod error;
+pub mod report;
 pub mod schema;
 pub mod sha256;
 pub mod stats;

@@ -152,6 +152,11 @@ pub struct Slope {
     pub checks: usize,
     /// The slope, unit per day.
     pub per_day: f64,
+    /// The weighted mean time of the run, days after its first check: the line is
+    /// `centre_value + per_day·(t − centre_days)`.
+    pub centre_days: f64,
+    /// The weighted mean value of the run, in the unit.
+    pub centre_value: f64,
     /// Its standard error, unit per day: the one the recorded uncertainties give, times the
     /// scatter ratio.
     pub std_per_day: f64,
@@ -251,6 +256,8 @@ pub fn slope(points: &[Point], alpha: f64) -> Option<Slope> {
         to: points[n - 1].id,
         checks: n,
         per_day: b,
+        centre_days: xm,
+        centre_value: ym,
         std_per_day: se,
         scatter_ratio,
         t,
@@ -357,16 +364,16 @@ pub fn assess(series: &Series, options: &Options) -> Result<Assessment, TrendErr
                 statistic: s.t.abs(),
                 threshold: s.critical,
                 text: format!(
-                    "drift {}{} {unit}/day over checks {}–{} ({} checks): |t| = {} > t({}; {}) = {} (two-sided α = {alpha}, Student)",
+                    "drift {}{} ± {} {unit}/day over checks {}–{} ({} checks): |t| = {} > {}, Student's two-sided quantile of α = {alpha} with {} degrees of freedom",
                     if s.per_day >= 0.0 { "+" } else { "" },
                     model_spec::units::readable(s.per_day, 4),
+                    model_spec::units::readable(s.std_per_day, 4),
                     s.from,
                     s.to,
                     s.checks,
                     fixed(s.t.abs(), 2),
-                    s.dof,
-                    alpha,
-                    fixed(s.critical, 3)
+                    fixed(s.critical, 3),
+                    s.dof
                 ),
             });
         }

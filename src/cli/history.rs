@@ -88,9 +88,14 @@ impl RecordArgs {
             None => Vec::new(),
             Some(list) => {
                 let paths: Vec<String> = list.split(',').map(|p| p.trim().to_string()).collect();
-                for p in &paths {
+                for (i, p) in paths.iter().enumerate() {
                     history::check::label("test path", p, true)
                         .map_err(|e| CliError::usage(format!("--record-paths: {e}")))?;
+                    if paths[..i].iter().any(|q| q.eq_ignore_ascii_case(p)) {
+                        return Err(CliError::usage(format!(
+                            "--record-paths: test path `{p}` is given twice"
+                        )));
+                    }
                 }
                 paths
             }
@@ -182,6 +187,13 @@ impl Recorder {
     /// # Errors
     /// A bad input for a database that cannot be made or written, or a check it refuses.
     pub fn stage(&mut self, check: &Check) -> CliResult<Staged<'_>> {
+        // A check the database would refuse makes no database.
+        check.validate().map_err(|e| {
+            CliError::input(format!(
+                "--db {}: cannot record the check: {e}",
+                self.db.display()
+            ))
+        })?;
         if self.store.is_none() {
             self.store =
                 Some(Store::open_or_create(&self.db).map_err(|e| history_error("--db", e))?);

@@ -21,6 +21,8 @@
 //! Values are kept in the unit the reports give them: µm for translational errors, µrad for
 //! angular ones.
 
+#![warn(missing_docs)]
+
 pub mod check;
 pub mod error;
 pub mod report;

@@ -519,6 +519,10 @@ fn the_real_pipeline_flags_a_drifting_location_error() {
     println!("first (baseline, trend) flags per series, checks 1-20: {firsts:?}");
     // The recorded σ are honest: the values scatter about the truth by their σ.
     let var = zs.iter().map(|z| z * z).sum::<f64>() / zs.len() as f64;
+    println!(
+        "mean square of (v − truth)/σ over {} checks: {var:.3}",
+        zs.len()
+    );
     assert!(
         (0.75..=1.3).contains(&var),
         "variance of (v − truth)/σ: {var}"

@@ -354,7 +354,7 @@ pub fn run(args: &HistoryArgs) -> CliResult {
             listing(&name, &machines, &checks)
         }
         (Some(id), Some(error)) => trend_outputs(args, &name, &all, id, error, &mut files)?,
-        (None, Some(_)) => unreachable!("clap requires --machine-id with --error"),
+        (None, Some(_)) => return Err(CliError::usage("--error needs --machine-id ID")),
     };
     text.push_str(&wrote(&write(files)?));
     print_text(&text, stdout_taken)
@@ -377,7 +377,8 @@ fn trend_error(e: TrendError) -> CliError {
             CliError::usage(format!("--error: {e}"))
         }
         TrendError::Reference { .. } => CliError::usage(format!("--baseline: {e}")),
-        TrendError::Options(m) => CliError::usage(format!("--alpha: {m}")),
+        TrendError::Alpha(m) => CliError::usage(format!("--alpha: {m}")),
+        TrendError::Tolerance(m) => CliError::usage(format!("--tolerance: {m}")),
         TrendError::UnknownMachine { .. } => CliError::usage(format!("--machine-id: {e}")),
         TrendError::EmptyHistory => CliError::input(format!("--db: {e}")),
     }

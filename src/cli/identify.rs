@@ -80,7 +80,14 @@ base_model, terms, parameters: [{name, error, basis, value, std, unit, determine
 residual_rms_um, rank, condition, confounded, samples, sigma_um, near_confounded, refinement: \
 {method, iterations, converged, …}, noise_model: {source, sigma_um, phi, whitened_sigma, text}, \
 notes, …}; `rtest validate --params` reads it. `--json -` \
-writes it to standard output (the text then goes to standard error).";
+writes it to standard output (the text then goes to standard error).
+
+History (docs/history.md): --record --machine-id ID keeps the identification, once it succeeded \
+and its outputs are written, in the machine's history database (--db, default \
+rtest-history.sqlite): machine id and fingerprint, model and terms, test paths (--record-paths), \
+the measurement time (--measured-at), the SHA-256 of every input file, every value with its σ and \
+unit, rank, unidentifiable groups and residual. rtest history shows the checks and each error's \
+trend.";
 
 /// Flags of `rtest identify`.
 #[derive(Debug, clap::Args)]

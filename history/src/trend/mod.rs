@@ -78,9 +78,12 @@ pub enum TrendError {
         /// Why.
         reason: String,
     },
-    /// A level outside [`ALPHA_RANGE`] or a tolerance that is not a positive number.
+    /// A level outside [`ALPHA_RANGE`].
     #[error("{0}")]
-    Options(String),
+    Alpha(String),
+    /// A tolerance that is not a positive number.
+    #[error("{0}")]
+    Tolerance(String),
 }
 
 /// What to flag.
@@ -271,12 +274,12 @@ pub fn slope(points: &[Point], alpha: f64) -> Option<Slope> {
 /// The flags of `series` under `options`.
 ///
 /// # Errors
-/// [`TrendError::Options`] for a level outside [`ALPHA_RANGE`] or a tolerance that is not a
-/// positive finite number; [`TrendError::Reference`] for a baseline not in the series.
+/// [`TrendError::Alpha`] for a level outside [`ALPHA_RANGE`], [`TrendError::Tolerance`] for
+/// a tolerance that is not a positive finite number; [`TrendError::Reference`] for a baseline not in the series.
 pub fn assess(series: &Series, options: &Options) -> Result<Assessment, TrendError> {
     let alpha = options.alpha;
     if !(ALPHA_RANGE.0..=ALPHA_RANGE.1).contains(&alpha) {
-        return Err(TrendError::Options(format!(
+        return Err(TrendError::Alpha(format!(
             "the level alpha must be between {} and {}, not {alpha}",
             ALPHA_RANGE.0, ALPHA_RANGE.1
         )));
@@ -284,7 +287,7 @@ pub fn assess(series: &Series, options: &Options) -> Result<Assessment, TrendErr
     if let Some(l) = options.tolerance
         && !(l.is_finite() && l > 0.0)
     {
-        return Err(TrendError::Options(format!(
+        return Err(TrendError::Tolerance(format!(
             "a tolerance must be a positive number, not {l}"
         )));
     }

@@ -49,10 +49,11 @@ enum Verb {
     Instrument(cli::instrument::InstrumentVerb),
     Segment(cli::segment::SegmentArgs),
     Plan(cli::plan::PlanArgs),
+    History(cli::history::HistoryArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 15] = [
+const VERBS: [&str; 16] = [
     "machines",
     "gains",
     "generate",
@@ -68,6 +69,7 @@ const VERBS: [&str; 15] = [
     "instrument",
     "segment",
     "plan",
+    "history",
 ];
 
 /// A clap error as one line: its message and its hints, without the usage block.
@@ -128,6 +130,7 @@ fn main() -> ExitCode {
         Verb::Instrument(a) => cli::instrument::run(a),
         Verb::Segment(a) => cli::segment::run(a),
         Verb::Plan(a) => cli::plan::run(a),
+        Verb::History(a) => cli::history::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -534,8 +534,10 @@ fn draw_path_panel(
 }
 
 mod spectrum;
+mod trend;
 
 pub use spectrum::spectrum;
+pub use trend::{TrendFigure, TrendPoint, trend};
 
 #[cfg(test)]
 mod tests;

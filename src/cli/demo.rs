@@ -10,6 +10,12 @@ use std::time::Instant;
 /// Directory the demo writes to, relative to the working directory.
 const OUT_DIR: &str = "rtest-demo";
 
+/// The history database the demo records its identification in, inside [`OUT_DIR`].
+const HISTORY: &str = "rtest-history.sqlite";
+
+/// The machine id of the demo's virtual machine in that history.
+const MACHINE_ID: &str = "demo";
+
 /// Flags of `rtest demo`.
 #[derive(Debug, clap::Args)]
 #[command(
@@ -43,8 +49,10 @@ gains-reduced.md (the Markdown gain table of the reduced model, mm/mm and mm/rad
 diagnose.json (rtest diagnose --json), seed-ac-extended.toml (the machine with the extended \
 model, rtest diagnose --model-out) and the figures of rtest diagnose --plot: k4-path.svg, \
 k1-path.svg, k2-path.svg (measured against predicted error, base and extended model) and \
-k4-spectrum.svg, k1-spectrum.svg, k2-spectrum.svg (residual components before and after). The \
-same steps one by one: rtest simulate / identify / validate / diagnose.",
+k4-spectrum.svg, k1-spectrum.svg, k2-spectrum.svg (residual components before and after). It \
+records the identification on K4 in the history database rtest-demo/rtest-history.sqlite \
+(machine id demo; each run adds a check: rtest history --db rtest-demo/rtest-history.sqlite). The \
+same steps one by one: rtest simulate / identify / validate / diagnose / history.",
     after_help = EXIT_CODES
 )]
 pub struct DemoArgs {}
@@ -54,6 +62,9 @@ pub fn run(_args: &DemoArgs) -> CliResult {
     let start = Instant::now();
     let dir = Path::new(OUT_DIR);
     check_outputs(&[], &[], &[("demo", dir)])?;
+    // A history left by an earlier run is checked before any work.
+    let db = dir.join(HISTORY);
+    let mut recorder = super::history::Recorder::open("demo:", &db, MACHINE_ID, &["K4"])?;
     let result = demo::run(OUT_DIR).map_err(|e| CliError::computation(e.to_string()))?;
     let mut files = Outputs::new();
     let mut listed = Vec::new();
@@ -66,6 +77,35 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         listed.push((name, what));
     }
     write(files)?;
+    let recorded = record(&mut recorder, &result.files)?;
     let seconds = start.elapsed().as_secs_f64();
-    super::print(&(result.text + &demo::written(OUT_DIR, &listed, seconds)))
+    super::print(&(result.text + &demo::written(OUT_DIR, &listed, seconds) + &recorded))
+}
+
+/// Records the demo's identification on K4 (its `identify.json`, from `k4.csv`) in the
+/// history; returns the line that says so.
+fn record(recorder: &mut super::history::Recorder, files: &[demo::DemoFile]) -> CliResult<String> {
+    let file = |name: &str| {
+        files
+            .iter()
+            .find(|f| f.name == name)
+            .ok_or_else(|| CliError::computation(format!("demo: no {name} to record")))
+    };
+    let k4 = file("k4.csv")?;
+    recorder.add_input(
+        "--data",
+        &format!("{OUT_DIR}/k4.csv"),
+        k4.contents.as_bytes(),
+    );
+    let report: solver::io::report::IdentificationReport =
+        serde_json::from_str(&file("identify.json")?.contents)
+            .map_err(|e| CliError::computation(format!("demo: identify.json: {e}")))?;
+    let check = history::Check::from_identification(&report, recorder.provenance());
+    let id = recorder
+        .stage(&check)?
+        .commit()
+        .map_err(|e| CliError::input(format!("demo: {e}")))?;
+    Ok(format!(
+        "Recorded the identification on K4 as check {id} of machine `{MACHINE_ID}` in {OUT_DIR}/{HISTORY}; its trend: rtest history --db {OUT_DIR}/{HISTORY} --machine-id {MACHINE_ID} --error XOC\n"
+    ))
 }

@@ -3,7 +3,8 @@
 
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use super::history;
+use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text};
 use output::{Outputs, Target};
 use solver::fitting::campaign::{identify_campaign, identify_campaign_refined};
 use solver::fitting::hmatrix::HMatrixError;
@@ -79,7 +80,14 @@ base_model, terms, parameters: [{name, error, basis, value, std, unit, determine
 residual_rms_um, rank, condition, confounded, samples, sigma_um, near_confounded, refinement: \
 {method, iterations, converged, …}, noise_model: {source, sigma_um, phi, whitened_sigma, text}, \
 notes, …}; `rtest validate --params` reads it. `--json -` \
-writes it to standard output (the text then goes to standard error).";
+writes it to standard output (the text then goes to standard error).
+
+History (docs/history.md): --record --machine-id ID keeps the identification, once it succeeded \
+and its outputs are written, in the machine's history database (--db, default \
+rtest-history.sqlite): machine id and fingerprint, model and terms, test paths (--record-paths), \
+the measurement time (--measured-at), the SHA-256 of every input file, every value with its σ and \
+unit, rank, unidentifiable groups and residual. rtest history shows the checks and each error's \
+trend.";
 
 /// Flags of `rtest identify`.
 #[derive(Debug, clap::Args)]
@@ -151,6 +159,8 @@ pub struct IdentifyArgs {
     instrument: args::InstrumentArgs,
     #[command(flatten)]
     bounds: ValueBounds,
+    #[command(flatten)]
+    history: history::RecordArgs,
 }
 
 /// Runs `rtest identify`.
@@ -190,7 +200,11 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     inputs.extend(args.instrument.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
-    check_outputs(&inputs, &outputs, &[])?;
+    let db = args.history.input();
+    let mut all_inputs = inputs.clone();
+    all_inputs.extend(db.as_ref().map(|(f, p)| (*f, p.as_path())));
+    check_outputs(&all_inputs, &outputs, &[])?;
+    let mut recorder = args.history.recorder(&inputs)?;
     let read = args.records.read_options();
     let noise = args.noise.choice(&m, &read, &args.instrument)?;
     let data = data_path.display().to_string();
@@ -261,7 +275,10 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         files.add("--json", target.clone(), json);
     }
     let stdout_taken = matches!(args.json, Some(Target::Stdout));
-    text.push_str(&wrote(&write(files)?));
+    let check = recorder
+        .as_ref()
+        .map(|r| ::history::Check::from_identification(&report, r.provenance()));
+    text.push_str(&history::write_and_record(files, recorder.as_mut(), check)?);
     print_text(&text, stdout_taken)
 }
 
@@ -333,7 +350,11 @@ fn run_campaign(
     inputs.extend(args.instrument.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
-    check_outputs(&inputs, &outputs, &[])?;
+    let db = args.history.input();
+    let mut checked = inputs.clone();
+    checked.extend(db.as_ref().map(|(f, p)| (*f, p.as_path())));
+    check_outputs(&checked, &outputs, &[])?;
+    let mut recorder = args.history.recorder(&inputs)?;
     loaded.check_times(flag, m, model)?;
     let noise = args.noise.choice(m, &read, &args.instrument)?;
     let opts = IdentifyOptions::new().constraint(args::constraint(args.constraint.as_deref())?);
@@ -377,7 +398,10 @@ fn run_campaign(
         out.add("--json", target.clone(), json);
     }
     let stdout_taken = matches!(args.json, Some(Target::Stdout));
-    text.push_str(&wrote(&write(out)?));
+    let check = recorder
+        .as_ref()
+        .map(|r| ::history::Check::from_campaign(&report, r.provenance()));
+    text.push_str(&history::write_and_record(out, recorder.as_mut(), check)?);
     print_text(&text, stdout_taken)
 }
 

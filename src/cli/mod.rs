@@ -11,6 +11,7 @@ pub mod diagnose;
 pub mod figures;
 pub mod gains;
 pub mod generate;
+pub mod history;
 pub mod identify;
 pub mod instrument;
 pub mod machines;

@@ -5,6 +5,7 @@
 
 use crate::time::Timestamp;
 use serde::Serialize;
+use solver::io::report::identify::ParameterReport;
 use solver::io::report::{CampaignReport, IdentificationReport};
 
 /// The longest machine id, test-path label, or text field of a check, in characters.
@@ -50,6 +51,25 @@ pub struct Parameter {
     pub determined: bool,
     /// Fixed to 0 by the constraint.
     pub fixed: bool,
+}
+
+impl Parameter {
+    /// The parameter as an identification report writes it; `owner` and `of` as a campaign
+    /// report gives them (`None` in a single identification).
+    fn from_report(q: &ParameterReport, owner: Option<String>, of: Option<String>) -> Parameter {
+        Parameter {
+            name: q.name.clone(),
+            error: q.error.clone(),
+            basis: q.basis.clone(),
+            owner,
+            of,
+            value: q.value,
+            std: q.std,
+            unit: q.unit.clone(),
+            determined: q.determined,
+            fixed: q.fixed,
+        }
+    }
 }
 
 /// Whether a check fitted one record or a campaign.
@@ -177,18 +197,7 @@ impl Check {
             parameters: report
                 .parameters
                 .iter()
-                .map(|q| Parameter {
-                    name: q.name.clone(),
-                    error: q.error.clone(),
-                    basis: q.basis.clone(),
-                    owner: None,
-                    of: None,
-                    value: q.value,
-                    std: q.std,
-                    unit: q.unit.clone(),
-                    determined: q.determined,
-                    fixed: q.fixed,
-                })
+                .map(|q| Parameter::from_report(q, None, None))
                 .collect(),
             rank: report.rank,
             free_parameters: report.free_parameters,
@@ -239,21 +248,7 @@ impl Check {
             parameters: report
                 .parameters
                 .iter()
-                .map(|c| {
-                    let q = &c.parameter;
-                    Parameter {
-                        name: q.name.clone(),
-                        error: q.error.clone(),
-                        basis: q.basis.clone(),
-                        owner: Some(c.owner.clone()),
-                        of: c.of.clone(),
-                        value: q.value,
-                        std: q.std,
-                        unit: q.unit.clone(),
-                        determined: q.determined,
-                        fixed: q.fixed,
-                    }
-                })
+                .map(|c| Parameter::from_report(&c.parameter, Some(c.owner.clone()), c.of.clone()))
                 .collect(),
             rank: report.rank,
             free_parameters: report.free_parameters,

@@ -5,10 +5,10 @@
 //! against (a generic "first-order HTM product" library), and a third independent check of the
 //! gains.
 
-use model_spec::kinematics::{FrameTurn, Step, chain_steps};
+use model_spec::kinematics::{Step, chain_steps};
 use model_spec::{AxisKind, ErrorId, Machine, Side, Value};
 use nalgebra::{Matrix3, Vector3};
-use solver::simulation::exact::coordinate_rotation;
+use solver::simulation::exact::{coordinate_rotation, frame_rotation};
 
 /// A machine's chains lowered once, for repeated evaluation.
 #[derive(Clone, Debug)]
@@ -97,12 +97,7 @@ impl<'m> FirstOrderChain<'m> {
                     }
                 }
                 Step::Frame { axis, turn } => {
-                    // Columns x' y' z' (nalgebra reads the rows of `frame()` as columns).
-                    let own = Matrix3::from(self.m.axes[*axis].direction.frame());
-                    let r = match turn {
-                        FrameTurn::Into => own,
-                        FrameTurn::Back => own.transpose(),
-                    };
+                    let r = *frame_rotation(&self.m.axes[*axis].direction, *turn).matrix();
                     v.nominal = r * v.nominal;
                     for p in &mut v.parts {
                         *p = r * *p;

@@ -32,8 +32,8 @@
 //! mounted anew has a position of its own.
 
 use crate::model::{Effect, Model};
-use crate::simulation::exact::coordinate_rotation;
-use model_spec::kinematics::{FrameTurn, Step, chain_steps};
+use crate::simulation::exact::{coordinate_rotation, frame_rotation};
+use model_spec::kinematics::{Step, chain_steps};
 use model_spec::units::short;
 use model_spec::{AxisKind, Machine, Side, SymbolId, Value};
 use nalgebra::{Matrix3, Vector3};
@@ -85,15 +85,9 @@ impl<'m> OffsetGains<'m> {
                         r *= coordinate_rotation(own.dir, q).matrix();
                     }
                 }
-                // Into (or back out of) an inclined axis's own frame, as the exact chain has
-                // it: nalgebra reads `[[f64; 3]; 3]` as columns, so `own` has the columns
-                // x' y' z'.
+                // Into (or back out of) an inclined axis's own frame, as the exact chain has it.
                 Step::Frame { axis, turn } => {
-                    let own = Matrix3::from(m.axes[*axis].direction.frame());
-                    r *= match turn {
-                        FrameTurn::Into => own,
-                        FrameTurn::Back => own.transpose(),
-                    };
+                    r *= frame_rotation(&m.axes[*axis].direction, *turn).matrix();
                 }
                 // Errors are zero in the nominal chain: identity.
                 Step::ErrorTranslation(_) | Step::ErrorRotation(_) => {}

@@ -28,7 +28,7 @@
 //! machine and the expected length.
 
 use model_spec::kinematics::{FrameTurn, Step, chain_steps};
-use model_spec::{AxisKind, Dir, ErrorId, Machine, Offset, Side, Value};
+use model_spec::{AxisDirection, AxisKind, Dir, ErrorId, Machine, Offset, Side, Value};
 use nalgebra::{Matrix3, Rotation3, Translation3, Vector3};
 
 /// A rigid transform of the exact virtual machine: rotation matrix and translation (mm).
@@ -93,6 +93,17 @@ impl ErrorVector {
         let (p, o) = (&self.position, &self.orientation);
         [p.x, p.y, p.z, o.x, o.y, o.z]
     }
+}
+
+/// The rotation of a [`Step::Frame`] of an axis whose direction is `direction`: into its own
+/// frame (the matrix whose columns are `x' y' z'`) or back (its transpose).
+pub fn frame_rotation(direction: &AxisDirection, turn: FrameTurn) -> Rotation3<f64> {
+    // nalgebra reads `[[f64; 3]; 3]` as columns: `own` has the columns x' y' z'.
+    let own = Matrix3::from(direction.frame());
+    Rotation3::from_matrix_unchecked(match turn {
+        FrameTurn::Into => own,
+        FrameTurn::Back => own.transpose(),
+    })
 }
 
 /// The rotation by `angle` (rad) about the positive coordinate direction `dir`.
@@ -206,18 +217,10 @@ impl<'m> VirtualMachine<'m> {
                         * coordinate_rotation(Dir::Y, err(&e[1]))
                         * coordinate_rotation(Dir::Z, err(&e[2])),
                 ),
-                Step::Frame { axis, turn } => {
-                    // nalgebra reads `[[f64; 3]; 3]` as columns: `own` has the columns x' y' z'.
-                    let own = Matrix3::from(self.machine.axes[*axis].direction.frame());
-                    let rows = match turn {
-                        FrameTurn::Into => own,
-                        FrameTurn::Back => own.transpose(),
-                    };
-                    Transform::from_parts(
-                        Translation3::identity(),
-                        Rotation3::from_matrix_unchecked(rows),
-                    )
-                }
+                Step::Frame { axis, turn } => Transform::from_parts(
+                    Translation3::identity(),
+                    frame_rotation(&self.machine.axes[*axis].direction, *turn),
+                ),
                 Step::Motion {
                     axis,
                     positioning_error,

@@ -35,7 +35,7 @@ The model is --model NAME (the terms of a model of the machine: full, reduced, �
 (NAME or NAME@BASIS: XOC, ECC@harmonic:2, EXX@reversal, EXX@poly:2, dx0@time:1, \
 EXX@period:5, EXX@step:100, dz0@exp:20, ECC@velocity, SXY), or both (the terms are added to the \
 model). velocity (the servo lag, in ms) and exp:TAU need a `t_s` column; the instrument terms \
-SXX … SZY are dimensionless (docs/conventions.md). The record needs at least one reading (3 per sample) more than \
+SXX … SZY are dimensionless (docs/conventions.md); a kinematic symbol of the description, written exactly as under [symbols] (Zt, Xw), is identified as its change in µm (constants only; the report gives its nominal and identified length in mm, docs/identification.md). The record needs at least one reading (3 per sample) more than \
 the model has parameters.
 
 A parameter the data cannot determine gets no number: it is printed as \"not determined: \
@@ -106,7 +106,8 @@ pub struct IdentifyArgs {
     model: Option<String>,
     /// Terms to identify, added to --model or alone: comma list of NAME or NAME@BASIS
     /// (`ECC@harmonic:2,dx0@time:1`; bases const, harmonic:K, poly:K, reversal, time:K,
-    /// period:P, step:V, exp:TAU, velocity; instrument terms SXX … SZY).
+    /// period:P, step:V, exp:TAU, velocity; instrument terms SXX … SZY; kinematic symbols by
+    /// their exact name, `Zt`, identified as a change in µm).
     #[arg(long, value_name = "LIST")]
     terms: Option<String>,
     /// The measurement CSV (axes in mm and degrees, dx_um,dy_um,dz_um in µm), or a comma list

@@ -9,7 +9,8 @@
 //! `first + k`), each defined in the atoms and earlier intermediates, so a gain is a small
 //! polynomial over a DAG whose size grows with the chain, not exponentially.
 //!
-//! A chain short enough never reaches the bound: every built-in machine derives exactly the
+//! A chain short enough is not named at all ([`crate::GainModel::derive`] tries the expanded
+//! form first, up to [`DeriveOptions::EXPAND_UP_TO`] terms): every built-in machine derives exactly the
 //! expanded canonical polynomials of the seed's tables, and compiles to the same program.
 //! Intermediates are named up to a constant factor (`p`, `−p` and `2p` share one), and a
 //! polynomial named twice is one intermediate.
@@ -35,12 +36,16 @@ impl DeriveOptions {
         max_terms: usize::MAX,
     };
 
-    /// The default bound, 6 terms: one more than the largest quantity or product of any
-    /// built-in machine (5 terms), so that their gains and programs are the expanded ones. A
-    /// smaller bound names more and gives long chains fewer operations: the gains of the
+    /// The default bound for chains too long to expand, 6 terms. A smaller bound names more and gives long chains fewer operations: the gains of the
     /// synthetic chain of 12 rotary axes take 1 856 operations at 6 terms, 2 132 at 8, 2 507 at
     /// 12 and 2 849 at 24 (`docs/codegen.md`, long chains).
     pub const DEFAULT_MAX_TERMS: usize = 6;
+
+    /// The bound under which [`crate::GainModel::derive`] keeps a chain expanded, 32 terms:
+    /// when no quantity or product of a chain exceeds it, nothing is named. Every built-in
+    /// machine stays under it (the largest, the nutating head, reaches 20 terms; axes along
+    /// x, y and z reach 7); the synthetic chains exceed it from 7 rotary axes on.
+    pub const EXPAND_UP_TO: usize = 32;
 }
 
 impl Default for DeriveOptions {
@@ -216,6 +221,10 @@ pub(crate) struct Namer {
     definitions: Vec<Poly>,
     /// Monic polynomial (leading coefficient 1) → its intermediate.
     named: FxHashMap<Poly, Atom>,
+    /// A trial that names nothing ([`Namer::trial`]).
+    trial: bool,
+    /// Set when a trial met a quantity beyond its bound.
+    exceeded: bool,
 }
 
 impl Namer {
@@ -227,7 +236,24 @@ impl Namer {
             rules: Rules::of(atoms),
             definitions: Vec::new(),
             named: FxHashMap::default(),
+            trial: false,
+            exceeded: false,
         }
+    }
+
+    /// A namer that names nothing: a quantity beyond `max_terms` marks the trial as
+    /// [`Namer::exceeded`] and becomes zero, so that the rest of the walk stays cheap (its
+    /// result is then discarded).
+    pub(crate) fn trial(atoms: &AtomTable, max_terms: usize) -> Namer {
+        Namer {
+            trial: true,
+            ..Namer::new(atoms, DeriveOptions { max_terms })
+        }
+    }
+
+    /// `true` when a trial met a quantity it would have had to name.
+    pub(crate) fn exceeded(&self) -> bool {
+        self.exceeded
     }
 
     /// `p` in canonical form.
@@ -249,6 +275,10 @@ impl Namer {
     fn name(&mut self, p: &Poly) -> Poly {
         if p.len() <= 1 {
             return p.clone();
+        }
+        if self.trial {
+            self.exceeded = true;
+            return Poly::zero();
         }
         let lead = p.leading_coefficient();
         let scaled;

@@ -142,3 +142,30 @@ fn other_topologies_compile_without_warnings() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[path = "support/chains.rs"]
+mod chains;
+
+/// Inclined axes and long chains: a table turning about `[0, 1, 1]` (its compensation module
+/// holds `√2` in `f64` and `f32`), a chain of twelve rotary axes with inclined ones, whole and
+/// split. The roots of the frames are written as `core::f64::consts::SQRT_2`, not as literals
+/// Clippy denies (`approx_constant`).
+#[test]
+fn inclined_axes_and_long_chains_compile_without_warnings() {
+    let dir = support::scratch("inclined");
+    let tilted = include_str!("machines/one-rotary.toml").replace("\"-y\"", "[0, 1, 1]");
+    let tilted = model_spec::parse_machine("tilted.toml", &tilted).unwrap();
+    let code = codegen::emit::generate_machine(&tilted, &[]).unwrap();
+    assert!(code.contains("pub mod compensation"));
+    assert!(
+        code.contains("core::f64::consts::SQRT_2") && code.contains("core::f32::consts::SQRT_2")
+    );
+    support::check_no_std_lib(&dir, &code);
+    let chain = chains::synthetic(12, false);
+    for bound in [codegen::MAX_INSTRUCTIONS, 600] {
+        let code = codegen::emit::generate_machine_with(&chain, &[], bound).unwrap();
+        assert_eq!(bound < 1000, code.contains("fn gains_part1("));
+        support::check_no_std_lib(&dir, &code);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -112,10 +112,20 @@ pub struct GainModel {
 }
 
 impl GainModel {
-    /// Derives the gains of `errors` (catalogue ids of `m`, any order; kept in the given order)
-    /// with the default bound of terms ([`DeriveOptions::default`]).
+    /// Derives the gains of `errors` (catalogue ids of `m`, any order; kept in the given order).
+    ///
+    /// A chain whose every quantity and product stays within
+    /// [`DeriveOptions::EXPAND_UP_TO`] terms is kept expanded: on such short chains the expanded
+    /// polynomials compile to the fewest operations (a nutating head with its `√2` entries
+    /// takes 228 operations expanded, 267 with the default bound). A longer chain is derived
+    /// with the default bound ([`DeriveOptions::default`]), whose operations grow with the
+    /// chain instead of doubling with every axis; the first attempt then costs one more
+    /// derivation at the larger bound, itself bounded.
     pub fn derive(m: &Machine, errors: &[ErrorId]) -> GainModel {
-        GainModel::derive_with(m, errors, DeriveOptions::default())
+        let atoms = AtomTable::new(m);
+        let trial = Namer::trial(&atoms, DeriveOptions::EXPAND_UP_TO);
+        GainModel::derive_in(m, errors, atoms, trial)
+            .unwrap_or_else(|| GainModel::derive_with(m, errors, DeriveOptions::default()))
     }
 
     /// Derives the gains of `errors` keeping polynomials of at most `options.max_terms` terms
@@ -127,8 +137,24 @@ impl GainModel {
     /// gains are the same whatever the bound.
     pub fn derive_with(m: &Machine, errors: &[ErrorId], options: DeriveOptions) -> GainModel {
         let atoms = AtomTable::new(m);
-        let mut w = Walk::new(m, &atoms, Namer::new(&atoms, options), errors);
+        let namer = Namer::new(&atoms, options);
+        GainModel::derive_in(m, errors, atoms, namer)
+            .expect("only a trial namer gives up, and this one names")
+    }
+
+    /// The gains derived with `namer`; `None` when it is a trial that met a quantity beyond
+    /// its bound.
+    fn derive_in(
+        m: &Machine,
+        errors: &[ErrorId],
+        atoms: AtomTable,
+        namer: Namer,
+    ) -> Option<GainModel> {
+        let mut w = Walk::new(m, &atoms, namer, errors);
         w.run();
+        if w.exceeded() {
+            return None;
+        }
         let (out, inter) = w.finish();
         let mut shared: Vec<[Poly; 6]> = out
             .into_iter()
@@ -147,7 +173,7 @@ impl GainModel {
                 }
             }
         }
-        GainModel {
+        Some(GainModel {
             machine: m.name.clone(),
             error_names: errors
                 .iter()
@@ -160,7 +186,7 @@ impl GainModel {
             errors: errors.to_vec(),
             atoms,
             gains: Gains::new(shared, inter),
-        }
+        })
     }
 
     /// Numeric gains at a pose: `commands` per axis (linear mm, rotary rad), `params` per

@@ -152,6 +152,12 @@ impl<'a> Walk<'a> {
         (self.out, self.namer.finish())
     }
 
+    /// `true` when the walk ran on a trial namer that met a quantity beyond its bound
+    /// ([`Namer::trial`]): its contributions are then not the gains.
+    pub(crate) fn exceeded(&self) -> bool {
+        self.namer.exceeded()
+    }
+
     fn value(&self, v: Value) -> Poly {
         match v {
             Value::Number(x) => {

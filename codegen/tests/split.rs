@@ -126,6 +126,26 @@ fn every_builtin_machine_compiles_without_warnings() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A model whose gains are all constant (the positioning errors of three linear axes): its
+/// single-precision correction reads neither the pose nor a parameter, and names both
+/// arguments so that nothing is unused.
+#[test]
+fn a_model_of_constant_gains_compiles_without_warnings() {
+    let dir = support::scratch("constant");
+    let text = format!(
+        "{}\n[models.positioning]\ndescription = \"positioning errors only\"\nerrors = [\"EXX\", \"EYY\", \"EZZ\"]\n",
+        include_str!("machines/no-symbols.toml")
+    );
+    let m = model_spec::parse_machine("constant.toml", &text).unwrap();
+    let code = codegen::emit::generate_machine(&m, &["positioning"]).unwrap();
+    assert!(
+        code.contains("_pose: &[f32;"),
+        "the f32 correction does not read the pose"
+    );
+    support::check_no_std_lib(&dir, &code);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Machines unlike the built-in ones, compensation module included: no kinematic symbol at all
 /// (its functions read no parameter), one rotary axis about a negative direction.
 #[test]

@@ -45,14 +45,23 @@ impl Layout {
     }
 }
 
-/// `params` or, for a program that reads no kinematic parameter, `_params` (no unused
+/// `name` or, for a program that reads none of the inputs `range`, `_name` (no unused
 /// argument in the emitted code).
+fn argument_name(p: &Program, range: std::ops::Range<usize>, name: &str) -> proc_macro2::Ident {
+    let reads = p
+        .ops
+        .iter()
+        .any(|op| matches!(*op, crate::ir::Op::Input(k) if range.contains(&(k as usize))));
+    if reads {
+        ident(name)
+    } else {
+        ident(&format!("_{name}"))
+    }
+}
+
+/// `params` or, for a program that reads no kinematic parameter, `_params`.
 fn params_name(p: &Program, layout: &Layout) -> proc_macro2::Ident {
-    let reads = p.ops.iter().any(|op| {
-        matches!(*op, crate::ir::Op::Input(k)
-            if (layout.pose..layout.pose + layout.params).contains(&(k as usize)))
-    });
-    ident(if reads { "params" } else { "_params" })
+    argument_name(p, layout.pose..layout.pose + layout.params, "params")
 }
 
 /// The body of a program: its `let`s, then `out[k] = …` per output (or an array expression
@@ -93,6 +102,7 @@ pub(crate) fn compensation_module(c: &CompensationPrograms) -> TokenStream {
         params_name(&c.step, &layout),
         params_name(&c.first_step, &layout),
     );
+    let first_pose = argument_name(&c.first_step, 0..layout.pose, "pose");
     let counts = |p: &Program| p.op_counts().to_string();
     let target_doc = format!(" Straight-line code: {}.", counts(&c.target));
     let step_doc = format!(" Straight-line code: {}.", counts(&c.step));
@@ -195,13 +205,6 @@ pub(crate) fn compensation_module(c: &CompensationPrograms) -> TokenStream {
                 }
                 q
             }
-            /// The first-order correction in single precision: `out[..AXIS_COUNT]` the
-            /// change to add to every command (mm, rad), `out[AXIS_COUNT..]` the predicted
-            /// error at the commanded pose (as [`step`]'s residual). `pose` and `params` in the
-            /// order of [`super::super::POSE_INPUTS`] and [`super::super::PARAMETERS`]. One
-            /// step, no iteration: it leaves the second order of the correction (its angle
-            /// squared times the lever arm) and the rounding of `f32`; the bound is stated and
-            /// tested in the documentation of rtest's compensation.
             /// [`compensate`] on slices: `commanded` and `out` one command per axis,
             /// `params` in the order of [`super::super::PARAMETERS`], `values` one per error.
             ///
@@ -233,9 +236,17 @@ pub(crate) fn compensation_module(c: &CompensationPrograms) -> TokenStream {
                     out,
                 );
             }
+            /// The first-order correction in single precision: `out[..AXIS_COUNT]` the
+            /// change to add to every command (mm, rad), `out[AXIS_COUNT..]` the predicted
+            /// error at the commanded pose (as [`step`]'s residual). `pose` and `params` in the
+            /// order of [`super::super::POSE_INPUTS`] and [`super::super::PARAMETERS`]. One
+            /// step, no iteration: it leaves the second order of the correction (its angle
+            /// squared times the lever arm) and the rounding of `f32`; the bound is stated and
+            /// tested in the documentation of rtest's compensation.
+            ///
             #[doc = #first_doc]
             pub fn first_order_f32(
-                pose: &[f32; #pose_len],
+                #first_pose: &[f32; #pose_len],
                 #fp: &[f32; #params_len],
                 values: &[f32; N],
                 out: &mut [f32; #out_len],

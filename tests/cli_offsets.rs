@@ -109,6 +109,65 @@ fn a_pivot_length_off_its_nominal_is_identified_reported_and_validated() {
     assert!(before > 20.0 && after < 0.6, "{before} -> {after}");
 }
 
+/// The identified pivot length goes into the corrected description's `[symbols]` (beside the
+/// folded location errors); identified again with that description, the change is zero
+/// within its uncertainty.
+#[test]
+fn an_identified_pivot_length_is_folded_into_the_corrected_description() {
+    let dir = temp_dir("fold");
+    write(&dir, "truth.toml", HEAD_TABLE_TRUTH);
+    simulate_head_table(&dir, "pair-B-C", "4", "pair.csv", &[]);
+    let identify = |machine: &str, json: &str| {
+        ok(
+            &dir,
+            &[
+                "identify",
+                "--machine",
+                machine,
+                "--terms",
+                DETERMINED,
+                "--data",
+                "pair.csv",
+                "--json",
+                json,
+            ],
+        );
+        read_json(&dir.join(json))
+    };
+    let first = identify("head-table-bc", "id.json");
+    let zt = param(&first, "Zt")["value"].as_f64().unwrap();
+    let text = ok(
+        &dir,
+        &words(
+            "compensate --machine head-table-bc --params id.json --kinematics-out corrected.toml",
+        ),
+    );
+    assert!(
+        text.lines()
+            .any(|l| l.contains("folded: Zt = ") && l.contains("into its default")),
+        "{text}"
+    );
+    let toml = std::fs::read_to_string(dir.join("corrected.toml")).unwrap();
+    let default: f64 = toml
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("Zt = "))
+        .and_then(|rest| rest.split_whitespace().next())
+        .unwrap_or_else(|| panic!("Zt in [symbols]: {toml}"))
+        .parse()
+        .unwrap();
+    assert!(
+        (default - (-250.0 + zt / 1000.0)).abs() < 1e-12,
+        "{default}, {zt}"
+    );
+    assert!(toml.contains("#   Zt changed by "), "{toml}");
+    let again = identify("corrected.toml", "again.json");
+    for name in ["Zt", "XOC", "YOC"] {
+        let p = param(&again, name);
+        let (v, s) = (p["value"].as_f64().unwrap(), p["std"].as_f64().unwrap());
+        assert!((v / s).abs() < 4.0, "{name} identified again: {p}");
+    }
+}
+
 #[test]
 fn a_ball_position_is_reported_as_not_separable_from_its_set_up_error() {
     let dir = temp_dir("ball");

@@ -39,8 +39,9 @@ corrected and is reported. A corrected pose outside a stroke or range is refused
 NC words keep their decimals (--decimals N for more); the rounding this costs is reported.
 
 --kinematics-out FILE: the machine description with the location errors folded into its \
-kinematic offsets; what cannot be folded (angular location errors, squareness, component \
-errors) is listed. --tables DIR: one CSV per axis of its component errors against its position \
+kinematic offsets and the identified kinematic symbols (--terms Zt) into their defaults; what \
+cannot be folded (angular location errors, squareness, component errors, lengths of the \
+workpiece side, undetermined changes) is listed. --tables DIR: one CSV per axis of its component errors against its position \
 at --pitch mm (--pitch-deg for rotary axes), with the positioning correction in the axis's own \
 sense (docs/compensation-tables.md).
 
@@ -225,6 +226,15 @@ pub fn run(args: &CompensateArgs) -> CliResult {
                         compact(f.after_mm)
                     )
                 })
+                .chain(corrected.symbols.iter().map(|f| {
+                    format!(
+                        "{} = {} µm into its default: {} -> {} mm",
+                        f.name,
+                        readable(f.change_mm * 1e3, 4),
+                        compact(f.before_mm),
+                        compact(f.after_mm)
+                    )
+                }))
                 .collect(),
             not_folded: corrected
                 .not_folded

@@ -17,6 +17,11 @@
 //!   symbol would change the machine's parameter list and its generated code);
 //! - **no `offset`** on the axis entry: an `offset = [x, y, z]` is added after its `axis` line.
 //!
+//! An identified kinematic symbol (a length identified as a term under its own name, `Zt`)
+//! changes its default by the identified change, before the location errors are added. A
+//! symbol of the workpiece side (where the ball sits: a set-up, not the machine) and a change
+//! the data did not determine are not folded, and are listed.
+//!
 //! Everything else of the text stays byte for byte as it was, comments included; a comment
 //! block at the end lists what was folded. The machine keeps its `name`, so that generated
 //! code, reports and files keep lining up with it; its fingerprint changes (the offsets are
@@ -31,7 +36,7 @@
 
 mod spans;
 
-use super::values::{CompensationError, MachineErrors};
+use super::values::{CompensationError, MachineErrors, ValueSource};
 use model_spec::catalogue::Motion;
 use model_spec::units::format_scaled;
 use model_spec::{AxisId, Dir, ErrorId, ErrorKind, Link, Machine, Value, parse_machine};
@@ -61,6 +66,19 @@ pub struct Folded {
     pub place: String,
 }
 
+/// An identified kinematic symbol folded into its default.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FoldedSymbol {
+    /// The symbol's name (`Zt`).
+    pub name: String,
+    /// The identified change, mm.
+    pub change_mm: f64,
+    /// Its default before, mm.
+    pub before_mm: f64,
+    /// Its default after, mm.
+    pub after_mm: f64,
+}
+
 /// A compensated term that is not folded into the description, with why.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NotFolded {
@@ -81,6 +99,8 @@ pub struct CorrectedDescription {
     pub toml: String,
     /// The errors folded into its offsets.
     pub folded: Vec<Folded>,
+    /// The identified kinematic symbols folded into their defaults.
+    pub symbols: Vec<FoldedSymbol>,
     /// The compensated terms it cannot hold.
     pub not_folded: Vec<NotFolded>,
 }
@@ -181,6 +201,7 @@ pub fn corrected_description(
     let mut not_folded = Vec::new();
     // Per axis, the coordinates whose written value changes: (axis, coordinate index).
     let mut changed: Vec<(AxisId, usize)> = Vec::new();
+    let symbols = fold_symbols(m, errors, &mut expected, &mut not_folded)?;
     for t in errors.terms() {
         let model_spec::terms::Effect::Error(e) = t.term.effect else {
             continue;
@@ -305,8 +326,8 @@ pub fn corrected_description(
         }
     }
     let mut toml = spans::apply(text, edits);
-    if !folded.is_empty() {
-        toml.push_str(&comment_block(errors.file(), &folded, m));
+    if !folded.is_empty() || !symbols.is_empty() {
+        toml.push_str(&comment_block(errors.file(), &folded, &symbols, m));
     }
 
     let back_file = format!("<{} corrected>", m.name);
@@ -321,18 +342,75 @@ pub fn corrected_description(
     Ok(CorrectedDescription {
         toml: format!("{bom}{toml}"),
         folded,
+        symbols,
         not_folded,
     })
 }
 
+/// Folds the identified changes of the machine's kinematic symbols into their defaults in
+/// `expected`; a symbol of the workpiece (where the ball sits: a set-up, not the machine) and
+/// a change the data did not determine are listed in `not_folded` instead.
+fn fold_symbols(
+    m: &Machine,
+    errors: &MachineErrors,
+    expected: &mut Machine,
+    not_folded: &mut Vec<NotFolded>,
+) -> Result<Vec<FoldedSymbol>, CompensationError> {
+    let workpiece = m.workpiece_symbols();
+    let mut folded = Vec::new();
+    for k in errors.kinematic_changes() {
+        let not = |reason: &str| NotFolded {
+            term: k.term,
+            spelling: k.spelling.clone(),
+            values: k.change_mm.into_iter().collect(),
+            reason: reason.to_string(),
+        };
+        if workpiece.contains(&k.symbol) {
+            not_folded.push(not(
+                "a length of the workpiece side (where the ball sits in this set-up), not of the machine",
+            ));
+            continue;
+        }
+        let change = match (k.change_mm, k.source) {
+            (Some(c), ValueSource::Measured | ValueSource::FixedToZero) => c,
+            _ => {
+                not_folded.push(not(
+                    "the data did not determine it (a constraint's minimum-norm choice is no length of the machine)",
+                ));
+                continue;
+            }
+        };
+        if change == 0.0 {
+            continue;
+        }
+        let sym = &mut expected.symbols[k.symbol];
+        let (before, after) = (sym.default, sym.default + change);
+        if !after.is_finite() {
+            return Err(CompensationError::NonFinite {
+                file: errors.file().to_string(),
+                what: format!("the corrected default of symbol {}", sym.name),
+                value: after,
+            });
+        }
+        sym.default = after;
+        folded.push(FoldedSymbol {
+            name: sym.name.clone(),
+            change_mm: change,
+            before_mm: before,
+            after_mm: after,
+        });
+    }
+    Ok(folded)
+}
+
 /// The comment appended to a corrected description: what was folded, from which file.
-fn comment_block(file: &str, folded: &[Folded], m: &Machine) -> String {
+fn comment_block(file: &str, folded: &[Folded], symbols: &[FoldedSymbol], m: &Machine) -> String {
     let clean: String = file
         .chars()
         .map(|c| if c.is_control() { ' ' } else { c })
         .collect();
     let mut out = format!(
-        "\n# Kinematic offsets corrected by rtest with the location errors identified in\n# {clean} (machine {}); the rest of this file is as it was:\n",
+        "\n# Kinematic offsets corrected by rtest with the values identified in\n# {clean} (machine {}); the rest of this file is as it was:\n",
         m.name
     );
     for f in folded {
@@ -341,6 +419,15 @@ fn comment_block(file: &str, folded: &[Folded], m: &Machine) -> String {
             f.name,
             format_scaled(f.value_mm + 0.0, 3),
             f.place,
+            number(f.before_mm),
+            number(f.after_mm)
+        ));
+    }
+    for f in symbols {
+        out.push_str(&format!(
+            "#   {} changed by {} µm as identified: {} → {} mm\n",
+            f.name,
+            format_scaled(f.change_mm + 0.0, 3),
             number(f.before_mm),
             number(f.after_mm)
         ));

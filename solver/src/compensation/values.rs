@@ -126,6 +126,23 @@ pub struct CompensatedTerm {
     pub source: ValueSource,
 }
 
+/// An identified change of a kinematic symbol (a length of the description, mm): no error
+/// compensation holds it, the corrected description does
+/// ([`crate::compensation::kinematics::corrected_description`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct KinematicChange {
+    /// The term (`Effect::KinematicOffset` on the constant basis).
+    pub term: Term,
+    /// The symbol.
+    pub symbol: model_spec::SymbolId,
+    /// Its spelling (the symbol's name, `Zt`).
+    pub spelling: String,
+    /// The change of the symbol, mm; `None` where the data did not determine it.
+    pub change_mm: Option<f64>,
+    /// Where the value comes from.
+    pub source: ValueSource,
+}
+
 /// A term of the identification that compensation leaves out, and why.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LeftOut {
@@ -147,6 +164,8 @@ pub struct MachineErrors {
     fingerprint: String,
     errors: Vec<ErrorId>,
     terms: Vec<CompensatedTerm>,
+    /// The identified changes of kinematic symbols (left out of compensation).
+    kinematic: Vec<KinematicChange>,
     /// Per term: its error's index in `errors`.
     slots: Vec<usize>,
     /// +1 per axis: the direction of motion the bases see (no compensated basis reads it).
@@ -163,7 +182,7 @@ fn left_out_reason(m: &Machine, term: &Term) -> Option<String> {
             "an instrument term of the R-test (a sensor's gain or cross-talk), not an error of the machine"
         }
         (Effect::KinematicOffset(_), _) => {
-            "a kinematic offset of the description (a length, mm): its identified value belongs in the description's [symbols] and the controller's kinematic parameters, not in an error compensation"
+            "a kinematic offset of the description (a length, mm): its identified value belongs in the description's [symbols] (--kinematics-out folds it) and the controller's kinematic parameters, not in an error compensation"
         }
         (Effect::Error(e), _) if matches!(m.catalogue[e].kind, ErrorKind::Setup { .. }) => {
             "a set-up error of the workpiece (where the ball was placed), not an error of the machine"
@@ -217,7 +236,17 @@ impl MachineErrors {
                 });
             }
         }
+        let value_source = |cols: std::ops::Range<usize>| {
+            if cols.clone().any(|j| id.fixed[j]) {
+                ValueSource::FixedToZero
+            } else if cols.clone().any(|j| !id.determined[j]) {
+                ValueSource::MinimumNorm
+            } else {
+                ValueSource::Measured
+            }
+        };
         let mut compensated: Vec<CompensatedTerm> = Vec::new();
+        let mut kinematic = Vec::new();
         let mut left_out = Vec::new();
         let mut missing = (Vec::new(), Vec::new());
         let mut column = 0;
@@ -227,6 +256,15 @@ impl MachineErrors {
             column += w;
             let spelling = term.spelling(m);
             let values = id.values[cols.clone()].to_vec();
+            if let Effect::KinematicOffset(symbol) = term.effect {
+                kinematic.push(KinematicChange {
+                    term: *term,
+                    symbol,
+                    spelling: spelling.clone(),
+                    change_mm: values.iter().copied().flatten().next(),
+                    source: value_source(cols.clone()),
+                });
+            }
             if let Some(reason) = left_out_reason(m, term) {
                 left_out.push(LeftOut {
                     term: spelling,
@@ -245,18 +283,11 @@ impl MachineErrors {
                     }));
                 continue;
             }
-            let source = if cols.clone().any(|j| id.fixed[j]) {
-                ValueSource::FixedToZero
-            } else if cols.clone().any(|j| !id.determined[j]) {
-                ValueSource::MinimumNorm
-            } else {
-                ValueSource::Measured
-            };
             compensated.push(CompensatedTerm {
                 term: *term,
                 spelling,
                 coefficients: values.into_iter().flatten().collect(),
-                source,
+                source: value_source(cols),
             });
         }
         if !missing.0.is_empty() {
@@ -289,6 +320,7 @@ impl MachineErrors {
                 fingerprint: own,
                 errors,
                 terms: compensated,
+                kinematic,
                 slots,
                 motion: vec![1; m.axes.len()],
             },
@@ -314,6 +346,12 @@ impl MachineErrors {
             .filter(|t| t.source != ValueSource::Measured)
             .map(|t| (t.spelling.as_str(), t.source))
             .collect()
+    }
+
+    /// The identified changes of kinematic symbols, in the order of the identification
+    /// (also listed as left out: no error compensation holds them).
+    pub fn kinematic_changes(&self) -> &[KinematicChange] {
+        &self.kinematic
     }
 
     /// The file the values were read from.

@@ -661,11 +661,14 @@ fn evaluate(s: &mut Session, tab: Option<&str>, expression: &str) -> Result<Valu
     Ok(r["result"]["value"].clone())
 }
 
-/// Prints the tab to PDF as the print dialog would, without header and footer.
+/// Prints the tab to PDF as the print dialog would, without header and footer, on A4 paper
+/// unless the page sets its own size (`@page { size: ... }`).
 fn print(s: &mut Session, tab: Option<&str>) -> Result<Vec<u8>, String> {
+    const INCH: f64 = 25.4; // mm
     let r = s.call(
         "Page.printToPDF",
         json!({ "printBackground": true, "displayHeaderFooter": false,
+                "paperWidth": 210.0 / INCH, "paperHeight": 297.0 / INCH,
                 "preferCSSPageSize": true }),
         tab,
     )?;

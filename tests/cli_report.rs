@@ -359,3 +359,21 @@ fn bad_inputs_are_refused_without_an_output() {
         entries(&dir)
     );
 }
+
+#[test]
+fn the_verb_documents_itself_and_its_usage_errors_name_it() {
+    let dir = temp_dir("help");
+    let help = ok(&dir, &["report", "--help"]);
+    for s in [
+        "µm",
+        "µrad",
+        "SHA-256",
+        "Content-Security-Policy",
+        "3 a computation failed",
+    ] {
+        assert!(help.contains(s), "`{s}` not in the help");
+    }
+    fails(&dir, &["report", "--bogus"], 2, &["rtest report --help"]);
+    let top = ok(&dir, &["--help"]);
+    assert!(top.contains("report"), "{top}");
+}

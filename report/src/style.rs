@@ -34,7 +34,7 @@ nav ol { columns: 2; margin: 0.3em 0 1em 0; }
 dl.facts { display: grid; grid-template-columns: max-content auto; gap: 0.15em 1em; }
 dl.facts dt { font-weight: bold; }
 dl.facts dd { margin: 0; overflow-wrap: anywhere; }
-table { border-collapse: collapse; margin: 0.6em 0 1.2em 0; font-size: 0.95em; }
+table { border-collapse: collapse; margin: 0.6em 0 1.2em 0; font-size: 0.95em; min-width: 60%; }
 caption { text-align: left; font-weight: bold; padding-bottom: 0.3em; caption-side: top; }
 th, td { border: 1px solid #aaa; padding: 0.15em 0.5em; vertical-align: top; }
 th { background: #e8edf2; text-align: left; }

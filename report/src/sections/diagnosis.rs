@@ -96,7 +96,7 @@ pub fn write(
                 vec![
                     Cell::text(format!("{}@{}", f.error, f.basis)),
                     Cell::text(f.description.clone()),
-                    Cell::number(finding_value(f)),
+                    Cell::text(finding_value(f)),
                     Cell::text(unit(&f.unit)),
                     Cell::number(format!("{} %", fixed(100.0 * f.explained_fraction, 1))),
                     Cell::number(p_value(f.p_value)),
@@ -163,7 +163,7 @@ pub fn write(
     b.subheading("What remains");
     match (&d.adequacy, &d.adequacy_unavailable) {
         (Some(a), _) => b.paragraph(&format!(
-            "{}: p = {} over {} record{} ({} draws): {}.",
+            "Test of the extended model's residual against the noise ({}): p = {} over {} record{} ({} draws): {}.",
             a.test,
             p_value(a.p_value),
             a.records.len(),

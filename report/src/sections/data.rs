@@ -65,7 +65,7 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
             "compensation: commanded poses",
             &c.input,
             c.poses.to_string(),
-            format!("{} poses, {}", c.poses, c.format),
+            format!("format {}", c.format),
         );
     }
     b.table(

@@ -19,6 +19,8 @@
 //! Content-Security-Policy `<meta>` forbids every other source; there is no script. Every text
 //! that comes from a file is escaped ([`html::escape`]).
 
+#![warn(missing_docs)]
+
 pub mod base64;
 pub mod figures;
 pub mod html;

@@ -48,7 +48,7 @@ pub fn num(x: f64, d: usize) -> String {
     readable(x, d)
 }
 
-/// An optional number, `–` when absent (`n/a` reads as a value).
+/// An optional number with `d` decimals, `none` when absent (undetermined).
 pub fn opt(x: Option<f64>, d: usize) -> String {
     x.map_or_else(|| "none".into(), |x| fixed(x, d))
 }

@@ -345,6 +345,23 @@ fn bad_inputs_are_refused_without_an_output() {
         1,
         &["--report"],
     );
+    // compensate --report summarises corrected poses: without --path it is a usage error.
+    run(
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--kinematics-out",
+            "k.toml",
+            "--report",
+            "r.html",
+        ],
+        2,
+        &["--report summarises corrected poses: give --path"],
+    );
+    assert!(!dir.join("k.toml").exists());
     // No report given; the report as an input.
     run(&["report", "-o", "r.html"], 2, &[]);
     fails(

@@ -50,10 +50,11 @@ enum Verb {
     Segment(cli::segment::SegmentArgs),
     Plan(cli::plan::PlanArgs),
     History(cli::history::HistoryArgs),
+    Report(cli::report::ReportArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 16] = [
+const VERBS: [&str; 17] = [
     "machines",
     "gains",
     "generate",
@@ -70,6 +71,7 @@ const VERBS: [&str; 16] = [
     "segment",
     "plan",
     "history",
+    "report",
 ];
 
 /// A clap error as one line: its message and its hints, without the usage block.
@@ -131,6 +133,7 @@ fn main() -> ExitCode {
         Verb::Segment(a) => cli::segment::run(a),
         Verb::Plan(a) => cli::plan::run(a),
         Verb::History(a) => cli::history::run(a),
+        Verb::Report(a) => cli::report::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -867,6 +867,7 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
         "k4-path.svg",
         "k4-spectrum.svg",
         "k4.csv",
+        "report.html",
         "rtest-history.sqlite",
         "seed-ac-extended.toml",
         "seed_ac.rs",

@@ -47,7 +47,8 @@ sense (docs/compensation-tables.md).
 
 The workpiece point of the correction is the material point under the tool tip; --param sets \
 kinematic symbols (the tool length, say) as in `gains`. --json writes the summary \
-(docs/compensation.md).";
+(docs/compensation.md); --report FILE writes the HTML report of the identification of --params \
+and this compensation (docs/report.md; needs --path).";
 
 /// Flags of `rtest compensate`.
 #[derive(Debug, clap::Args)]
@@ -93,6 +94,10 @@ pub struct CompensateArgs {
     /// Also write the summary as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
+    /// Also write the HTML report (docs/report.md) of the identification of --params and this
+    /// compensation to FILE (`-`: standard output).
+    #[arg(long, value_name = "FILE")]
+    report: Option<Target>,
     #[command(flatten)]
     bounds: ValueBounds,
 }
@@ -109,6 +114,11 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             "--json summarises corrected poses: give --path",
         ));
     }
+    if args.report.is_some() && args.path.is_none() {
+        return Err(CliError::usage(
+            "--report summarises corrected poses: give --path",
+        ));
+    }
     if args.nc.is_none() && args.decimals.is_some() {
         return Err(CliError::usage("--decimals applies to NC programs (--nc)"));
     }
@@ -120,6 +130,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         ("-o", args.output.as_ref()),
         ("--kinematics-out", args.kinematics_out.as_ref()),
         ("--json", args.json.as_ref()),
+        ("--report", args.report.as_ref()),
     ]
     .into_iter()
     .filter_map(|(f, t)| t.map(|t| (f, t)))
@@ -268,6 +279,13 @@ pub fn run(args: &CompensateArgs) -> CliResult {
                     to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
                 files.add("--json", target.clone(), json);
             }
+            if let Some(target) = &args.report {
+                files.add(
+                    "--report",
+                    target.clone(),
+                    html_report(args, &m, &inputs, &report)?,
+                );
+            }
             compensation(&report)
         }
         None => format!(
@@ -279,8 +297,29 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         ),
     };
     text.push_str(&wrote(&write(files)?));
-    let stdout_taken = [&args.output, &args.kinematics_out, &args.json]
+    let stdout_taken = [&args.output, &args.kinematics_out, &args.json, &args.report]
         .iter()
         .any(|t| matches!(t, Some(Target::Stdout)));
     print_text(&text, stdout_taken)
+}
+
+/// The HTML report (`--report`) of the identification of `--params` and of `report`, the
+/// compensation just computed; `inputs` are hashed.
+fn html_report(
+    args: &CompensateArgs,
+    m: &model_spec::Machine,
+    inputs: &[(&str, &std::path::Path)],
+    report: &CompensationReport,
+) -> CliResult<String> {
+    let mut i = super::report::inputs_for(m, inputs);
+    let fail = |e: ::report::InputError| CliError::input(format!("--params: {e}"));
+    let params = ::report::inputs::read_document(&args.params).map_err(fail)?;
+    let file = args.params.display().to_string();
+    i.add(&file, params).map_err(fail)?;
+    i.add(
+        "this run of rtest compensate",
+        ::report::Document::Compensation(Box::new(report.clone())),
+    )
+    .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+    super::report::render("--report", &i)
 }

@@ -13,6 +13,9 @@ const OUT_DIR: &str = "rtest-demo";
 /// The history database the demo records its identification in, inside [`OUT_DIR`].
 const HISTORY: &str = "rtest-history.sqlite";
 
+/// The HTML report of the check, inside [`OUT_DIR`].
+const REPORT: &str = "report.html";
+
 /// The machine id of the demo's virtual machine in that history.
 const MACHINE_ID: &str = "demo";
 
@@ -49,7 +52,9 @@ gains-reduced.md (the Markdown gain table of the reduced model, mm/mm and mm/rad
 diagnose.json (rtest diagnose --json), seed-ac-extended.toml (the machine with the extended \
 model, rtest diagnose --model-out) and the figures of rtest diagnose --plot: k4-path.svg, \
 k1-path.svg, k2-path.svg (measured against predicted error, base and extended model) and \
-k4-spectrum.svg, k1-spectrum.svg, k2-spectrum.svg (residual components before and after). It \
+k4-spectrum.svg, k1-spectrum.svg, k2-spectrum.svg (residual components before and after), and \
+report.html (the HTML report of the check: identification, validations, diagnosis with its \
+figures; docs/report.md). It \
 records the identification on K4 in the history database rtest-demo/rtest-history.sqlite \
 (machine id demo; each run adds a check: rtest history --db rtest-demo/rtest-history.sqlite). The \
 same steps one by one: rtest simulate / identify / validate / diagnose / history.",
@@ -76,6 +81,11 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         files.add_in_dir("demo", dir, &name, svg);
         listed.push((name, what));
     }
+    files.add_in_dir("demo", dir, REPORT, html_report(&result)?);
+    listed.push((
+        REPORT.to_string(),
+        "the HTML report of the check: identification on K4, validations on K1 and K2, diagnosis with its figures (rtest report, docs/report.md)".to_string(),
+    ));
     write(files)?;
     let recorded = record(&mut recorder, &result.files)?;
     let seconds = start.elapsed().as_secs_f64();
@@ -108,4 +118,35 @@ fn record(recorder: &mut super::history::Recorder, files: &[demo::DemoFile]) -> 
     Ok(format!(
         "Recorded the identification on K4 as check {id} of machine `{MACHINE_ID}` in {OUT_DIR}/{HISTORY}; its trend: rtest history --db {OUT_DIR}/{HISTORY} --machine-id {MACHINE_ID} --error XOC\n"
     ))
+}
+
+/// The HTML report of the demo's check: its identification on K4, its validations, its
+/// diagnosis with the path figures, the measurement files hashed as written.
+fn html_report(result: &demo::Demo) -> CliResult<String> {
+    let m = super::load_machine("seed-ac")?;
+    let mut i = super::report::inputs_for(&m, &[]);
+    let fail = |e: ::report::InputError| CliError::computation(format!("demo: {e}"));
+    for f in &result.files {
+        let path = format!("{OUT_DIR}/{}", f.name);
+        if ["k4.csv", "k1.csv", "k2.csv"].contains(&f.name.as_str()) {
+            i.files.push(::report::InputFile {
+                role: "measurement".into(),
+                path: path.clone(),
+                digest: Some((
+                    history::sha256::sha256_hex(f.contents.as_bytes()),
+                    f.contents.len() as u64,
+                )),
+            });
+        }
+        let wanted = f.name == "identify.json"
+            || f.name == "diagnose.json"
+            || (f.name.starts_with("validate-") && f.name.ends_with(".json"));
+        if wanted {
+            let doc = ::report::inputs::classify(&path, &f.contents).map_err(fail)?;
+            i.add(&path, doc).map_err(fail)?;
+        }
+    }
+    i.path_figures = ::report::figures::path_figures(&result.figures)
+        .map_err(|e| CliError::computation(format!("demo: {e}")))?;
+    super::report::render("demo", &i)
 }

@@ -67,6 +67,10 @@ machine's errors shared); held-out records come from --validate (each on a new s
 set-up errors are refitted with the machine held) or --validate-campaign FILE. Scanned \
 parameters keep their grid value and --plot is not available on campaigns.
 
+--report FILE writes the HTML report of the diagnosis (docs/report.md): findings, gain, what \
+remains, the residual components and, for one record, the measured-against-predicted figures \
+of every record inline.
+
 --json writes the report (docs/diagnosis.md): {machine, data, base_model, zeroed, alpha, \
 base_fit, structure, dictionary_size, unexcited, findings: [{error, basis, description, values, \
 stds, unit, amplitude, phase_deg, explained_fraction, f, p_value, correction, candidates_tried, \
@@ -161,6 +165,10 @@ pub struct DiagnoseArgs {
     /// (created if missing).
     #[arg(long, value_name = "DIR")]
     plot: Option<PathBuf>,
+    /// Also write the HTML report of this diagnosis to FILE (docs/report.md: findings, gain,
+    /// what remains, the figures inline; `-`: standard output).
+    #[arg(long, value_name = "FILE")]
+    report: Option<Target>,
     #[command(flatten)]
     records: RecordLimits,
     #[command(flatten)]
@@ -204,6 +212,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     outputs.extend(args.model_out.iter().map(|t| ("--model-out", t)));
+    outputs.extend(args.report.iter().map(|t| ("--report", t)));
     let dirs: Vec<(&str, &Path)> = args.plot.iter().map(|d| ("--plot", d.as_path())).collect();
     check_outputs(&inputs, &outputs, &dirs)?;
 
@@ -290,14 +299,38 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
         files.add("--json", target.clone(), json);
     }
-    if let Some(dir) = &args.plot {
+    let figs = if args.plot.is_some() || args.report.is_some() {
         let mut records = vec![(data.clone(), &record, true)];
         records.extend(held.iter().map(|(n, r)| (n.clone(), r, false)));
-        let figs = figures(&m, &d, &label, &opts, &records)
-            .map_err(|e| CliError::computation(format!("--plot: {e}")))?;
-        for (name, _, svg) in super::figures::svgs(&figs)? {
+        let flag = if args.plot.is_some() {
+            "--plot"
+        } else {
+            "--report"
+        };
+        Some(
+            figures(&m, &d, &label, &opts, &records)
+                .map_err(|e| CliError::computation(format!("{flag}: {e}")))?,
+        )
+    } else {
+        None
+    };
+    if let (Some(dir), Some(figs)) = (&args.plot, &figs) {
+        for (name, _, svg) in super::figures::svgs(figs)? {
             files.add_in_dir("--plot", dir, &name, svg);
         }
+    }
+    if let Some(target) = &args.report {
+        let mut i = super::report::inputs_for(&m, &inputs);
+        if let Some(figs) = &figs {
+            i.path_figures = ::report::figures::path_figures(figs)
+                .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+        }
+        add_diagnosis(&mut i, &report)?;
+        files.add(
+            "--report",
+            target.clone(),
+            super::report::render("--report", &i)?,
+        );
     }
     let mut text = diagnosis(&report);
     text.push_str(zeroed_note(&record, args.zeroed));
@@ -394,6 +427,7 @@ fn run_campaign(
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     outputs.extend(args.model_out.iter().map(|t| ("--model-out", t)));
+    outputs.extend(args.report.iter().map(|t| ("--report", t)));
     check_outputs(&inputs, &outputs, &[])?;
     let flag = if args.campaign.is_some() {
         "--campaign"
@@ -460,6 +494,19 @@ fn run_campaign(
         let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
         files_out.add("--json", target.clone(), json);
     }
+    if let Some(target) = &args.report {
+        let mut i = super::report::inputs_for(m, &inputs);
+        i.no_path_figures = Some(
+            "No path figures: a campaign diagnosis draws none (diagnose one record for them)."
+                .into(),
+        );
+        add_diagnosis(&mut i, &report)?;
+        files_out.add(
+            "--report",
+            target.clone(),
+            super::report::render("--report", &i)?,
+        );
+    }
     let mut text = diagnosis(&report);
     text.push_str(&fitted.zeroed_notes(if args.campaign.is_some() {
         "say `zeroed = true` for it in the campaign file"
@@ -469,4 +516,13 @@ fn run_campaign(
     let stdout_taken = outputs.iter().any(|(_, t)| matches!(t, Target::Stdout));
     text.push_str(&wrote(&write(files_out)?));
     print_text(&text, stdout_taken)
+}
+
+/// Adds the diagnosis just computed to the inputs of its HTML report (`--report`).
+fn add_diagnosis(i: &mut ::report::Inputs, r: &DiagnosisReport) -> CliResult {
+    i.add(
+        "this run of rtest diagnose",
+        ::report::Document::Diagnosis(Box::new(r.clone())),
+    )
+    .map_err(|e| CliError::computation(format!("--report: {e}")))
 }

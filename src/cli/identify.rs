@@ -75,6 +75,9 @@ their labels, set-ups (records with the same set-up share its errors), ball posi
 and optional start times on one campaign clock. The report gives the shared values, one block \
 per set-up and per record, and each record's residual; its JSON has \"kind\": \"campaign\".
 
+--report FILE writes the HTML report of this identification (docs/report.md: values with \
+uncertainties, what the data cannot separate, the input files with their SHA-256; one record).
+
 --json writes the report (docs/identification.md): {machine, fingerprint, data, model, \
 base_model, terms, parameters: [{name, error, basis, value, std, unit, determined, fixed}], \
 residual_rms_um, rank, condition, confounded, samples, sigma_um, near_confounded, refinement: \
@@ -143,6 +146,10 @@ pub struct IdentifyArgs {
     /// Also write the report as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
+    /// Also write the HTML report of this identification to FILE (docs/report.md; one
+    /// record; `-`: standard output).
+    #[arg(long, value_name = "FILE")]
+    report: Option<Target>,
     /// Read the measurement in blocks and fold them into an incremental QR: for long records
     /// (10^6 samples and more), memory bounded by the number of parameters. First order (the
     /// refinement needs the whole record).
@@ -200,7 +207,8 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     inputs.extend(args.noise.input());
     inputs.extend(args.instrument.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
-    let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
+    let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
+    outputs.extend(args.report.iter().map(|t| ("--report", t)));
     let db = args.history.input();
     let mut all_inputs = inputs.clone();
     all_inputs.extend(db.as_ref().map(|(f, p)| (*f, p.as_path())));
@@ -275,7 +283,22 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
         files.add("--json", target.clone(), json);
     }
-    let stdout_taken = matches!(args.json, Some(Target::Stdout));
+    if let Some(target) = &args.report {
+        let mut i = super::report::inputs_for(&m, &inputs);
+        i.add(
+            "this run of rtest identify",
+            ::report::Document::Identification(Box::new(report.clone())),
+        )
+        .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+        files.add(
+            "--report",
+            target.clone(),
+            super::report::render("--report", &i)?,
+        );
+    }
+    let stdout_taken = [&args.json, &args.report]
+        .iter()
+        .any(|t| matches!(t, Some(Target::Stdout)));
     let check = recorder
         .as_ref()
         .map(|r| ::history::Check::from_identification(&report, r.provenance()));
@@ -321,6 +344,11 @@ fn run_campaign(
     model: &solver::model::Model,
     files: &[PathBuf],
 ) -> CliResult {
+    if args.report.is_some() {
+        return Err(CliError::usage(
+            "--report covers one record; a campaign (several --data files, --campaign) has no HTML report: drop --report",
+        ));
+    }
     if args.stream {
         return Err(CliError::usage(
             "--stream reads one long record; a campaign (several --data files) is fitted whole: drop --stream",

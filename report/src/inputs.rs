@@ -1,0 +1,473 @@
+//! What a report is made of: the JSON reports rtest writes (recognised by their content), the
+//! figures the verb that asks for the report has drawn, the input files with their SHA-256, and
+//! the checks that the reports belong together (one machine, one model, the same data).
+
+use serde_json::Value;
+use solver::io::report::compensate::CompensationReport;
+use solver::io::report::{DiagnosisReport, IdentificationReport, ValidationReport};
+use std::path::Path;
+
+/// One report of rtest, recognised by its content.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Document {
+    /// What `rtest identify --json` writes (one record).
+    Identification(Box<IdentificationReport>),
+    /// What `rtest validate --json` writes (one record).
+    Validation(Box<ValidationReport>),
+    /// What `rtest diagnose --json` writes.
+    Diagnosis(Box<DiagnosisReport>),
+    /// What `rtest compensate --json` writes.
+    Compensation(Box<CompensationReport>),
+}
+
+impl Document {
+    /// The report's kind in words (`identification`, …).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Document::Identification(_) => "identification",
+            Document::Validation(_) => "validation",
+            Document::Diagnosis(_) => "diagnosis",
+            Document::Compensation(_) => "compensation",
+        }
+    }
+
+    /// The machine it is of.
+    pub fn machine(&self) -> &str {
+        match self {
+            Document::Identification(r) => &r.machine,
+            Document::Validation(r) => &r.machine,
+            Document::Diagnosis(r) => &r.machine,
+            Document::Compensation(r) => &r.machine,
+        }
+    }
+}
+
+/// Why a report cannot be read or does not fit with the others.
+#[derive(Debug, thiserror::Error)]
+pub enum InputError {
+    /// The file cannot be read.
+    #[error("{file}: cannot read: {source}")]
+    Read {
+        /// The file.
+        file: String,
+        /// The system's reason.
+        source: std::io::Error,
+    },
+    /// The file is not JSON, or is a JSON that no verb of rtest writes.
+    #[error(
+        "{file}: not a report of rtest ({why}); give what identify --json, validate --json, diagnose --json or compensate --json writes"
+    )]
+    Unknown {
+        /// The file.
+        file: String,
+        /// Where and why, with line and column when the text is not JSON.
+        why: String,
+    },
+    /// A report of a known kind with a missing or malformed field.
+    #[error("{file}: {kind} report: {why}")]
+    Field {
+        /// The file.
+        file: String,
+        /// The kind of report its content names.
+        kind: &'static str,
+        /// serde's message: the field, its line and column.
+        why: String,
+    },
+    /// A campaign report: the HTML report covers one record.
+    #[error(
+        "{file}: a campaign {kind} report (\"kind\": \"campaign\"); the HTML report covers single-record reports"
+    )]
+    Campaign {
+        /// The file.
+        file: String,
+        /// `identification` or `validation`.
+        kind: &'static str,
+    },
+    /// Two reports of a kind that can appear once.
+    #[error("{file}: a second {kind} report ({first} is one): give one")]
+    Twice {
+        /// The second file.
+        file: String,
+        /// The kind.
+        kind: &'static str,
+        /// The first file of that kind.
+        first: String,
+    },
+    /// Two reports that cannot be of the same check.
+    #[error("{file} and {other} disagree: {why}")]
+    Disagree {
+        /// The report added last.
+        file: String,
+        /// The one it disagrees with.
+        other: String,
+        /// What differs.
+        why: String,
+    },
+}
+
+/// Reads the report in `path` and recognises its kind from its fields.
+///
+/// # Errors
+/// [`InputError`]: unreadable, not JSON, not a report of rtest, a field missing or malformed, a
+/// campaign report.
+pub fn read_document(path: &Path) -> Result<Document, InputError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| InputError::Read {
+        file: file.clone(),
+        source,
+    })?;
+    classify(&file, &text)
+}
+
+/// The report in `text` (read from `file`), recognised by its fields: `findings` and
+/// `base_fit` (diagnosis), `compensated` and `left_out` (compensation), `per_direction` and
+/// `prediction` (validation), `parameters`, `fingerprint` and `refinement` (identification).
+///
+/// # Errors
+/// As [`read_document`].
+pub fn classify(file: &str, text: &str) -> Result<Document, InputError> {
+    let value: Value = serde_json::from_str(text).map_err(|e| InputError::Unknown {
+        file: file.to_string(),
+        why: format!("not JSON: {e}"),
+    })?;
+    let Value::Object(map) = &value else {
+        return Err(InputError::Unknown {
+            file: file.to_string(),
+            why: "the JSON is not an object".into(),
+        });
+    };
+    let has = |keys: &[&str]| keys.iter().all(|k| map.contains_key(*k));
+    let campaign = map.get("kind").and_then(Value::as_str) == Some("campaign");
+    let typed = |kind: &'static str| {
+        move |e: serde_json::Error| InputError::Field {
+            file: file.to_string(),
+            kind,
+            why: e.to_string(),
+        }
+    };
+    if has(&["findings", "base_fit"]) {
+        let r = serde_json::from_str(text).map_err(typed("diagnosis"))?;
+        Ok(Document::Diagnosis(Box::new(r)))
+    } else if has(&["compensated", "left_out", "axes"]) {
+        let r = serde_json::from_str(text).map_err(typed("compensation"))?;
+        Ok(Document::Compensation(Box::new(r)))
+    } else if has(&["per_direction", "prediction"]) {
+        if campaign {
+            return Err(InputError::Campaign {
+                file: file.to_string(),
+                kind: "validation",
+            });
+        }
+        let r = serde_json::from_str(text).map_err(typed("validation"))?;
+        Ok(Document::Validation(Box::new(r)))
+    } else if has(&["parameters", "fingerprint", "refinement"]) {
+        if campaign {
+            return Err(InputError::Campaign {
+                file: file.to_string(),
+                kind: "identification",
+            });
+        }
+        let r = serde_json::from_str(text).map_err(typed("identification"))?;
+        Ok(Document::Identification(Box::new(r)))
+    } else {
+        Err(InputError::Unknown {
+            file: file.to_string(),
+            why: "a JSON object without the fields of any of them (parameters, per_direction, findings, compensated)".into(),
+        })
+    }
+}
+
+/// A figure ready for the page: its id (an HTML id), its SVG text and its caption (what it
+/// shows, what the abscissa is).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Figure {
+    /// The HTML id (`fig-k4-path`).
+    pub id: String,
+    /// The SVG text, as `plots` returns it.
+    pub svg: String,
+    /// What it shows and what its abscissa is.
+    pub caption: String,
+}
+
+/// An input file of the check: its role, its path and, when it could be read, its SHA-256.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InputFile {
+    /// What it was (`--data`, `identification report`).
+    pub role: String,
+    /// The path as given.
+    pub path: String,
+    /// SHA-256 (hex) and size in bytes of the file as read when the report was written;
+    /// `None` when it could not be read from there.
+    pub digest: Option<(String, u64)>,
+}
+
+impl InputFile {
+    /// `path` with its SHA-256, read now (`None` when it cannot be read: a path relative to
+    /// another working directory, a file since removed).
+    pub fn hashed(role: &str, path: &str) -> InputFile {
+        InputFile {
+            role: role.to_string(),
+            path: path.to_string(),
+            digest: history::sha256::sha256_file(Path::new(path)).ok(),
+        }
+    }
+}
+
+/// The machine as its description gives it, when the verb has it (the reports name it only).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MachineFacts {
+    /// Its name.
+    pub name: String,
+    /// Its description.
+    pub description: String,
+    /// Its fingerprint (topology and machine-side kinematic defaults).
+    pub fingerprint: String,
+    /// Per axis: name, kind (`linear`, `rotary`), side (`work`, `tool`), stroke in mm or
+    /// degrees with its unit (`unlimited` for a rotary axis without limits).
+    pub axes: Vec<[String; 4]>,
+}
+
+impl MachineFacts {
+    /// The facts of `m`.
+    pub fn of(m: &model_spec::Machine) -> MachineFacts {
+        let axes = m
+            .axes
+            .iter()
+            .map(|a| {
+                // Limits are in the axis's command unit: mm, or degrees.
+                let rotary = a.kind == model_spec::AxisKind::Rotary;
+                let [lo, hi] = a.limits;
+                [
+                    a.name.clone(),
+                    if rotary { "rotary" } else { "linear" }.to_string(),
+                    match a.side {
+                        model_spec::Side::Work => "work",
+                        model_spec::Side::Tool => "tool",
+                    }
+                    .to_string(),
+                    if lo.is_finite() && hi.is_finite() {
+                        format!(
+                            "{} to {} {}",
+                            model_spec::units::short(lo),
+                            model_spec::units::short(hi),
+                            if rotary { "deg" } else { "mm" }
+                        )
+                    } else {
+                        "unlimited".to_string()
+                    },
+                ]
+            })
+            .collect();
+        MachineFacts {
+            name: m.name.clone(),
+            description: m.description.clone(),
+            fingerprint: m.fingerprint(),
+            axes,
+        }
+    }
+}
+
+/// Everything a report shows: the reports, with the file each came from, the figures, the
+/// input files and when the report was written.
+#[derive(Clone, Debug, Default)]
+pub struct Inputs {
+    /// The identification and its file.
+    pub identification: Option<(String, IdentificationReport)>,
+    /// The validations and their files, in the order given.
+    pub validations: Vec<(String, ValidationReport)>,
+    /// The diagnosis and its file.
+    pub diagnosis: Option<(String, DiagnosisReport)>,
+    /// The compensation and its file.
+    pub compensation: Option<(String, CompensationReport)>,
+    /// The machine's description, when the verb has it.
+    pub machine: Option<MachineFacts>,
+    /// Measured against predicted along each path, drawn by the verb that computed the
+    /// predictions (`diagnose --report`); empty otherwise.
+    pub path_figures: Vec<Figure>,
+    /// Why there are no path figures, when there are none (one line).
+    pub no_path_figures: Option<String>,
+    /// The input files, hashed.
+    pub files: Vec<InputFile>,
+    /// When the report was written (RFC 3339, UTC); `None` leaves it out.
+    pub written_at: Option<String>,
+}
+
+/// Two paths that name the same file: equal once `./` prefixes are dropped, or both readable
+/// and the same file.
+fn same_file(a: &str, b: &str) -> bool {
+    let plain = |s: &str| s.trim_start_matches("./").to_string();
+    if plain(a) == plain(b) {
+        return true;
+    }
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+impl Inputs {
+    /// No report yet.
+    pub fn new() -> Inputs {
+        Inputs::default()
+    }
+
+    /// Whether no report has been added.
+    pub fn is_empty(&self) -> bool {
+        self.identification.is_none()
+            && self.validations.is_empty()
+            && self.diagnosis.is_none()
+            && self.compensation.is_none()
+    }
+
+    /// Every report added, as (file, machine name).
+    fn machines(&self) -> Vec<(&str, &str)> {
+        let mut out: Vec<(&str, &str)> = Vec::new();
+        if let Some((f, r)) = &self.identification {
+            out.push((f, &r.machine));
+        }
+        out.extend(
+            self.validations
+                .iter()
+                .map(|(f, r)| (f.as_str(), r.machine.as_str())),
+        );
+        if let Some((f, r)) = &self.diagnosis {
+            out.push((f, &r.machine));
+        }
+        if let Some((f, r)) = &self.compensation {
+            out.push((f, &r.machine));
+        }
+        out
+    }
+
+    /// Adds `doc`, read from `file`, after checking that it belongs with the reports already
+    /// added: the same machine (and the machine of [`Inputs::machine`], fingerprint included),
+    /// the identification's model for validations and compensations, the identification's data
+    /// and its model (the base or the extended one) for a diagnosis; one identification,
+    /// diagnosis and compensation at most, and no record validated twice.
+    ///
+    /// # Errors
+    /// [`InputError::Twice`], [`InputError::Disagree`].
+    pub fn add(&mut self, file: &str, doc: Document) -> Result<(), InputError> {
+        let disagree = |other: &str, why: String| InputError::Disagree {
+            file: file.to_string(),
+            other: other.to_string(),
+            why,
+        };
+        if let Some((other, machine)) = self.machines().first()
+            && *machine != doc.machine()
+        {
+            return Err(disagree(
+                other,
+                format!(
+                    "machine `{}` against `{machine}`: reports of two machines",
+                    doc.machine()
+                ),
+            ));
+        }
+        if let Some(m) = &self.machine {
+            if m.name != doc.machine() {
+                return Err(disagree(
+                    "--machine",
+                    format!("machine `{}` against `{}`", doc.machine(), m.name),
+                ));
+            }
+            if let Document::Identification(r) = &doc
+                && r.fingerprint != m.fingerprint
+            {
+                return Err(disagree(
+                    "--machine",
+                    format!(
+                        "fingerprint {} against {}: the description has changed since the identification",
+                        r.fingerprint, m.fingerprint
+                    ),
+                ));
+            }
+        }
+        let twice = |kind: &'static str, first: &str| InputError::Twice {
+            file: file.to_string(),
+            kind,
+            first: first.to_string(),
+        };
+        match doc {
+            Document::Identification(r) => {
+                if let Some((first, _)) = &self.identification {
+                    return Err(twice("identification", first));
+                }
+                for (f, v) in &self.validations {
+                    check_model(&v.model, &r.model).map_err(|why| disagree(f, why))?;
+                }
+                if let Some((f, c)) = &self.compensation {
+                    check_model(&c.model, &r.model).map_err(|why| disagree(f, why))?;
+                }
+                if let Some((f, d)) = &self.diagnosis {
+                    check_diagnosis(d, &r).map_err(|why| disagree(f, why))?;
+                }
+                self.identification = Some((file.to_string(), *r));
+            }
+            Document::Validation(v) => {
+                if let Some((f, r)) = &self.identification {
+                    check_model(&v.model, &r.model).map_err(|why| disagree(f, why))?;
+                }
+                if let Some((f, _)) = self
+                    .validations
+                    .iter()
+                    .find(|(_, w)| same_file(&w.data, &v.data))
+                {
+                    return Err(disagree(
+                        f,
+                        format!("both validate on {}: the same record twice", v.data),
+                    ));
+                }
+                self.validations.push((file.to_string(), *v));
+            }
+            Document::Diagnosis(d) => {
+                if let Some((first, _)) = &self.diagnosis {
+                    return Err(twice("diagnosis", first));
+                }
+                if let Some((f, r)) = &self.identification {
+                    check_diagnosis(&d, r).map_err(|why| disagree(f, why))?;
+                }
+                self.diagnosis = Some((file.to_string(), *d));
+            }
+            Document::Compensation(c) => {
+                if let Some((first, _)) = &self.compensation {
+                    return Err(twice("compensation", first));
+                }
+                if let Some((f, r)) = &self.identification {
+                    check_model(&c.model, &r.model).map_err(|why| disagree(f, why))?;
+                }
+                self.compensation = Some((file.to_string(), *c));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A validation's or compensation's model against the identification's.
+fn check_model(model: &str, identified: &str) -> Result<(), String> {
+    if model == identified {
+        Ok(())
+    } else {
+        Err(format!(
+            "model `{model}` against the identified model `{identified}`: values of another model"
+        ))
+    }
+}
+
+/// A diagnosis against the identification: the same fitted record, and the identified model is
+/// the diagnosis's base model or its extended model.
+fn check_diagnosis(d: &DiagnosisReport, r: &IdentificationReport) -> Result<(), String> {
+    if !same_file(&d.data, &r.data) {
+        return Err(format!(
+            "the diagnosis fitted {} and the identification {}: other data",
+            d.data, r.data
+        ));
+    }
+    if r.model != d.base_model && r.model != d.extended_model.label {
+        return Err(format!(
+            "the identified model `{}` is neither the diagnosed model `{}` nor its extension `{}`",
+            r.model, d.base_model, d.extended_model.label
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,110 @@
+//! Section 2: the data: every record the reports name with its samples, and every input file
+//! with its size and SHA-256.
+
+use crate::html::{Body, Cell};
+use crate::inputs::Inputs;
+
+/// Writes the data section.
+pub fn write(b: &mut Body, inputs: &Inputs) {
+    let (id, title) = super::SECTIONS[1];
+    b.section(id, title);
+    let mut rows: Vec<Vec<Cell>> = Vec::new();
+    let mut row = |role: &str, file: &str, samples: String, note: String| {
+        rows.push(vec![
+            Cell::text(role),
+            Cell::text(file),
+            Cell::number(samples),
+            Cell::text(note),
+        ]);
+    };
+    if let Some((_, r)) = &inputs.identification {
+        row(
+            "identification: fitted",
+            &r.data,
+            r.samples.to_string(),
+            format!(
+                "{} readings{}",
+                r.readings,
+                if r.zeroed {
+                    ", zeroed at the first sample"
+                } else {
+                    ""
+                }
+            ),
+        );
+    }
+    for (_, v) in &inputs.validations {
+        row(
+            "validation",
+            &v.data,
+            v.samples.to_string(),
+            if v.zeroed {
+                "zeroed at the first sample".into()
+            } else {
+                String::new()
+            },
+        );
+    }
+    if let Some((_, d)) = &inputs.diagnosis {
+        row(
+            "diagnosis: fitted",
+            &d.data,
+            d.samples.to_string(),
+            if d.zeroed {
+                "zeroed at the first sample".into()
+            } else {
+                String::new()
+            },
+        );
+        for (f, n) in &d.held_out {
+            row("diagnosis: held out", f, n.to_string(), String::new());
+        }
+    }
+    if let Some((_, c)) = &inputs.compensation {
+        row(
+            "compensation: commanded poses",
+            &c.input,
+            c.poses.to_string(),
+            format!("format {}", c.format),
+        );
+    }
+    b.table(
+        "Records (paths as the verbs were given them)",
+        &["Role", "File", "Samples", "Note"],
+        &rows,
+    );
+    if inputs.files.is_empty() {
+        b.absent("No input file was hashed.");
+    } else {
+        let rows: Vec<Vec<Cell>> = inputs
+            .files
+            .iter()
+            .map(|f| match &f.digest {
+                Some((hash, bytes)) => vec![
+                    Cell::text(f.role.clone()),
+                    Cell::text(f.path.clone()),
+                    Cell::number(bytes.to_string()),
+                    Cell::Markup(format!(
+                        "<span class=\"hash\">{}</span>",
+                        crate::html::escape(hash)
+                    )),
+                ],
+                None => vec![
+                    Cell::text(f.role.clone()),
+                    Cell::text(f.path.clone()),
+                    Cell::number("–"),
+                    Cell::text("not readable from here: no hash"),
+                ],
+            })
+            .collect();
+        b.table(
+            "Input files and their SHA-256, as read when this report was written",
+            &["Role", "Path", "Bytes", "SHA-256"],
+            &rows,
+        );
+    }
+    if let Some(t) = &inputs.written_at {
+        b.facts(&[("Report written", t.clone())]);
+    }
+    b.end_section();
+}

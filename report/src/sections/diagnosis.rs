@@ -1,0 +1,282 @@
+//! Section 5: the diagnosis: the findings with their significance, the gain on the fitted and
+//! the held-out records, the verdict against the noise, what remains unexplained, and the
+//! figures.
+
+use super::{num, unit, value_std};
+use crate::html::{Body, Cell};
+use crate::inputs::{Figure, Inputs};
+use model_spec::units::{fixed, p_value, short};
+use solver::io::report::diagnose::FindingReport;
+
+/// A finding's value(s) with uncertainties; a harmonic with its amplitude and phase.
+fn finding_value(f: &FindingReport) -> String {
+    let mut parts: Vec<String> = f
+        .columns
+        .iter()
+        .zip(f.values.iter().zip(&f.stds))
+        .map(|(c, (v, s))| {
+            if f.columns.len() > 1 {
+                format!(
+                    "{}: {}",
+                    c.rsplit(':').next().unwrap_or(c),
+                    value_std(*v, *s)
+                )
+            } else {
+                value_std(*v, *s)
+            }
+        })
+        .collect();
+    if let Some(h) = &f.harmonic {
+        parts.push(format!(
+            "amplitude {}, phase {}°",
+            value_std(Some(h.amplitude), h.amplitude_std),
+            value_std(Some(h.phase_deg), h.phase_std_deg)
+        ));
+    }
+    if let Some(s) = &f.scan {
+        parts.push(format!(
+            "{} = {} {} (95 % interval {} to {})",
+            s.parameter,
+            short(s.value),
+            s.unit,
+            short(s.low),
+            short(s.high)
+        ));
+    }
+    parts.join("; ")
+}
+
+/// Writes the diagnosis section, with its spectrum figure and the path figures.
+pub fn write(
+    b: &mut Body,
+    inputs: &Inputs,
+    spectrum: Option<&Figure>,
+) -> Result<(), crate::RenderError> {
+    let (id, title) = super::SECTIONS[4];
+    b.section(id, title);
+    let Some((file, d)) = &inputs.diagnosis else {
+        b.absent("No diagnosis in this report (rtest diagnose --json, or diagnose --report).");
+        b.end_section();
+        return Ok(());
+    };
+    b.facts(&[
+        ("Report", file.clone()),
+        ("Fitted record", format!("{} ({} samples)", d.data, d.samples)),
+        (
+            "Base model",
+            format!(
+                "{}: residual RMS {} µm ({} µm with the outliers' samples)",
+                d.base_model,
+                num(d.base_fit.residual_rms_um, 3),
+                num(d.base_fit.residual_rms_um_with_outliers, 3)
+            ),
+        ),
+        ("Noise model", d.noise_model.clone()),
+        (
+            "Search",
+            format!(
+                "{} candidates (harmonics up to {}, Legendre order up to {}, time order up to {}); significance {} per step after the correction for the candidates tried",
+                d.dictionary_size,
+                d.dictionary_extent[0],
+                d.dictionary_extent[1],
+                d.dictionary_extent[2],
+                short(d.alpha)
+            ),
+        ),
+        ("Stopped", d.stop.reason.clone()),
+    ]);
+    b.subheading("Findings");
+    if d.findings.is_empty() {
+        b.paragraph("No significant effect beyond the base model.");
+    } else {
+        let rows: Vec<Vec<Cell>> = d
+            .findings
+            .iter()
+            .map(|f| {
+                vec![
+                    Cell::text(format!("{}@{}", f.error, f.basis)),
+                    Cell::text(f.description.clone()),
+                    Cell::text(finding_value(f)),
+                    Cell::text(unit(&f.unit)),
+                    Cell::number(format!("{} %", fixed(100.0 * f.explained_fraction, 1))),
+                    Cell::number(p_value(f.p_value)),
+                    Cell::text(if f.alternatives.is_empty() {
+                        f.status.clone()
+                    } else {
+                        format!("{}; not told from {}", f.status, f.alternatives.join(", "))
+                    }),
+                ]
+            })
+            .collect();
+        b.table(
+            "Effects found, in the order added (values in the extended model)",
+            &[
+                "Term",
+                "What it is",
+                "Value ± std",
+                "Unit",
+                "Explains",
+                "p (corrected)",
+                "Status",
+            ],
+            &rows,
+        );
+    }
+    if !d.confounded.is_empty() {
+        let lines: Vec<String> = d
+            .confounded
+            .iter()
+            .map(|c| {
+                format!(
+                    "{}@{}: a combination of {}",
+                    c.error,
+                    c.basis,
+                    c.with.join(", ")
+                )
+            })
+            .collect();
+        b.paragraph(
+            "Candidates the extended model already spans (the data cannot see them apart):",
+        );
+        b.list(&lines);
+    }
+    b.subheading("Gain");
+    let mut rows = vec![gain_row("fitted", &d.gain.fit)];
+    rows.extend(d.gain.validation.iter().map(|g| gain_row("held out", g)));
+    b.table(
+        &format!(
+            "Residual RMS, µm: base model {} and extended model {}",
+            d.base_model, d.extended_model.label
+        ),
+        &["Record", "Role", "Base", "Extended", "Counted"],
+        &rows,
+    );
+    b.paragraph(&format!(
+        "The extended model is {}.",
+        if d.recommended {
+            "recommended"
+        } else {
+            "not recommended"
+        }
+    ));
+    b.list(&d.recommendation);
+    b.subheading("What remains");
+    match (&d.adequacy, &d.adequacy_unavailable) {
+        (Some(a), _) => b.paragraph(&format!(
+            "Test of the extended model's residual against the noise ({}): p = {} over {} record{} ({} draws): {}.",
+            a.test,
+            p_value(a.p_value),
+            a.records.len(),
+            model_spec::units::plural(a.records.len(), "s"),
+            a.draws,
+            if a.consistent_with_noise {
+                "what remains is consistent with the noise"
+            } else {
+                "what remains is more than the noise"
+            }
+        )),
+        (None, Some(why)) => b.paragraph(&format!("No test against the noise: {why}")),
+        (None, None) => b.paragraph("No test against the noise."),
+    }
+    if !d.unexplained.is_empty() {
+        let rows: Vec<Vec<Cell>> = d
+            .unexplained
+            .iter()
+            .map(|u| {
+                let mut shape = u.shape.clone();
+                if let Some(p) = u.period {
+                    shape.push_str(&format!(", period {} {}", short(p), u.unit));
+                }
+                if let Some(at) = u.at {
+                    shape.push_str(&format!(", at {} {}", short(at), u.unit));
+                }
+                if let Some([a, z]) = u.samples {
+                    shape.push_str(&format!(", samples {a} to {z}"));
+                }
+                vec![
+                    Cell::text(u.data.clone()),
+                    Cell::text(u.direction.clone()),
+                    Cell::number(num(u.rms_um, 3)),
+                    Cell::text(u.follows.clone().unwrap_or_else(|| "nothing simple".into())),
+                    Cell::text(shape),
+                    Cell::number(num(u.explained_rms_um, 3)),
+                ]
+            })
+            .collect();
+        b.table(
+            "Unexplained: per direction the noise does not account for (RMS in µm)",
+            &[
+                "Record",
+                "Direction",
+                "RMS",
+                "Follows",
+                "Shape",
+                "Shape explains",
+            ],
+            &rows,
+        );
+    }
+    if !d.outliers.is_empty() {
+        let rows: Vec<Vec<Cell>> = d
+            .outliers
+            .iter()
+            .map(|o| {
+                vec![
+                    Cell::text(o.data.clone()),
+                    Cell::number(o.line.map_or("–".into(), |l| l.to_string())),
+                    Cell::number(o.sample.to_string()),
+                    Cell::text(o.direction.clone()),
+                    Cell::number(num(o.residual_um, 3)),
+                    Cell::number(num(o.threshold_um, 3)),
+                ]
+            })
+            .collect();
+        b.table(
+            "Outliers, left out of the fits (µm)",
+            &[
+                "Record",
+                "Line",
+                "Sample",
+                "Direction",
+                "Residual",
+                "Threshold",
+            ],
+            &rows,
+        );
+    }
+    if let Some(f) = spectrum {
+        crate::place_figure(b, f)?;
+    }
+    b.subheading("Measured against predicted along the paths");
+    if inputs.path_figures.is_empty() {
+        b.absent(inputs.no_path_figures.as_deref().unwrap_or(
+            "No path figures: they need the measurements, which the JSON reports do not hold; rtest diagnose --report draws them.",
+        ));
+    }
+    for f in &inputs.path_figures {
+        crate::place_figure(b, f)?;
+    }
+    b.end_section();
+    Ok(())
+}
+
+fn gain_row(role: &str, g: &solver::io::report::diagnose::GainRow) -> Vec<Cell> {
+    vec![
+        Cell::text(g.data.clone()),
+        Cell::text(role),
+        Cell::number(num(g.residual_rms_um_before, 3)),
+        Cell::number(num(g.residual_rms_um_after, 3)),
+        Cell::text(if g.estimable {
+            "yes".to_string()
+        } else {
+            format!(
+                "no: the prediction needs {} (not determined)",
+                g.undetermined
+                    .iter()
+                    .map(|u| u.join(" + "))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            )
+        }),
+    ]
+}

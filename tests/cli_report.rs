@@ -1,0 +1,396 @@
+//! End-to-end tests of the HTML report: `identify --report`, `diagnose --report`, `compensate
+//! --report` and `rtest report` from the JSON files, on measurements simulated by `rtest
+//! simulate` on the exact virtual machine; every report self-contained (no address, no script,
+//! every figure sized and scalable); bad inputs refused with one stderr line, the project's exit
+//! code and no output file.
+
+use std::path::Path;
+
+mod common;
+use common::{TempDir, entries, fails, ok};
+
+fn temp_dir(name: &str) -> TempDir {
+    common::temp_dir_tagged("cli-report", name)
+}
+
+/// k4.csv and k1.csv of seed-ac with the demo truth, and `id.json`: the reduced model
+/// identified on K4, and `v1.json`: its validation on K1.
+fn set_up(name: &str) -> TempDir {
+    let dir = temp_dir(name);
+    for (path, seed) in [("K4", "1"), ("K1", "2")] {
+        let out = format!("{}.csv", path.to_ascii_lowercase());
+        ok(
+            &dir,
+            &[
+                "simulate",
+                "--machine",
+                "seed-ac",
+                "--path",
+                path,
+                "--truth",
+                "seed-ac-demo",
+                "--seed",
+                seed,
+                "-o",
+                &out,
+            ],
+        );
+    }
+    ok(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--json",
+            "id.json",
+        ],
+    );
+    ok(
+        &dir,
+        &[
+            "validate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--data",
+            "k1.csv",
+            "--json",
+            "v1.json",
+        ],
+    );
+    dir
+}
+
+fn read(dir: &Path, name: &str) -> String {
+    std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// The value of attribute `name` in the tag starting `tag`.
+fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let p = format!(" {name}=\"");
+    let start = tag.find(&p)? + p.len();
+    Some(&tag[start..start + tag[start..].find('"')?])
+}
+
+/// Checks what a browser needs of `html` to make no request and draw every figure: the
+/// Content-Security-Policy, no address, no script, references to `data:` and `#` only, every
+/// `<svg>` with a positive width and height and a viewBox, inside a `<figure>` with an id and a
+/// caption. Returns the number of figures.
+fn check_self_contained(html: &str) -> usize {
+    assert!(html.starts_with("<!DOCTYPE html>"));
+    assert!(html.contains(
+        "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; style-src 'unsafe-inline'; font-src data:; img-src data:\">"
+    ));
+    for bad in [
+        "http://",
+        "https://",
+        "<script",
+        "<link",
+        "<iframe",
+        "<img",
+        "javascript:",
+    ] {
+        assert!(!html.contains(bad), "the report contains {bad}");
+    }
+    for key in ["src=", "href=", "url("] {
+        for (at, _) in html.match_indices(key) {
+            let r = &html[at..(at + 30).min(html.len())];
+            assert!(
+                r.starts_with("src=\"data:")
+                    || r.starts_with("url(\"data:")
+                    || r.starts_with("href=\"#"),
+                "a reference that leaves the page: {r}"
+            );
+        }
+    }
+    let svgs: Vec<&str> = html
+        .match_indices("<svg")
+        .map(|(at, _)| {
+            let rest = &html[at..];
+            &rest[..rest.find('>').unwrap()]
+        })
+        .collect();
+    for tag in &svgs {
+        for a in ["width", "height"] {
+            let v: f64 = attribute(tag, a)
+                .unwrap_or_else(|| panic!("no {a}: {tag}"))
+                .parse()
+                .unwrap();
+            assert!(v > 0.0, "{tag}");
+        }
+        assert!(attribute(tag, "viewBox").is_some(), "{tag}");
+    }
+    assert_eq!(html.matches("<figure id=\"fig-").count(), svgs.len());
+    assert_eq!(html.matches("<figcaption>").count(), svgs.len());
+    svgs.len()
+}
+
+/// The headings of a report, in order.
+fn headings(html: &str) -> Vec<&str> {
+    html.lines()
+        .filter(|l| l.starts_with("<h2>") || l.starts_with("<h3>"))
+        .collect()
+}
+
+#[test]
+fn identify_report_holds_the_values_and_says_what_is_absent() {
+    let dir = set_up("identify");
+    let out = ok(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--report",
+            "id.html",
+        ],
+    );
+    assert!(out.contains("Wrote id.html"), "{out}");
+    let html = read(&dir, "id.html");
+    assert_eq!(check_self_contained(&html), 0);
+    assert!(html.contains("<h1>R-test check of seed-ac</h1>"));
+    // The values of the JSON, with their uncertainty, in the table.
+    let id: serde_json::Value = serde_json::from_str(&read(&dir, "id.json")).unwrap();
+    let xoc = id["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "XOC")
+        .unwrap();
+    let std = xoc["std"].as_f64().unwrap();
+    assert!(std > 0.0);
+    assert!(
+        html.contains("<td>XOC</td><td class=\"num\">"),
+        "no XOC row"
+    );
+    // The input file with its SHA-256, the axes of the machine.
+    assert!(html.contains("<td>--data</td><td>k4.csv</td>"));
+    assert!(html.contains("<span class=\"hash\">"));
+    assert!(html.contains("<caption>Axes</caption>"));
+    // Absent parts, one line each.
+    for part in ["No validation", "No diagnosis", "No compensation"] {
+        assert!(
+            html.contains(&format!("<p class=\"absent\">{part} in this report")),
+            "{part}"
+        );
+    }
+}
+
+#[test]
+fn the_whole_check_from_json_files_and_from_the_verbs() {
+    let dir = set_up("whole");
+    ok(
+        &dir,
+        &[
+            "diagnose",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--validate",
+            "k1.csv",
+            "--json",
+            "d.json",
+            "--report",
+            "d.html",
+        ],
+    );
+    let d_html = read(&dir, "d.html");
+    // Path figures of K4 and K1 and the spectrum of K4.
+    assert_eq!(check_self_contained(&d_html), 3, "{:?}", headings(&d_html));
+    assert!(d_html.contains("<figure id=\"fig-k4-path\">"));
+    assert!(d_html.contains("<figure id=\"fig-k1-path\">"));
+    assert!(d_html.contains("<figure id=\"fig-diagnosis-spectrum\">"));
+    assert!(d_html.contains("ECC@harmonic:2"));
+
+    // The poses of the compensation: the first 20 of K1.
+    let k1 = read(&dir, "k1.csv");
+    let mut poses = String::from("X,Y,Z,A,C\n");
+    for line in k1.lines().filter(|l| !l.starts_with('#')).skip(1).take(20) {
+        poses.push_str(&line.split(',').take(5).collect::<Vec<_>>().join(","));
+        poses.push('\n');
+    }
+    std::fs::write(dir.join("poses.csv"), poses).unwrap();
+    ok(
+        &dir,
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--path",
+            "poses.csv",
+            "-o",
+            "corrected.csv",
+            "--json",
+            "c.json",
+            "--report",
+            "c.html",
+        ],
+    );
+    let c_html = read(&dir, "c.html");
+    check_self_contained(&c_html);
+    assert!(c_html.contains("<h2>6. Compensation</h2>"));
+    assert!(c_html.contains("<caption>Corrections per axis"));
+    assert!(
+        c_html.contains("<h2>3. Identified values</h2>\n<dl"),
+        "the identification of --params"
+    );
+
+    let out = ok(
+        &dir,
+        &[
+            "report",
+            "id.json",
+            "v1.json",
+            "d.json",
+            "c.json",
+            "--machine",
+            "seed-ac",
+            "-o",
+            "check.html",
+        ],
+    );
+    assert!(out.contains("Wrote check.html"), "{out}");
+    let html = read(&dir, "check.html");
+    // The validation figure and the spectrum; path figures need the measurements.
+    assert_eq!(check_self_contained(&html), 2);
+    assert!(html.contains("No path figures: they need the measurements"));
+    assert!(!html.contains(" in this report ("), "every part is given");
+    // The records the reports name are hashed when readable from here.
+    for f in ["k4.csv", "k1.csv", "poses.csv", "id.json"] {
+        assert!(
+            html.contains(&format!("<td>{f}</td><td class=\"num\">")),
+            "{f} hashed"
+        );
+    }
+    insta::assert_snapshot!(headings(&html).join("\n"));
+}
+
+#[test]
+fn bad_inputs_are_refused_without_an_output() {
+    let dir = set_up("bad");
+    let run = |args: &[&str], code: i32, needles: &[&str]| {
+        fails(&dir, args, code, needles);
+        assert!(!dir.join("r.html").exists(), "{args:?} left an output");
+    };
+    // A CSV given instead of a JSON.
+    run(
+        &["report", "id.json", "k4.csv", "-o", "r.html"],
+        1,
+        &["k4.csv: not a report of rtest (not JSON: ", "line 1 column"],
+    );
+    // A JSON of no verb.
+    std::fs::write(dir.join("other.json"), "{\"rows\": [1, 2]}\n").unwrap();
+    run(
+        &["report", "other.json", "-o", "r.html"],
+        1,
+        &["other.json: not a report of rtest"],
+    );
+    // Two reports of different machines.
+    let v =
+        read(&dir, "v1.json").replace("\"machine\": \"seed-ac\"", "\"machine\": \"head-table-bc\"");
+    std::fs::write(dir.join("v-other.json"), v).unwrap();
+    run(
+        &["report", "id.json", "v-other.json", "-o", "r.html"],
+        1,
+        &[
+            "v-other.json and id.json disagree",
+            "head-table-bc",
+            "two machines",
+        ],
+    );
+    // A malformed field, named with its line.
+    let v = read(&dir, "v1.json").replacen("\"samples\": ", "\"samples\": -", 1);
+    std::fs::write(dir.join("v-bad.json"), v).unwrap();
+    run(
+        &["report", "v-bad.json", "-o", "r.html"],
+        1,
+        &["v-bad.json: validation report: ", "line "],
+    );
+    // An output in a missing directory.
+    fails(
+        &dir,
+        &["report", "id.json", "-o", "missing/r.html"],
+        1,
+        &["missing"],
+    );
+    assert!(!dir.join("missing").exists());
+    fails(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--data",
+            "k4.csv",
+            "--report",
+            "missing/r.html",
+        ],
+        1,
+        &["--report"],
+    );
+    // compensate --report summarises corrected poses: without --path it is a usage error.
+    run(
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--kinematics-out",
+            "k.toml",
+            "--report",
+            "r.html",
+        ],
+        2,
+        &["--report summarises corrected poses: give --path"],
+    );
+    assert!(!dir.join("k.toml").exists());
+    // No report given; the report as an input.
+    run(&["report", "-o", "r.html"], 2, &[]);
+    fails(
+        &dir,
+        &["report", "id.json", "-o", "id.json"],
+        2,
+        &["id.json"],
+    );
+    assert!(
+        entries(&dir).iter().all(|e| !e.ends_with(".html")),
+        "{:?}",
+        entries(&dir)
+    );
+}
+
+#[test]
+fn the_verb_documents_itself_and_its_usage_errors_name_it() {
+    let dir = temp_dir("help");
+    let help = ok(&dir, &["report", "--help"]);
+    for s in [
+        "µm",
+        "µrad",
+        "SHA-256",
+        "Content-Security-Policy",
+        "3 a computation failed",
+    ] {
+        assert!(help.contains(s), "`{s}` not in the help");
+    }
+    fails(&dir, &["report", "--bogus"], 2, &["rtest report --help"]);
+    let top = ok(&dir, &["--help"]);
+    assert!(top.contains("report"), "{top}");
+}

@@ -124,11 +124,18 @@ pub fn run(args: &GainsArgs) -> CliResult {
         },
     )?;
     let model = GainModel::derive(&m, &errors);
-    let atoms = model.atoms.all_values(&pose.commands, &pose.params);
-    let atom_errors = atom_error_bounds(&m, &model, &pose, &atoms);
+    // The shared form (fast on long chains): each named intermediate is evaluated in turn
+    // with its bound, which becomes the error bound of its atom.
+    let mut atoms = model.atoms.all_values(&pose.commands, &pose.params);
+    let mut atom_errors = atom_error_bounds(&m, &model, &pose, &atoms);
+    for d in model.intermediates().definitions() {
+        let (value, bound) = evaluate_with_bound(d, &atoms, &atom_errors);
+        atoms.push(value);
+        atom_errors.push(bound);
+    }
     let mut gains = vec![[0.0; 6]; errors.len()];
     let mut vanishing = Vec::new();
-    for (i, polys) in model.gains.iter().enumerate() {
+    for (i, polys) in model.gains.shared().iter().enumerate() {
         for (k, p) in polys.iter().enumerate() {
             let (value, bound) = evaluate_with_bound(p, &atoms, &atom_errors);
             if !value.is_finite() {
@@ -213,7 +220,8 @@ fn lengths(m: &Machine, pose: &Pose) -> f64 {
 }
 
 /// The value of `p` at the atom values `x` and a bound on its absolute error, given a bound
-/// `dx` on the error of every atom value.
+/// `dx` on the error of every atom value (a named intermediate is an atom whose bound is that
+/// of its own evaluation).
 ///
 /// With `P` the polynomial of the absolute values of `p`'s coefficients, evaluated term by
 /// term: the input errors move the value by at most `P(|x| + dx) − P(|x|)` (to first order,

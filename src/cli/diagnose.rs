@@ -9,7 +9,7 @@ use output::{Outputs, Target};
 use solver::diagnosis::campaign::diagnose_campaign;
 use solver::diagnosis::dictionary::DictionaryOptions;
 use solver::diagnosis::figures::figures;
-use solver::diagnosis::{DiagnoseError, DiagnoseOptions, diagnose};
+use solver::diagnosis::{DiagnoseError, DiagnoseOptions, diagnose_with_progress};
 use solver::fitting::check_values;
 use solver::io::report::campaign_diagnose::CampaignDiagnosisReport;
 use solver::io::report::{DiagnosisReport, DiagnosisSource, to_json};
@@ -81,9 +81,17 @@ unexplained}; `--json -` writes \
 it to standard output. --model-out writes the machine description (the text of --machine) with \
 the extended model appended as [models.extended] (extended2, … if that name is taken). --plot \
 DIR writes SVG figures: per record the measured error against the base and extended \
-predictions along the path (<name>-path.svg), the residual spectrum before and after \
+predictions along the path (<name>-path.svg; against the position of the axis that sweeps the \
+largest share of its stroke or range, one that never reverses first: `C (deg)`, `X (mm)`; the \
+sample index only when no axis moves), the residual spectrum before and after \
 (<name>-spectrum.svg), and what remains unexplained against what it follows \
-(<name>-unexplained-<dir>.svg). Every output is computed first; they are all written or none is.";
+(<name>-unexplained-<dir>.svg). Every output is computed first; they are all written or none is. \
+The text lists the unexcited candidates (their columns are zero on the fitted record).
+
+Progress: on a terminal, a bar on standard error follows the reading of the records, the stages \
+of the diagnosis and the candidates scored at each selection step, once the work has run half a \
+second (RTEST_PROGRESS_DELAY_MS sets the delay, in ms), and is cleared when it ends; never on a \
+pipe or a file, nor with `--json -`.";
 
 /// Flags of `rtest diagnose`.
 #[derive(Debug, clap::Args)]
@@ -217,16 +225,22 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     check_outputs(&inputs, &outputs, &dirs)?;
 
     let read = args.records.read_options();
-    let record = super::read_record(
-        "--data",
-        &m,
-        data_path,
-        &read,
-        &args.instrument,
-        &m.default_parameters(),
-    )?;
+    // Progress bars on a terminal's standard error, unless the JSON report takes standard output.
+    let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
+    let record = {
+        let (_bar, read) = super::progress::reading(shown, data_path, &read);
+        super::read_record(
+            "--data",
+            &m,
+            data_path,
+            &read,
+            &args.instrument,
+            &m.default_parameters(),
+        )?
+    };
     let mut held = Vec::new();
     for f in &held_files {
+        let (_bar, read) = super::progress::reading(shown, f, &read);
         held.push((
             f.display().to_string(),
             super::read_record(
@@ -251,7 +265,10 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     }
     let data = data_path.display().to_string();
     opts.data_name = data.clone();
-    let d = diagnose(&m, &model, &record, &held, &opts).map_err(|e| match e {
+    let bar = super::progress::Bar::new(shown, false);
+    let d = diagnose_with_progress(&m, &model, &record, &held, &opts, &bar);
+    drop(bar);
+    let d = d.map_err(|e| match e {
         DiagnoseError::Estimate(e)
         | DiagnoseError::Refine(solver::fitting::RefineError::Estimate(e)) => {
             super::identify::estimate_error(e)

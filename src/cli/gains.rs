@@ -3,11 +3,14 @@
 
 use super::{CliError, CliResult, EXIT_CODES, args, pose_args};
 use codegen::GainModel;
+use codegen::atoms::AtomKind;
+use codegen::poly::Poly;
 use codegen::table::{self, render};
-use solver::fitting::GainSource;
-use solver::io::report::{GainTableReport, PoseGainsReport, to_json};
+use model_spec::{AxisKind, Machine};
+use solver::io::report::gains::COLUMNS;
+use solver::io::report::{GainTableReport, PoseGains, PoseGainsReport, to_json};
 use solver::io::text::gains::{pose_gains, title};
-use solver::simulation::pose::{PoseError, complete};
+use solver::simulation::pose::{Pose, PoseError, complete};
 
 const LONG_ABOUT: &str = "\
 Error-gain functions of a machine (the seed's Tables 1 and 2): how each error of the model moves \
@@ -18,19 +21,27 @@ translational error, mm per rad of an angular error) and ΔI ΔJ ΔK (orientatio
 per mm or per rad), written in Sa/Ca (sine/cosine of rotary axis A's command), Xm (linear \
 command of X, mm) and the kinematic symbols (mm).
 
-With --at: the numbers at that pose, computed by the same code the identification uses: for \
-every error [gx, gy, gz], tool frame, mm/mm for translational errors and mm/rad for angular \
-errors (1 mm/rad = 1 µm of error vector per mrad; an error of e µm moves the tool point by g·e \
-µm, an error of e µrad by g·e nm). Axis positions in mm and degrees, kinematic parameters in mm \
-(defaults from the machine description, overridden by --param). Every rotary axis must be given; \
-linear axes left out of --at are filled by the machine's nominal tool-centre-point inverse \
-kinematics (the linear positions that put the tool point on the workpiece point at the given \
-rotary positions). The pose must be within the machine's strokes and ranges unless \
---allow-off-stroke is given.
+With --at: the numbers at that pose, the six gains of every error evaluated from the same \
+polynomials: position [gx, gy, gz] (tool frame; mm/mm for translational errors, mm/rad for angular \
+errors: 1 mm/rad = 1 µm of error vector per mrad; an error of e µm moves the tool point by g·e µm, \
+an error of e µrad by g·e nm) and orientation [gi, gj, gk] of the tool axis (1/mm, 1/rad). Axis \
+positions in mm and degrees, kinematic parameters in mm (defaults from the machine description, \
+overridden by --param). Every rotary axis must be given; linear axes left out of --at are filled \
+by the machine's nominal tool-centre-point inverse kinematics (the linear positions that put the \
+tool point on the workpiece point at the given rotary positions), and the output says which. The \
+pose must be within the machine's strokes and ranges unless --allow-off-stroke is given. A gain is \
+written 0 when its polynomial is identically zero, or when its value at the pose is within the \
+bound on the rounding error of its evaluation (a cancellation at this pose: such gains are listed, \
+never shown as -7.4e-15).
 
 JSON without --at: {\"machine\", \"model\" (null with --errors), \"units\", \"columns\", \
-\"atoms\": {name: meaning}, \"gains\": {error: [6 formulas]}}. JSON with --at: {error: [gx, gy, gz]}, \
-errors in model order.";
+\"atoms\": {name: meaning}, \"gains\": {error: [6 formulas]}}. JSON with --at: {\"machine\", \
+\"model\", \"pose\": {\"commands\": {axis: value}, \"filled_by_inverse_kinematics\": [axes], \
+\"parameters\": {symbol: mm}, \"tool_point_to_workpiece_point\"}, \"units\": {\"commands\": \
+{axis: \"mm\"|\"deg\"}, ...}, \"error_vector\", \"zeros\", \"gains\": {error: {\"kind\", \
+\"position\": [gx, gy, gz], \"position_unit\", \"orientation\": [gi, gj, gk], \
+\"orientation_unit\"}}, \"vanishing_at_this_pose\": [\"ERROR gx\", ...]}, errors in model order; \
+numbers are the shortest decimals that read back to the same double, zeros are written 0.";
 
 /// `--format` of the gain tables.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -112,31 +123,128 @@ pub fn run(args: &GainsArgs) -> CliResult {
             PoseError::MissingRotary(_) => CliError::usage(format!("--at: {e}")),
         },
     )?;
-    let mut source = GainSource::new(&m, &errors, &pose.params)
-        .map_err(|e| CliError::usage(format!("--param: {e}")))?;
-    let mut gains = vec![[0.0; 3]; source.errors().len()];
-    source
-        .position_gains(&pose.commands, &mut gains)
-        .map_err(|e| CliError::computation(format!("--at: {e}")))?;
-    let names: Vec<String> = errors
-        .iter()
-        .map(|&e| m.catalogue[e].name.clone())
-        .collect();
-    let angular: Vec<bool> = errors
-        .iter()
-        .map(|&e| m.catalogue[e].is_angular())
-        .collect();
+    let model = GainModel::derive(&m, &errors);
+    // The shared form (fast on long chains): each named intermediate is evaluated in turn
+    // with its bound, which becomes the error bound of its atom.
+    let mut atoms = model.atoms.all_values(&pose.commands, &pose.params);
+    let mut atom_errors = atom_error_bounds(&m, &model, &pose, &atoms);
+    for d in model.intermediates().definitions() {
+        let (value, bound) = evaluate_with_bound(d, &atoms, &atom_errors);
+        atoms.push(value);
+        atom_errors.push(bound);
+    }
+    let mut gains = vec![[0.0; 6]; errors.len()];
+    let mut vanishing = Vec::new();
+    for (i, polys) in model.gains.shared().iter().enumerate() {
+        for (k, p) in polys.iter().enumerate() {
+            let (value, bound) = evaluate_with_bound(p, &atoms, &atom_errors);
+            if !value.is_finite() {
+                return Err(CliError::computation(format!(
+                    "--at: gain {} of {} is not finite at this pose ({value})",
+                    COLUMNS[k], model.error_names[i]
+                )));
+            }
+            gains[i][k] = if p.is_zero() {
+                0.0
+            } else if value.abs() <= bound {
+                vanishing.push(format!("{} {}", model.error_names[i], COLUMNS[k]));
+                0.0
+            } else {
+                value
+            };
+        }
+    }
     if let (None, Some(note)) = (table_format, pose.off_ball_note()) {
         // The JSON stays what tools read; the note goes to standard error.
         super::print_text(&format!("{note}\n"), true)?;
     }
+    // The distance from the tool point to the workpiece point is 0 to rounding after the
+    // inverse kinematics: within the bound of its own rounding it is written 0.
+    let mut pose = pose;
+    if pose.gap_mm <= 16.0 * f64::EPSILON * lengths(&m, &pose) {
+        pose.gap_mm = 0.0;
+    }
+    let report = PoseGains {
+        names: &model.error_names,
+        angular: &model.angular,
+        gains: &gains,
+        vanishing,
+        zeros: ZERO_RULE.into(),
+    };
     let out = match table_format {
-        Some(f) => pose_gains(&m, &title, &pose, &names, &angular, &gains, f),
+        Some(f) => pose_gains(&m, &title, &pose, &report, f),
         None => to_json(
-            &PoseGainsReport::new(&names, &gains)
+            &PoseGainsReport::new(&m, model_name.as_deref(), &pose, &report)
                 .map_err(|e| CliError::computation(format!("--at: {e}")))?,
         )
         .map_err(|e| CliError::computation(format!("--format: {e}")))?,
     };
     super::print(&out)
+}
+
+/// How `rtest gains --at` decides that a gain is zero (said in its outputs).
+pub const ZERO_RULE: &str = "A gain is written 0 when its polynomial is identically zero, or when its value at this pose is within the bound on the rounding error of its evaluation (it vanishes here to the precision of the numbers; such gains are listed).";
+
+/// Bound on the absolute error of each atom's value at `pose` (`atoms`: the values, in atom
+/// order): a sine or cosine carries the rounding of degrees to radians and of the function,
+/// `ε·(2·|θ| + 1)` for θ in rad; a linear command the inverse kinematics filled carries the
+/// distance it left between the tool point and the workpiece point plus `ε` times the lengths
+/// it was computed from; every other number (a command or parameter as given, a constant of an
+/// inclined frame) is exact to `ε` relative. `ε` is the machine epsilon of `f64`.
+fn atom_error_bounds(m: &Machine, model: &GainModel, pose: &Pose, atoms: &[f64]) -> Vec<f64> {
+    let eps = f64::EPSILON;
+    let lengths = lengths(m, pose);
+    model
+        .atoms
+        .kinds
+        .iter()
+        .zip(atoms)
+        .map(|(kind, &v)| match *kind {
+            AtomKind::Sin(a) | AtomKind::Cos(a) => eps * (2.0 * pose.commands[a].abs() + 1.0),
+            AtomKind::Command(a) if pose.from_ik[a] => pose.gap_mm + eps * lengths,
+            _ => eps * v.abs(),
+        })
+        .collect()
+}
+
+/// The sum of the magnitudes of the lengths a pose is computed from (kinematic parameters and
+/// linear commands), mm: the scale of the rounding of positions at the pose.
+fn lengths(m: &Machine, pose: &Pose) -> f64 {
+    pose.params.iter().map(|p| p.abs()).sum::<f64>()
+        + m.axes
+            .iter()
+            .zip(&pose.commands)
+            .filter(|(a, _)| a.kind == AxisKind::Linear)
+            .map(|(_, c)| c.abs())
+            .sum::<f64>()
+}
+
+/// The value of `p` at the atom values `x` and a bound on its absolute error, given a bound
+/// `dx` on the error of every atom value (a named intermediate is an atom whose bound is that
+/// of its own evaluation).
+///
+/// With `P` the polynomial of the absolute values of `p`'s coefficients, evaluated term by
+/// term: the input errors move the value by at most `P(|x| + dx) − P(|x|)` (to first order,
+/// all terms positive), and evaluating `n` operations of products and a sum in floating point
+/// adds at most `γₙ·P(|x| + dx)` with `γₙ = n·u / (1 − n·u)` (Higham, *Accuracy and Stability
+/// of Numerical Algorithms*, §3.1), `n` = highest degree + coefficient rounding + number of
+/// terms; the bound is doubled to cover its own rounding.
+fn evaluate_with_bound(p: &Poly, x: &[f64], dx: &[f64]) -> (f64, f64) {
+    let (mut plain, mut moved, mut degree) = (0.0f64, 0.0f64, 0u32);
+    for (mono, c) in p.terms() {
+        let c = c.to_f64().abs();
+        let (mut a, mut b) = (c, c);
+        for &(atom, e) in mono.factors() {
+            let i = atom as usize;
+            a *= x[i].abs().powi(e as i32);
+            b *= (x[i].abs() + dx[i]).powi(e as i32);
+        }
+        plain += a;
+        moved += b;
+        degree = degree.max(mono.degree());
+    }
+    let n = (degree as usize + 3 + p.len()) as f64;
+    let u = f64::EPSILON / 2.0;
+    let gamma = n * u / (1.0 - n * u);
+    (p.eval(x), 2.0 * (gamma * moved + (moved - plain)))
 }

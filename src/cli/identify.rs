@@ -90,7 +90,11 @@ and its outputs are written, in the machine's history database (--db, default \
 rtest-history.sqlite): machine id and fingerprint, model and terms, test paths (--record-paths), \
 the measurement time (--measured-at), the SHA-256 of every input file, every value with its σ and \
 unit, rank, unidentifiable groups and residual. rtest history shows the checks and each error's \
-trend.";
+trend.
+
+Progress: on a terminal, a bar on standard error follows the reading of --data (bytes of the \
+file, with --stream too) once it has run half a second (RTEST_PROGRESS_DELAY_MS sets the delay, \
+in ms) and is cleared when it ends; never on a pipe or a file, nor with `--json -`.";
 
 /// Flags of `rtest identify`.
 #[derive(Debug, clap::Args)]
@@ -217,17 +221,22 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let read = args.records.read_options();
     let noise = args.noise.choice(&m, &read, &args.instrument)?;
     let data = data_path.display().to_string();
+    // A progress bar while the file is read, on a terminal's standard error, unless the JSON
+    // report takes standard output.
+    let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
     let (ident, refinement, streaming, notes) = if args.stream {
-        let (ident, run) = identify_file(&m, &model, data_path, &opts, args.block as usize, &read)
-            .map_err(|e| match e {
-                StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
-                e @ StreamingError::ReadTwice(_) => CliError::input(format!("--data: {e}")),
-                StreamingError::HMatrix(e @ HMatrixError::Times { .. }) => {
-                    CliError::input(format!("--data {data}: {e}"))
-                }
-                StreamingError::Estimate(e) => estimate_error(e),
-                other => CliError::computation(format!("--data: cannot identify: {other}")),
-            })?;
+        let (bar, read) = super::progress::reading(shown, data_path, &read);
+        let fitted = identify_file(&m, &model, data_path, &opts, args.block as usize, &read);
+        drop(bar);
+        let (ident, run) = fitted.map_err(|e| match e {
+            StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
+            e @ StreamingError::ReadTwice(_) => CliError::input(format!("--data: {e}")),
+            StreamingError::HMatrix(e @ HMatrixError::Times { .. }) => {
+                CliError::input(format!("--data {data}: {e}"))
+            }
+            StreamingError::Estimate(e) => estimate_error(e),
+            other => CliError::computation(format!("--data: cannot identify: {other}")),
+        })?;
         let streaming = StreamingReport {
             blocks: run.blocks,
             block: args.block as usize,
@@ -235,7 +244,10 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         };
         (ident, None, Some(streaming), String::new())
     } else {
-        let record = super::read_record("--data", &m, data_path, &read, &args.instrument, &params)?;
+        let record = {
+            let (_bar, read) = super::progress::reading(shown, data_path, &read);
+            super::read_record("--data", &m, data_path, &read, &args.instrument, &params)?
+        };
         super::check_times("--data", data_path, &m, &opts.fitted_model(&model), &record)?;
         let note = zeroed_note(&record, args.zeroed).to_string();
         if args.first_order {

@@ -19,6 +19,7 @@ pub mod path;
 pub mod path_nc;
 pub mod plan;
 pub mod pose_args;
+pub mod progress;
 pub mod report;
 pub mod segment;
 pub mod simulate;

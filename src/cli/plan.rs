@@ -10,7 +10,8 @@ use solver::fitting::EstimateError;
 use solver::fitting::Tolerances;
 use solver::fitting::noise::{MAX_PHI, NoiseModel, NoiseSource};
 use solver::fitting::plan::{
-    self, BASE_BALL, BallPosition, Plan, PlanError, PlannedTest, Targets, candidates, suggest,
+    self, BASE_BALL, BallPosition, Plan, PlanError, PlannedTest, Targets, candidates,
+    suggest_with_progress,
 };
 use solver::io::report::plan::{PlanReport, PlanSource};
 use solver::io::report::to_json;
@@ -52,7 +53,11 @@ balls, records, parameters: [{name, error, basis, owner, unit, determined, std}]
 columns, condition, confounded, near_confounded, targets, largest, suggestion: {criterion, \
 interest, step_mm, positions, evaluated, ranking: [{place, test, ball, paths_item, samples, \
 ball_arg, newly_determined, rank, columns, determined, largest, sum_squares}], skipped: [{test, ball, \
-reason}]}}; `null` only where the plan does not determine a value.";
+reason}]}}; `null` only where the plan does not determine a value.
+
+Progress: on a terminal, a bar on standard error follows the candidates evaluated once the work \
+has run half a second (RTEST_PROGRESS_DELAY_MS sets the delay, in ms) and is cleared when it \
+ends; never on a pipe or a file, nor with `--json -`.";
 
 /// Flags of `rtest plan`.
 #[derive(Debug, clap::Args)]
@@ -376,7 +381,16 @@ pub fn run(args: &PlanArgs) -> CliResult {
         urad: args.target_urad,
         ms: args.target_ms,
     };
-    let suggestion = suggest(&m, &model, &plan, &predicted, &set, &targets, &tol).map_err(fail)?;
+    // A progress bar on a terminal's standard error, unless the JSON report takes standard
+    // output.
+    let bar = super::progress::Bar::new(
+        super::progress::wanted(matches!(args.json, Some(Target::Stdout))),
+        false,
+    );
+    let suggestion =
+        suggest_with_progress(&m, &model, &plan, &predicted, &set, &targets, &tol, &bar);
+    drop(bar);
+    let suggestion = suggestion.map_err(fail)?;
     let source = PlanSource {
         label: &label,
         base_model: args.model.as_deref(),

@@ -7,7 +7,7 @@ use super::structure::{self, Component};
 use super::{DiagnoseOptions, Diagnosis};
 use crate::fitting::{Identification, ValidateError, ValidateOptions, validate};
 use crate::record::Record;
-use model_spec::Machine;
+use model_spec::{AxisKind, Machine};
 use std::path::Path;
 
 /// How many components a spectrum figure shows.
@@ -42,7 +42,8 @@ pub struct PathFigure {
     pub what: String,
     /// Its title.
     pub title: String,
-    /// What the abscissa is (`C (deg)` or `sample index`).
+    /// What the abscissa is, with its unit: the axis that moves most (`C (deg)`, `X (mm)`;
+    /// see [`abscissa`]), or what a residual follows.
     pub x_label: String,
     /// The abscissa.
     pub x: Vec<f64>,
@@ -129,30 +130,75 @@ fn stem(name: &str, taken: &mut Vec<String>) -> String {
     out
 }
 
-/// The abscissa of a path figure: the rotary axis that moves most while moving one way
-/// (degrees), else the sample index.
-fn abscissa(m: &Machine, record: &Record) -> (String, Vec<f64>) {
-    let mut best: Option<(usize, f64)> = None;
-    for a in m.rotary_axes() {
+/// The abscissa of a path figure: the position of the axis that moves most along the path,
+/// in degrees for a rotary axis and mm for a linear one, labelled with the axis and unit
+/// (`C (deg)`, `X (mm)`).
+///
+/// "Most" is the share of its own travel an axis sweeps on the path: the range of its
+/// commands over the width of its stroke (linear) or range (rotary, at most one turn; a
+/// rotary axis without limits counts one turn). An axis that moves one way (never reverses)
+/// comes before one that reverses, whatever their shares: an abscissa that turns back folds
+/// the curves onto themselves. Equal shares go to the rotary axis, then to the first axis
+/// in the machine's order. Only a path on which no axis moves falls back to the sample
+/// index, and its label says so.
+pub fn abscissa(m: &Machine, record: &Record) -> (String, Vec<f64>) {
+    // (one way?, share, rotary?, axis), compared lexicographically; the first axis wins ties.
+    let mut best: Option<(bool, f64, bool, usize)> = None;
+    for (a, axis) in m.axes.iter().enumerate() {
         let q: Vec<f64> = record.samples.iter().map(|s| s.commands[a]).collect();
-        let range = q.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
-            - q.iter().cloned().fold(f64::INFINITY, f64::min);
-        let monotonic = q.windows(2).all(|w| w[1] >= w[0]) || q.windows(2).all(|w| w[1] <= w[0]);
-        if range > 1e-9 && monotonic && best.is_none_or(|(_, r)| range > r) {
-            best = Some((a, range));
+        let (lo, hi) = q
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                (l.min(v), h.max(v))
+            });
+        let rotary = axis.kind == AxisKind::Rotary;
+        // Range on the path and width of the axis's travel, in the units people read.
+        let (range, travel) = if rotary {
+            let width = (axis.limits[1] - axis.limits[0]).min(360.0);
+            (
+                (hi - lo).to_degrees(),
+                if width.is_finite() { width } else { 360.0 },
+            )
+        } else {
+            (hi - lo, axis.limits[1] - axis.limits[0])
+        };
+        // Commands that differ by less than this are rounding, not motion (1 nm, 1 µdeg).
+        if range.is_nan() || range <= 1e-6 {
+            continue;
+        }
+        let share = if travel.is_finite() && travel > 0.0 {
+            range / travel
+        } else {
+            1.0
+        };
+        let one_way = q.windows(2).all(|w| w[1] >= w[0]) || q.windows(2).all(|w| w[1] <= w[0]);
+        let better = match best {
+            None => true,
+            Some((w, s, r, _)) => (one_way, share, rotary) > (w, s, r),
+        };
+        if better {
+            best = Some((one_way, share, rotary, a));
         }
     }
     match best {
-        Some((a, _)) => (
-            format!("{} (deg)", m.axes[a].name),
-            record
+        Some((_, _, rotary, a)) => {
+            let axis = &m.axes[a];
+            let unit = if rotary { "deg" } else { "mm" };
+            let x = record
                 .samples
                 .iter()
-                .map(|s| s.commands[a].to_degrees())
-                .collect(),
-        ),
+                .map(|s| {
+                    if rotary {
+                        s.commands[a].to_degrees()
+                    } else {
+                        s.commands[a]
+                    }
+                })
+                .collect();
+            (format!("{} ({unit})", axis.name), x)
+        }
         None => (
-            "sample index".into(),
+            "sample index (no axis moves on this path)".into(),
             (0..record.samples.len()).map(|i| i as f64).collect(),
         ),
     }
@@ -301,4 +347,84 @@ pub fn figures(
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::abscissa;
+    use crate::simulation::paths::record_from_commands;
+    use model_spec::Machine;
+
+    fn seed_ac() -> Machine {
+        model_spec::builtin("seed-ac").unwrap().unwrap()
+    }
+
+    /// A path of seed-ac (axes X A C Y Z) from per-sample commands (mm, degrees).
+    fn path(rows: &[[f64; 5]]) -> crate::record::Record {
+        let commands = rows
+            .iter()
+            .map(|r| vec![r[0], r[1].to_radians(), r[2].to_radians(), r[3], r[4]])
+            .collect();
+        record_from_commands(commands, (0..rows.len()).map(|i| i as f64).collect())
+    }
+
+    #[test]
+    fn a_turning_table_is_drawn_against_its_angle() {
+        let rows: Vec<[f64; 5]> = (0..9)
+            .map(|i| {
+                let c = 45.0 * i as f64;
+                [
+                    -217.5 * c.to_radians().cos(),
+                    -30.0,
+                    c,
+                    217.5 * c.to_radians().sin(),
+                    0.0,
+                ]
+            })
+            .collect();
+        let (label, x) = abscissa(&seed_ac(), &path(&rows));
+        assert_eq!(label, "C (deg)");
+        assert!((x[8] - 360.0).abs() < 1e-9, "{x:?}");
+    }
+
+    #[test]
+    fn a_linear_sweep_is_drawn_against_the_linear_axis_in_mm() {
+        // C stands still, A dithers back and forth by a degree, X sweeps one way.
+        let rows: Vec<[f64; 5]> = (0..5)
+            .map(|i| {
+                [
+                    -100.0 + 50.0 * i as f64,
+                    if i % 2 == 0 { 0.0 } else { 1.0 },
+                    90.0,
+                    0.0,
+                    0.0,
+                ]
+            })
+            .collect();
+        let (label, x) = abscissa(&seed_ac(), &path(&rows));
+        assert_eq!(label, "X (mm)");
+        assert_eq!(x, vec![-100.0, -50.0, 0.0, 50.0, 100.0]);
+    }
+
+    #[test]
+    fn the_larger_share_of_travel_wins_among_axes_that_move_one_way() {
+        // A sweeps 60 of its 240 degrees (0.25), Y 100 of its 800 mm (0.125).
+        let rows: Vec<[f64; 5]> = (0..4)
+            .map(|i| [0.0, -20.0 * i as f64, 0.0, 100.0 / 3.0 * i as f64, 0.0])
+            .collect();
+        assert_eq!(abscissa(&seed_ac(), &path(&rows)).0, "A (deg)");
+        // Y 400 of 800 mm (0.5) now beats A.
+        let rows: Vec<[f64; 5]> = (0..4)
+            .map(|i| [0.0, -20.0 * i as f64, 0.0, 400.0 / 3.0 * i as f64, 0.0])
+            .collect();
+        assert_eq!(abscissa(&seed_ac(), &path(&rows)).0, "Y (mm)");
+    }
+
+    #[test]
+    fn only_a_path_where_nothing_moves_falls_back_and_says_so() {
+        let rows = [[10.0, -30.0, 45.0, 0.0, 5.0]; 3];
+        let (label, x) = abscissa(&seed_ac(), &path(&rows));
+        assert_eq!(label, "sample index (no axis moves on this path)");
+        assert_eq!(x, vec![0.0, 1.0, 2.0]);
+    }
 }

@@ -46,6 +46,7 @@ use crate::fitting::validate::{ValidateError, ValidateOptions};
 use crate::fitting::{
     EstimateError, Identification, IdentifyOptions, measurement_vector, with_offsets,
 };
+use crate::io::progress::{Progress, Unwatched};
 use crate::model::{Effect, Model};
 use crate::record::Record;
 use confounded::confounded_with;
@@ -259,6 +260,36 @@ pub fn diagnose(
     held_out: &[(String, Record)],
     o: &DiagnoseOptions,
 ) -> Result<Diagnosis, DiagnoseError> {
+    diagnose_with_progress(m, base, record, held_out, o, &Unwatched)
+}
+
+/// The stages of a diagnosis, in order, as [`diagnose_with_progress`] reports them.
+pub const STAGES: [&str; 7] = [
+    "base fit",
+    "noise model",
+    "candidates' columns",
+    "selection",
+    "extended fit",
+    "held-out records",
+    "lack of fit",
+];
+
+/// [`diagnose`], telling `progress` where it is: `diagnosis` with the number of [`STAGES`]
+/// begun (done of total), and within the selection every candidate scored (`selection`, done
+/// of the candidates of the step; each step starts again from 0).
+///
+/// # Errors
+/// As [`diagnose`].
+pub fn diagnose_with_progress(
+    m: &Machine,
+    base: &Model,
+    record: &Record,
+    held_out: &[(String, Record)],
+    o: &DiagnoseOptions,
+    progress: &dyn Progress,
+) -> Result<Diagnosis, DiagnoseError> {
+    let stage = |k: usize| progress.update("diagnosis", k as u64, STAGES.len() as u64);
+    stage(0);
     let base_given = base.clone();
     let base = if o.zeroed {
         with_offsets(base)
@@ -287,6 +318,7 @@ pub fn diagnose(
         (&cleaned, f)
     };
 
+    stage(1);
     // The noise model, and the readings and columns whitened by it: every test after is the
     // textbook one on white noise of unit variance.
     let vopts = ValidateOptions {
@@ -310,6 +342,7 @@ pub fn diagnose(
         let b = heldout::predict(m, &f, held_out, &mut source, &vopts)?;
         (f, b)
     };
+    stage(2);
     let layout = [record.samples.len()];
     let mut y = measurement_vector(record)?;
     let mut h_raw = h_matrix(m, &all, record, &mut source)?;
@@ -380,7 +413,9 @@ pub fn diagnose(
         rss_base,
         live: &candidates_live,
         o,
+        progress,
     };
+    stage(3);
     let (chosen, stop) = search::select(&problem);
     // A scanned parameter refined on a fine grid, with every other finding in place.
     let mut refined = Vec::new();
@@ -395,6 +430,7 @@ pub fn diagnose(
         );
     }
 
+    stage(4);
     // Every finding fitted together; the implausible ones are then left out of the extended
     // model, which is fitted again.
     let mut with_all = base.clone();
@@ -468,6 +504,7 @@ pub fn diagnose(
         &widths,
     );
 
+    stage(5);
     let validation = heldout::held_out_gain(
         m,
         &base_fit,
@@ -477,6 +514,7 @@ pub fn diagnose(
         &mut source,
         &vopts,
     )?;
+    stage(6);
     // Lack of fit of the extended model against the noise on every record, and what remains
     // where it fails, described.
     let adequacy = match &noise.source {

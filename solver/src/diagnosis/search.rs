@@ -29,6 +29,8 @@ pub(super) struct Problem<'a> {
     pub live: &'a [usize],
     /// The options.
     pub o: &'a DiagnoseOptions,
+    /// Told of every candidate scored in a step (`selection`, done of the step's pool).
+    pub progress: &'a dyn crate::io::progress::Progress,
 }
 
 /// A step of the selection, before the extended fit gives its values.
@@ -72,6 +74,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         rss_base,
         live: candidates_live,
         o,
+        progress,
     } = *p;
     let n = y.len();
     // One selection step on the model `q` (orthonormal) over the candidates `pool`: the
@@ -79,9 +82,13 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
     let step = |q: &Span, pool: &[usize], seed: u64| -> Result<Chosen, Stop> {
         let r = q.project_out(y);
         let rss = r.norm_squared();
+        let total = pool.len() as u64;
+        progress.update("selection", 0, total);
         let scored: Vec<Scored> = pool
             .iter()
-            .filter_map(|&c| {
+            .enumerate()
+            .filter_map(|(k, &c)| {
+                progress.update("selection", k as u64 + 1, total);
                 let d = q.new_directions(&group(nb + c));
                 (d.ncols() > 0).then(|| {
                     let delta = d.tr_mul(&r).norm_squared();

@@ -16,6 +16,7 @@ pub mod campaign;
 pub mod csv;
 pub mod nc;
 pub mod poses;
+pub mod progress;
 pub mod report;
 pub mod segment;
 pub mod sensors;

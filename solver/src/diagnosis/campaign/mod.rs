@@ -294,6 +294,7 @@ pub fn diagnose_campaign(
         rss_base,
         live: &live,
         o,
+        progress: &crate::io::progress::Unwatched,
     };
     let (chosen, stop) = search::select(&problem);
 

@@ -28,6 +28,7 @@ use super::{Plan, PlanError, PlannedCampaign, Predicted};
 use crate::fitting::campaign::design::{Design, Layout, design_matrix};
 use crate::fitting::campaign::{Campaign, CampaignRecord, Owner};
 use crate::fitting::least_squares::Tolerances;
+use crate::io::progress::{Progress, Unwatched};
 use crate::model::Model;
 use model_spec::Machine;
 use nalgebra::DMatrix;
@@ -303,7 +304,28 @@ pub fn suggest(
     targets: &Targets,
     tol: &Tolerances,
 ) -> Result<Suggestion, PlanError> {
+    suggest_with_progress(m, model, plan, predicted, set, targets, tol, &Unwatched)
+}
+
+/// [`suggest`], telling `progress` of every candidate predicted (`candidates`, done of the
+/// number of candidates).
+///
+/// # Errors
+/// As [`suggest`].
+#[allow(clippy::too_many_arguments)]
+pub fn suggest_with_progress(
+    m: &Machine,
+    model: &Model,
+    plan: &Plan,
+    predicted: &Predicted,
+    set: &CandidateSet,
+    targets: &Targets,
+    tol: &Tolerances,
+    progress: &dyn Progress,
+) -> Result<Suggestion, PlanError> {
     targets.check()?;
+    let total = set.candidates.len() as u64;
+    progress.update("candidates", 0, total);
     let before = &predicted.prediction;
     let planned = &predicted.planned;
     let plan_design = &predicted.design;
@@ -360,6 +382,7 @@ pub fn suggest(
                 candidate: c,
                 score: score(m, before, &after, &names, targets),
             });
+            progress.update("candidates", ranking.len() as u64, total);
         }
     }
     ranking.sort_by_key(|r| r.candidate);

@@ -32,6 +32,10 @@ pub(crate) struct Lines<R> {
     eof: bool,
     /// The last line handed out ended with the source, without a line end.
     open_end: bool,
+    /// Bytes read from the source so far.
+    read: u64,
+    /// Told of every read ([`ReadOptions::progress`]).
+    progress: Option<crate::io::progress::ReadProgress>,
 }
 
 impl<R: Read> Lines<R> {
@@ -47,6 +51,8 @@ impl<R: Read> Lines<R> {
             number: 0,
             eof: false,
             open_end: false,
+            read: 0,
+            progress: opts.progress.clone(),
         }
     }
 
@@ -136,6 +142,10 @@ impl<R: Read> Lines<R> {
                 }
                 Ok(n) => {
                     (self.start, self.end) = (0, n);
+                    self.read += n as u64;
+                    if let Some(p) = &self.progress {
+                        p.read(self.read);
+                    }
                     return Ok(true);
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}

@@ -84,6 +84,8 @@ pub struct ReadOptions {
     /// Longest line, bytes (its line end not counted). Default 65 536. The readers never hold
     /// more of a line, and read at most this plus [`READ_BUFFER_BYTES`] of a longer one.
     pub max_line_bytes: usize,
+    /// Called with the bytes read of the source so far, for a progress bar. Default `None`.
+    pub progress: Option<crate::io::progress::ReadProgress>,
 }
 
 impl Default for ReadOptions {
@@ -93,6 +95,7 @@ impl Default for ReadOptions {
             allow_off_stroke: false,
             on_ball_tolerance_mm: crate::simulation::pose::ON_BALL_TOLERANCE_MM,
             max_line_bytes: 65_536,
+            progress: None,
         }
     }
 }

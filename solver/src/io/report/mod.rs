@@ -35,7 +35,7 @@ pub use campaign::{CampaignReport, CampaignSource};
 pub use campaign_read::{CampaignRead, ReadValues, read_values};
 pub use campaign_validate::{CampaignValidationReport, CampaignValidationSource};
 pub use diagnose::{DiagnosisReport, DiagnosisSource};
-pub use gains::{GainTableReport, PoseGainsReport};
+pub use gains::{GainTableReport, PoseGains, PoseGainsReport};
 pub use identify::{IdentificationReport, IdentificationSource};
 pub use read::{IdentifiedValues, ReportError, read_identification};
 pub use validate::{ValidationReport, ValidationSource};

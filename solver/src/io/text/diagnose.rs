@@ -400,6 +400,14 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
         r.unexcited.len(),
         r.data
     ));
+    if !r.unexcited.is_empty() {
+        out.push_str(&format!(
+            "Unexcited ({}: their columns are zero at every sample of {}, so the data cannot excite them and no test is made of them; they are no finding, and not shown to be absent):\n",
+            r.unexcited.len(),
+            r.data
+        ));
+        out.push_str(&wrap(&r.unexcited, ", ", "  ", 100));
+    }
     out.push_str(&format!(
         "Forward selection, significance α = {} per step after the correction for the candidates tried:\n",
         r.alpha

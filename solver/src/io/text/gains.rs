@@ -1,7 +1,9 @@
-//! Numeric gains at one pose for people (text, Markdown or LaTeX): per error `[gx, gy, gz]` in
-//! the tool frame, mm/mm for translational errors and mm/rad for angular errors.
+//! Numeric gains at one pose for people (text, Markdown or LaTeX): per error the position gains
+//! `[gx, gy, gz]` in the tool frame (mm/mm for translational errors, mm/rad for angular errors)
+//! and the orientation gains `[gi, gj, gk]` of the tool axis (1/mm or 1/rad).
 
 use super::{header, table};
+use crate::io::report::PoseGains;
 use crate::simulation::pose::Pose;
 use codegen::table::Format;
 use model_spec::units::{fixed, short};
@@ -33,17 +35,24 @@ pub fn describe_pose(m: &Machine, pose: &Pose) -> String {
         .join(", ")
 }
 
-/// The table of the gains `gains` of the errors `names` (`angular[i]`: an angular error) at
-/// `pose`, titled `title`.
+/// The table of the gains `g` (`[gx, gy, gz, gi, gj, gk]` per error) at `pose`, titled
+/// `title`, with the rule that decided the zeros and the gains that vanish at this pose.
 pub fn pose_gains(
     m: &Machine,
     title: &str,
     pose: &Pose,
-    names: &[String],
-    angular: &[bool],
-    gains: &[[f64; 3]],
+    g: &PoseGains<'_>,
     format: Format,
 ) -> String {
+    let zero_note = if g.vanishing.is_empty() {
+        g.zeros.clone()
+    } else {
+        format!(
+            "{} Vanishing at this pose: {}.",
+            g.zeros,
+            g.vanishing.join(", ")
+        )
+    };
     let params = m
         .symbols
         .iter()
@@ -58,22 +67,21 @@ pub fn pose_gains(
             if params.is_empty() { "none" } else { &params }
         ),
         "Error vector = tool point minus workpiece point, in the tool frame (first order).".into(),
-        "gx gy gz: mm/mm for translational errors, mm/rad for angular errors (1 mm/rad = 1 µm per mrad).".into(),
+        "gx gy gz: position, mm/mm for translational errors, mm/rad for angular errors (1 mm/rad = 1 µm per mrad).".into(),
+        "gi gj gk: orientation of the tool axis (unit vector), 1/mm for translational errors, 1/rad for angular errors.".into(),
+        zero_note,
     ];
     notes.extend(pose.off_ball_note());
-    let head = header(&["error", "unit", "gx", "gy", "gz"]);
-    let rows: Vec<Vec<String>> = names
+    let head = header(&["error", "unit", "gx", "gy", "gz", "gi", "gj", "gk"]);
+    let rows: Vec<Vec<String>> = g
+        .names
         .iter()
-        .zip(angular)
-        .zip(gains)
+        .zip(g.angular)
+        .zip(g.gains)
         .map(|((n, &ang), g)| {
-            vec![
-                n.clone(),
-                if ang { "mm/rad" } else { "mm/mm" }.to_string(),
-                fixed(g[0], 6),
-                fixed(g[1], 6),
-                fixed(g[2], 6),
-            ]
+            let mut row = vec![n.clone(), if ang { "mm/rad" } else { "mm/mm" }.to_string()];
+            row.extend(g.iter().map(|&v| fixed(v, 6)));
+            row
         })
         .collect();
     match format {
@@ -83,7 +91,7 @@ pub fn pose_gains(
                 out.push_str(&format!("{n}  \n"));
             }
             out.push_str(&format!("\n| {} |\n", head.join(" | ")));
-            out.push_str("|---|---|---:|---:|---:|\n");
+            out.push_str("|---|---|---:|---:|---:|---:|---:|---:|\n");
             for r in &rows {
                 out.push_str(&format!("| {} |\n", r.join(" | ")));
             }
@@ -94,14 +102,13 @@ pub fn pose_gains(
             for n in &notes {
                 out.push_str(&format!("% {n}\n"));
             }
-            out.push_str("\\begin{longtable}{llrrr}\n");
+            out.push_str("\\begin{longtable}{llrrrrrr}\n");
             out.push_str(&format!("\\caption{{{title}}}\\\\\n\\hline\n"));
-            out.push_str("error & unit & $g_x$ & $g_y$ & $g_z$ \\\\\n\\hline\n\\endhead\n");
+            out.push_str(
+                "error & unit & $g_x$ & $g_y$ & $g_z$ & $g_i$ & $g_j$ & $g_k$ \\\\\n\\hline\n\\endhead\n",
+            );
             for r in &rows {
-                out.push_str(&format!(
-                    "${}$ & {} & {} & {} & {} \\\\\n",
-                    r[0], r[1], r[2], r[3], r[4]
-                ));
+                out.push_str(&format!("${}$ & {} \\\\\n", r[0], r[1..].join(" & ")));
             }
             out.push_str("\\hline\n\\end{longtable}\n");
             out

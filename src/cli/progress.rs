@@ -1,0 +1,137 @@
+//! Progress bars on standard error for the long work of a verb: reading a measurement file, the
+//! suggestion of `rtest plan`, a diagnosis. The library reports progress
+//! (`solver::io::progress`); this module alone draws.
+//!
+//! A bar is drawn only when standard error is a terminal, never when standard output carries
+//! the JSON report (`--json -`: the text for people then goes to standard error), and only once
+//! the work has taken [`DEFAULT_DELAY`] (or `RTEST_PROGRESS_DELAY_MS` milliseconds): short work
+//! draws nothing. The bar is cleared when the work ends, finished or failed, so nothing else
+//! on standard error changes.
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use solver::io::progress::{Progress, ReadProgress};
+use std::io::IsTerminal;
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// How long work runs before its bar is drawn.
+pub const DEFAULT_DELAY: Duration = Duration::from_millis(500);
+
+/// The environment variable that sets the delay before a bar is drawn, in milliseconds.
+pub const DELAY_VARIABLE: &str = "RTEST_PROGRESS_DELAY_MS";
+
+/// The delay before a bar is drawn: [`DELAY_VARIABLE`] when it holds a whole number of
+/// milliseconds, else [`DEFAULT_DELAY`].
+fn delay() -> Duration {
+    std::env::var(DELAY_VARIABLE)
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .map_or(DEFAULT_DELAY, Duration::from_millis)
+}
+
+/// Whether a verb may draw a bar: standard error is a terminal and standard output does not
+/// carry the JSON report (`json_on_stdout`).
+pub fn wanted(json_on_stdout: bool) -> bool {
+    !json_on_stdout && std::io::stderr().is_terminal()
+}
+
+/// What a bar shares with the hooks that move it.
+#[derive(Clone)]
+struct Shared {
+    bar: ProgressBar,
+    start: Instant,
+    delay: Duration,
+    drawn: Arc<AtomicBool>,
+}
+
+impl Shared {
+    /// Moves the bar to `done` of `total` of `what`, drawing it once the delay has passed.
+    fn set(&self, what: &str, done: u64, total: u64) {
+        if !self.drawn.load(Ordering::Relaxed) && self.start.elapsed() >= self.delay {
+            self.drawn.store(true, Ordering::Relaxed);
+            self.bar.set_draw_target(ProgressDrawTarget::stderr());
+        }
+        // The numbers first, in one update, then the words when they change: the bar never
+        // shows the count of one piece of work against the total of another.
+        self.bar.update(|s| {
+            s.set_len(total);
+            s.set_pos(done.min(total));
+        });
+        if self.bar.message() != what {
+            self.bar.set_message(what.to_string());
+        }
+    }
+}
+
+/// A bar for one piece of work, cleared when dropped (the work finished or failed). Without
+/// [`wanted`] it draws nothing at all.
+pub struct Bar {
+    shared: Option<Shared>,
+}
+
+impl Bar {
+    /// A bar, drawn only when `wanted` (see [`wanted`]) and once the work has lasted the delay;
+    /// `bytes` shows the counts as sizes (reading a file).
+    pub fn new(wanted: bool, bytes: bool) -> Bar {
+        if !wanted {
+            return Bar { shared: None };
+        }
+        let template = if bytes {
+            "{msg} [{bar:30}] {bytes}/{total_bytes} ({eta} left)"
+        } else {
+            "{msg} [{bar:30}] {pos}/{len} ({elapsed})"
+        };
+        let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::hidden());
+        if let Ok(style) = ProgressStyle::with_template(template) {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        Bar {
+            shared: Some(Shared {
+                bar,
+                start: Instant::now(),
+                delay: delay(),
+                drawn: Arc::new(AtomicBool::new(false)),
+            }),
+        }
+    }
+
+    /// The hook for a CSV reader of `path`: the bar follows the bytes read of the file's size
+    /// (`None` without a bar, or when the size is unknown: a pipe has none).
+    pub fn read_hook(&self, path: &Path) -> Option<ReadProgress> {
+        let s = self.shared.clone()?;
+        let size = std::fs::metadata(path).ok().filter(|f| f.is_file())?.len();
+        let what = format!("reading {}", path.display());
+        Some(ReadProgress::new(move |read| s.set(&what, read, size)))
+    }
+}
+
+impl Progress for Bar {
+    fn update(&self, what: &str, done: u64, total: u64) {
+        if let Some(s) = &self.shared {
+            s.set(what, done, total);
+        }
+    }
+}
+
+impl Drop for Bar {
+    fn drop(&mut self) {
+        if let Some(s) = &self.shared {
+            s.bar.finish_and_clear();
+        }
+    }
+}
+
+/// A bar for reading `path` and the read options that move it (a copy of `read`): keep the
+/// bar while the file is read, and drop it after (it clears itself).
+pub fn reading(
+    wanted: bool,
+    path: &Path,
+    read: &solver::io::csv::ReadOptions,
+) -> (Bar, solver::io::csv::ReadOptions) {
+    let bar = Bar::new(wanted, true);
+    let mut read = read.clone();
+    read.progress = bar.read_hook(path);
+    (bar, read)
+}

@@ -157,7 +157,11 @@ fn identify_report_holds_the_values_and_says_what_is_absent() {
     );
     assert!(out.contains("Wrote id.html"), "{out}");
     let html = read(&dir, "id.html");
-    assert_eq!(check_self_contained(&html), 0);
+    // The fitted record, measured against predicted along its path (against C).
+    assert_eq!(check_self_contained(&html), 1);
+    assert!(html.contains("<figure id=\"fig-k4-path\">"));
+    assert!(html.contains("identified model (reduced)"));
+    assert!(html.contains("Abscissa: C (deg)."));
     assert!(html.contains("<h1>R-test check of seed-ac</h1>"));
     // The values of the JSON, with their uncertainty, in the table.
     let id: serde_json::Value = serde_json::from_str(&read(&dir, "id.json")).unwrap();
@@ -266,9 +270,27 @@ fn the_whole_check_from_json_files_and_from_the_verbs() {
     );
     assert!(out.contains("Wrote check.html"), "{out}");
     let html = read(&dir, "check.html");
-    // The validation figure and the spectrum; path figures need the measurements.
-    assert_eq!(check_self_contained(&html), 2);
-    assert!(html.contains("No path figures: they need the measurements"));
+    // The validation figure, the spectrum, and the paths of K4 (fitted) and K1 (validation)
+    // read from the records the reports name.
+    assert_eq!(check_self_contained(&html), 4);
+    assert!(html.contains("<figure id=\"fig-k4-path\">"));
+    assert!(html.contains("<figure id=\"fig-k1-path\">"));
+    assert!(html.contains("k1.csv (validation): measured and predicted error"));
+    // Without the records (another working directory), the report says what is not drawn.
+    let away = dir.join("away");
+    std::fs::create_dir(&away).unwrap();
+    for f in ["id.json", "v1.json"] {
+        std::fs::copy(dir.join(f), away.join(f)).unwrap();
+    }
+    ok(&away, &["report", "id.json", "v1.json", "-o", "away.html"]);
+    let html_away = read(&away, "away.html");
+    assert_eq!(
+        check_self_contained(&html_away),
+        1,
+        "the validation figure only"
+    );
+    assert!(html_away.contains("k4.csv is not drawn: it could not be read here"));
+    assert!(html_away.contains("k1.csv is not drawn: it could not be read here"));
     assert!(!html.contains(" in this report ("), "every part is given");
     // The records the reports name are hashed when readable from here.
     for f in ["k4.csv", "k1.csv", "poses.csv", "id.json"] {

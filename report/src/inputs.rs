@@ -286,6 +286,11 @@ pub struct Inputs {
     pub path_figures: Vec<Figure>,
     /// Why there are no path figures, when there are none (one line).
     pub no_path_figures: Option<String>,
+    /// Measured against the identified model's prediction along the path of each record (the
+    /// fitted one and the validations'), drawn by the verb that read the records.
+    pub prediction_figures: Vec<Figure>,
+    /// The records of the check whose prediction is not drawn, and why (one line each).
+    pub prediction_not_drawn: Vec<String>,
     /// The input files, hashed.
     pub files: Vec<InputFile>,
     /// When the report was written (RFC 3339, UTC); `None` leaves it out.

@@ -302,6 +302,24 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             ::report::Document::Identification(Box::new(report.clone())),
         )
         .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+        if report.streaming.is_some() {
+            i.prediction_not_drawn.push(format!(
+                "{} is not drawn: a streamed record is read block by block, and its figure would read it all",
+                data_path.display()
+            ));
+        } else {
+            let json =
+                to_json(&report).map_err(|e| CliError::computation(format!("--report: {e}")))?;
+            let values = solver::io::report::read::parse_identification("this run", &json, &m)
+                .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+            let fitted = super::report::PathRecord {
+                path: data_path,
+                role: "fitted",
+                zeroed: args.zeroed,
+            };
+            (i.prediction_figures, i.prediction_not_drawn) =
+                super::report::path_figures("--report", &m, &values, &label, &[fitted])?;
+        }
         files.add(
             "--report",
             target.clone(),

@@ -26,9 +26,14 @@ and compensation, and for a diagnosis the identification's fitted record and its
 extended model. Campaign reports (\"kind\": \"campaign\") are not covered. The records and \
 files the reports name are hashed when they can be read from the working directory.
 
-The measured-against-predicted figures along each path need the measurements, which the JSON \
-reports do not hold: `rtest diagnose --report FILE` draws them. `identify`, `diagnose` and \
-`compensate` take --report FILE to write this report from what they just computed.
+The measured error against the identified model's prediction along each path (the \
+identification's record and every validation's, against the axis that moves most) is drawn \
+from the records the reports name, read from the working directory, with the identification's \
+values on the exact virtual machine; a record that cannot be read is named with why. The \
+machine is --machine, or the built-in the reports name. The diagnosis's base and extended \
+predictions along the paths are drawn by `rtest diagnose --report FILE`. `identify`, \
+`diagnose` and `compensate` take --report FILE to write this report from what they just \
+computed.
 
 The document makes no request of any kind: figures are inline SVG, their font (DejaVu Sans, \
 about 1 MB of the file) is embedded, a Content-Security-Policy forbids every other source, and \
@@ -88,8 +93,12 @@ pub fn run(args: &ReportArgs) -> CliResult {
     inputs_list.extend(machine_file.map(|p| ("--machine", p)));
     check_outputs(&inputs_list, &[("-o", &args.output)], &[])?;
     let mut inputs = Inputs::new();
-    if let Some(name) = &args.machine {
-        inputs.machine = Some(MachineFacts::of(&super::load_machine(name)?));
+    let machine = match &args.machine {
+        Some(name) => Some(super::load_machine(name)?),
+        None => None,
+    };
+    if let Some(m) = &machine {
+        inputs.machine = Some(MachineFacts::of(m));
     }
     inputs.written_at = now();
     for path in &args.reports {
@@ -101,14 +110,73 @@ pub fn run(args: &ReportArgs) -> CliResult {
     }
     inputs.files = named_files(&inputs, &args.reports, machine_file);
     inputs.no_path_figures = Some(
-        "No path figures: they need the measurements, which the JSON reports do not hold (rtest diagnose --report draws them).".into(),
+        "The base and extended models' predictions along the paths are drawn by rtest diagnose --report; section 4 draws the identified model's.".into(),
     );
+    draw_paths(&mut inputs, machine, &args.reports)?;
     let html = render("-o", &inputs)?;
     let mut files = Outputs::new();
     files.add("-o", args.output.clone(), html);
     let stdout_taken = matches!(args.output, Target::Stdout);
     let text = wrote(&write(files)?);
     print_text(&text, stdout_taken)
+}
+
+/// The identified model's prediction along the path of the identification's record and of
+/// every validation's, when the machine is known (`--machine`, or the built-in the reports
+/// name) and the records can be read from here; otherwise one line says why not.
+fn draw_paths(
+    inputs: &mut Inputs,
+    machine: Option<model_spec::Machine>,
+    reports: &[PathBuf],
+) -> CliResult<()> {
+    let Some((id_file, id)) = &inputs.identification else {
+        if !inputs.validations.is_empty() {
+            inputs.prediction_not_drawn.push(
+                "No path is drawn: the identified values are in the identification report, which is not given.".into(),
+            );
+        }
+        return Ok(());
+    };
+    let m = match machine.map_or_else(|| model_spec::load_machine(&id.machine), Ok) {
+        Ok(m) => m,
+        Err(_) => {
+            inputs.prediction_not_drawn.push(format!(
+                "No path is drawn: machine {} is no built-in; give its description with --machine.",
+                id.machine
+            ));
+            return Ok(());
+        }
+    };
+    let id_path = reports
+        .iter()
+        .find(|p| p.display().to_string() == *id_file)
+        .map_or_else(|| PathBuf::from(id_file), PathBuf::clone);
+    let values = match solver::io::report::read_values(&id_path, &m) {
+        Ok(solver::io::report::ReadValues::Single { values, .. }) => values,
+        Ok(_) => return Ok(()),
+        Err(e) => {
+            inputs
+                .prediction_not_drawn
+                .push(format!("No path is drawn: {e}"));
+            return Ok(());
+        }
+    };
+    let mut records = vec![PathRecord {
+        path: Path::new(&id.data),
+        role: "fitted",
+        zeroed: id.zeroed,
+    }];
+    for (_, v) in &inputs.validations {
+        records.push(PathRecord {
+            path: Path::new(&v.data),
+            role: "validation",
+            zeroed: v.zeroed,
+        });
+    }
+    let (figures, not_drawn) = path_figures("-o", &m, &values, &id.model, &records)?;
+    inputs.prediction_figures = figures;
+    inputs.prediction_not_drawn = not_drawn;
+    Ok(())
 }
 
 /// The files of a report given to `rtest report`: the JSON reports, the machine file, and
@@ -142,4 +210,65 @@ fn named_files(inputs: &Inputs, reports: &[PathBuf], machine: Option<&Path>) -> 
         named("compensation: commanded poses", &c.input);
     }
     out
+}
+
+/// A record whose measured error is drawn against the identified model's prediction along
+/// its path.
+pub struct PathRecord<'a> {
+    /// The record's file.
+    pub path: &'a Path,
+    /// Its role in the check (`fitted`, `validation`).
+    pub role: &'static str,
+    /// Whether the prediction is zeroed at the first sample (as the validation was).
+    pub zeroed: bool,
+}
+
+/// Measured against predicted error along the path of each record, the prediction that of
+/// the exact virtual machine at the identified `values` (model labelled `label`), drawn
+/// against the axis that moves most. A record that cannot be read from here, or not predicted,
+/// is not drawn: the second list says which and why, for the report.
+///
+/// # Errors
+/// A figure that cannot be drawn (exit code 3).
+pub fn path_figures(
+    flag: &str,
+    m: &model_spec::Machine,
+    values: &solver::io::report::IdentifiedValues,
+    label: &str,
+    records: &[PathRecord<'_>],
+) -> CliResult<(Vec<report::Figure>, Vec<String>)> {
+    use solver::diagnosis::figures::{Figures, validation_figure};
+    use solver::fitting::{ValidateOptions, validate};
+    let mut figures = Figures::default();
+    let mut not_drawn = Vec::new();
+    let mut taken = Vec::new();
+    let params = m.default_parameters();
+    for r in records {
+        let name = r.path.display().to_string();
+        let record = match solver::io::campaign::read_record_at(
+            r.path,
+            m,
+            &params,
+            &solver::io::csv::ReadOptions::default(),
+            None,
+        ) {
+            Ok(record) => record,
+            Err(e) => {
+                not_drawn.push(format!(
+                    "{name} is not drawn: it could not be read here ({e})"
+                ));
+                continue;
+            }
+        };
+        let opts = ValidateOptions::new().zeroed(r.zeroed).exact(true);
+        match validate(m, &values.model, &values.values, &record, &opts) {
+            Ok(v) => figures.paths.push(validation_figure(
+                m, &name, r.role, &record, &v, label, &mut taken,
+            )),
+            Err(e) => not_drawn.push(format!("{name} is not drawn: {e}")),
+        }
+    }
+    let drawn = report::figures::path_figures(&figures)
+        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
+    Ok((drawn, not_drawn))
 }

@@ -1,5 +1,6 @@
 //! Section 4: the validations: residual RMS and maximum per direction, on the nominal machine
-//! and with the identified model, µm, and their figure.
+//! and with the identified model, µm, and their figure; the measured error against the
+//! identified model's prediction along each path.
 
 use super::num;
 use crate::html::{Body, Cell};
@@ -16,6 +17,7 @@ pub fn write(
     b.section(id, title);
     if inputs.validations.is_empty() {
         b.absent("No validation in this report (rtest validate --json).");
+        paths(b, inputs)?;
         b.end_section();
         return Ok(());
     }
@@ -75,6 +77,23 @@ pub fn write(
     if let Some(f) = figure {
         crate::place_figure(b, f)?;
     }
+    paths(b, inputs)?;
     b.end_section();
+    Ok(())
+}
+
+/// The measured error against the identified model's prediction along each path, and the
+/// records not drawn with why.
+fn paths(b: &mut Body, inputs: &Inputs) -> Result<(), crate::RenderError> {
+    if inputs.prediction_figures.is_empty() && inputs.prediction_not_drawn.is_empty() {
+        return Ok(());
+    }
+    b.subheading("Measured against predicted along the paths");
+    if !inputs.prediction_not_drawn.is_empty() {
+        b.list(&inputs.prediction_not_drawn);
+    }
+    for f in &inputs.prediction_figures {
+        crate::place_figure(b, f)?;
+    }
     Ok(())
 }

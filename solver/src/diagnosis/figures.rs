@@ -5,7 +5,7 @@
 
 use super::structure::{self, Component};
 use super::{DiagnoseOptions, Diagnosis};
-use crate::fitting::{Identification, ValidateError, ValidateOptions, validate};
+use crate::fitting::{Identification, ValidateError, ValidateOptions, Validation, validate};
 use crate::record::Record;
 use model_spec::{AxisKind, Machine};
 use std::path::Path;
@@ -204,6 +204,59 @@ pub fn abscissa(m: &Machine, record: &Record) -> (String, Vec<f64>) {
     }
 }
 
+/// The x, y and z panels of a record (µm): the measured error (prediction plus residual of
+/// `v`) against each labelled prediction (mm per sample).
+fn panels(v: &Validation, predictions: &[(String, &Vec<[f64; 3]>)]) -> Vec<Panel> {
+    let um = |v: &[[f64; 3]], k: usize| v.iter().map(|r| r[k] * 1e3).collect::<Vec<f64>>();
+    let measured: Vec<[f64; 3]> = v
+        .prediction
+        .iter()
+        .zip(&v.residual)
+        .map(|(p, r)| [p[0] + r[0], p[1] + r[1], p[2] + r[2]])
+        .collect();
+    (0..3)
+        .map(|k| Panel {
+            name: format!("{} error", ["x", "y", "z"][k]),
+            measured: Series {
+                label: "measured".into(),
+                values: um(&measured, k),
+            },
+            predictions: predictions
+                .iter()
+                .map(|(label, p)| Series {
+                    label: label.clone(),
+                    values: um(p, k),
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+/// Measured against predicted error along the path of `record` (named `name`, its `role`
+/// such as `fitted` or `validation`), from the validation `v` of the model labelled `label`
+/// on it: the figure of a validation, drawn against the axis that moves most ([`abscissa`]).
+/// `taken` holds the file stems already used, so that two records never share a file name.
+pub fn validation_figure(
+    m: &Machine,
+    name: &str,
+    role: &str,
+    record: &Record,
+    v: &Validation,
+    label: &str,
+    taken: &mut Vec<String>,
+) -> PathFigure {
+    let (x_label, x) = abscissa(m, record);
+    let s = stem(name, taken);
+    PathFigure {
+        file_name: format!("{s}-path.svg"),
+        what: "figure: measured and predicted error along the path, x, y, z".into(),
+        title: format!("{name} ({role}): measured and predicted error, µm"),
+        x_label,
+        x,
+        panels: panels(v, &[(format!("identified model ({label})"), &v.prediction)]),
+    }
+}
+
 /// The figures of diagnosis `d` of the model labelled `label`, for every record (name,
 /// record, fitted?): the fitted record first, then the held-out ones.
 ///
@@ -238,32 +291,13 @@ pub fn figures(
         let before = predict(&d.base_fit)?;
         let after = predict(&d.extended_fit)?;
         let (x_label, x) = abscissa(m, record);
-        let um = |v: &[[f64; 3]], k: usize| v.iter().map(|r| r[k] * 1e3).collect::<Vec<f64>>();
-        let measured: Vec<[f64; 3]> = before
-            .prediction
-            .iter()
-            .zip(&before.residual)
-            .map(|(p, r)| [p[0] + r[0], p[1] + r[1], p[2] + r[2]])
-            .collect();
-        let panels = (0..3)
-            .map(|k| Panel {
-                name: format!("{} error", ["x", "y", "z"][k]),
-                measured: Series {
-                    label: "measured".into(),
-                    values: um(&measured, k),
-                },
-                predictions: vec![
-                    Series {
-                        label: format!("base model ({label})"),
-                        values: um(&before.prediction, k),
-                    },
-                    Series {
-                        label: format!("extended model ({ext_label})"),
-                        values: um(&after.prediction, k),
-                    },
-                ],
-            })
-            .collect();
+        let panels = panels(
+            &before,
+            &[
+                (format!("base model ({label})"), &before.prediction),
+                (format!("extended model ({ext_label})"), &after.prediction),
+            ],
+        );
         let role = if *fitted { "fitted" } else { "held out" };
         let s = stem(name, &mut taken);
         out.paths.push(PathFigure {

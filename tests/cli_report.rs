@@ -299,6 +299,14 @@ fn the_whole_check_from_json_files_and_from_the_verbs() {
             "{f} hashed"
         );
     }
+    // With the time each was last modified (UTC).
+    let at = html.rfind("<td>k4.csv</td><td class=\"num\">").unwrap();
+    let cells: Vec<&str> = html[at..].splitn(5, "<td").collect();
+    assert!(
+        cells[3].starts_with(">20") && cells[3].contains('T') && cells[3].contains("Z</td>"),
+        "{}",
+        cells[3]
+    );
     insta::assert_snapshot!(headings(&html).join("\n"));
 }
 

@@ -59,13 +59,21 @@ impl Timestamp {
     /// # Errors
     /// A message when the clock is before 1970 or beyond year 9999.
     pub fn now() -> Result<Timestamp, String> {
-        let secs = SystemTime::now()
+        Timestamp::of(SystemTime::now())
+    }
+
+    /// The time `t` (a file's modification time, say), to the second.
+    ///
+    /// # Errors
+    /// A message when `t` is before 1970 or beyond year 9999.
+    pub fn of(t: SystemTime) -> Result<Timestamp, String> {
+        let secs = t
             .duration_since(UNIX_EPOCH)
-            .map_err(|_| "the system clock is before 1970".to_string())?
+            .map_err(|_| "the time is before 1970".to_string())?
             .as_secs();
         match i64::try_from(secs) {
             Ok(s) if s <= LAST => Ok(Timestamp(s)),
-            _ => Err("the system clock is beyond the year 9999".into()),
+            _ => Err("the time is beyond the year 9999".into()),
         }
     }
 

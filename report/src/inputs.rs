@@ -199,6 +199,9 @@ pub struct InputFile {
     /// SHA-256 (hex) and size in bytes of the file as read when the report was written;
     /// `None` when it could not be read from there.
     pub digest: Option<(String, u64)>,
+    /// When the file was last modified, RFC 3339 UTC, as its file system says (the only date
+    /// a record carries: its samples hold seconds from its start); `None` when unknown.
+    pub modified: Option<String>,
 }
 
 impl InputFile {
@@ -209,6 +212,11 @@ impl InputFile {
             role: role.to_string(),
             path: path.to_string(),
             digest: history::sha256::sha256_file(Path::new(path)).ok(),
+            modified: std::fs::metadata(path)
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| history::Timestamp::of(t).ok())
+                .map(|t| t.to_string()),
         }
     }
 }

@@ -136,6 +136,7 @@ fn html_report(result: &demo::Demo) -> CliResult<String> {
                     history::sha256::sha256_hex(f.contents.as_bytes()),
                     f.contents.len() as u64,
                 )),
+                modified: None,
             });
         }
         let wanted = f.name == "identify.json"

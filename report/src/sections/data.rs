@@ -84,6 +84,7 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
                     Cell::text(f.role.clone()),
                     Cell::text(f.path.clone()),
                     Cell::number(bytes.to_string()),
+                    Cell::text(f.modified.clone().unwrap_or_else(|| "–".into())),
                     Cell::Markup(format!(
                         "<span class=\"hash\">{}</span>",
                         crate::html::escape(hash)
@@ -93,13 +94,14 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
                     Cell::text(f.role.clone()),
                     Cell::text(f.path.clone()),
                     Cell::number("–"),
+                    Cell::text("–"),
                     Cell::text("not readable from here: no hash"),
                 ],
             })
             .collect();
         b.table(
-            "Input files and their SHA-256, as read when this report was written",
-            &["Role", "Path", "Bytes", "SHA-256"],
+            "Input files: size, last modification (UTC, as the file system gives it) and SHA-256, as read when this report was written",
+            &["Role", "Path", "Bytes", "Modified", "SHA-256"],
             &rows,
         );
     }

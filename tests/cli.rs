@@ -2,11 +2,11 @@
 //! and every kind of bad input (message on one stderr line naming the flag and the item, exit
 //! code 2 for usage errors and 1 for other failures, no panic, no output file left behind).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Output;
 
 mod common;
-use common::{TempDir, entries, stderr, stdout};
+use common::{TempDir, entries, json_here as json, ok_here as ok, seed_file, stderr, triple};
 
 fn rtest_in(dir: Option<&Path>, args: &[&str]) -> Output {
     common::run(dir, args)
@@ -26,41 +26,6 @@ fn temp_dir(name: &str) -> TempDir {
 
 fn rtest(args: &[&str]) -> Output {
     rtest_in(None, args)
-}
-
-/// Runs `args`, asserts success and returns stdout.
-fn ok(args: &[&str]) -> String {
-    let o = rtest(args);
-    assert!(
-        o.status.success(),
-        "rtest {args:?} failed ({:?}): {}",
-        o.status.code(),
-        stderr(&o)
-    );
-    stdout(&o)
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let out = ok(args);
-    serde_json::from_str(&out).unwrap_or_else(|e| panic!("rtest {args:?}: not JSON ({e}):\n{out}"))
-}
-
-/// The built-in seed machine's TOML, copied into `dir`.
-fn seed_file(dir: &Path) -> PathBuf {
-    let text = model_spec::BUILTIN
-        .iter()
-        .find(|(n, _)| *n == "seed-ac")
-        .expect("seed-ac is built in")
-        .1;
-    let path = dir.join("my-seed.toml");
-    std::fs::write(&path, text).expect("write machine file");
-    path
-}
-
-fn triple(v: &serde_json::Value) -> [f64; 3] {
-    let a = v.as_array().expect("array");
-    assert_eq!(a.len(), 3, "{v}");
-    std::array::from_fn(|k| a[k].as_f64().expect("number"))
 }
 
 /// Keys of a JSON object in the order they appear in the text.

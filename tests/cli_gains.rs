@@ -3,10 +3,8 @@
 //! and orientation rows, and zeros written `0` (identically zero, or vanishing at the pose
 //! within the bound on the rounding error), never floating-point noise.
 
-use std::path::{Path, PathBuf};
-
 mod common;
-use common::{stderr, stdout};
+use common::{json_here as json, ok_here as ok, seed_file, triple};
 
 /// Table 3 of the seed (mm).
 const XW: f64 = -217.504;
@@ -14,41 +12,6 @@ const YW: f64 = -0.279;
 const ZW: f64 = 211.537;
 const ZC: f64 = 29.794;
 const TABLE_3: &str = "Xw=-217.504,Yw=-0.279,Zw=211.537,Zc=29.794";
-
-/// Runs `args`, asserts success and returns stdout.
-fn ok(args: &[&str]) -> String {
-    let o = common::run(None, args);
-    assert!(
-        o.status.success(),
-        "rtest {args:?} failed ({:?}): {}",
-        o.status.code(),
-        stderr(&o)
-    );
-    stdout(&o)
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let out = ok(args);
-    serde_json::from_str(&out).unwrap_or_else(|e| panic!("rtest {args:?}: not JSON ({e}):\n{out}"))
-}
-
-/// The built-in seed machine's TOML, copied into `dir`.
-fn seed_file(dir: &Path) -> PathBuf {
-    let text = model_spec::BUILTIN
-        .iter()
-        .find(|(n, _)| *n == "seed-ac")
-        .expect("seed-ac is built in")
-        .1;
-    let path = dir.join("my-seed.toml");
-    std::fs::write(&path, text).expect("write machine file");
-    path
-}
-
-fn triple(v: &serde_json::Value) -> [f64; 3] {
-    let a = v.as_array().expect("array");
-    assert_eq!(a.len(), 3, "{v}");
-    std::array::from_fn(|k| a[k].as_f64().expect("number"))
-}
 
 /// The position gains of `error` in a `gains --at --format json` report.
 fn position(v: &serde_json::Value, error: &str) -> [f64; 3] {

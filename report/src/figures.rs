@@ -5,7 +5,7 @@
 
 use crate::inputs::Figure;
 use plots::PlotError;
-use solver::diagnosis::figures::{Figures, Series};
+use solver::diagnosis::figures::{Figures, PathFigure, Series};
 use solver::io::report::{DiagnosisReport, ValidationReport};
 
 /// An HTML id from a file name (`k4-path.svg` → `fig-k4-path`): letters, digits and `-` only.
@@ -28,8 +28,26 @@ fn series(s: &Series) -> plots::Series {
     plots::Series::new(s.label.clone(), s.values.clone())
 }
 
-/// The path figures of a diagnosis (one per record: the measured error in x, y, z against the
-/// base and extended predictions along the path, µm), ready for the page.
+/// The SVG of one path figure: the measured error in x, y, z against the predictions along
+/// the path, µm (as `rtest diagnose --plot` writes it and the report places it).
+///
+/// # Errors
+/// A series `plots` refuses (empty, non-finite, of the wrong length).
+pub fn path_svg(f: &PathFigure) -> Result<String, PlotError> {
+    let panels: Vec<plots::Panel> = f
+        .panels
+        .iter()
+        .map(|p| plots::Panel {
+            name: p.name.clone(),
+            measured: series(&p.measured),
+            predictions: p.predictions.iter().map(series).collect(),
+        })
+        .collect();
+    plots::path_comparison(&f.title, &f.x_label, &f.x, &panels)
+}
+
+/// The path figures (one per record: the measured error in x, y, z against the predictions
+/// along the path, µm), ready for the page.
 ///
 /// # Errors
 /// A series `plots` refuses (empty, non-finite, of the wrong length).
@@ -38,24 +56,14 @@ pub fn path_figures(figures: &Figures) -> Result<Vec<Figure>, PlotError> {
         .paths
         .iter()
         .map(|f| {
-            let panels: Vec<plots::Panel> = f
-                .panels
-                .iter()
-                .map(|p| plots::Panel {
-                    name: p.name.clone(),
-                    measured: series(&p.measured),
-                    predictions: p.predictions.iter().map(series).collect(),
-                })
-                .collect();
             let labels: Vec<&str> = f
                 .panels
                 .first()
                 .map(|p| p.predictions.iter().map(|s| s.label.as_str()).collect())
                 .unwrap_or_default();
-            let svg = plots::path_comparison(&f.title, &f.x_label, &f.x, &panels)?;
             Ok(Figure {
                 id: figure_id(&f.file_name),
-                svg,
+                svg: path_svg(f)?,
                 caption: format!(
                     "{}. Points: the measured error (µm) in x, y and z of the tool frame; lines: the predictions of the {}; above each panel the RMS of measured minus predicted (µm). Abscissa: {}.",
                     f.title,

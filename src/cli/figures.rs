@@ -1,28 +1,16 @@
 //! The diagnosis figures drawn: the plain series of `solver::diagnosis::figures` handed to the
-//! `plots` crate, which returns SVG text.
+//! `plots` crate (path figures through `report::figures::path_svg`, the one conversion the
+//! HTML report uses too), which returns SVG text.
 
 use super::{CliError, CliResult};
-use solver::diagnosis::figures::{Figures, Series};
-
-fn series(s: &Series) -> plots::Series {
-    plots::Series::new(s.label.clone(), s.values.clone())
-}
+use solver::diagnosis::figures::Figures;
 
 /// Every figure as (file name, what it shows, SVG text).
 pub fn svgs(figures: &Figures) -> CliResult<Vec<(String, String, String)>> {
     let failed = |e: plots::PlotError| CliError::computation(format!("--plot: {e}"));
     let mut out = Vec::new();
     for f in &figures.paths {
-        let panels: Vec<plots::Panel> = f
-            .panels
-            .iter()
-            .map(|p| plots::Panel {
-                name: p.name.clone(),
-                measured: series(&p.measured),
-                predictions: p.predictions.iter().map(series).collect(),
-            })
-            .collect();
-        let svg = plots::path_comparison(&f.title, &f.x_label, &f.x, &panels).map_err(failed)?;
+        let svg = ::report::figures::path_svg(f).map_err(failed)?;
         out.push((f.file_name.clone(), f.what.clone(), svg));
     }
     for s in &figures.spectra {

@@ -99,7 +99,41 @@ pub fn read_json(path: &Path) -> Value {
 
 /// Runs `args` in `dir`, asserts success, returns stdout.
 pub fn ok(dir: &Path, args: &[&str]) -> String {
-    let o = run(Some(dir), args);
+    ok_in(Some(dir), args)
+}
+
+/// Runs `args` in the test's working directory, asserts success, returns stdout.
+pub fn ok_here(args: &[&str]) -> String {
+    ok_in(None, args)
+}
+
+/// The standard output of `args` (run in the test's working directory), read as JSON.
+pub fn json_here(args: &[&str]) -> Value {
+    let out = ok_here(args);
+    serde_json::from_str(&out).unwrap_or_else(|e| panic!("rtest {args:?}: not JSON ({e}):\n{out}"))
+}
+
+/// The built-in seed machine's TOML, copied into `dir` as `my-seed.toml`.
+pub fn seed_file(dir: &Path) -> std::path::PathBuf {
+    let text = model_spec::BUILTIN
+        .iter()
+        .find(|(n, _)| *n == "seed-ac")
+        .expect("seed-ac is built in")
+        .1;
+    let path = dir.join("my-seed.toml");
+    std::fs::write(&path, text).expect("write machine file");
+    path
+}
+
+/// A JSON array of three numbers.
+pub fn triple(v: &Value) -> [f64; 3] {
+    let a = v.as_array().expect("array");
+    assert_eq!(a.len(), 3, "{v}");
+    std::array::from_fn(|k| a[k].as_f64().expect("number"))
+}
+
+fn ok_in(dir: Option<&Path>, args: &[&str]) -> String {
+    let o = run(dir, args);
     assert!(
         o.status.success(),
         "rtest {args:?} failed ({:?}): {}",

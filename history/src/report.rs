@@ -7,7 +7,7 @@
 
 use crate::check::same_name;
 use crate::store::{MachineSummary, RecordedCheck};
-use crate::trend::{Assessment, LeftOut, Row, Series, Slope, Test, first_flag};
+use crate::trend::{Assessment, LeftOut, Row, Series, SeriesHead, Slope, Test, first_flag};
 use model_spec::units::{fixed, format_scaled, p_value, readable, symbol};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -154,29 +154,6 @@ pub struct TrendReport {
     pub left_out: Vec<LeftOut>,
 }
 
-/// What defines a series, for reports.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SeriesHead {
-    /// The machine id.
-    pub machine_id: String,
-    /// The parameter.
-    pub parameter: String,
-    /// Its unit.
-    pub unit: String,
-    /// The description's fingerprint.
-    pub fingerprint: String,
-    /// The description's name.
-    pub machine: String,
-    /// The model's label.
-    pub model: String,
-    /// The model's terms.
-    pub terms: Vec<String>,
-    /// The test paths.
-    pub paths: Vec<String>,
-    /// The constraint.
-    pub constraint: String,
-}
-
 impl TrendReport {
     /// The report of `assessment` on `series`, from the database `db`.
     pub fn new(
@@ -188,17 +165,7 @@ impl TrendReport {
         TrendReport {
             kind: "history-trend",
             db: db.to_string(),
-            series: SeriesHead {
-                machine_id: series.machine_id.clone(),
-                parameter: series.parameter.clone(),
-                unit: series.unit.clone(),
-                fingerprint: series.fingerprint.clone(),
-                machine: series.machine.clone(),
-                model: series.model.clone(),
-                terms: series.terms.clone(),
-                paths: series.paths.clone(),
-                constraint: series.constraint.clone(),
-            },
+            series: series.head.clone(),
             assessment,
             tolerance_from,
             left_out: series.left_out.clone(),

@@ -7,7 +7,9 @@
 mod common;
 
 use common::{TempDir, check};
-use history::trend::{Assessment, Options, Point, Series, Test, TrendError, assess, select, slope};
+use history::trend::{
+    Assessment, Options, Point, Series, SeriesHead, Test, TrendError, assess, select, slope,
+};
 use history::{Check, Provenance, RecordedCheck, Store, Timestamp};
 use solver::simulation::rng::Rng;
 
@@ -21,15 +23,17 @@ fn start() -> Timestamp {
 /// A series of XOC values (µm) with their uncertainties, one check a week.
 fn series(values: &[(f64, f64)]) -> Series {
     Series {
-        machine_id: "M123".into(),
-        parameter: "XOC".into(),
-        unit: "um".into(),
-        fingerprint: "fa038fe9e24c960a".into(),
-        machine: "seed-ac".into(),
-        model: "reduced".into(),
-        terms: vec!["XOC".into()],
-        paths: vec!["K4".into()],
-        constraint: "none".into(),
+        head: SeriesHead {
+            machine_id: "M123".into(),
+            parameter: "XOC".into(),
+            unit: "um".into(),
+            fingerprint: "fa038fe9e24c960a".into(),
+            machine: "seed-ac".into(),
+            model: "reduced".into(),
+            terms: vec!["XOC".into()],
+            paths: vec!["K4".into()],
+            constraint: "none".into(),
+        },
         reference: 1,
         points: values
             .iter()
@@ -97,8 +101,8 @@ fn a_series_keeps_comparable_checks_and_says_why_it_leaves_the_others_out() {
     checks.push(recorded(10, check("M123", 56, 10.8, 0.3)));
 
     let s = select(&checks, "M123", "x0c", None).unwrap();
-    assert_eq!(s.parameter, "XOC");
-    assert_eq!(s.unit, "um");
+    assert_eq!(s.head.parameter, "XOC");
+    assert_eq!(s.head.unit, "um");
     assert_eq!(s.reference, 10);
     assert_eq!(
         s.points.iter().map(|p| p.id).collect::<Vec<_>>(),
@@ -125,7 +129,7 @@ fn a_series_keeps_comparable_checks_and_says_why_it_leaves_the_others_out() {
     // A chosen baseline defines the series: check 4's model.
     let s = select(&checks, "M123", "XOC", Some(4)).unwrap();
     assert_eq!(s.points.iter().map(|p| p.id).collect::<Vec<_>>(), [4]);
-    assert_eq!(s.model, "reduced + ECC@harmonic:2");
+    assert_eq!(s.head.model, "reduced + ECC@harmonic:2");
 
     // Errors, each with what is known.
     match select(&checks, "M999", "XOC", None).unwrap_err() {

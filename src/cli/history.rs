@@ -424,7 +424,7 @@ fn trend_outputs(
     }
     let series = trend::select(all, id, error, args.baseline).map_err(trend_error)?;
     let (limit, from) = match &tolerances {
-        Some((_, t)) => tolerance_of(t, &series.parameter),
+        Some((_, t)) => tolerance_of(t, &series.head.parameter),
         None => (None, None),
     };
     let options = Options {

@@ -25,7 +25,7 @@
 
 mod select;
 
-pub use select::{LeftOut, Point, Series, select};
+pub use select::{LeftOut, Point, Series, SeriesHead, select};
 
 use crate::stats::{ALPHA_RANGE, normal_two_sided, student_p_value, student_two_sided};
 use crate::time::Timestamp;
@@ -304,11 +304,11 @@ pub fn assess(series: &Series, options: &Options) -> Result<Assessment, TrendErr
     };
     let Some(base) = points.get(b).copied() else {
         return Err(TrendError::NeverDetermined {
-            machine_id: series.machine_id.clone(),
-            parameter: series.parameter.clone(),
+            machine_id: series.head.machine_id.clone(),
+            parameter: series.head.parameter.clone(),
         });
     };
-    let unit = symbol(&series.unit).to_string();
+    let unit = symbol(&series.head.unit).to_string();
     let z = normal_two_sided(alpha);
     let mut rows = Vec::with_capacity(points.len());
     for (i, p) in points.iter().enumerate() {
@@ -323,7 +323,7 @@ pub fn assess(series: &Series, options: &Options) -> Result<Assessment, TrendErr
                     threshold: limit,
                     text: format!(
                         "|{}| = {} {unit} > tolerance {} {unit}{}",
-                        series.parameter,
+                        series.head.parameter,
                         fixed(v, 3),
                         model_spec::units::short(limit),
                         if proven {

@@ -35,9 +35,10 @@ pub struct LeftOut {
     pub reason: String,
 }
 
-/// One error's series on one machine: what makes the checks comparable, and the checks.
+/// What makes the checks of a series comparable: one error of one machine, measured with the
+/// same description, model, paths and constraint.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Series {
+pub struct SeriesHead {
     /// The machine id.
     pub machine_id: String,
     /// The parameter's name as recorded (`XOC`, `ECC@harmonic:2:cos`).
@@ -56,6 +57,14 @@ pub struct Series {
     pub paths: Vec<String>,
     /// The constraint.
     pub constraint: String,
+}
+
+/// One error's series on one machine: what makes the checks comparable, and the checks.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Series {
+    /// What makes the checks comparable (its fields are written inline).
+    #[serde(flatten)]
+    pub head: SeriesHead,
     /// The check that defined the series (the baseline when one was chosen, else the latest
     /// check that determined the error).
     pub reference: i64,
@@ -243,15 +252,17 @@ pub fn select(
         }
     }
     Ok(Series {
-        machine_id: machine_id.to_string(),
-        parameter: q.name.clone(),
-        unit: q.unit.clone(),
-        fingerprint: r.fingerprint.clone(),
-        machine: r.machine.clone(),
-        model: r.model.clone(),
-        terms: r.terms.clone(),
-        paths: r.paths.clone(),
-        constraint: r.constraint.clone(),
+        head: SeriesHead {
+            machine_id: machine_id.to_string(),
+            parameter: q.name.clone(),
+            unit: q.unit.clone(),
+            fingerprint: r.fingerprint.clone(),
+            machine: r.machine.clone(),
+            model: r.model.clone(),
+            terms: r.terms.clone(),
+            paths: r.paths.clone(),
+            constraint: r.constraint.clone(),
+        },
         reference: reference.id,
         points,
         left_out,

@@ -224,7 +224,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     // A progress bar while the file is read, on a terminal's standard error, unless the JSON
     // report takes standard output.
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
-    let (ident, refinement, streaming, notes) = if args.stream {
+    let (ident, refinement, streaming, notes, record) = if args.stream {
         let (bar, read) = super::progress::reading(shown, data_path, &read);
         let fitted = identify_file(&m, &model, data_path, &opts, args.block as usize, &read);
         drop(bar);
@@ -242,7 +242,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             block: args.block as usize,
             first_block: run.first_block,
         };
-        (ident, None, Some(streaming), String::new())
+        (ident, None, Some(streaming), String::new(), None)
     } else {
         let record = {
             let (_bar, read) = super::progress::reading(shown, data_path, &read);
@@ -253,7 +253,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         if args.first_order {
             let ident =
                 identify_noise(&m, &model, &record, &opts, &noise).map_err(estimate_error)?;
-            (ident, None, None, note)
+            (ident, None, None, note, Some(record))
         } else {
             let (ident, r) = identify_refined_noise(
                 &m,
@@ -264,7 +264,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
                 &noise,
             )
             .map_err(refine_error)?;
-            (ident, Some(r), None, note)
+            (ident, Some(r), None, note, Some(record))
         }
     };
     check_values(&m, &ident, &args.bounds.values()).map_err(|e| implausible(&e))?;
@@ -302,23 +302,26 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             ::report::Document::Identification(Box::new(report.clone())),
         )
         .map_err(|e| CliError::computation(format!("--report: {e}")))?;
-        if report.streaming.is_some() {
-            i.prediction_not_drawn.push(format!(
+        match &record {
+            None => i.prediction_not_drawn.push(format!(
                 "{} is not drawn: a streamed record is read block by block, and its figure would read it all",
                 data_path.display()
-            ));
-        } else {
-            let json =
-                to_json(&report).map_err(|e| CliError::computation(format!("--report: {e}")))?;
-            let values = solver::io::report::read::parse_identification("this run", &json, &m)
-                .map_err(|e| CliError::computation(format!("--report: {e}")))?;
-            let fitted = super::report::PathRecord {
-                path: data_path,
-                role: "fitted",
-                zeroed: args.zeroed,
-            };
-            (i.prediction_figures, i.prediction_not_drawn) =
-                super::report::path_figures("--report", &m, &values, &label, &[fitted])?;
+            )),
+            Some(record) => {
+                let json = to_json(&report)
+                    .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+                let values = solver::io::report::read::parse_identification("this run", &json, &m)
+                    .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+                let fitted = super::report::PathRecord {
+                    name: &data,
+                    role: "fitted",
+                    record,
+                    zeroed: args.zeroed,
+                    params: &params,
+                };
+                (i.prediction_figures, i.prediction_not_drawn) =
+                    super::report::path_figures("--report", &m, &values, &label, &[fitted])?;
+            }
         }
         files.add(
             "--report",

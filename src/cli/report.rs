@@ -161,19 +161,44 @@ fn draw_paths(
             return Ok(());
         }
     };
-    let mut records = vec![PathRecord {
-        path: Path::new(&id.data),
-        role: "fitted",
-        zeroed: id.zeroed,
-    }];
-    for (_, v) in &inputs.validations {
-        records.push(PathRecord {
-            path: Path::new(&v.data),
-            role: "validation",
-            zeroed: v.zeroed,
-        });
+    // The records the reports name, read here at the machine's default parameters; one that
+    // cannot be read, or predicted, is named with why.
+    let params = m.default_parameters();
+    let mut named = vec![(id.data.as_str(), "fitted", id.zeroed)];
+    named.extend(
+        inputs
+            .validations
+            .iter()
+            .map(|(_, v)| (v.data.as_str(), "validation", v.zeroed)),
+    );
+    let mut read = Vec::new();
+    let mut not_drawn = Vec::new();
+    for (name, role, zeroed) in named {
+        match solver::io::campaign::read_record_at(
+            Path::new(name),
+            &m,
+            &params,
+            &solver::io::csv::ReadOptions::default(),
+            None,
+        ) {
+            Ok(record) => read.push((name, role, zeroed, record)),
+            Err(e) => not_drawn.push(format!(
+                "{name} is not drawn: it could not be read here ({e})"
+            )),
+        }
     }
-    let (figures, not_drawn) = path_figures("-o", &m, &values, &id.model, &records)?;
+    let records: Vec<PathRecord<'_>> = read
+        .iter()
+        .map(|(name, role, zeroed, record)| PathRecord {
+            name,
+            role,
+            record,
+            zeroed: *zeroed,
+            params: &params,
+        })
+        .collect();
+    let (figures, unpredicted) = path_figures("-o", &m, &values, &id.model, &records)?;
+    not_drawn.extend(unpredicted);
     inputs.prediction_figures = figures;
     inputs.prediction_not_drawn = not_drawn;
     Ok(())
@@ -215,18 +240,22 @@ fn named_files(inputs: &Inputs, reports: &[PathBuf], machine: Option<&Path>) -> 
 /// A record whose measured error is drawn against the identified model's prediction along
 /// its path.
 pub struct PathRecord<'a> {
-    /// The record's file.
-    pub path: &'a Path,
+    /// The record's name (its file, as given).
+    pub name: &'a str,
     /// Its role in the check (`fitted`, `validation`).
     pub role: &'static str,
+    /// The record, read as the identification read it.
+    pub record: &'a solver::record::Record,
     /// Whether the prediction is zeroed at the first sample (as the validation was).
     pub zeroed: bool,
+    /// The kinematic parameters it was read and identified with (mm, symbol order).
+    pub params: &'a [f64],
 }
 
 /// Measured against predicted error along the path of each record, the prediction that of
 /// the exact virtual machine at the identified `values` (model labelled `label`), drawn
-/// against the axis that moves most. A record that cannot be read from here, or not predicted,
-/// is not drawn: the second list says which and why, for the report.
+/// against the axis that moves most. A record that cannot be predicted is not drawn: the
+/// second list says which and why, for the report.
 ///
 /// # Errors
 /// A figure that cannot be drawn (exit code 3).
@@ -242,30 +271,14 @@ pub fn path_figures(
     let mut figures = Figures::default();
     let mut not_drawn = Vec::new();
     let mut taken = Vec::new();
-    let params = m.default_parameters();
     for r in records {
-        let name = r.path.display().to_string();
-        let record = match solver::io::campaign::read_record_at(
-            r.path,
-            m,
-            &params,
-            &solver::io::csv::ReadOptions::default(),
-            None,
-        ) {
-            Ok(record) => record,
-            Err(e) => {
-                not_drawn.push(format!(
-                    "{name} is not drawn: it could not be read here ({e})"
-                ));
-                continue;
-            }
-        };
-        let opts = ValidateOptions::new().zeroed(r.zeroed).exact(true);
-        match validate(m, &values.model, &values.values, &record, &opts) {
+        let mut opts = ValidateOptions::new().zeroed(r.zeroed).exact(true);
+        opts.params = Some(r.params.to_vec());
+        match validate(m, &values.model, &values.values, r.record, &opts) {
             Ok(v) => figures.paths.push(validation_figure(
-                m, &name, r.role, &record, &v, label, &mut taken,
+                m, r.name, r.role, r.record, &v, label, &mut taken,
             )),
-            Err(e) => not_drawn.push(format!("{name} is not drawn: {e}")),
+            Err(e) => not_drawn.push(format!("{} is not drawn: {e}", r.name)),
         }
     }
     let drawn = report::figures::path_figures(&figures)

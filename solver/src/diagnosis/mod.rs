@@ -36,6 +36,7 @@ pub mod profile;
 mod search;
 pub mod select;
 pub mod structure;
+pub mod tones;
 pub mod unexplained;
 pub mod verdict;
 

@@ -77,6 +77,12 @@ pub struct Unexplained {
     pub shape: Shape,
     /// RMS of what the shape explains (the fitted shape minus its mean), mm.
     pub explained_rms_mm: f64,
+    /// For a step in a source that moves one way along the record (time, an axis turning one
+    /// way): the first sample (0-based, record order) past the jump; `None` otherwise.
+    pub sample: Option<usize>,
+    /// `true` when this describes the base model's residual on a fitted record
+    /// ([`describe_base`]); `false` for the extended model's residual.
+    pub base: bool,
     /// The source's value per sample (record order), for a figure.
     pub x: Vec<f64>,
     /// The fitted shape per sample, mm.
@@ -394,6 +400,10 @@ pub fn describe(
     match found {
         Some((b, name, unit, x, t)) if b < bic(rss0, 1) - 2.0 * (tried.max(1) as f64).ln() => {
             let explained = ((rss0 - rss(&y, &t.fitted)).max(0.0) / n).sqrt();
+            let sample = match t.shape {
+                Shape::Step { at } => split_at(&x, at),
+                _ => None,
+            };
             Unexplained {
                 data: data.to_string(),
                 direction,
@@ -402,6 +412,8 @@ pub fn describe(
                 unit: unit.into(),
                 shape: t.shape,
                 explained_rms_mm: explained,
+                sample,
+                base: false,
                 x,
                 fitted: t.fitted,
             }
@@ -414,15 +426,66 @@ pub fn describe(
             unit: String::new(),
             shape: Shape::Irregular,
             explained_rms_mm: 0.0,
+            sample: None,
+            base: false,
             x: (0..y.len()).map(|i| i as f64).collect(),
             fitted: vec![mean; y.len()],
         },
     }
 }
 
+/// The first sample past a step at `at` of a source `x` that moves one way along the record
+/// (every sample before it below `at`, every one from it on above, or the reverse); `None`
+/// when the step does not split the record in two.
+fn split_at(x: &[f64], at: f64) -> Option<usize> {
+    let first = x.iter().position(|&v| (v >= at) != (x[0] >= at))?;
+    let side = x[first] >= at;
+    x[first..]
+        .iter()
+        .all(|&v| (v >= at) == side)
+        .then_some(first)
+}
+
+/// What the base model leaves on the fitted records where the lack-of-fit test `a` of the
+/// extended model fails (nothing when it passes): the findings may have absorbed on the fitted
+/// records what the held-out records then mispredict (a look-alike of a jump, a bump), so the
+/// base residual is described where it is, in every direction of a fitted record whose RMS is
+/// more than [`super::adequacy::NOISE_MULTIPLE`] times the noise's σ, and kept when it follows
+/// something (an irregular base residual adds nothing to the extended model's description).
+/// `fitted`: name, record and base residual per sample (mm) of every fitted record.
+pub fn describe_base(
+    m: &Machine,
+    a: &super::adequacy::Adequacy,
+    fitted: &[(&str, &Record, Vec<[f64; 3]>)],
+) -> Vec<Unexplained> {
+    if a.consistent_with_noise {
+        return Vec::new();
+    }
+    let Some(sigma) = a.records.first().map(|r| r.noise_sigma_mm) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (name, rec, res) in fitted {
+        let n = res.len().max(1) as f64;
+        for d in 0..3 {
+            let rms = (res.iter().map(|v| v[d] * v[d]).sum::<f64>() / n).sqrt();
+            if rms <= super::adequacy::NOISE_MULTIPLE * sigma[d] {
+                continue;
+            }
+            let mut u = describe(m, (name, rec), res, d);
+            if u.shape != Shape::Irregular {
+                u.base = true;
+                out.push(u);
+            }
+        }
+    }
+    out
+}
+
 /// What remains where the lack-of-fit test `a` fails (nothing when it passes): every (record,
-/// direction) whose own p-value passes after a Bonferroni factor over all of them, and at least
-/// the one with the smallest. `records`: name, record and residual per sample (mm), in the
+/// direction) whose own p-value passes after a Bonferroni factor over all of them or whose
+/// residual is more than [`super::adequacy::NOISE_MULTIPLE`] times the noise, and at least the
+/// one with the smallest p-value. `records`: name, record and residual per sample (mm), in the
 /// order of `a.records`.
 pub fn describe_failures(
     m: &Machine,
@@ -440,8 +503,12 @@ pub fn describe_failures(
         .flat_map(|r| r.p_values)
         .fold(f64::INFINITY, f64::min);
     let mut out = Vec::new();
-    for (r, (name, rec, res)) in a.records.iter().zip(records) {
-        let described = |d: usize| tests * r.p_values[d] < alpha || r.p_values[d] == smallest;
+    for (k, (r, (name, rec, res))) in a.records.iter().zip(records).enumerate() {
+        let described = |d: usize| {
+            tests * r.p_values[d] < alpha
+                || r.p_values[d] == smallest
+                || a.over_noise.contains(&(k, d))
+        };
         for d in (0..3).filter(|&d| described(d)) {
             out.push(describe(m, (name, rec), res, d));
         }
@@ -553,6 +620,20 @@ mod tests {
                 // A box of samples 100..=105 is also a step pair of C; a step alone is not.
                 ref s => panic!("seed {seed}: {s:?} following {:?}", u.follows),
             }
+        }
+    }
+
+    #[test]
+    fn a_knock_is_a_step_at_its_sample() {
+        // The ball knocked 3 µm at sample 150 of K4: on K4 C turns one way, so whichever source
+        // the step is found in (time or C), the sample past the jump is 150.
+        let (m, r) = k4();
+        for seed in 1..=5 {
+            let res = residual(&m, &r, seed, |i, _| if i >= 150 { 3e-3 } else { 0.0 });
+            let u = describe(&m, ("K4", &r), &res, 1);
+            assert!(matches!(u.shape, Shape::Step { .. }), "seed {seed}: {u:?}");
+            let at = u.sample.expect("a step that splits the record");
+            assert!(at.abs_diff(150) <= 2, "seed {seed}: sample {at}");
         }
     }
 

@@ -5,17 +5,11 @@ use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
-use solver::fitting::campaign::validate_campaign;
-use solver::fitting::hmatrix::parameter_names;
-use solver::fitting::sanity::check_model_values;
+use solver::fitting::campaign::validate::validate_campaign_with_progress;
 use solver::fitting::validate::Unidentified;
-use solver::fitting::{ValidateError, ValidateOptions, validate};
-use solver::io::report::{
-    CampaignValidationReport, CampaignValidationSource, ReadValues, ValidationReport,
-    ValidationSource, to_json,
-};
-use solver::io::text::campaign::campaign_validation;
-use solver::io::text::validate::{validation, zeroed_note};
+use solver::fitting::{ValidateError, ValidateOptions};
+use solver::io::report::{ValidationReport, ValidationSource, read_identification, to_json};
+use solver::io::text::validate::validation;
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -107,12 +101,18 @@ pub struct ValidateArgs {
     bounds: ValueBounds,
 }
 
-/// Runs `rtest validate`.
+/// Runs `rtest validate`: the identification's values (of one record or several) predict
+/// the records of `--data` or `--campaign`, each on its set-up.
 pub fn run(args: &ValidateArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     let files = match &args.data {
         Some(list) => args::files("--data", list)?,
         None => Vec::new(),
+    };
+    let flag = if args.campaign.is_some() {
+        "--campaign"
+    } else {
+        "--data"
     };
     let mut inputs = vec![("--params", args.params.as_path())];
     inputs.extend(files.iter().map(|f| ("--data", f.as_path())));
@@ -121,80 +121,108 @@ pub fn run(args: &ValidateArgs) -> CliResult {
     inputs.extend(args.instrument.input());
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
-    let read_values = solver::io::report::read_values(&args.params, &m)
+    let id = read_identification(&args.params, &m)
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
-    let single_case =
-        files.len() == 1 && args.campaign.is_none() && args.setup.is_none() && args.param.is_none();
-    match read_values {
-        ReadValues::Single { values, .. } if single_case => run_single(args, &m, &files[0], values),
-        values => run_campaign(args, &m, &files, &values),
+    let values = &id.values;
+    campaign::check_campaign_values(&m, &values.layout, &values.values, &args.bounds.values())
+        .map_err(|e| implausible(args, &e))?;
+    let read = args.records.read_options();
+    let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
+    let instrument = args.instrument.load()?;
+    let through = instrument.as_ref().map(|(i, f)| (i, *f));
+    let file_list = match &args.campaign {
+        Some(path) => solver::io::campaign::read_campaign_file(path, &m)
+            .map_err(|e| CliError::input(format!("--campaign: {e}")))?
+            .records
+            .iter()
+            .map(|r| r.path.clone())
+            .collect(),
+        None => files.clone(),
+    };
+    let mut loaded = {
+        let (_bar, read) = super::progress::reading_all(shown, &file_list, &read);
+        match &args.campaign {
+            Some(path) => campaign::from_file("--campaign", &m, path, &read, through)?,
+            None => {
+                let params = super::pose_args::params(&m, args.param.as_deref())?;
+                campaign::from_files("--data", &m, &files, &params, args.zeroed, &read, through)?
+            }
+        }
+    };
+    if args.campaign.is_none() {
+        let setup = match &args.setup {
+            Some(setup) => {
+                solver::fitting::campaign::check_label("--setup", setup)
+                    .map_err(|e| CliError::usage(e.to_string()))?;
+                Some(setup.clone())
+            }
+            None => fitted_setup(values, &loaded.campaign),
+        };
+        if let Some(setup) = setup {
+            for r in &mut loaded.campaign.records {
+                r.setup = setup.clone();
+            }
+        }
     }
-}
-
-/// One record predicted by a single identification: the prediction as it always was.
-fn run_single(
-    args: &ValidateArgs,
-    m: &model_spec::Machine,
-    data_path: &std::path::Path,
-    params: solver::io::report::IdentifiedValues,
-) -> CliResult {
-    let names = parameter_names(m, &params.model);
-    check_model_values(
-        m,
-        &params.model,
-        &names,
-        &params.values,
-        &args.bounds.values(),
-    )
-    .map_err(|e| implausible(args, &e))?;
-    let record = super::read_record(
-        "--data",
-        m,
-        data_path,
-        &args.records.read_options(),
-        &args.instrument,
-        &m.default_parameters(),
-    )?;
-    super::check_times("--data", data_path, m, &params.model, &record)?;
+    loaded.check_times(flag, &m, &values.model)?;
     let mut opts = ValidateOptions::default();
-    opts.zeroed = args.zeroed;
     opts.exact = !args.first_order;
     if args.refuse_undetermined {
         opts.unidentified = Unidentified::Refuse;
     }
-    let v = validate(m, &params.model, &params.values, &record, &opts)
-        .map_err(|e| validate_error(args, e, false))?;
-    let (params_file, data) = (
-        args.params.display().to_string(),
-        data_path.display().to_string(),
-    );
+    let v = {
+        let bar = super::progress::counting(shown);
+        validate_campaign_with_progress(&m, values, &loaded.campaign, &opts, &bar)
+            .map_err(|e| validate_error(args, e))?
+    };
+    let params_file = args.params.display().to_string();
+    let kinematics: Vec<Vec<f64>> = loaded
+        .campaign
+        .records
+        .iter()
+        .map(|r| r.params.clone())
+        .collect();
     let source = ValidationSource {
-        machine: &m.name,
-        model: &params.model_name,
+        model: &id.model_name,
         params: &params_file,
-        data: &data,
+        data: &loaded.files,
+        kinematics: &kinematics,
         exact: !args.first_order,
     };
-    let report = ValidationReport::new(source, &v)
-        .map_err(|e| CliError::computation(format!("--data: {e}")))?;
+    let report = ValidationReport::new(&m, source, &v)
+        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
     let mut text = validation(&report);
-    text.push_str(zeroed_note(&record, args.zeroed));
-    finish(args, text, to_json(&report))
-}
-
-/// Writes `json` (the report's JSON, when asked) and prints `text`.
-fn finish(
-    args: &ValidateArgs,
-    mut text: String,
-    json: Result<String, serde_json::Error>,
-) -> CliResult {
+    text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {
+        "say `zeroed = true` for it in the campaign file"
+    } else {
+        "give --zeroed"
+    }));
     let mut files = Outputs::new();
     if let Some(target) = &args.json {
-        let json = json.map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
         files.add("--json", target.clone(), json);
     }
     text.push_str(&wrote(&write(files)?));
     print_text(&text, matches!(args.json, Some(Target::Stdout)))
+}
+
+/// The set-up of `--data` records without `--setup`: the identification's, when it fitted one
+/// set-up whose kinematic parameters are every record's (one ball mounting, measured along
+/// other paths: the usual check of one record on another); `None` (each record on a new set-up
+/// of its own, refitted) otherwise.
+fn fitted_setup(
+    values: &solver::fitting::campaign::CampaignValues,
+    c: &solver::fitting::campaign::Campaign,
+) -> Option<String> {
+    let layout = &values.layout;
+    let [setup] = layout.setups.as_slice() else {
+        return None;
+    };
+    let params = &layout.records.first()?.params;
+    c.records
+        .iter()
+        .all(|r| r.params == *params)
+        .then(|| setup.clone())
 }
 
 /// Values that cannot be a machine's, as a verb's error.
@@ -205,78 +233,16 @@ fn implausible(args: &ValidateArgs, e: &solver::fitting::Implausible) -> CliErro
     ))
 }
 
-/// A validation error as a verb's error; `campaign`: a record that does not fit the
-/// identification's campaign (its set-up, its start) is a bad input.
-fn validate_error(args: &ValidateArgs, e: ValidateError, campaign: bool) -> CliError {
+/// A validation error as a verb's error: a record that does not fit the identification (its
+/// set-up, its start) is a bad input.
+fn validate_error(args: &ValidateArgs, e: ValidateError) -> CliError {
     match e {
         ValidateError::Unidentified(names) => CliError::input(format!(
             "--params: {} gave no value for {} (not determined by the identification) and --refuse-undetermined is set (without it they are set to 0)",
             args.params.display(),
             names.join(", ")
         )),
-        ValidateError::Shape(why) if campaign => {
-            CliError::input(format!("--data: cannot validate: {why}"))
-        }
+        ValidateError::Shape(why) => CliError::input(format!("--data: cannot validate: {why}")),
         other => CliError::computation(format!("--data: cannot validate: {other}")),
     }
-}
-
-/// Records predicted with a campaign's values (or a single identification seen as a campaign
-/// of one record), each on its set-up.
-fn run_campaign(
-    args: &ValidateArgs,
-    m: &model_spec::Machine,
-    files: &[PathBuf],
-    read_values: &ReadValues,
-) -> CliResult {
-    campaign::refuse_instrument(&args.instrument)?;
-    let (values, model_name) = read_values
-        .as_campaign(m)
-        .map_err(|e| CliError::input(format!("--params: {e}")))?;
-    campaign::check_campaign_values(m, &values.layout, &values.values, &args.bounds.values())
-        .map_err(|e| implausible(args, &e))?;
-    let read = args.records.read_options();
-    let mut loaded = match &args.campaign {
-        Some(path) => campaign::from_file("--campaign", m, path, &read, None)?,
-        None => {
-            let params = super::pose_args::params(m, args.param.as_deref())?;
-            campaign::from_files("--data", m, files, &params, args.zeroed, &read, None)?
-        }
-    };
-    if let Some(setup) = &args.setup {
-        solver::fitting::campaign::check_label("--setup", setup)
-            .map_err(|e| CliError::usage(e.to_string()))?;
-        for r in &mut loaded.campaign.records {
-            r.setup = setup.clone();
-        }
-    }
-    let flag = if args.campaign.is_some() {
-        "--campaign"
-    } else {
-        "--data"
-    };
-    loaded.check_times(flag, m, &values.model)?;
-    let mut opts = ValidateOptions::default();
-    opts.exact = !args.first_order;
-    if args.refuse_undetermined {
-        opts.unidentified = Unidentified::Refuse;
-    }
-    let v = validate_campaign(m, &values, &loaded.campaign, &opts)
-        .map_err(|e| validate_error(args, e, true))?;
-    let params_file = args.params.display().to_string();
-    let source = CampaignValidationSource {
-        model: &model_name,
-        params: &params_file,
-        data: &loaded.files,
-        exact: !args.first_order,
-    };
-    let report = CampaignValidationReport::new(m, source, &v)
-        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
-    let mut text = campaign_validation(&report);
-    text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {
-        "say `zeroed = true` for it in the campaign file"
-    } else {
-        "give --zeroed"
-    }));
-    finish(args, text, to_json(&report))
 }

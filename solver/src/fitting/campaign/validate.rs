@@ -29,24 +29,29 @@ use super::clock::own_clock_terms;
 use super::design::{Layout, Owner, RecordSpec, block};
 use super::{Campaign, CampaignIdentification, CampaignRecord};
 use crate::fitting::hmatrix::{GainSource, check_model, parameter_name};
-use crate::fitting::identify::{check_readings, with_offsets};
-use crate::fitting::least_squares::{Constraint, EstimateError, Tolerances, least_squares};
+use crate::fitting::identify::{check_readings, fit_rows, with_offsets};
+use crate::fitting::least_squares::{Constraint, EstimateError, Tolerances};
 use crate::fitting::measurement_vector;
+use crate::fitting::noise::SampleWhitening;
 use crate::fitting::refine::{
     GaussNewton, RefineError, RefineOptions, exact_prediction, gauss_newton,
 };
 use crate::fitting::validate::{
     Stats, Unidentified, ValidateError, ValidateOptions, Validation, statistics,
 };
+use crate::io::progress::{Progress, Unwatched};
 use crate::model::{Model, Term};
 use model_spec::Machine;
 use nalgebra::DVector;
 
-/// Identified values as a campaign sees them: the model, the layout it was fitted with, one
-/// value and standard uncertainty per layout column (mm, rad; `None`: not determined).
+/// Identified values as a campaign sees them (one record is a campaign of one): the model, the
+/// layout it was fitted with, and per layout column the value and standard uncertainty (mm,
+/// rad; `None`: not determined) and what the fit says of it. What validation and compensation
+/// take from an identification, whether computed here or read from a report.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CampaignValues {
-    /// The model as given.
+    /// The model as given (without the zero offsets a zeroed record adds: each record's own
+    /// model is in [`Layout::records`]).
     pub model: Model,
     /// The layout of the identification.
     pub layout: Layout,
@@ -54,6 +59,12 @@ pub struct CampaignValues {
     pub values: Vec<Option<f64>>,
     /// One standard uncertainty per layout column.
     pub std: Vec<Option<f64>>,
+    /// Per layout column: whether the data determine it (a parameter fixed by the constraint
+    /// counts as determined). Under a `minimum-norm` constraint an undetermined column has a
+    /// value: the constraint's choice, not a measurement.
+    pub determined: Vec<bool>,
+    /// Per layout column: fixed to 0 by the constraint.
+    pub fixed: Vec<bool>,
 }
 
 impl CampaignValues {
@@ -64,29 +75,32 @@ impl CampaignValues {
             layout: ident.layout.clone(),
             values: ident.fit.values.clone(),
             std: ident.fit.std.clone(),
+            determined: ident.fit.identifiability.determined.clone(),
+            fixed: ident.fit.fixed.clone(),
         }
     }
 
-    /// A single identification of `model` (its values and uncertainties one per model column)
-    /// seen as a campaign of one record labelled `label` on set-up `label`, at kinematic
-    /// parameters `params` (mm): its set-up terms belong to set-up `label`, its sensor-offset
-    /// and time terms to record `label`.
+    /// Values of `model` on one record labelled `label` (on a set-up of that label, at
+    /// kinematic parameters `params`, mm, not zeroed, on its own clock): `values` one per
+    /// column of `model` (mm, rad; `None`: none), determined where given, none fixed, without
+    /// uncertainties. Values typed in, or from elsewhere, as an identification of one record
+    /// gives them.
     ///
     /// # Errors
-    /// A model that does not fit `m`; values that are not one per column.
-    pub fn single(
+    /// A model that does not fit `m`; values that are not one per column; a label that is not
+    /// one.
+    pub fn of_model(
         m: &Machine,
         model: &Model,
         values: &[Option<f64>],
-        std: &[Option<f64>],
         label: &str,
         params: Vec<f64>,
     ) -> Result<CampaignValues, EstimateError> {
-        if values.len() != model.width() || std.len() != model.width() {
+        super::check_label("record", label).map_err(|e| EstimateError::Shape(e.0))?;
+        if values.len() != model.width() {
             return Err(EstimateError::Shape(format!(
-                "{} values and {} uncertainties for the {} columns of the model",
+                "{} values for the {} columns of the model",
                 values.len(),
-                std.len(),
                 model.width()
             )));
         }
@@ -99,19 +113,143 @@ impl CampaignValues {
             samples: 0,
         };
         let layout = Layout::of_records(m, model, &[spec], None)?;
+        let at = single_columns(&layout, model)
+            .ok_or_else(|| EstimateError::Shape("the record's model has other columns".into()))?;
         let n = layout.columns.len();
-        let (mut v, mut s) = (vec![None; n], vec![None; n]);
-        for (k, &c) in layout.records[0].columns.iter().enumerate() {
-            v[c] = values[k];
-            s[c] = std[k];
-        }
-        Ok(CampaignValues {
+        let mut v = CampaignValues {
             model: model.clone(),
             layout,
-            values: v,
-            std: s,
+            values: vec![None; n],
+            std: vec![None; n],
+            determined: vec![false; n],
+            fixed: vec![false; n],
+        };
+        for (k, x) in values.iter().enumerate() {
+            v.values[at[k]] = *x;
+            v.determined[at[k]] = x.is_some();
+        }
+        Ok(v)
+    }
+
+    /// The layout columns owned by `owner`, in layout order.
+    pub fn columns_of(&self, owner: Owner) -> Vec<usize> {
+        (0..self.layout.columns.len())
+            .filter(|&j| self.layout.columns[j].owner == owner)
+            .collect()
+    }
+}
+
+impl CampaignIdentification {
+    /// The identification of one record (`ident`, e.g. a streamed one) as a campaign of one:
+    /// the record labelled `label`, on set-up `label`, at kinematic parameters `params` (mm),
+    /// on its own clock; its fit's columns put in layout order and named as a campaign names
+    /// them (`XOW[k4]`). Values, uncertainties, residual and statistics are `ident`'s, bit for
+    /// bit.
+    ///
+    /// # Errors
+    /// A label that is not one, a model that does not fit `m`, parameters that are not one
+    /// per symbol.
+    pub fn of_record(
+        m: &Machine,
+        ident: &crate::fitting::Identification,
+        label: &str,
+        params: Vec<f64>,
+    ) -> Result<CampaignIdentification, EstimateError> {
+        super::check_label("record", label).map_err(|e| EstimateError::Shape(e.0))?;
+        if params.len() != m.symbols.len() {
+            return Err(EstimateError::Shape(format!(
+                "{} kinematic parameters for the {} symbols of machine {}",
+                params.len(),
+                m.symbols.len(),
+                m.name
+            )));
+        }
+        let model = given_model(&ident.model, ident.zeroed);
+        let spec = RecordSpec {
+            label: label.into(),
+            setup: label.into(),
+            params,
+            zeroed: ident.zeroed,
+            start_s: None,
+            samples: ident.samples,
+        };
+        let layout = Layout::of_records(m, &model, &[spec], None)?;
+        let order = single_columns(&layout, &ident.model).ok_or_else(|| {
+            EstimateError::Shape(
+                "the identification's model and its record's have other columns".into(),
+            )
+        })?;
+        let mut fit = super::fit::to_layout_order(ident.fit.clone(), &order);
+        fit.names = layout.names();
+        let is_offset: Vec<bool> = layout
+            .columns
+            .iter()
+            .map(|c| matches!(c.term.effect, crate::model::Effect::SensorOffset(_)))
+            .collect();
+        let swallowed = crate::fitting::identifiability::swallowed_by_offsets(
+            &fit.names,
+            &fit.identifiability.confounded,
+            &is_offset,
+        );
+        let records = vec![super::RecordFit {
+            label: label.into(),
+            setup: label.into(),
+            samples: ident.samples,
+            zeroed: ident.zeroed,
+            rss: fit.rss,
+        }];
+        Ok(CampaignIdentification {
+            machine: ident.machine.clone(),
+            model,
+            layout,
+            fit,
+            records,
+            swallowed,
+            backend: ident.backend,
+            noise: ident.noise.clone(),
+            whitened_sigma: ident.whitened_sigma,
         })
     }
+}
+
+/// The model as given of a record's `fitted` model: without the constant `dx0 dy0 dz0` when
+/// the record is `zeroed` (its layout adds them back).
+pub fn given_model(fitted: &Model, zeroed: bool) -> Model {
+    if !zeroed {
+        return fitted.clone();
+    }
+    Model {
+        terms: fitted
+            .terms
+            .iter()
+            .filter(|t| {
+                !(matches!(t.effect, crate::model::Effect::SensorOffset(_))
+                    && t.basis == crate::model::Basis::Const)
+            })
+            .copied()
+            .collect(),
+    }
+}
+
+/// For a layout of one record, the layout column of each column of `fitted` (the record's
+/// model, its columns matched by term and component, in any order); `None` when the two do
+/// not have the same columns.
+pub fn single_columns(layout: &Layout, fitted: &Model) -> Option<Vec<usize>> {
+    let record = layout.records.first()?;
+    if layout.records.len() != 1 || record.model.width() != fitted.width() {
+        return None;
+    }
+    let own = record.model.columns();
+    fitted
+        .columns()
+        .into_iter()
+        .map(|(t, k)| {
+            let term = fitted.terms[t];
+            own.iter()
+                .position(|&(u, j)| record.model.terms[u] == term && j == k)
+                .map(|p| record.columns[p])
+        })
+        .collect()
 }
 
 /// A parameter refitted on a validation record.
@@ -140,6 +278,9 @@ pub struct RecordValidation {
     pub setup_fitted: bool,
     /// Whether the record itself was fitted (its own values came from the identification).
     pub record_fitted: bool,
+    /// Whether its readings were zeroed at the first sample (its own `dx0 dy0 dz0` in its
+    /// model).
+    pub zeroed: bool,
     /// The parameters refitted on the record (none when every value came from the
     /// identification).
     pub refitted: Vec<Refitted>,
@@ -170,18 +311,33 @@ pub fn validate_campaign(
     campaign: &Campaign,
     opts: &ValidateOptions,
 ) -> Result<CampaignValidation, ValidateError> {
+    validate_campaign_with_progress(m, values, campaign, opts, &Unwatched)
+}
+
+/// As [`validate_campaign`], reporting the records validated to `progress` (`records`, one
+/// unit per record).
+///
+/// # Errors
+/// As [`validate_record`].
+pub fn validate_campaign_with_progress(
+    m: &Machine,
+    values: &CampaignValues,
+    campaign: &Campaign,
+    opts: &ValidateOptions,
+    progress: &dyn Progress,
+) -> Result<CampaignValidation, ValidateError> {
     campaign.check(m).map_err(|e| ValidateError::Shape(e.0))?;
-    campaign
-        .refuse_covariances("a campaign's validation")
-        .map_err(|e| ValidateError::Shape(e.0))?;
     let mut records = Vec::with_capacity(campaign.records.len());
     let (mut measured, mut predicted) = (Vec::new(), Vec::new());
-    for r in &campaign.records {
+    let total = campaign.records.len() as u64;
+    for (i, r) in campaign.records.iter().enumerate() {
+        progress.update("validating records", i as u64, total);
         let v = validate_record(m, values, r, opts)?;
         measured.extend(r.record.measured.iter().copied());
         predicted.extend(v.validation.prediction.iter().copied());
         records.push(v);
     }
+    progress.update("validating records", total, total);
     let (per_direction, overall) = statistics(&measured, &predicted);
     Ok(CampaignValidation {
         records,
@@ -400,12 +556,19 @@ pub fn validate_record(
         let h_r = h.select_columns(&refit);
         let refit_names: Vec<String> = refit.iter().map(|&k| names[k].clone()).collect();
         let tol = Tolerances::default();
-        let first = least_squares(
+        // Readings through an instrument carry their covariances: the refit weights by them,
+        // as the identification does.
+        let weights = SampleWhitening::of(rec)
+            .map_err(|e| ValidateError::Shape(format!("record `{}`: {e}", r.label)))?;
+        let (first, _) = fit_rows(
             &h_r,
             &(&y - predict(&v).map_err(failed)?),
             &refit_names,
             &Constraint::None,
             &tol,
+            None,
+            &[rec.samples.len()],
+            weights.as_ref(),
         )?;
         let fit = if opts.exact {
             let coordinates = r
@@ -420,7 +583,7 @@ pub fn validate_record(
                 tolerances: &tol,
                 noise: None,
                 coordinates,
-                weights: None,
+                weights: weights.as_ref(),
             };
             let start = first;
             let base = v.clone();
@@ -479,6 +642,7 @@ pub fn validate_record(
         setup: r.setup.clone(),
         setup_fitted: setup.is_some(),
         record_fitted: fitted.is_some(),
+        zeroed: r.zeroed,
         refitted,
         validation: Validation {
             samples: rec.samples.len(),

@@ -62,33 +62,42 @@ Plausibility: readings beyond --max-reading-um and poses outside the strokes are
 their lines; identified values beyond --max-error-um / --max-error-urad are an error (exit code \
 3), not a result.
 
-Campaigns (docs/campaigns.md): --data a.csv,b.csv fits several records together, each on its own \
-ball set-up (its own XOW YOW ZOW, named XOW[a]) and with its own R-test zero (dx0[a] when \
---zeroed), the machine's errors shared; --param NAME=VALUE,... gives every record the same \
-kinematic parameters (the ball's position). --campaign FILE reads a TOML list of records with \
-their labels, set-ups (records with the same set-up share its errors), ball positions, zeroing \
-and optional start times on one campaign clock. The report gives the shared values, one block \
-per set-up and per record, and each record's residual; its JSON has \"kind\": \"campaign\".
+Campaigns (docs/campaigns.md): a record is a campaign of one, and --data a.csv,b.csv fits several \
+records together, each on its own ball set-up (its own XOW YOW ZOW, named XOW[a]) and with its \
+own R-test zero (dx0[a] when --zeroed), the machine's errors shared; --param NAME=VALUE,... gives \
+every record the same kinematic parameters (the ball's position). --campaign FILE reads a TOML \
+list of records with their labels, set-ups (records with the same set-up share its errors), ball \
+positions, zeroing and optional start times on one campaign clock. The report of several \
+records gives the shared values, one block per set-up and per record, and each record's \
+residual. --stream reads one long record in blocks and takes one --data file: several records \
+are fitted whole, in one design matrix held in memory.
 
---report FILE writes the HTML report of this identification (docs/report.md: values with \
-uncertainties, what the data cannot separate, the input files with their SHA-256; one record).
+--report FILE writes the HTML report of this identification (docs/report.md: the records with \
+their ball positions and set-ups, values with uncertainties, what the data cannot separate, each \
+record's measured error against its prediction along its path, the input files with their \
+SHA-256).
 
---json writes the report (docs/identification.md): {machine, fingerprint, data, model, \
-base_model, terms, parameters: [{name, error, basis, value, std, unit, determined, fixed}], \
-residual_rms_um, rank, condition, confounded, samples, sigma_um, near_confounded, refinement: \
-{method, iterations, converged, …}, noise_model: {source, sigma_um, phi, whitened_sigma, text}, \
-notes, …}; `rtest validate --params` reads it. `--json -` \
-writes it to standard output (the text then goes to standard error).
+--json writes the report (docs/identification.md), version 2: {version, machine, fingerprint, \
+data, model, base_model, terms, setups: [{label, records}], records: [{label, data, setup, \
+params, zeroed, samples, residual_rms_um}], parameters: [{name, error, basis, value, std, unit, \
+determined, fixed}], residual_rms_um, rank, condition, confounded, samples, zeroed, sigma_um, \
+near_confounded, refinement: {method, iterations, converged, …}, noise_model: {source, \
+sigma_um, phi, whitened_sigma, text}, notes, …}; several records: \"kind\": \"campaign\", no \
+data nor zeroed, every parameter with its owner (shared, setup, record) and the set-up's or \
+record's label (of). `rtest validate --params` and `rtest compensate --params` read it (and what \
+earlier versions wrote). `--json -` writes it to standard output (the text then goes to \
+standard error).
 
 History (docs/history.md): --record --machine-id ID keeps the identification, once it succeeded \
 and its outputs are written, in the machine's history database (--db, default \
 rtest-history.sqlite): machine id and fingerprint, model and terms, test paths (--record-paths), \
 the measurement time (--measured-at), the SHA-256 of every input file, every value with its σ and \
-unit, rank, unidentifiable groups and residual. rtest history shows the checks and each error's \
-trend.
+unit, rank, unidentifiable groups and residual; a campaign is one check whose paths are its \
+records' labels and whose parameters carry their owners. rtest history shows the checks and each \
+error's trend (of a campaign: its shared values).
 
-Progress: on a terminal, a bar on standard error follows the reading of --data (bytes of the \
-file, with --stream too) once it has run half a second (RTEST_PROGRESS_DELAY_MS sets the delay, \
+Progress: on a terminal, a bar on standard error follows the reading of the records (bytes of \
+the files, with --stream too) once it has run half a second (RTEST_PROGRESS_DELAY_MS sets the delay, \
 in ms) and is cleared when it ends; never on a pipe or a file, nor with `--json -`.";
 
 /// Flags of `rtest identify`.
@@ -145,13 +154,13 @@ pub struct IdentifyArgs {
     /// Also write the report as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
-    /// Also write the HTML report of this identification to FILE (docs/report.md; one
-    /// record; `-`: standard output).
+    /// Also write the HTML report of this identification to FILE (docs/report.md; one record
+    /// or a campaign; `-`: standard output).
     #[arg(long, value_name = "FILE")]
     report: Option<Target>,
     /// Read the measurement in blocks and fold them into an incremental QR: for long records
     /// (10^6 samples and more), memory bounded by the number of parameters. First order (the
-    /// refinement needs the whole record).
+    /// refinement needs the whole record); one --data file.
     #[arg(long)]
     stream: bool,
     #[command(flatten)]
@@ -240,6 +249,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let (ident, refinement, streaming, loaded) = if args.stream {
         let data_path = files[0].as_path();
         let (bar, read) = super::progress::reading(shown, data_path, &read);
+        let opts = opts.clone().zeroed(args.zeroed);
         let fitted = identify_file(&m, &model, data_path, &opts, args.block as usize, &read);
         drop(bar);
         let (ident, run) = fitted.map_err(|e| stream_error(e, data_path))?;

@@ -13,36 +13,47 @@ use solver::io::text::validate::validation;
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
-Checks identified values on another measurement: the model and values of an `rtest identify` \
-JSON (--params) predict the readings of a measurement CSV (--data: axes in mm and degrees, \
-dx_um,dy_um,dz_um in µm), and the residual (measured minus predicted) is reported per direction \
-x, y, z of the tool frame and overall: RMS and maximum in µm, before (the nominal machine: \
-prediction 0) and after (the identified model). Overall RMS = sqrt(Σ r² / 3N).
+Checks identified values on other measurements: the model and values of an `rtest identify` \
+JSON (--params: one record or a campaign of several) predict the readings of measurement CSVs \
+(--data FILE[,FILE...]: axes in mm and degrees, dx_um,dy_um,dz_um in µm; or the records of \
+--campaign FILE), each record on its set-up, and the residual (measured minus predicted) is \
+reported per record, per direction x, y, z of the tool frame and overall: RMS and maximum in µm, \
+before (the nominal machine: prediction 0) and after (the identified model). Overall RMS = \
+sqrt(Σ r² / 3N).
 
 The values must belong to the machine: the JSON's machine name and fingerprint (topology and \
 machine-side kinematic defaults) must be this machine's, its base model must exist, every \
 parameter must be there, and every value within --max-error-um / --max-error-urad.
 
-The prediction is the exact virtual machine at the identified values (no linearisation); with \
---first-order it is the first-order model H·v (the difference is the second-order terms, about \
-1e-3 µm for errors of tens of µm and µrad). With --zeroed (readings zeroed at the first sample) \
-the prediction is zeroed at the first sample too, so constant effects cancel.
+The prediction is the exact virtual machine at the identified values, at each record's \
+kinematic parameters (no linearisation); with --first-order it is the first-order model H·v \
+(the difference is the second-order terms, about 1e-3 µm for errors of tens of µm and µrad).
+
+Set-ups (docs/campaigns.md): shared values (the machine's errors) come from the identification. \
+A record on a set-up the identification fitted uses that set-up's values XOW YOW ZOW; a record \
+on a new set-up has them refitted on it with everything else held, and the report says which \
+parameters were refitted and their values. Without --setup, the --data records are on the \
+identification's set-up when it fitted one set-up at their kinematic parameters (one ball \
+mounting measured along other paths: the usual check of one record on another), else each on a \
+new set-up named by its file's stem; --setup LABEL puts every --data record on set-up LABEL (a \
+fitted one, or a new one). With --zeroed (readings zeroed at the first sample) each record's \
+zero dx0 dy0 dz0 joins its model and is refitted on it, unless it is the fitted record itself. \
+--instrument reads sensor readings, and a refit weights the samples by their covariances.
 
 Parameters the identification could not determine (value null) are set to 0 and named; \
 --refuse-undetermined makes that an error instead.
 
-Campaigns (docs/campaigns.md): --params may be a campaign identification, and --data a comma list \
-or --campaign FILE a campaign of records to predict. Shared values come from the \
-identification; a record on a fitted set-up (the same set-up label; --setup LABEL puts every \
---data record on one) uses that set-up's values; a record on a new set-up has its set-up errors \
-XOW YOW ZOW (and its zero, when zeroed) refitted on it with everything else held, and the \
-report says which parameters were refitted. A single identification is a campaign of one \
-record labelled by the stem of its data file.
+--json writes (docs/campaigns.md) version 2: {version, machine, model, params, data, samples, \
+prediction, measured_rms_um, residual_rms_um, measured_max_um, residual_max_um, per_direction: \
+{x, y, z: {measured_rms_um, measured_max_um, residual_rms_um, residual_max_um}}, zeroed, \
+unidentified_set_to_zero, records: [{label, data, setup, setup_fitted, record_fitted, zeroed, \
+params, samples, refitted: [{name, value, std, unit}], measured_rms_um, …, per_direction, \
+unidentified_set_to_zero}]}; several records: \"kind\": \"campaign\", without data and zeroed. \
+`--json -` writes it to standard output.
 
---json writes {machine, model, params, data, samples, prediction, measured_rms_um, \
-residual_rms_um, measured_max_um, residual_max_um, per_direction: {x, y, z: {measured_rms_um, \
-measured_max_um, residual_rms_um, residual_max_um}}, zeroed, unidentified_set_to_zero} \
-(docs/identification.md); `--json -` writes it to standard output.";
+Progress: on a terminal, bars on standard error follow the reading and the validation of the \
+records once they have run half a second (RTEST_PROGRESS_DELAY_MS), cleared when they end; never \
+on a pipe or a file, nor with `--json -`.";
 
 /// Flags of `rtest validate`.
 #[derive(Debug, clap::Args)]
@@ -55,7 +66,8 @@ pub struct ValidateArgs {
     /// Built-in machine (see `rtest machines`) or path of a machine TOML file.
     #[arg(long, value_name = "NAME|FILE")]
     machine: String,
-    /// The JSON written by `rtest identify --json` (values in µm and µrad).
+    /// The JSON written by `rtest identify --json`, of one record or a campaign (values in µm
+    /// and µrad).
     #[arg(long, value_name = "FILE")]
     params: PathBuf,
     /// The measurement CSV to predict (axes in mm and degrees, dx_um,dy_um,dz_um in µm), or a
@@ -72,7 +84,8 @@ pub struct ValidateArgs {
     #[arg(long, value_name = "FILE", conflicts_with_all = ["data", "zeroed", "param", "setup"])]
     campaign: Option<PathBuf>,
     /// The set-up label of every --data record: a set-up of the identification (its set-up
-    /// errors are used) or a new one (refitted on each record). Default: each record its own
+    /// errors are used) or a new one (refitted on each record). Default: the identification's
+    /// set-up when it fitted one at the records' kinematic parameters, else each record its own
     /// set-up, named by its file's stem.
     #[arg(long, value_name = "LABEL")]
     setup: Option<String>,
@@ -80,8 +93,8 @@ pub struct ValidateArgs {
     /// overriding the machine's defaults.
     #[arg(long, value_name = "NAME=VALUE,...")]
     param: Option<String>,
-    /// The readings of --data were zeroed at the first sample: zero the prediction there too
-    /// (one record and a single identification), or refit each record's zero (a campaign).
+    /// The readings of --data were zeroed at the first sample: each record's zero dx0 dy0 dz0
+    /// is refitted on it (the fitted record's own is used).
     #[arg(long)]
     zeroed: bool,
     /// Predict with the first-order model H·v instead of the exact machine.

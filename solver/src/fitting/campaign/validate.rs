@@ -498,11 +498,21 @@ pub fn validate_record(
     let mut defaulted = Vec::new();
     let mut v = vec![0.0; sources.len()];
     let nominal = layout.nominal_mm();
+    // The identification's columns named as its report names them: a record's as a single fit
+    // does (`XOW`), a campaign's with their owners (`XOW[k4]`).
+    let report_name = |c: usize| -> String {
+        let col = &layout.columns[c];
+        if layout.records.len() == 1 {
+            parameter_name(m, &col.term, col.component)
+        } else {
+            col.name.clone()
+        }
+    };
     for (k, s) in sources.iter().enumerate() {
         if let Some(c) = s {
             match values.values[*c] {
                 Some(x) => v[k] = x,
-                None => defaulted.push(layout.columns[*c].name.clone()),
+                None => defaulted.push(report_name(*c)),
             }
             // A kinematic offset's value is a change from the identification's value of its
             // symbol: on a record modelled with another value it is the identified length

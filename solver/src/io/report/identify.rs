@@ -330,6 +330,23 @@ pub fn backend_name(b: Backend) -> &'static str {
     }
 }
 
+/// Why the report of one record's identification cannot be made.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordReportError {
+    /// A value, uncertainty or statistic that is not finite: the computation failed.
+    #[error(transparent)]
+    NonFinite(#[from] NonFinite),
+    /// The identification does not make a campaign of one record (its model does not fit the
+    /// machine, or the kinematic parameters are not one per symbol).
+    #[error("the record of {data}: {why}")]
+    Record {
+        /// The record's file.
+        data: String,
+        /// What does not fit.
+        why: String,
+    },
+}
+
 /// What an identification report of one record says besides the identification.
 #[derive(Clone, Copy, Debug)]
 pub struct IdentificationSource<'a> {
@@ -359,13 +376,13 @@ impl IdentificationReport {
     /// identification modelled them with; see [`IdentificationReport::of_record`].
     ///
     /// # Errors
-    /// [`NonFinite`] when a value, uncertainty or statistic is not finite.
+    /// As [`IdentificationReport::of_record`].
     pub fn new(
         m: &Machine,
         source: IdentificationSource,
         ident: &Identification,
         refinement: Option<&Refinement>,
-    ) -> Result<IdentificationReport, NonFinite> {
+    ) -> Result<IdentificationReport, RecordReportError> {
         let mut params = m.default_parameters();
         for (j, (t, _)) in ident.model.columns().into_iter().enumerate() {
             if let (Some(s), Some(Some(v))) = (
@@ -383,19 +400,23 @@ impl IdentificationReport {
     /// file, on a set-up of that label) reported by [`IdentificationReport::of_campaign`].
     ///
     /// # Errors
-    /// [`NonFinite`] when a value, uncertainty or statistic is not finite.
+    /// [`RecordReportError::NonFinite`] when a value, uncertainty or statistic is not finite;
+    /// [`RecordReportError::Record`] when the identification's model does not fit `m` or
+    /// `params` are not one per symbol.
     pub fn of_record(
         m: &Machine,
         source: IdentificationSource,
         ident: &Identification,
         params: Vec<f64>,
         refinement: Option<&Refinement>,
-    ) -> Result<IdentificationReport, NonFinite> {
+    ) -> Result<IdentificationReport, RecordReportError> {
         let label = crate::io::campaign::stem_label(std::path::Path::new(source.data));
         let campaign =
-            CampaignIdentification::of_record(m, ident, &label, params).map_err(|e| NonFinite {
-                field: format!("the record of {}: {e}", source.data),
-                value: f64::NAN,
+            CampaignIdentification::of_record(m, ident, &label, params).map_err(|e| {
+                RecordReportError::Record {
+                    data: source.data.to_string(),
+                    why: e.to_string(),
+                }
             })?;
         let data = [source.data.to_string()];
         let source = CampaignSource {
@@ -403,7 +424,9 @@ impl IdentificationReport {
             base_model: source.base_model,
             data: &data,
         };
-        IdentificationReport::of_campaign(m, source, &campaign, refinement)
+        Ok(IdentificationReport::of_campaign(
+            m, source, &campaign, refinement,
+        )?)
     }
 
     /// The report of `ident` on machine `m`, refined as `refinement` says (`None`: first

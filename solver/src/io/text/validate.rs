@@ -59,14 +59,16 @@ pub fn validation(r: &ValidationReport) -> String {
         rows.push(("campaign".to_string(), r.rows()));
     }
     text.push_str(&residual_table_rows(&rows));
+    let one = r.records.len() == 1;
     for x in &r.records {
-        text.push_str(&record_line(x));
+        text.push_str(&record_line(x, one));
     }
     text
 }
 
-/// Where a record's values came from, what was refitted on it, and what was set to 0.
-fn record_line(x: &RecordValidationReport) -> String {
+/// Where a record's values came from, what was refitted on it, and what was set to 0 (`one`:
+/// the only record validated, its sentence without its label).
+fn record_line(x: &RecordValidationReport, one: bool) -> String {
     let mut out = String::new();
     let from = match (x.setup_fitted, x.record_fitted) {
         (true, true) => "a fitted record".to_string(),
@@ -103,9 +105,13 @@ fn record_line(x: &RecordValidationReport) -> String {
         ));
     }
     if !x.unidentified_set_to_zero.is_empty() {
+        let who = if one {
+            "Set to 0".to_string()
+        } else {
+            format!("{}: set to 0", x.label)
+        };
         out.push_str(&format!(
-            "{}: set to 0 in the prediction (no value: not determined by the identification): {}\n",
-            x.label,
+            "{who} in the prediction (no value: not determined by the identification): {}\n",
             x.unidentified_set_to_zero.join(", ")
         ));
     }

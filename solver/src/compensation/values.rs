@@ -78,21 +78,17 @@ pub enum CompensationError {
     /// Records of the identification modelled with different values of a kinematic symbol of
     /// the machine's side (not the ball's position): which value the machine has is not known.
     #[error(
-        "{file}: records `{first}` and `{other}` were modelled with different values of the machine's kinematic symbol `{symbol}` ({first_mm} and {other_mm} mm): the identification does not say which the machine has; compensate with values identified on records of one `{symbol}`"
+        "{file}: {records} were modelled with different values of the machine's kinematic symbol `{symbol}` ({values} mm): the identification does not say which the machine has; compensate with values identified on records of one `{symbol}`"
     )]
     RecordsDiffer {
         /// The file of the values.
         file: String,
         /// The symbol.
         symbol: String,
-        /// A record.
-        first: String,
-        /// Its value, mm.
-        first_mm: String,
-        /// A record with another value.
-        other: String,
-        /// Its value, mm.
-        other_mm: String,
+        /// Two records that differ: "records `a` and `b`".
+        records: String,
+        /// Their values: "200 and 210".
+        values: String,
     },
     /// Identified values whose parts do not fit together (built by hand, not read).
     #[error("{file}: {why}")]
@@ -229,10 +225,8 @@ fn machine_params(
                 return Err(CompensationError::RecordsDiffer {
                     file: file.to_string(),
                     symbol: sym.name.clone(),
-                    first: first.label.clone(),
-                    first_mm: mm(a),
-                    other: r.label.clone(),
-                    other_mm: mm(b),
+                    records: format!("records `{}` and `{}`", first.label, r.label),
+                    values: format!("{} and {}", mm(a), mm(b)),
                 });
             }
         }

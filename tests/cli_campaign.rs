@@ -582,3 +582,120 @@ fn a_campaign_clock_shares_a_drift_and_the_report_reads_back() {
         &["bad.json", ".owner"],
     );
 }
+
+/// Four weekly campaigns of seed-ac (K4 and K1, each on its own ball set-up) recorded in a
+/// history: each is one check whose paths are its records, and `history --error XOC` trends the
+/// campaign's shared value, flagging the change the truth made.
+#[test]
+fn a_recorded_campaign_is_one_check_whose_shared_errors_trend() {
+    let dir = temp_dir("history");
+    for (week, xoc) in [(1, 10.0), (2, 10.0), (3, 13.0), (4, 16.0)] {
+        let w = format!("w{week}");
+        std::fs::create_dir_all(dir.join(&w)).unwrap();
+        std::fs::write(
+            dir.join(&w).join("truth.toml"),
+            format!(
+                "machine = \"seed-ac\"\nnoise_um = 0.3\nseed = {week}\n[errors]\nXOW = 12.0\nYOW = -18.0\nZOW = 15.0\nYOA = 20.0\nZOA = -15.0\nBOA = 25.0\nCOA = -18.0\nXOC = {xoc}\nYOC = -22.0\nAOC = 30.0\nBOC = -12.0\n"
+            ),
+        )
+        .unwrap();
+        for (path, seed) in [("K4", 10 * week), ("K1", 10 * week + 1)] {
+            let out = format!("{w}/{}.csv", path.to_ascii_lowercase());
+            ok(
+                &dir,
+                &[
+                    "simulate",
+                    "--machine",
+                    "seed-ac",
+                    "--path",
+                    path,
+                    "--truth",
+                    &format!("{w}/truth.toml"),
+                    "--seed",
+                    &seed.to_string(),
+                    "-o",
+                    &out,
+                ],
+            );
+        }
+        let text = ok(
+            &dir,
+            &[
+                "identify",
+                "--machine",
+                "seed-ac",
+                "--model",
+                "reduced",
+                "--data",
+                &format!("{w}/k4.csv,{w}/k1.csv"),
+                "--record",
+                "--db",
+                "h.sqlite",
+                "--machine-id",
+                "M7",
+                "--measured-at",
+                &format!("2025-03-{:02}", 3 + 7 * (week - 1)),
+            ],
+        );
+        assert!(
+            text.contains(&format!("Recorded as check {week} of machine M7")),
+            "{text}"
+        );
+    }
+    ok(&dir, &["history", "--db", "h.sqlite", "--json", "l.json"]);
+    let checks = read_json(&dir.join("l.json"))["checks"].clone();
+    assert_eq!(checks.as_array().unwrap().len(), 4);
+    for c in checks.as_array().unwrap() {
+        assert_eq!(c["kind"], "campaign");
+        assert_eq!(c["paths"], serde_json::json!(["k4", "k1"]));
+    }
+    let text = ok(
+        &dir,
+        &[
+            "history",
+            "--db",
+            "h.sqlite",
+            "--machine-id",
+            "M7",
+            "--error",
+            "XOC",
+            "--json",
+            "xoc.json",
+        ],
+    );
+    assert!(text.contains("paths k4, k1"), "{text}");
+    let t = read_json(&dir.join("xoc.json"));
+    let rows = t["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 4, "every campaign is in the series");
+    for (r, truth) in rows.iter().zip([10.0, 10.0, 13.0, 16.0]) {
+        let (v, s) = (r["value"].as_f64().unwrap(), r["std"].as_f64().unwrap());
+        assert!(
+            ((v - truth) / s).abs() < 4.0,
+            "XOC {v} ± {s}, truth {truth}"
+        );
+    }
+    let flagged = |i: usize| {
+        rows[i]["flags"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f["test"] == "baseline")
+    };
+    assert!(!flagged(1), "week 2 is the baseline's machine");
+    assert!(
+        flagged(2) && flagged(3),
+        "XOC moved by 3 and 6 µm: {rows:?}"
+    );
+    // A set-up's value is no error of the machine, but the history keeps it with its owner.
+    let c = &checks[0];
+    let xow = c["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "XOW[k4]")
+        .unwrap();
+    assert_eq!(
+        (xow["owner"].as_str(), xow["of"].as_str()),
+        (Some("setup"), Some("k4"))
+    );
+}

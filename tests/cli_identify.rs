@@ -387,7 +387,8 @@ fn zeroed_readings_name_what_the_offsets_swallow() {
         assert!((got - want).abs() < 1e-4, "{name}: {got} vs {want}");
     }
 
-    // Zeroed validation: constant effects cancel; the parameters set to 0 are named.
+    // Zeroed validation: constant effects cancel (the record's zero refitted on it); the
+    // parameters set to 0 are named.
     let text = ok(
         &dir,
         &[
@@ -416,9 +417,15 @@ fn zeroed_readings_name_what_the_offsets_swallow() {
         .iter()
         .map(|s| s.as_str().unwrap())
         .collect();
-    for n in ["XOC", "YOA", "ZOA", "dx0", "dy0", "dz0"] {
-        assert!(unset.contains(&n), "{n} in {unset:?}");
-    }
+    assert_eq!(unset, ["YOA", "ZOA", "XOC"]);
+    // The record's own zero is refitted on it (its readings were zeroed at their first sample).
+    let refitted: Vec<&str> = v["records"][0]["refitted"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(refitted, ["dx0[k1]", "dy0[k1]", "dz0[k1]"]);
     // Without --zeroed, the zeroed file is noticed.
     let text = ok(
         &dir,

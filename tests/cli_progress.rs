@@ -187,3 +187,46 @@ fn a_bar_is_drawn_on_a_terminal_and_cleared() {
         "{out:?}"
     );
 }
+
+#[test]
+fn a_campaign_draws_its_bars_on_a_terminal() {
+    let dir = records("campaign");
+    let args = [
+        "identify",
+        "--machine",
+        "seed-ac",
+        "--model",
+        "reduced",
+        "--data",
+        "k4.csv,k1.csv",
+        "--json",
+        "c.json",
+    ];
+    let Some(out) = under_terminal(&dir, &args) else {
+        eprintln!("skipped: `script` (util-linux) cannot run a pseudo-terminal here");
+        return;
+    };
+    assert!(
+        out.contains("reading 2 records ["),
+        "no bar while the records are read: {out:?}"
+    );
+    assert!(out.contains("Campaign identification"), "{out:?}");
+    let args = [
+        "validate",
+        "--machine",
+        "seed-ac",
+        "--params",
+        "c.json",
+        "--data",
+        "k4.csv,k1.csv",
+    ];
+    let Some(out) = under_terminal(&dir, &args) else {
+        return;
+    };
+    assert!(out.contains("reading 2 records ["), "{out:?}");
+    assert!(
+        out.contains("validating records ["),
+        "no bar while the records are validated: {out:?}"
+    );
+    assert!(out.contains("Validation on 2 records"), "{out:?}");
+}

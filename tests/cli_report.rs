@@ -424,3 +424,100 @@ fn the_verb_documents_itself_and_its_usage_errors_name_it() {
     let top = ok(&dir, &["--help"]);
     assert!(top.contains("report"), "{top}");
 }
+
+/// A campaign: K4 with the ball where the description puts it, K1 with the ball 40 mm higher
+/// (each its own set-up), identified together; K2 validated on a new set-up (its set-up errors
+/// refitted on it); poses compensated. `identify --report` and `rtest report` of the campaign
+/// identification, its validation and the compensation hold every section: the records with
+/// their ball positions and set-ups, the shared values with their uncertainties and what the
+/// records cannot separate, the values of each set-up, each record's figure, the validated
+/// record's new set-up with its refitted values, the compensation with the set-ups left out.
+#[test]
+fn the_report_of_a_campaign_and_its_validation() {
+    let dir = temp_dir("campaign");
+    let run = |line: &str| ok(&dir, &common::words(line));
+    run("simulate --machine seed-ac --path K4 --truth seed-ac-demo --seed 1 -o k4.csv");
+    run(
+        "simulate --machine seed-ac --path K1 --truth seed-ac-demo --seed 2 --param Zw=251.537 -o k1.csv",
+    );
+    run("simulate --machine seed-ac --path K2 --truth seed-ac-demo --seed 3 -o k2.csv");
+    std::fs::write(
+        dir.join("c.toml"),
+        "[[record]]\nfile = \"k4.csv\"\n\n[[record]]\nfile = \"k1.csv\"\nsetup = \"high\"\nparams = { Zw = 251.537 }\n",
+    )
+    .unwrap();
+    let out = run(
+        "identify --machine seed-ac --model reduced --terms ECC@harmonic:2 --campaign c.toml \
+         --json c.json --report id.html",
+    );
+    assert!(out.contains("Wrote id.html"), "{out}");
+    let html = read(&dir, "id.html");
+    // Each record measured against predicted along its path.
+    assert_eq!(check_self_contained(&html), 2, "{:?}", headings(&html));
+    assert!(html.contains("<figure id=\"fig-k4-path\">"));
+    assert!(html.contains("<figure id=\"fig-k1-path\">"));
+    for h in [
+        "<h3>Shared values: the machine&#39;s errors</h3>",
+        "<h3>Set-up k4</h3>",
+        "<h3>Set-up high</h3>",
+    ] {
+        assert!(html.contains(h), "{h} in {:?}", headings(&html));
+    }
+    // The records with their set-ups and ball positions (the machine is known: against its
+    // defaults).
+    assert!(
+        html.contains("<td>k1</td><td>high</td><td>k1.csv</td>"),
+        "records table"
+    );
+    assert!(html.contains("<td>Zw = 251.537</td>"), "K1's ball position");
+    assert!(
+        html.contains("<td>as the machine&#39;s defaults</td>"),
+        "K4's"
+    );
+    assert!(html.contains("<td>XOW[high]</td><td class=\"num\">"));
+    assert!(html.contains("<td>ECC@harmonic:2:sin</td><td class=\"num\">"));
+    assert!(html.contains("2 records on 2 set-ups"));
+
+    run("validate --machine seed-ac --params c.json --data k2.csv --json v.json");
+    let k2 = read(&dir, "k2.csv");
+    let mut poses = String::from("X,Y,Z,A,C\n");
+    for line in k2.lines().filter(|l| !l.starts_with('#')).skip(1).take(20) {
+        poses.push_str(&line.split(',').take(5).collect::<Vec<_>>().join(","));
+        poses.push('\n');
+    }
+    std::fs::write(dir.join("poses.csv"), poses).unwrap();
+    run(
+        "compensate --machine seed-ac --params c.json --path poses.csv -o corrected.csv \
+         --json comp.json --report comp.html",
+    );
+    let comp = read(&dir, "comp.html");
+    check_self_contained(&comp);
+    assert!(
+        comp.contains("<td>XOW[high]</td><td>a set-up error"),
+        "left out"
+    );
+    let out = run("report c.json v.json comp.json --machine seed-ac -o check.html");
+    assert!(out.contains("Wrote check.html"), "{out}");
+    let html = read(&dir, "check.html");
+    // The validation bars, and the paths of K4, K1 (fitted) and K2 (validated).
+    assert_eq!(check_self_contained(&html), 4, "{:?}", headings(&html));
+    assert!(html.contains("k2.csv (validation): measured and predicted error"));
+    assert!(html.contains("<h3>Set-ups of the validated records</h3>"));
+    assert!(html.contains("new: its set-up errors refitted on the record"));
+    assert!(html.contains("XOW[k2] = "), "the refitted values");
+    assert!(html.contains("<p class=\"absent\">No diagnosis in this report"));
+    for f in ["k4.csv", "k1.csv", "k2.csv", "c.json", "v.json"] {
+        assert!(
+            html.contains(&format!("<td>{f}</td><td class=\"num\">")),
+            "{f} hashed"
+        );
+    }
+    // The validation's JSON is of one record on a new set-up; the identification's of two.
+    let v: serde_json::Value = serde_json::from_str(&read(&dir, "v.json")).unwrap();
+    assert_eq!(v["version"], 2);
+    assert_eq!(v["records"][0]["setup"], "k2");
+    assert_eq!(v["records"][0]["setup_fitted"], false);
+    let c: serde_json::Value = serde_json::from_str(&read(&dir, "c.json")).unwrap();
+    assert_eq!(c["kind"], "campaign");
+    assert_eq!(c["records"][1]["params"]["Zw"], 251.537);
+}

@@ -1,7 +1,7 @@
 //! End to end: a campaign of sensor records (an R-test head of three sensors at 45°, two ball
 //! heights) identifies the same machine errors as the ball-centre records of the same runs,
-//! within their uncertainties; its validation and diagnosis refuse sensor records with the
-//! reason (they do not weight them yet).
+//! within their uncertainties; its diagnosis refuses sensor records with the reason (it does
+//! not weight them yet).
 
 mod common;
 use common::{fails, ok, read_json, temp_dir_tagged};
@@ -132,7 +132,7 @@ fn a_campaign_of_sensor_records_identifies_what_the_ball_centre_records_do() {
         1,
         &["s1_um"],
     );
-    // Validation and diagnosis of a campaign do not weight sensor records yet: refused.
+    // The diagnosis of a campaign does not weight sensor records yet: refused.
     fails(
         &dir,
         &[

@@ -1,12 +1,12 @@
-//! One check: an identification as the history keeps it. Built from the report of a single
-//! record ([`IdentificationReport`]) or of a campaign ([`CampaignReport`]) and what only the
-//! caller knows: the machine id, the test paths, the time of the measurement and the input
+//! One check: an identification as the history keeps it. Built from the identification
+//! report ([`IdentificationReport`], of one record or of a campaign of several) and what only
+//! the caller knows: the machine id, the test paths, the time of the measurement and the input
 //! files.
 
 use crate::time::Timestamp;
 use serde::Serialize;
+use solver::io::report::IdentificationReport;
 use solver::io::report::identify::ParameterReport;
-use solver::io::report::{CampaignReport, IdentificationReport};
 
 /// The longest machine id, test-path label, or text field of a check, in characters.
 pub const MAX_LABEL_CHARS: usize = 200;
@@ -174,61 +174,35 @@ fn stem(path: &str) -> String {
 }
 
 impl Check {
-    /// The check of a single record's identification.
+    /// The check of an identification, of one record ([`CheckKind::Record`], stored as a
+    /// single identification always was: parameters without owners, the terms with the zero
+    /// offsets of zeroed readings, the data file's stem as its path) or of several
+    /// ([`CheckKind::Campaign`]: every parameter with its owner, `shared`, `setup` or `record`,
+    /// and the records' labels as paths). The paths of `p`, when given, replace the default.
     pub fn from_identification(report: &IdentificationReport, p: Provenance) -> Check {
-        let paths = if p.paths.is_empty() {
-            vec![stem(&report.data)]
-        } else {
+        let campaign = report.is_campaign();
+        let paths = if !p.paths.is_empty() {
             p.paths
-        };
-        Check {
-            machine_id: p.machine_id,
-            fingerprint: report.fingerprint.clone(),
-            machine: report.machine.clone(),
-            model: report.model.clone(),
-            base_model: report.base_model.clone(),
-            terms: report.terms.clone(),
-            paths,
-            measured_at: p.measured_at,
-            recorded_at: p.recorded_at,
-            rtest_version: p.rtest_version,
-            kind: CheckKind::Record,
-            inputs: p.inputs,
-            parameters: report
-                .parameters
-                .iter()
-                .map(|q| Parameter::from_report(q, None, None))
-                .collect(),
-            rank: report.rank,
-            free_parameters: report.free_parameters,
-            condition: report.condition,
-            unidentifiable: report.confounded.clone(),
-            residual_rms_um: report.residual_rms_um,
-            sigma_um: report.sigma_um,
-            samples: report.samples,
-            dof: report.dof,
-            zeroed: report.zeroed,
-            constraint: report.constraint.clone(),
-            refinement: report.refinement.method.clone(),
-            noise_model: report.noise_model.as_ref().map(|n| n.text.clone()),
-        }
-    }
-
-    /// The check of a campaign's identification.
-    pub fn from_campaign(report: &CampaignReport, p: Provenance) -> Check {
-        let paths = if p.paths.is_empty() {
+        } else if campaign {
             report.records.iter().map(|r| r.label.clone()).collect()
         } else {
-            p.paths
+            let data = report
+                .data
+                .as_deref()
+                .or_else(|| report.records.first().map(|r| r.data.as_str()))
+                .unwrap_or("");
+            vec![stem(data)]
         };
         let mut terms = report.terms.clone();
-        // The records' zero offsets are not among a campaign's terms; a zeroed record adds them,
-        // and they change what the other values mean.
-        for q in &report.parameters {
-            if q.owner == "record" && q.parameter.basis == "const" {
-                let t = q.parameter.error.clone();
-                if !terms.contains(&t) {
-                    terms.push(t);
+        if campaign {
+            // The records' zero offsets are not among a campaign's terms; a zeroed record adds
+            // them, and they change what the other values mean.
+            for q in &report.parameters {
+                if q.owner.as_deref() == Some("record") && q.basis == "const" {
+                    let t = q.error.clone();
+                    if !terms.contains(&t) {
+                        terms.push(t);
+                    }
                 }
             }
         }
@@ -243,12 +217,22 @@ impl Check {
             measured_at: p.measured_at,
             recorded_at: p.recorded_at,
             rtest_version: p.rtest_version,
-            kind: CheckKind::Campaign,
+            kind: if campaign {
+                CheckKind::Campaign
+            } else {
+                CheckKind::Record
+            },
             inputs: p.inputs,
             parameters: report
                 .parameters
                 .iter()
-                .map(|c| Parameter::from_report(&c.parameter, Some(c.owner.clone()), c.of.clone()))
+                .map(|q| {
+                    if campaign {
+                        Parameter::from_report(q, q.owner.clone(), q.of.clone())
+                    } else {
+                        Parameter::from_report(q, None, None)
+                    }
+                })
                 .collect(),
             rank: report.rank,
             free_parameters: report.free_parameters,
@@ -258,10 +242,10 @@ impl Check {
             sigma_um: report.sigma_um,
             samples: report.samples,
             dof: report.dof,
-            zeroed: report.records.iter().any(|r| r.zeroed),
+            zeroed: report.any_zeroed(),
             constraint: report.constraint.clone(),
             refinement: report.refinement.method.clone(),
-            noise_model: Some(report.noise_model.text.clone()),
+            noise_model: report.noise_model.as_ref().map(|n| n.text.clone()),
         }
     }
 

@@ -8,8 +8,8 @@
 //!   paths, the times (UTC, RFC 3339), the SHA-256 of every input file ([`sha256`]), the rtest
 //!   version, every identified value with its standard uncertainty and unit, the
 //!   identifiability (rank, the groups the data could not separate) and the residual RMS.
-//!   [`Check::from_identification`] and [`Check::from_campaign`] build it from the reports of
-//!   `rtest identify`.
+//!   [`Check::from_identification`] builds it from the report of `rtest identify`, of one
+//!   record or of a campaign of several (whose shared values trend like a record's).
 //! - [`Store`] is the database ([`schema`]: versioned by `PRAGMA user_version`, migrated in
 //!   order). One transaction per check, WAL mode and a busy timeout, so several processes can
 //!   record at once; a damaged or foreign file is refused with its name and never changed.

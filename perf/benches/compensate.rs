@@ -100,7 +100,7 @@ fn program(c: &mut Criterion) {
     };
     let report = IdentificationReport::new(&m, source, &ident, Some(&refinement)).unwrap();
     let values = parse_identification("id.json", &to_json(&report).unwrap(), &m).unwrap();
-    let (errors, _) = MachineErrors::from_identified(&m, &values).unwrap();
+    let (errors, _) = MachineErrors::from_values(&m, &values.values, &values.file).unwrap();
     // 10^5 blocks along K4, over and over.
     let mut text = String::from("%\nO2000 (LONG)\nG21 G90 G94\n");
     for i in 0..100_000 {

@@ -88,12 +88,14 @@ pub fn validation_figure(
     }
     let mut rows = Vec::new();
     for (_, v) in validations {
-        for (dir, d) in v.rows() {
-            rows.push((
-                format!("{} {dir}", record_name(&v.data)),
-                d.measured_rms_um,
-                d.residual_rms_um,
-            ));
+        for x in &v.records {
+            for (dir, d) in x.rows() {
+                rows.push((
+                    format!("{} {dir}", record_name(&x.data)),
+                    d.measured_rms_um,
+                    d.residual_rms_um,
+                ));
+            }
         }
     }
     let svg = plots::spectrum(

@@ -10,9 +10,9 @@ use std::path::Path;
 /// One report of rtest, recognised by its content.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Document {
-    /// What `rtest identify --json` writes (one record).
+    /// What `rtest identify --json` writes (one record or a campaign of several).
     Identification(Box<IdentificationReport>),
-    /// What `rtest validate --json` writes (one record).
+    /// What `rtest validate --json` writes (one record or several).
     Validation(Box<ValidationReport>),
     /// What `rtest diagnose --json` writes.
     Diagnosis(Box<DiagnosisReport>),
@@ -73,16 +73,6 @@ pub enum InputError {
         /// serde's message: the field, its line and column.
         why: String,
     },
-    /// A campaign report: the HTML report covers one record.
-    #[error(
-        "{file}: a campaign {kind} report (\"kind\": \"campaign\"); the HTML report covers single-record reports"
-    )]
-    Campaign {
-        /// The file.
-        file: String,
-        /// `identification` or `validation`.
-        kind: &'static str,
-    },
     /// Two reports of a kind that can appear once.
     #[error("{file}: a second {kind} report ({first} is one): give one")]
     Twice {
@@ -108,8 +98,7 @@ pub enum InputError {
 /// Reads the report in `path` and recognises its kind from its fields.
 ///
 /// # Errors
-/// [`InputError`]: unreadable, not JSON, not a report of rtest, a field missing or malformed, a
-/// campaign report.
+/// [`InputError`]: unreadable, not JSON, not a report of rtest, a field missing or malformed.
 pub fn read_document(path: &Path) -> Result<Document, InputError> {
     let file = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|source| InputError::Read {
@@ -122,6 +111,8 @@ pub fn read_document(path: &Path) -> Result<Document, InputError> {
 /// The report in `text` (read from `file`), recognised by its fields: `findings` and
 /// `base_fit` (diagnosis), `compensated` and `left_out` (compensation), `per_direction` and
 /// `prediction` (validation), `parameters`, `fingerprint` and `refinement` (identification).
+/// Identifications and validations of one record or several, version 1 or 2, are read as
+/// [`IdentificationReport::from_json`] and [`ValidationReport::from_json`] read them.
 ///
 /// # Errors
 /// As [`read_document`].
@@ -137,12 +128,29 @@ pub fn classify(file: &str, text: &str) -> Result<Document, InputError> {
         });
     };
     let has = |keys: &[&str]| keys.iter().all(|k| map.contains_key(*k));
-    let campaign = map.get("kind").and_then(Value::as_str) == Some("campaign");
     let typed = |kind: &'static str| {
         move |e: serde_json::Error| InputError::Field {
             file: file.to_string(),
             kind,
             why: e.to_string(),
+        }
+    };
+    let read = |kind: &'static str| {
+        move |e: solver::io::report::ReportError| InputError::Field {
+            file: file.to_string(),
+            kind,
+            why: match e {
+                solver::io::report::ReportError::Json {
+                    line,
+                    column,
+                    message,
+                    ..
+                } => format!("{message} at line {line} column {column}"),
+                solver::io::report::ReportError::Field { field, message, .. } => {
+                    format!("field `{field}`: {message}")
+                }
+                other => other.to_string(),
+            },
         }
     };
     if has(&["findings", "base_fit"]) {
@@ -152,22 +160,10 @@ pub fn classify(file: &str, text: &str) -> Result<Document, InputError> {
         let r = serde_json::from_str(text).map_err(typed("compensation"))?;
         Ok(Document::Compensation(Box::new(r)))
     } else if has(&["per_direction", "prediction"]) {
-        if campaign {
-            return Err(InputError::Campaign {
-                file: file.to_string(),
-                kind: "validation",
-            });
-        }
-        let r = serde_json::from_str(text).map_err(typed("validation"))?;
+        let r = ValidationReport::from_json(file, text).map_err(read("validation"))?;
         Ok(Document::Validation(Box::new(r)))
     } else if has(&["parameters", "fingerprint", "refinement"]) {
-        if campaign {
-            return Err(InputError::Campaign {
-                file: file.to_string(),
-                kind: "identification",
-            });
-        }
-        let r = serde_json::from_str(text).map_err(typed("identification"))?;
+        let r = IdentificationReport::from_json(file, text).map_err(read("identification"))?;
         Ok(Document::Identification(Box::new(r)))
     } else {
         Err(InputError::Unknown {
@@ -233,6 +229,9 @@ pub struct MachineFacts {
     /// Per axis: name, kind (`linear`, `rotary`), side (`work`, `tool`), stroke in mm or
     /// degrees with its unit (`unlimited` for a rotary axis without limits).
     pub axes: Vec<[String; 4]>,
+    /// The kinematic symbols and their default values, mm (a record's ball position is shown
+    /// where it differs from them).
+    pub symbols: Vec<(String, f64)>,
 }
 
 impl MachineFacts {
@@ -271,6 +270,11 @@ impl MachineFacts {
             description: m.description.clone(),
             fingerprint: m.fingerprint(),
             axes,
+            symbols: m
+                .symbols
+                .iter()
+                .map(|s| (s.name.clone(), s.default))
+                .collect(),
         }
     }
 }
@@ -421,15 +425,17 @@ impl Inputs {
                 if let Some((f, r)) = &self.identification {
                     check_model(&v.model, &r.model).map_err(|why| disagree(f, why))?;
                 }
-                if let Some((f, _)) = self
-                    .validations
-                    .iter()
-                    .find(|(_, w)| same_file(&w.data, &v.data))
-                {
-                    return Err(disagree(
-                        f,
-                        format!("both validate on {}: the same record twice", v.data),
-                    ));
+                for (f, w) in &self.validations {
+                    if let Some(x) = v
+                        .records
+                        .iter()
+                        .find(|x| w.records.iter().any(|y| same_file(&y.data, &x.data)))
+                    {
+                        return Err(disagree(
+                            f,
+                            format!("both validate on {}: the same record twice", x.data),
+                        ));
+                    }
                 }
                 self.validations.push((file.to_string(), *v));
             }
@@ -467,13 +473,23 @@ fn check_model(model: &str, identified: &str) -> Result<(), String> {
     }
 }
 
-/// A diagnosis against the identification: the same fitted record, and the identified model is
-/// the diagnosis's base model or its extended model.
+/// A diagnosis against the identification: the same fitted records, and the identified model
+/// is the diagnosis's base model or its extended model.
 fn check_diagnosis(d: &DiagnosisReport, r: &IdentificationReport) -> Result<(), String> {
-    if !same_file(&d.data, &r.data) {
+    let diagnosed: Vec<&str> = match &d.campaign {
+        Some(c) => c.records.iter().map(|x| x.data.as_str()).collect(),
+        None => vec![d.data.as_str()],
+    };
+    let identified: Vec<&str> = r.records.iter().map(|x| x.data.as_str()).collect();
+    let same = diagnosed.len() == identified.len()
+        && identified
+            .iter()
+            .all(|i| diagnosed.iter().any(|d| same_file(d, i)));
+    if !same {
         return Err(format!(
             "the diagnosis fitted {} and the identification {}: other data",
-            d.data, r.data
+            diagnosed.join(", "),
+            identified.join(", ")
         ));
     }
     if r.model != d.base_model && r.model != d.extended_model.label {

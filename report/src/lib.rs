@@ -11,7 +11,10 @@
 //! with their SHA-256); the identified values with their standard uncertainties in µm and
 //! µrad, and the groups the data could not separate; the validations; the diagnosis (findings,
 //! gain, what remains unexplained); the compensation. A section whose report is absent is one
-//! line saying so.
+//! line saying so. An identification or validation may be of one record or of a campaign of
+//! several (a record is a campaign of one): a campaign's records are listed with their ball
+//! positions and set-ups, its shared values apart from each set-up's and record's, and each
+//! validated record with its set-up (fitted, or new and refitted).
 //!
 //! Self-contained: the document makes no request of any kind. Figures are inline SVG
 //! ([`svg`]) drawn by the `plots` crate; their font (the vendored DejaVu Sans) is embedded as

@@ -1,5 +1,6 @@
-//! Whole reports from small hand-written reports: escaping, the Content-Security-Policy, no
-//! address anywhere, absent sections said in one line.
+//! Whole reports from small hand-written reports (of version 1, as rtest wrote them before
+//! reports had records): escaping, the Content-Security-Policy, no address anywhere, absent
+//! sections said in one line.
 
 use super::*;
 
@@ -175,11 +176,34 @@ fn unknown_and_malformed_reports_name_file_line_and_field() {
     assert!(text.starts_with("v.json: validation report: "), "{text}");
     assert!(text.contains("line 2"), "{text}");
     let e = inputs::classify(
-        "c.json",
-        &identification("m").replacen('{', "{\"kind\": \"campaign\", ", 1),
+        "i.json",
+        &identification("m").replacen('{', "{\"version\": 3, ", 1),
     )
     .unwrap_err();
-    assert!(e.to_string().contains("campaign identification"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("i.json: identification report: field `version`: 3"),
+        "{e}"
+    );
+}
+
+#[test]
+fn version_1_reports_of_one_record_gain_their_record() {
+    let i = inputs(&[
+        ("id.json", identification("seed-ac")),
+        ("v1.json", validation("seed-ac", "reduced", "runs/k1.csv")),
+    ])
+    .unwrap();
+    let (_, r) = i.identification.as_ref().unwrap();
+    assert_eq!(r.version, 1);
+    assert_eq!(r.records.len(), 1);
+    assert_eq!(r.records[0].label, "k4");
+    assert_eq!(r.records[0].data, "k4.csv");
+    assert_eq!(r.setups[0].records, ["k4"]);
+    let (_, v) = &i.validations[0];
+    assert_eq!(v.records.len(), 1);
+    assert_eq!(v.records[0].label, "k1");
+    assert_eq!(v.records[0].unidentified_set_to_zero, ["YOC"]);
 }
 
 #[test]

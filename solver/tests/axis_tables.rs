@@ -9,7 +9,7 @@ use model_spec::units::parse_scaled;
 use model_spec::{AxisKind, Machine, parse_machine};
 use solver::compensation::tables::{AxisTable, MAX_TABLE_POINTS, Pitch, axis_tables};
 use solver::compensation::values::MachineErrors;
-use solver::io::report::IdentifiedValues;
+use solver::fitting::campaign::CampaignValues;
 use solver::model::{Model, Term};
 use solver::simulation::exact::chain_transform;
 
@@ -33,21 +33,9 @@ fn errors_of(m: &Machine, terms: &[(&str, &[f64])]) -> MachineErrors {
         .iter()
         .flat_map(|(_, v)| v.iter().map(|x| Some(*x)))
         .collect();
-    let n = values.len();
-    assert_eq!(n, model.width());
-    let id = IdentifiedValues {
-        file: "id.json".into(),
-        machine: m.name.clone(),
-        fingerprint: m.fingerprint(),
-        model_name: "test".into(),
-        model,
-        values,
-        std: vec![None; n],
-        determined: vec![true; n],
-        fixed: vec![false; n],
-        constraint: "none".into(),
-    };
-    MachineErrors::from_identified(m, &id).unwrap().0
+    assert_eq!(values.len(), model.width());
+    let id = CampaignValues::of_model(m, &model, &values, "k4", m.default_parameters()).unwrap();
+    MachineErrors::from_values(m, &id, "id.json").unwrap().0
 }
 
 /// Positioning, straightness and angular errors of a linear axis `X` and a rotary axis `C`,

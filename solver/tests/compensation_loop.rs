@@ -69,7 +69,9 @@ fn identified(m: &Machine, model: &Model, record: &Record) -> MachineErrors {
     .unwrap();
     let json = to_json(&report).unwrap();
     let values = parse_identification("identify.json", &json, m).unwrap();
-    MachineErrors::from_identified(m, &values).unwrap().0
+    MachineErrors::from_values(m, &values.values, &values.file)
+        .unwrap()
+        .0
 }
 
 /// A random five-axis path of `n` poses: random A and C within their ranges (|A| ≥ 10°), a

@@ -9,6 +9,7 @@ use common::{Rng, builtin};
 use model_spec::Machine;
 use nalgebra::DVector;
 use solver::compensation::values::{CompensationError, MachineErrors, ValueSource};
+use solver::fitting::campaign::CampaignValues;
 use solver::fitting::hmatrix::h_matrix_auto;
 use solver::fitting::{Constraint, IdentifyOptions, RefineOptions, identify_refined};
 use solver::io::report::read::parse_identification;
@@ -28,22 +29,11 @@ fn model(m: &Machine, spellings: &[&str]) -> Model {
     }
 }
 
-/// Identified values of `model` as if read from `file`: determined, unconstrained.
-fn identified(m: &Machine, model: Model, values: Vec<Option<f64>>) -> IdentifiedValues {
-    let n = values.len();
-    assert_eq!(n, model.width());
-    IdentifiedValues {
-        file: "id.json".into(),
-        machine: m.name.clone(),
-        fingerprint: m.fingerprint(),
-        model_name: "test".into(),
-        model,
-        determined: values.iter().map(Option::is_some).collect(),
-        std: vec![None; n],
-        fixed: vec![false; n],
-        values,
-        constraint: "none".into(),
-    }
+/// Identified values of `model` on one record at the machine's defaults: determined,
+/// unconstrained.
+fn identified(m: &Machine, model: Model, values: Vec<Option<f64>>) -> CampaignValues {
+    assert_eq!(values.len(), model.width());
+    CampaignValues::of_model(m, &model, &values, "k4", m.default_parameters()).unwrap()
 }
 
 /// Random commands within the strokes and ranges of `m` (mm, rad; ±180° when unlimited).
@@ -105,7 +95,7 @@ fn the_values_at_a_pose_are_the_h_matrix_columns_times_the_identified_values() {
         model.clone(),
         values.iter().copied().map(Some).collect(),
     );
-    let (errors, left_out) = MachineErrors::from_identified(&m, &id).unwrap();
+    let (errors, left_out) = MachineErrors::from_values(&m, &id, "id.json").unwrap();
     assert!(left_out.is_empty(), "{left_out:?}");
     assert_eq!(errors.errors(), model.errors().as_slice());
     let names: Vec<&str> = errors
@@ -173,7 +163,7 @@ fn what_compensation_leaves_out_is_listed_with_its_value() {
         .collect();
     values[3] = None; // an undetermined drift is not needed
     let id = identified(&m, model, values);
-    let (errors, left_out) = MachineErrors::from_identified(&m, &id).unwrap();
+    let (errors, left_out) = MachineErrors::from_values(&m, &id, "id.json").unwrap();
     let out: Vec<(&str, Vec<Option<f64>>)> = left_out
         .iter()
         .map(|l| (l.term.as_str(), l.values.clone()))
@@ -210,19 +200,11 @@ fn undetermined_values_are_refused_with_the_terms_and_what_to_do() {
     let m = builtin("seed-ac");
     let model = model(&m, &["XOC", "ECC@harmonic:2", "YOA", "dx0"]);
     let id = identified(&m, model, vec![None, Some(1e-6), None, Some(2e-3), None]);
-    let e = MachineErrors::from_identified(&m, &id).unwrap_err();
+    let e = MachineErrors::from_values(&m, &id, "id.json").unwrap_err();
     assert!(matches!(e, CompensationError::Undetermined { .. }));
     assert_eq!(
         e.to_string(),
         "id.json: no value for XOC, ECC@harmonic:2: the data do not determine them (the fit was rank-deficient), and compensation needs a value for every term it puts onto the machine; identify again with a constraint that fixes what you know (`--constraint zero:XOC,ECC@harmonic:2:sin`), or with a record from another path that separates them, or leave them out of the model"
-    );
-    // Another machine's values are refused.
-    let other = builtin("head-table-bc");
-    let e = MachineErrors::from_identified(&other, &id).unwrap_err();
-    assert!(
-        e.to_string()
-            .starts_with("id.json: the values were identified on machine `seed-ac` (fingerprint"),
-        "{e}"
     );
 }
 
@@ -259,7 +241,7 @@ fn a_constrained_fit_is_taken_and_says_which_values_come_from_the_constraint() {
     // Unconstrained: XOC, YOA and ZOA have no value (null), so compensation refuses.
     let (m, id) = zeroed_identification(Constraint::None);
     assert_eq!(id.constraint, "none");
-    let e = MachineErrors::from_identified(&m, &id)
+    let e = MachineErrors::from_values(&m, &id.values, &id.file)
         .unwrap_err()
         .to_string();
     assert!(
@@ -276,7 +258,7 @@ fn a_constrained_fit_is_taken_and_says_which_values_come_from_the_constraint() {
     ]));
     assert_eq!(id.constraint, "zero: XOC, YOA, ZOA");
     assert!(id.constrained());
-    let (errors, left_out) = MachineErrors::from_identified(&m, &id).unwrap();
+    let (errors, left_out) = MachineErrors::from_values(&m, &id.values, &id.file).unwrap();
     let fixed: Vec<(&str, ValueSource)> = errors.set_by_constraint();
     assert_eq!(
         fixed,
@@ -304,7 +286,7 @@ fn a_constrained_fit_is_taken_and_says_which_values_come_from_the_constraint() {
     // Minimum norm: every value is given; the undetermined ones are listed as its choice.
     let (m, id) = zeroed_identification(Constraint::MinimumNorm);
     assert_eq!(id.constraint, "minimum-norm");
-    let (errors, _) = MachineErrors::from_identified(&m, &id).unwrap();
+    let (errors, _) = MachineErrors::from_values(&m, &id.values, &id.file).unwrap();
     let chosen: Vec<&str> = errors.set_by_constraint().iter().map(|(t, _)| *t).collect();
     assert_eq!(chosen, ["YOA", "ZOA", "XOC"]);
     assert!(
@@ -330,9 +312,9 @@ fn the_report_reader_takes_what_the_fit_says_of_each_value_and_names_bad_fields(
     assert_eq!(v.fingerprint, m.fingerprint());
     assert_eq!(v.constraint, "zero: YOC");
     assert!(v.constrained());
-    assert_eq!(v.std, [Some(0.25e-3), None, Some(0.5e-6), None]);
-    assert_eq!(v.determined, [true, true, false, false]);
-    assert_eq!(v.fixed, [false, true, false, false]);
+    assert_eq!(v.values.std, [Some(0.25e-3), None, Some(0.5e-6), None]);
+    assert_eq!(v.values.determined, [true, true, false, false]);
+    assert_eq!(v.values.fixed, [false, true, false, false]);
     // Without the fields: an unconstrained fit, determined where a value is given.
     let bare = ok
         .replace("\"constraint\": \"zero: YOC\",", "")
@@ -342,8 +324,8 @@ fn the_report_reader_takes_what_the_fit_says_of_each_value_and_names_bad_fields(
     let v = parse_identification("id.json", &bare, &m).unwrap();
     assert_eq!(v.constraint, "none");
     assert!(!v.constrained());
-    assert_eq!(v.determined, [true, true, true, false]);
-    assert_eq!(v.fixed, [false; 4]);
+    assert_eq!(v.values.determined, [true, true, true, false]);
+    assert_eq!(v.values.fixed, [false; 4]);
     for (bad, expected) in [
         (
             ok.replace("\"value\": 0,", "\"value\": 3,"),

@@ -9,10 +9,10 @@ use common::{Rng, builtin};
 use model_spec::{AxisKind, Machine, Side, parse_machine};
 use solver::compensation::kinematics::corrected_description;
 use solver::compensation::values::MachineErrors;
+use solver::fitting::campaign::{CampaignIdentification, CampaignValues};
 use solver::fitting::{
     Constraint, Identification, IdentifyOptions, RefineOptions, identify_refined,
 };
-use solver::io::report::IdentifiedValues;
 use solver::model::{Model, Term};
 use solver::record::Record;
 use solver::simulation::exact::{VirtualMachine, tool_centre_point_ik};
@@ -40,20 +40,9 @@ fn model(m: &Machine, spellings: &[&str]) -> Model {
 fn errors_of(m: &Machine, names: &[(&str, f64)]) -> MachineErrors {
     let spellings: Vec<&str> = names.iter().map(|(n, _)| *n).collect();
     let model = model(m, &spellings);
-    let n = model.width();
-    let id = IdentifiedValues {
-        file: "id.json".into(),
-        machine: m.name.clone(),
-        fingerprint: m.fingerprint(),
-        model_name: "test".into(),
-        model,
-        values: names.iter().map(|(_, v)| Some(*v)).collect(),
-        std: vec![None; n],
-        determined: vec![true; n],
-        fixed: vec![false; n],
-        constraint: "none".into(),
-    };
-    MachineErrors::from_identified(m, &id).unwrap().0
+    let values: Vec<Option<f64>> = names.iter().map(|(_, v)| Some(*v)).collect();
+    let id = CampaignValues::of_model(m, &model, &values, "k4", m.default_parameters()).unwrap();
+    MachineErrors::from_values(m, &id, "id.json").unwrap().0
 }
 
 /// The largest difference (mm) of the exact error vectors of `a` with `errors_a` and `b` with
@@ -322,23 +311,10 @@ fn fold_and_identify_again(
     let model = model(m, terms);
     let first = identify(m, &model, data, zero);
     let n = model.width();
-    let id = IdentifiedValues {
-        file: "first.json".into(),
-        machine: m.name.clone(),
-        fingerprint: m.fingerprint(),
-        model_name: "test".into(),
-        model: model.clone(),
-        values: first.fit.values.clone(),
-        std: first.fit.std.clone(),
-        determined: first.fit.identifiability.determined.clone(),
-        fixed: first.fit.fixed.clone(),
-        constraint: if zero.is_empty() {
-            "none".into()
-        } else {
-            format!("zero: {}", zero.join(", "))
-        },
-    };
-    let (errors, _) = MachineErrors::from_identified(m, &id).unwrap();
+    let id = CampaignValues::of(
+        &CampaignIdentification::of_record(m, &first, "first", m.default_parameters()).unwrap(),
+    );
+    let (errors, _) = MachineErrors::from_values(m, &id, "first.json").unwrap();
     let c = corrected_description(m, text, &errors).unwrap();
     let corrected = parse_machine("corrected.toml", &c.toml).unwrap();
     let again = identify(&corrected, &model, data, zero);

@@ -537,16 +537,12 @@ fn a_campaign_shares_a_machine_length_and_gives_each_set_up_its_ball_position() 
         base_model: Some("location"),
         data: &["near.csv".to_string(), "far.csv".to_string()],
     };
-    let report = solver::io::report::CampaignReport::new(&m, source, &id, None).unwrap();
+    let report = IdentificationReport::of_campaign(&m, source, &id, None).unwrap();
     let json = to_json(&report).unwrap();
-    let root: serde_json::Value = serde_json::from_str(&json).unwrap();
-    let back =
-        solver::io::report::campaign_read::parse_campaign_report("c.json", &root, &m).unwrap();
+    let back = parse_identification("c.json", &json, &m).unwrap();
     assert_eq!(back.values.values, id.fit.values);
-    let tampered: serde_json::Value =
-        serde_json::from_str(&json.replacen("\"nominal_mm\": 60.0", "\"nominal_mm\": 61.0", 1))
-            .unwrap();
-    let e = solver::io::report::campaign_read::parse_campaign_report("c.json", &tampered, &m)
+    let tampered = json.replacen("\"nominal_mm\": 60.0", "\"nominal_mm\": 61.0", 1);
+    let e = parse_identification("c.json", &tampered, &m)
         .unwrap_err()
         .to_string();
     assert!(
@@ -610,14 +606,14 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
     );
     let json = to_json(&report).unwrap();
     let back = parse_identification("zt.json", &json, &m).unwrap();
-    let k = back
-        .model
+    let (back_model, back_values) = back.single_record().unwrap();
+    let k = back_model
         .terms
         .iter()
         .position(|t| *t == Term::parse(&m, "Zt").unwrap())
         .unwrap();
     let j = id.fit.names.iter().position(|n| n == "Zt").unwrap();
-    assert_eq!(back.values[k], id.fit.values[j]);
+    assert_eq!(back_values[k], id.fit.values[j]);
     // Tampered or missing lengths are refused, naming the field.
     let tampered = json.replacen("\"nominal_mm\": -250.0", "\"nominal_mm\": -249.0", 1);
     assert_ne!(tampered, json);
@@ -637,8 +633,8 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
     let turn_c = simulate(&m, &truth, &builtin_path(&m, "turn-C").unwrap().unwrap()).unwrap();
     let v = validate(
         &m,
-        &back.model,
-        &back.values,
+        &back_model,
+        &back_values,
         &turn_c,
         &ValidateOptions::new().exact(true),
     )
@@ -688,7 +684,9 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
 #[test]
 fn a_change_identified_at_another_value_is_read_back_against_the_default() {
     // Identified with the controller's Zt = -250.01 (the machine's is -250.04): the change is
-    // -30 µm from -250.01; read back on the description (default -250) it is -40 µm.
+    // -30 µm from -250.01; on the description (default -250) it is -40 µm: what a report of
+    // version 1 (which does not say what the record was modelled with) reads back, and what
+    // compensation folds into the description.
     let m = machine("head-table-bc");
     let zt = symbol(&m, "Zt");
     let mut params = m.default_parameters();
@@ -717,14 +715,30 @@ fn a_change_identified_at_another_value_is_read_back_against_the_default() {
     };
     let json = to_json(&IdentificationReport::new(&m, source, &id, Some(&r)).unwrap()).unwrap();
     assert!(json.contains("\"nominal_mm\": -250.01"), "{json}");
+    // Version 2: the record says it was modelled with Zt = -250.01, and the change is from it.
     let back = parse_identification("zt.json", &json, &m).unwrap();
-    let k = back.model.terms.len() - 1;
-    let last = back.values[back.model.width() - 1].unwrap();
-    assert_eq!(back.model.terms[k], Term::parse(&m, "Zt").unwrap());
+    assert_eq!(back.values.layout.records[0].params[zt], -250.01);
+    let (back_model, back_values) = back.single_record().unwrap();
+    let k = back_model.terms.len() - 1;
+    assert_eq!(back_model.terms[k], Term::parse(&m, "Zt").unwrap());
+    let change = back_values[back_model.width() - 1].unwrap();
+    assert!((change + 0.030).abs() < 1e-9, "{change}");
+    // Version 1 (no record): read back on the description, the change is from its default.
+    let root: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let mut v1 = root.as_object().unwrap().clone();
+    for key in ["version", "records", "setups"] {
+        v1.remove(key);
+    }
+    let v1 = serde_json::to_string(&v1).unwrap();
+    let old = parse_identification("zt.json", &v1, &m).unwrap();
+    assert_eq!(old.version, 1);
+    let (_, old_values) = old.single_record().unwrap();
+    let last = old_values[back_model.width() - 1].unwrap();
     assert!((last + 0.040).abs() < 1e-9, "{last}");
     // A compensation leaves the length out and says where it belongs.
     let (errors, left_out) =
-        solver::compensation::values::MachineErrors::from_identified(&m, &back).unwrap();
+        solver::compensation::values::MachineErrors::from_values(&m, &back.values, &back.file)
+            .unwrap();
     assert!(!errors.errors().is_empty());
     let zt = left_out.iter().find(|l| l.term == "Zt").unwrap();
     assert!(

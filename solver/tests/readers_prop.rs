@@ -200,8 +200,8 @@ fn check_report(m: &Machine, bytes: &[u8]) {
     };
     match result {
         Ok(v) => {
-            assert_eq!(v.values.len(), v.model.width());
-            assert!(v.values.iter().flatten().all(|x| x.is_finite()));
+            assert_eq!(v.values.values.len(), v.values.layout.columns.len());
+            assert!(v.values.values.iter().flatten().all(|x| x.is_finite()));
         }
         Err(ReportError::Field {
             file,

@@ -6,6 +6,9 @@ mod common;
 use common::{Rng, builtin};
 use model_spec::Machine;
 use nalgebra::DVector;
+use solver::fitting::campaign::{
+    Campaign, CampaignIdentification, CampaignRecord, CampaignValues, validate_campaign,
+};
 use solver::fitting::hmatrix::h_matrix_auto;
 use solver::fitting::validate::{
     Unidentified, ValidateError, ValidateOptions, statistics, validate,
@@ -147,15 +150,37 @@ fn identified_on_k4_predicts_k1_and_k2() {
             if sigma > 0.0 {
                 assert!(v.overall.residual_rms > 0.4e-3, "at the noise level");
             }
+            // The one path of validation (a record is a campaign of one, here on the fitted
+            // set-up) predicts as the record's own validation does.
             let data = format!("{name}.csv");
+            let values = CampaignValues::of(
+                &CampaignIdentification::of_record(&m, &ident, "k4", m.default_parameters())
+                    .unwrap(),
+            );
+            let record = CampaignRecord::new(
+                name.to_lowercase(),
+                rec.clone(),
+                m.default_parameters(),
+                "k4",
+                false,
+            );
+            let cv = validate_campaign(
+                &m,
+                &values,
+                &Campaign::new(vec![record]).unwrap(),
+                &ValidateOptions::default(),
+            )
+            .unwrap();
+            assert_eq!(cv.records[0].validation.prediction, v.prediction);
+            assert!(cv.records[0].setup_fitted && cv.records[0].refitted.is_empty());
             let source = ValidationSource {
-                machine: "seed-ac",
                 model: "reduced",
                 params: "id.json",
-                data: &data,
+                data: &[data],
+                kinematics: &[m.default_parameters()],
                 exact: false,
             };
-            let j = ValidationReport::new(source, &v).unwrap();
+            let j = ValidationReport::new(&m, source, &cv).unwrap();
             let text = serde_json::to_value(&j).unwrap();
             for key in [
                 "data",
@@ -267,9 +292,10 @@ fn identify_json_has_the_fields_and_reads_back() {
     );
     // Read back: same model and values (µm, µrad → mm, rad).
     let back = parse_identification("id.json", &text, &m).unwrap();
-    assert_eq!(back.model, ident.model);
+    let (back_model, back_values) = back.single_record().unwrap();
+    assert_eq!(back_model, ident.model);
     assert_eq!(back.model_name, "reduced+");
-    for (a, b) in back.values.iter().zip(&ident.fit.values) {
+    for (a, b) in back_values.iter().zip(&ident.fit.values) {
         match (a, b) {
             (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-15 * b.abs().max(1e-9)),
             (None, None) => {}
@@ -279,7 +305,7 @@ fn identify_json_has_the_fields_and_reads_back() {
     // The values validate.
     let rec = measure(&m, &model, &x, k1(&m), 0.0, 2, true);
     let zeroed = ValidateOptions::new().zeroed(true);
-    let v = validate(&m, &back.model, &back.values, &rec, &zeroed).unwrap();
+    let v = validate(&m, &back_model, &back_values, &rec, &zeroed).unwrap();
     assert!(v.overall.residual_rms < 2e-3);
 }
 
@@ -303,8 +329,8 @@ fn bad_identify_json_names_the_file_and_the_field() {
         .replace("FP", &m.fingerprint());
     let ok = ok.as_str();
     let v = parse_identification("id.json", ok, &m).unwrap();
-    assert_eq!(v.values, vec![Some(1.5e-3), Some(2e-6), None]);
-    assert_eq!(v.model.terms.len(), 2);
+    assert_eq!(v.values.values, vec![Some(1.5e-3), Some(2e-6), None]);
+    assert_eq!(v.values.model.terms.len(), 2);
     let cases = [
         (
             ok.replace("\"seed-ac\"", "\"other\""),

@@ -1,23 +1,25 @@
-//! What `identify`, `validate` and `diagnose` share for campaigns: the records of
-//! `--data a.csv,b.csv` (each its own set-up and its own R-test zero) or of `--campaign FILE`,
-//! their checks, and the plausibility of a campaign's values.
+//! What `identify`, `validate` and `diagnose` share: the records of `--data a.csv,b.csv` (each
+//! its own set-up and its own R-test zero; one file is a campaign of one) or of
+//! `--campaign FILE`, their checks, and the plausibility of a campaign's values.
 
 use super::{CliError, CliResult};
 use model_spec::Machine;
 use model_spec::instrument::{Instrument, ReadingsFrame};
+use solver::fitting::Constraint;
 use solver::fitting::campaign::{Campaign, CampaignRecord, Layout};
+use solver::fitting::hmatrix::parameter_name;
 use solver::fitting::sanity::{ValueLimits, check_model_values};
 use solver::io::campaign::{CampaignFileError, labels_from_files, load_campaign, read_record_at};
 use solver::io::csv::ReadOptions;
 use solver::model::Model;
 use std::path::{Path, PathBuf};
 
-/// Refuses `--instrument` for a campaign's validation or diagnosis: they do not weight records
-/// by the covariances sensor readings carry (a campaign's identification does).
+/// Refuses `--instrument` for a campaign's diagnosis: it does not weight records by the
+/// covariances sensor readings carry (identification and validation do).
 pub fn refuse_instrument(instrument: &super::args::InstrumentArgs) -> CliResult<()> {
     if instrument.instrument.is_some() {
         return Err(CliError::usage(
-            "--instrument: the validation and diagnosis of a campaign (several files or --campaign) do not weight records by the per-sample covariances of sensor readings yet: identify the campaign (which does), or validate and diagnose one sensor record at a time",
+            "--instrument: diagnoses of a campaign (several files or --campaign) do not weight records by the per-sample covariances of sensor readings yet: identify and validate the campaign (which do), or diagnose one sensor record at a time",
         ));
     }
     Ok(())
@@ -130,15 +132,22 @@ impl Loaded {
     /// The note for every record whose first reading is exactly 0 but that is not declared
     /// zeroed.
     pub fn zeroed_notes(&self, hint: &str) -> String {
+        let one = self.campaign.records.len() == 1;
         self.campaign
             .records
             .iter()
             .filter(|r| r.record.looks_zeroed() && !r.zeroed)
             .map(|r| {
-                format!(
-                    "Note: the first reading of record `{}` is exactly 0: if its readings were zeroed at the first sample, {hint}.\n",
-                    r.label
-                )
+                if one {
+                    format!(
+                        "Note: the first reading is exactly 0: if the readings were zeroed at the first sample, {hint}.\n"
+                    )
+                } else {
+                    format!(
+                        "Note: the first reading of record `{}` is exactly 0: if its readings were zeroed at the first sample, {hint}.\n",
+                        r.label
+                    )
+                }
             })
             .collect()
     }
@@ -168,4 +177,56 @@ pub fn check_campaign_values(
     limits: &ValueLimits,
 ) -> Result<(), solver::fitting::Implausible> {
     check_model_values(m, &columns_model(layout), &layout.names(), values, limits)
+}
+
+/// The constraint of a fit of `campaign`: as given, except that a campaign of one record also
+/// takes the names its report writes (`dx0`, `XOW`) for the columns of its record and set-up
+/// (`dx0[k4]`, `XOW[k4]`), so that one record is constrained as a single identification always
+/// was. A name that is neither stays as it is (the fit names it as unknown).
+pub fn constraint_for(
+    m: &Machine,
+    model: &Model,
+    campaign: &Campaign,
+    constraint: Constraint,
+) -> Constraint {
+    let Constraint::Zero(names) = constraint else {
+        return constraint;
+    };
+    let [r] = campaign.records.as_slice() else {
+        return Constraint::Zero(names);
+    };
+    let spec = solver::fitting::campaign::RecordSpec {
+        label: r.label.clone(),
+        setup: r.setup.clone(),
+        params: r.params.clone(),
+        zeroed: r.zeroed,
+        start_s: r.start_s,
+        samples: r.record.samples.len(),
+    };
+    let Ok(layout) = Layout::of_records(m, model, &[spec], None) else {
+        return Constraint::Zero(names);
+    };
+    let canonical = |z: &str| match z.trim().split_once('@') {
+        Some((e, b)) => format!("{}@{b}", model_spec::canonical_name(e)),
+        None => model_spec::canonical_name(z.trim()),
+    };
+    Constraint::Zero(
+        names
+            .into_iter()
+            .map(|z| {
+                if layout.columns.iter().any(|c| c.name == z.trim()) {
+                    return z;
+                }
+                let want = canonical(&z);
+                layout
+                    .columns
+                    .iter()
+                    .find(|c| {
+                        let bare = parameter_name(m, &c.term, c.component);
+                        bare == z.trim() || bare == want
+                    })
+                    .map_or(z, |c| c.name.clone())
+            })
+            .collect(),
+    )
 }

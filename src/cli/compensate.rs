@@ -10,8 +10,6 @@ use solver::compensation::kinematics::corrected_description;
 use solver::compensation::run::{CommandedPose, compensate_poses};
 use solver::compensation::tables::{Pitch, axis_tables};
 use solver::compensation::values::{CompensationError, MachineErrors};
-use solver::fitting::hmatrix::parameter_names;
-use solver::fitting::sanity::check_model_values;
 use solver::io::nc::{Dialect, WriteOptions, read_program};
 use solver::io::poses::{axis_words, from_file_units, read_pose_file, to_file_units};
 use solver::io::report::compensate::{CompensationReport, CompensationSource, KinematicsReport};
@@ -21,10 +19,14 @@ use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
 Puts identified errors back onto the machine. The values are those of an `rtest identify` JSON \
-(--params, position-dependent terms included); what is compensated is the machine's geometric \
-errors only: set-up errors of the ball, the R-test's sensor offsets and instrument terms, time, \
-velocity and reversal terms are left out and listed. A value the identification could not \
-determine is refused (identify with a constraint, or with another path).
+(--params: one record or a campaign of several, position-dependent terms included); what is \
+compensated is the machine's geometric errors only, its shared values: the set-up errors of the \
+ball (one set per set-up in a campaign, XOW[k4]), the R-test's sensor offsets and instrument \
+terms, every parameter of a record, time, velocity and reversal terms are left out and listed. \
+A value the identification could not determine is refused (identify with a constraint, or with \
+another path). The records' ball positions do not matter to the correction; the machine's other \
+kinematic symbols (the tool's length) come from the description and --param, and records \
+modelled with different values of one are refused (which one the machine has is unknown).
 
 --path IN -o OUT: corrected commands. IN is a CSV of commanded poses (one column per machine \
 axis named by its letter, mm and degrees; other columns kept as they are) or, with --nc \
@@ -61,7 +63,8 @@ pub struct CompensateArgs {
     /// Built-in machine (see `rtest machines`) or path of a machine TOML file.
     #[arg(long, value_name = "NAME|FILE")]
     machine: String,
-    /// The JSON written by `rtest identify --json` (values in µm and µrad).
+    /// The JSON written by `rtest identify --json`, of one record or a campaign (values in µm
+    /// and µrad).
     #[arg(long, value_name = "FILE")]
     params: PathBuf,
     /// The commanded poses: a CSV (columns named by the axis letters) or, with --nc, a program.
@@ -144,15 +147,17 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     let params = super::pose_args::params(&m, args.param.as_deref())?;
     let id = read_identification(&args.params, &m)
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
-    let names = parameter_names(&m, &id.model);
-    check_model_values(&m, &id.model, &names, &id.values, &args.bounds.values()).map_err(|e| {
-        CliError::input(format!(
-            "--params: {}: {e}: these cannot be the errors of a machine tool (--max-error-um, --max-error-urad change the bounds)",
-            args.params.display()
-        ))
-    })?;
-    let (errors, left_out) = MachineErrors::from_identified(&m, &id)
+    let v = &id.values;
+    super::campaign::check_campaign_values(&m, &v.layout, &v.values, &args.bounds.values())
+        .map_err(|e| {
+            CliError::input(format!(
+                "--params: {}: {e}: these cannot be the errors of a machine tool (--max-error-um, --max-error-urad change the bounds)",
+                args.params.display()
+            ))
+        })?;
+    let (errors, left_out) = MachineErrors::from_values(&m, v, &id.file)
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
+    let symbols_note = symbols_note(&m, &params, errors.record_params(), args.param.is_some());
     let mut files = Outputs::new();
     let params_file = args.params.display().to_string();
     let mut source = CompensationSource::of(&m, &id.model_name, &params_file, &errors, &left_out);
@@ -296,6 +301,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             kinematics_and_tables(source.kinematics.as_ref(), &source.tables)
         ),
     };
+    text.push_str(&symbols_note);
     text.push_str(&wrote(&write(files)?));
     let stdout_taken = [&args.output, &args.kinematics_out, &args.json, &args.report]
         .iter()
@@ -322,4 +328,38 @@ fn html_report(
     )
     .map_err(|e| CliError::computation(format!("--report: {e}")))?;
     super::report::render("--report", &i)
+}
+
+/// The note on the machine's kinematic symbols: where the records of the identification were
+/// modelled with other values of the machine's side (not the ball's position) than the
+/// correction uses (`params`, mm: the defaults and `--param`), which; empty otherwise.
+fn symbols_note(m: &model_spec::Machine, params: &[f64], records: &[f64], given: bool) -> String {
+    let workpiece = m.workpiece_symbols();
+    let differ: Vec<String> = m
+        .symbols
+        .iter()
+        .enumerate()
+        .filter(|(s, _)| !workpiece.contains(s))
+        .filter(|(s, _)| records.get(*s).is_some_and(|r| *r != params[*s]))
+        .map(|(s, sym)| {
+            format!(
+                "{} = {} mm (the correction uses {} mm)",
+                sym.name,
+                model_spec::units::short(records[s]),
+                model_spec::units::short(params[s])
+            )
+        })
+        .collect();
+    if differ.is_empty() {
+        return String::new();
+    }
+    format!(
+        "Note: the identification's records were modelled with {}; the correction takes the machine's kinematic symbols from {}.\n",
+        differ.join(", "),
+        if given {
+            "--param and the description's defaults"
+        } else {
+            "the description's defaults (--param sets them)"
+        }
+    )
 }

@@ -6,21 +6,16 @@ use super::campaign;
 use super::history;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text};
 use output::{Outputs, Target};
-use solver::fitting::campaign::{identify_campaign, identify_campaign_refined};
+use solver::fitting::campaign::{
+    CampaignIdentification, CampaignValues, identify_campaign, identify_campaign_refined,
+};
 use solver::fitting::hmatrix::HMatrixError;
 use solver::fitting::noise::NoiseChoice;
 use solver::fitting::streaming::{StreamingError, identify_file};
-use solver::fitting::{
-    EstimateError, IdentifyOptions, RefineError, RefineOptions, check_values, identify_noise,
-    identify_refined_noise,
-};
+use solver::fitting::{EstimateError, IdentifyOptions, RefineError, RefineOptions};
 use solver::io::report::identify::StreamingReport;
-use solver::io::report::{
-    CampaignReport, CampaignSource, IdentificationReport, IdentificationSource, to_json,
-};
-use solver::io::text::campaign::campaign_identification;
+use solver::io::report::{CampaignSource, IdentificationReport, to_json};
 use solver::io::text::identify::identification;
-use solver::io::text::validate::zeroed_note;
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -67,33 +62,42 @@ Plausibility: readings beyond --max-reading-um and poses outside the strokes are
 their lines; identified values beyond --max-error-um / --max-error-urad are an error (exit code \
 3), not a result.
 
-Campaigns (docs/campaigns.md): --data a.csv,b.csv fits several records together, each on its own \
-ball set-up (its own XOW YOW ZOW, named XOW[a]) and with its own R-test zero (dx0[a] when \
---zeroed), the machine's errors shared; --param NAME=VALUE,... gives every record the same \
-kinematic parameters (the ball's position). --campaign FILE reads a TOML list of records with \
-their labels, set-ups (records with the same set-up share its errors), ball positions, zeroing \
-and optional start times on one campaign clock. The report gives the shared values, one block \
-per set-up and per record, and each record's residual; its JSON has \"kind\": \"campaign\".
+Campaigns (docs/campaigns.md): a record is a campaign of one, and --data a.csv,b.csv fits several \
+records together, each on its own ball set-up (its own XOW YOW ZOW, named XOW[a]) and with its \
+own R-test zero (dx0[a] when --zeroed), the machine's errors shared; --param NAME=VALUE,... gives \
+every record the same kinematic parameters (the ball's position). --campaign FILE reads a TOML \
+list of records with their labels, set-ups (records with the same set-up share its errors), ball \
+positions, zeroing and optional start times on one campaign clock. The report of several \
+records gives the shared values, one block per set-up and per record, and each record's \
+residual. --stream reads one long record in blocks and takes one --data file: several records \
+are fitted whole, in one design matrix held in memory.
 
---report FILE writes the HTML report of this identification (docs/report.md: values with \
-uncertainties, what the data cannot separate, the input files with their SHA-256; one record).
+--report FILE writes the HTML report of this identification (docs/report.md: the records with \
+their ball positions and set-ups, values with uncertainties, what the data cannot separate, each \
+record's measured error against its prediction along its path, the input files with their \
+SHA-256).
 
---json writes the report (docs/identification.md): {machine, fingerprint, data, model, \
-base_model, terms, parameters: [{name, error, basis, value, std, unit, determined, fixed}], \
-residual_rms_um, rank, condition, confounded, samples, sigma_um, near_confounded, refinement: \
-{method, iterations, converged, …}, noise_model: {source, sigma_um, phi, whitened_sigma, text}, \
-notes, …}; `rtest validate --params` reads it. `--json -` \
-writes it to standard output (the text then goes to standard error).
+--json writes the report (docs/identification.md), version 2: {version, machine, fingerprint, \
+data, model, base_model, terms, setups: [{label, records}], records: [{label, data, setup, \
+params, zeroed, samples, residual_rms_um}], parameters: [{name, error, basis, value, std, unit, \
+determined, fixed}], residual_rms_um, rank, condition, confounded, samples, zeroed, sigma_um, \
+near_confounded, refinement: {method, iterations, converged, …}, noise_model: {source, \
+sigma_um, phi, whitened_sigma, text}, notes, …}; several records: \"kind\": \"campaign\", no \
+data nor zeroed, every parameter with its owner (shared, setup, record) and the set-up's or \
+record's label (of). `rtest validate --params` and `rtest compensate --params` read it (and what \
+earlier versions wrote). `--json -` writes it to standard output (the text then goes to \
+standard error).
 
 History (docs/history.md): --record --machine-id ID keeps the identification, once it succeeded \
 and its outputs are written, in the machine's history database (--db, default \
 rtest-history.sqlite): machine id and fingerprint, model and terms, test paths (--record-paths), \
 the measurement time (--measured-at), the SHA-256 of every input file, every value with its σ and \
-unit, rank, unidentifiable groups and residual. rtest history shows the checks and each error's \
-trend.
+unit, rank, unidentifiable groups and residual; a campaign is one check whose paths are its \
+records' labels and whose parameters carry their owners. rtest history shows the checks and each \
+error's trend (of a campaign: its shared values).
 
-Progress: on a terminal, a bar on standard error follows the reading of --data (bytes of the \
-file, with --stream too) once it has run half a second (RTEST_PROGRESS_DELAY_MS sets the delay, \
+Progress: on a terminal, a bar on standard error follows the reading of the records (bytes of \
+the files, with --stream too) once it has run half a second (RTEST_PROGRESS_DELAY_MS sets the delay, \
 in ms) and is cleared when it ends; never on a pipe or a file, nor with `--json -`.";
 
 /// Flags of `rtest identify`.
@@ -150,13 +154,13 @@ pub struct IdentifyArgs {
     /// Also write the report as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
-    /// Also write the HTML report of this identification to FILE (docs/report.md; one
-    /// record; `-`: standard output).
+    /// Also write the HTML report of this identification to FILE (docs/report.md; one record
+    /// or a campaign; `-`: standard output).
     #[arg(long, value_name = "FILE")]
     report: Option<Target>,
     /// Read the measurement in blocks and fold them into an incremental QR: for long records
     /// (10^6 samples and more), memory bounded by the number of parameters. First order (the
-    /// refinement needs the whole record).
+    /// refinement needs the whole record); one --data file.
     #[arg(long)]
     stream: bool,
     #[command(flatten)]
@@ -175,7 +179,8 @@ pub struct IdentifyArgs {
     history: history::RecordArgs,
 }
 
-/// Runs `rtest identify`.
+/// Runs `rtest identify`: one record or several, read as a campaign (a record is a campaign
+/// of one), fitted together, reported once; `--stream` reads one long record in blocks.
 pub fn run(args: &IdentifyArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     let (label, model) = args::model(&m, args.model.as_deref(), args.terms.as_deref())?;
@@ -183,31 +188,52 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         Some(list) => args::files("--data", list)?,
         None => Vec::new(),
     };
-    if args.campaign.is_some() || files.len() > 1 {
-        return run_campaign(args, &m, &label, &model, &files);
-    }
-    let data_path = files[0].as_path();
-    let params = super::pose_args::params(&m, args.param.as_deref())?;
-    let mut opts = IdentifyOptions::new()
-        .zeroed(args.zeroed)
-        .constraint(args::constraint(args.constraint.as_deref())?);
-    if args.param.is_some() {
-        opts = opts.params(params.clone());
-    }
+    let flag = if args.campaign.is_some() {
+        "--campaign"
+    } else {
+        "--data"
+    };
     let declared = args.noise.declared()?;
-    if args.stream
-        && (args.noise.noise_record.is_some() || matches!(declared, NoiseChoice::Model(_)))
-    {
-        return Err(CliError::usage(
-            "--stream fits by ordinary least squares in one pass; --noise models and --noise-record need the whole record (drop --stream, or use --noise white)",
-        ));
+    if args.stream {
+        if files.len() > 1 {
+            return Err(CliError::usage(
+                "--stream reads one long record in blocks into an incremental QR; several records are fitted whole (each with its own set-up and zero, in one design matrix held in memory): give one --data file, or drop --stream",
+            ));
+        }
+        if args.noise.noise_record.is_some() || matches!(declared, NoiseChoice::Model(_)) {
+            return Err(CliError::usage(
+                "--stream fits by ordinary least squares in one pass; --noise models and --noise-record need the whole record (drop --stream, or use --noise white)",
+            ));
+        }
+        if args.param.is_some() {
+            return Err(CliError::usage(
+                "--stream reads the file at the machine's default kinematic parameters; drop --param, or --stream",
+            ));
+        }
     }
-    if args.stream && args.param.is_some() {
-        return Err(CliError::usage(
-            "--stream reads the file at the machine's default kinematic parameters; drop --param, or --stream",
-        ));
-    }
-    let mut inputs = vec![("--data", data_path)];
+    let params = super::pose_args::params(&m, args.param.as_deref())?;
+    let read = args.records.read_options();
+    // A progress bar while the records are read, on a terminal's standard error, unless the
+    // JSON report takes standard output.
+    let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
+    let instrument = args.instrument.load()?;
+    let through = instrument.as_ref().map(|(i, f)| (i, *f));
+    // The records' files: those of --data now; a campaign file's once it is read.
+    let file_list = match &args.campaign {
+        Some(path) => {
+            check_outputs(&[("--campaign", path.as_path())], &[], &[])?;
+            let f = solver::io::campaign::read_campaign_file(path, &m)
+                .map_err(|e| CliError::input(format!("--campaign: {e}")))?;
+            f.records.iter().map(|r| r.path.clone()).collect()
+        }
+        None => files.clone(),
+    };
+    let mut inputs: Vec<(&str, &std::path::Path)> = args
+        .campaign
+        .iter()
+        .map(|p| ("--campaign", p.as_path()))
+        .collect();
+    inputs.extend(file_list.iter().map(|p| (flag, p.as_path())));
     inputs.extend(args.noise.input());
     inputs.extend(args.instrument.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
@@ -218,63 +244,81 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     all_inputs.extend(db.as_ref().map(|(f, p)| (*f, p.as_path())));
     check_outputs(&all_inputs, &outputs, &[])?;
     let mut recorder = args.history.recorder(&inputs)?;
-    let read = args.records.read_options();
     let noise = args.noise.choice(&m, &read, &args.instrument)?;
-    let data = data_path.display().to_string();
-    // A progress bar while the file is read, on a terminal's standard error, unless the JSON
-    // report takes standard output.
-    let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
-    let (ident, refinement, streaming, notes, record) = if args.stream {
+    let opts = IdentifyOptions::new().constraint(args::constraint(args.constraint.as_deref())?);
+    let (ident, refinement, streaming, loaded) = if args.stream {
+        let data_path = files[0].as_path();
         let (bar, read) = super::progress::reading(shown, data_path, &read);
+        let opts = opts.clone().zeroed(args.zeroed);
         let fitted = identify_file(&m, &model, data_path, &opts, args.block as usize, &read);
         drop(bar);
-        let (ident, run) = fitted.map_err(|e| match e {
-            StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
-            e @ StreamingError::ReadTwice(_) => CliError::input(format!("--data: {e}")),
-            StreamingError::HMatrix(e @ HMatrixError::Times { .. }) => {
-                CliError::input(format!("--data {data}: {e}"))
-            }
-            StreamingError::Estimate(e) => estimate_error(e),
-            other => CliError::computation(format!("--data: cannot identify: {other}")),
-        })?;
+        let (ident, run) = fitted.map_err(|e| stream_error(e, data_path))?;
         let streaming = StreamingReport {
             blocks: run.blocks,
             block: args.block as usize,
             first_block: run.first_block,
         };
-        (ident, None, Some(streaming), String::new(), None)
+        let record_label = solver::io::campaign::stem_label(data_path);
+        let ident = CampaignIdentification::of_record(&m, &ident, &record_label, params.clone())
+            .map_err(estimate_error)?;
+        (ident, None, Some(streaming), None)
     } else {
-        let record = {
-            let (_bar, read) = super::progress::reading(shown, data_path, &read);
-            super::read_record("--data", &m, data_path, &read, &args.instrument, &params)?
+        let loaded = {
+            let (_bar, read) = super::progress::reading_all(shown, &file_list, &read);
+            match &args.campaign {
+                Some(path) => campaign::from_file("--campaign", &m, path, &read, through)?,
+                None => campaign::from_files(
+                    "--data",
+                    &m,
+                    &files,
+                    &params,
+                    args.zeroed,
+                    &read,
+                    through,
+                )?,
+            }
         };
-        super::check_times("--data", data_path, &m, &opts.fitted_model(&model), &record)?;
-        let note = zeroed_note(&record, args.zeroed).to_string();
-        if args.first_order {
-            let ident =
-                identify_noise(&m, &model, &record, &opts, &noise).map_err(estimate_error)?;
-            (ident, None, None, note, Some(record))
+        loaded.check_times(flag, &m, &model)?;
+        let c = &loaded.campaign;
+        let opts = IdentifyOptions::new().constraint(campaign::constraint_for(
+            &m,
+            &model,
+            c,
+            opts.constraint.clone(),
+        ));
+        // Records modelled with different values of a machine length cannot share its change:
+        // a bad input, said before any fitting.
+        let labelled: Vec<(&str, &[f64])> = c
+            .records
+            .iter()
+            .map(|r| (r.label.as_str(), r.params.as_slice()))
+            .collect();
+        solver::fitting::offsets::check_shared_symbols(&m, &model, &labelled)
+            .map_err(|e| CliError::input(format!("{flag}: {e}")))?;
+        let (ident, refinement) = if args.first_order {
+            let ident = identify_campaign(&m, &model, c, &opts, &noise).map_err(estimate_error)?;
+            (ident, None)
         } else {
-            let (ident, r) = identify_refined_noise(
-                &m,
-                &model,
-                &record,
-                &opts,
-                &RefineOptions::default(),
-                &noise,
-            )
-            .map_err(refine_error)?;
-            (ident, Some(r), None, note, Some(record))
-        }
+            let (ident, r) =
+                identify_campaign_refined(&m, &model, c, &opts, &RefineOptions::default(), &noise)
+                    .map_err(refine_error)?;
+            (ident, Some(r))
+        };
+        (ident, refinement, None, Some(loaded))
     };
-    check_values(&m, &ident, &args.bounds.values()).map_err(|e| implausible(&e))?;
-    let source = IdentificationSource {
-        data: &data,
+    campaign::check_campaign_values(&m, &ident.layout, &ident.fit.values, &args.bounds.values())
+        .map_err(|e| implausible(&e))?;
+    let data: Vec<String> = match &loaded {
+        Some(l) => l.files.clone(),
+        None => files.iter().map(|f| f.display().to_string()).collect(),
+    };
+    let source = CampaignSource {
         label: &label,
         base_model: args.model.as_deref(),
+        data: &data,
     };
-    let mut report = IdentificationReport::new(&m, source, &ident, refinement.as_ref())
-        .map_err(|e| CliError::computation(format!("--data: {e}")))?;
+    let mut report = IdentificationReport::of_campaign(&m, source, &ident, refinement.as_ref())
+        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
     report.streaming = streaming;
     if args.param.is_some() {
         report.notes.push(format!(
@@ -289,45 +333,21 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             parameters_text(&m, &params)
         ));
     }
-    text.push_str(&notes);
-    let mut files = Outputs::new();
+    if let Some(l) = &loaded {
+        text.push_str(&l.zeroed_notes(if args.campaign.is_some() {
+            "say `zeroed = true` for it in the campaign file"
+        } else {
+            "give --zeroed"
+        }));
+    }
+    let mut out = Outputs::new();
     if let Some(target) = &args.json {
         let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
-        files.add("--json", target.clone(), json);
+        out.add("--json", target.clone(), json);
     }
     if let Some(target) = &args.report {
-        let mut i = super::report::inputs_for(&m, &inputs);
-        i.add(
-            "this run of rtest identify",
-            ::report::Document::Identification(Box::new(report.clone())),
-        )
-        .map_err(|e| CliError::computation(format!("--report: {e}")))?;
-        match &record {
-            None => i.prediction_not_drawn.push(format!(
-                "{} is not drawn: a streamed record is read block by block, and its figure would read it all",
-                data_path.display()
-            )),
-            Some(record) => {
-                let json = to_json(&report)
-                    .map_err(|e| CliError::computation(format!("--report: {e}")))?;
-                let values = solver::io::report::read::parse_identification("this run", &json, &m)
-                    .map_err(|e| CliError::computation(format!("--report: {e}")))?;
-                let fitted = super::report::PathRecord {
-                    name: &data,
-                    role: "fitted",
-                    record,
-                    zeroed: args.zeroed,
-                    params: &params,
-                };
-                (i.prediction_figures, i.prediction_not_drawn) =
-                    super::report::path_figures("--report", &m, &values, &label, &[fitted])?;
-            }
-        }
-        files.add(
-            "--report",
-            target.clone(),
-            super::report::render("--report", &i)?,
-        );
+        let html = html_report(&m, &inputs, &report, &ident, loaded.as_ref(), &label)?;
+        out.add("--report", target.clone(), html);
     }
     let stdout_taken = [&args.json, &args.report]
         .iter()
@@ -335,8 +355,66 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let check = recorder
         .as_ref()
         .map(|r| ::history::Check::from_identification(&report, r.provenance()));
-    text.push_str(&history::write_and_record(files, recorder.as_mut(), check)?);
+    text.push_str(&history::write_and_record(out, recorder.as_mut(), check)?);
     print_text(&text, stdout_taken)
+}
+
+/// The HTML report (`--report`) of this identification: its records, set-ups and values, and
+/// each record's measured error against its prediction along its path (not drawn for a
+/// streamed record, whose samples were never held whole).
+fn html_report(
+    m: &model_spec::Machine,
+    inputs: &[(&str, &std::path::Path)],
+    report: &IdentificationReport,
+    ident: &CampaignIdentification,
+    loaded: Option<&campaign::Loaded>,
+    label: &str,
+) -> CliResult<String> {
+    let mut i = super::report::inputs_for(m, inputs);
+    i.add(
+        "this run of rtest identify",
+        ::report::Document::Identification(Box::new(report.clone())),
+    )
+    .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+    match loaded {
+        None => i.prediction_not_drawn.push(format!(
+            "{} is not drawn: a streamed record is read block by block, and its figure would read it all",
+            report.data.as_deref().unwrap_or("the record")
+        )),
+        Some(l) => {
+            let values = CampaignValues::of(ident);
+            let records: Vec<super::report::PathRecord<'_>> = l
+                .campaign
+                .records
+                .iter()
+                .zip(&l.files)
+                .map(|(r, f)| super::report::PathRecord {
+                    name: f,
+                    role: "fitted",
+                    record: r,
+                })
+                .collect();
+            (i.prediction_figures, i.prediction_not_drawn) =
+                super::report::path_figures("--report", m, &values, label, &records)?;
+        }
+    }
+    super::report::render("--report", &i)
+}
+
+/// A streaming error as a verb's error.
+fn stream_error(
+    e: StreamingError<solver::io::csv::CsvError>,
+    data_path: &std::path::Path,
+) -> CliError {
+    match e {
+        StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
+        e @ StreamingError::ReadTwice(_) => CliError::input(format!("--data: {e}")),
+        StreamingError::HMatrix(e @ HMatrixError::Times { .. }) => {
+            CliError::input(format!("--data {}: {e}", data_path.display()))
+        }
+        StreamingError::Estimate(e) => estimate_error(e),
+        other => CliError::computation(format!("--data: cannot identify: {other}")),
+    }
 }
 
 /// `Xw = -217.504 mm, …`: every symbol and its value.
@@ -367,104 +445,6 @@ fn refine_error(e: RefineError) -> CliError {
             "--data: the refinement against the exact machine failed: {other} (--first-order skips it)"
         )),
     }
-}
-
-/// `rtest identify` on a campaign: `--data a.csv,b.csv` or `--campaign FILE`.
-fn run_campaign(
-    args: &IdentifyArgs,
-    m: &model_spec::Machine,
-    label: &str,
-    model: &solver::model::Model,
-    files: &[PathBuf],
-) -> CliResult {
-    if args.report.is_some() {
-        return Err(CliError::usage(
-            "--report covers one record; a campaign (several --data files, --campaign) has no HTML report: drop --report",
-        ));
-    }
-    if args.stream {
-        return Err(CliError::usage(
-            "--stream reads one long record; a campaign (several --data files) is fitted whole: drop --stream",
-        ));
-    }
-    let read = args.records.read_options();
-    let instrument = args.instrument.load()?;
-    let through = instrument.as_ref().map(|(i, f)| (i, *f));
-    let loaded = match &args.campaign {
-        Some(path) => {
-            check_outputs(&[("--campaign", path.as_path())], &[], &[])?;
-            campaign::from_file("--campaign", m, path, &read, through)?
-        }
-        None => {
-            let params = super::pose_args::params(m, args.param.as_deref())?;
-            campaign::from_files("--data", m, files, &params, args.zeroed, &read, through)?
-        }
-    };
-    let flag = if args.campaign.is_some() {
-        "--campaign"
-    } else {
-        "--data"
-    };
-    let all_inputs = loaded.inputs();
-    let mut inputs: Vec<(&str, &std::path::Path)> =
-        all_inputs.iter().map(|p| (flag, p.as_path())).collect();
-    inputs.extend(args.noise.input());
-    inputs.extend(args.instrument.input());
-    inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
-    let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
-    let db = args.history.input();
-    let mut checked = inputs.clone();
-    checked.extend(db.as_ref().map(|(f, p)| (*f, p.as_path())));
-    check_outputs(&checked, &outputs, &[])?;
-    let mut recorder = args.history.recorder(&inputs)?;
-    loaded.check_times(flag, m, model)?;
-    let noise = args.noise.choice(m, &read, &args.instrument)?;
-    let opts = IdentifyOptions::new().constraint(args::constraint(args.constraint.as_deref())?);
-    let c = &loaded.campaign;
-    // Records modelled with different values of a machine length cannot share its change: a
-    // bad input, said before any fitting.
-    let labelled: Vec<(&str, &[f64])> = c
-        .records
-        .iter()
-        .map(|r| (r.label.as_str(), r.params.as_slice()))
-        .collect();
-    solver::fitting::offsets::check_shared_symbols(m, model, &labelled)
-        .map_err(|e| CliError::input(format!("{flag}: {e}")))?;
-    let (ident, refinement) = if args.first_order {
-        let ident = identify_campaign(m, model, c, &opts, &noise).map_err(estimate_error)?;
-        (ident, None)
-    } else {
-        let (ident, r) =
-            identify_campaign_refined(m, model, c, &opts, &RefineOptions::default(), &noise)
-                .map_err(refine_error)?;
-        (ident, Some(r))
-    };
-    campaign::check_campaign_values(m, &ident.layout, &ident.fit.values, &args.bounds.values())
-        .map_err(|e| implausible(&e))?;
-    let source = CampaignSource {
-        label,
-        base_model: args.model.as_deref(),
-        data: &loaded.files,
-    };
-    let report = CampaignReport::new(m, source, &ident, refinement.as_ref())
-        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
-    let mut text = campaign_identification(&report);
-    text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {
-        "say `zeroed = true` for it in the campaign file"
-    } else {
-        "give --zeroed"
-    }));
-    let mut out = Outputs::new();
-    if let Some(target) = &args.json {
-        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
-        out.add("--json", target.clone(), json);
-    }
-    let stdout_taken = matches!(args.json, Some(Target::Stdout));
-    let check = recorder
-        .as_ref()
-        .map(|r| ::history::Check::from_campaign(&report, r.provenance()));
-    text.push_str(&history::write_and_record(out, recorder.as_mut(), check)?);
-    print_text(&text, stdout_taken)
 }
 
 /// An estimation error as a verb's error: an unknown constraint name is a usage error, too few

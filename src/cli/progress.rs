@@ -1,5 +1,6 @@
-//! Progress bars on standard error for the long work of a verb: reading a measurement file, the
-//! suggestion of `rtest plan`, a diagnosis. The library reports progress
+//! Progress bars on standard error for the long work of a verb: reading a measurement file or
+//! the records of a campaign, validating a campaign's records, the suggestion of `rtest plan`,
+//! a diagnosis. The library reports progress
 //! (`solver::io::progress`); this module alone draws.
 //!
 //! A bar is drawn only when standard error is a terminal, never when standard output carries
@@ -107,6 +108,39 @@ impl Bar {
     }
 }
 
+impl Bar {
+    /// The hook for CSV readers of `paths`, read whole one after the other (the records of a
+    /// campaign): the bar follows the bytes read of all of them together (`None` without a
+    /// bar, or when a size is unknown). A reader's count falling back marks the next file.
+    pub fn read_all_hook(&self, paths: &[std::path::PathBuf]) -> Option<ReadProgress> {
+        let s = self.shared.clone()?;
+        let mut sizes = Vec::with_capacity(paths.len());
+        for p in paths {
+            sizes.push(std::fs::metadata(p).ok().filter(|f| f.is_file())?.len());
+        }
+        let total: u64 = sizes.iter().sum();
+        let what = match paths.len() {
+            1 => format!("reading {}", paths[0].display()),
+            n => format!("reading {n} records"),
+        };
+        // (bytes of the files done, bytes read of the current one)
+        let state = Arc::new(std::sync::Mutex::new((0u64, 0u64)));
+        Some(ReadProgress::new(move |read| {
+            let done = {
+                let Ok(mut st) = state.lock() else {
+                    return;
+                };
+                if read < st.1 {
+                    st.0 += st.1;
+                }
+                st.1 = read;
+                st.0 + read
+            };
+            s.set(&what, done, total);
+        }))
+    }
+}
+
 impl Progress for Bar {
     fn update(&self, what: &str, done: u64, total: u64) {
         if let Some(s) = &self.shared {
@@ -134,4 +168,22 @@ pub fn reading(
     let mut read = read.clone();
     read.progress = bar.read_hook(path);
     (bar, read)
+}
+
+/// A bar for reading the records `paths` one after the other and the read options that move it
+/// (a copy of `read`): keep the bar while they are read, and drop it after.
+pub fn reading_all(
+    wanted: bool,
+    paths: &[std::path::PathBuf],
+    read: &solver::io::csv::ReadOptions,
+) -> (Bar, solver::io::csv::ReadOptions) {
+    let bar = Bar::new(wanted, true);
+    let mut read = read.clone();
+    read.progress = bar.read_all_hook(paths);
+    (bar, read)
+}
+
+/// A bar counting `what` (records validated), drawn as the others.
+pub fn counting(wanted: bool) -> Bar {
+    Bar::new(wanted, false)
 }

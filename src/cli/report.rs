@@ -23,13 +23,19 @@ content. At most one identification, one diagnosis and one compensation; any num
 validations (each of another record). They must belong to one check: one machine (and the \
 machine of --machine, fingerprint included), the identification's model in every validation \
 and compensation, and for a diagnosis the identification's fitted record and its base or \
-extended model. Campaign reports (\"kind\": \"campaign\") are not covered. The records and \
-files the reports name are hashed when they can be read from the working directory.
+extended model. An identification or validation may be of one record or of a campaign of \
+several: the report then lists the records with their ball positions (kinematic parameters that \
+differ from the machine's defaults) and set-ups, the shared values (the machine's errors), the \
+values of each set-up and record, and for each validated record its set-up (fitted, or new and \
+refitted on the record). The records and files the reports name are hashed when they can be \
+read from the working directory.
 
-The measured error against the identified model's prediction along each path (the \
-identification's record and every validation's, against the axis that moves most) is drawn \
-from the records the reports name, read from the working directory, with the identification's \
-values on the exact virtual machine; a record that cannot be read is named with why. The \
+The measured error against the identified model's prediction along each path (every record of \
+the identification and of the validations, against the axis that moves most) is drawn from the \
+records the reports name, read from the working directory at their kinematic parameters, with \
+the identification's values on the exact virtual machine (a validated record on a new set-up \
+with its set-up errors refitted, as rtest validate did); a record that cannot be read is named \
+with why. The \
 machine is --machine, or the built-in the reports name. The diagnosis's base and extended \
 predictions along the paths are drawn by `rtest diagnose --report FILE`. `identify`, \
 `diagnose` and `compensate` take --report FILE to write this report from what they just \
@@ -121,9 +127,11 @@ pub fn run(args: &ReportArgs) -> CliResult {
     print_text(&text, stdout_taken)
 }
 
-/// The identified model's prediction along the path of the identification's record and of
-/// every validation's, when the machine is known (`--machine`, or the built-in the reports
-/// name) and the records can be read from here; otherwise one line says why not.
+/// The identified model's prediction along the path of every record of the identification and
+/// of every validation, when the machine is known (`--machine`, or the built-in the reports
+/// name) and the records can be read from here; otherwise one line says why not. A validated
+/// record on a set-up the identification did not fit has its set-up errors refitted on it, as
+/// `rtest validate` did.
 fn draw_paths(
     inputs: &mut Inputs,
     machine: Option<model_spec::Machine>,
@@ -151,9 +159,8 @@ fn draw_paths(
         .iter()
         .find(|p| p.display().to_string() == *id_file)
         .map_or_else(|| PathBuf::from(id_file), PathBuf::clone);
-    let values = match solver::io::report::read_values(&id_path, &m) {
-        Ok(solver::io::report::ReadValues::Single { values, .. }) => values,
-        Ok(_) => return Ok(()),
+    let values = match solver::io::report::read_identification(&id_path, &m) {
+        Ok(v) => v.values,
         Err(e) => {
             inputs
                 .prediction_not_drawn
@@ -161,27 +168,78 @@ fn draw_paths(
             return Ok(());
         }
     };
-    // The records the reports name, read here at the machine's default parameters; one that
-    // cannot be read, or predicted, is named with why.
-    let params = m.default_parameters();
-    let mut named = vec![(id.data.as_str(), "fitted", id.zeroed)];
-    named.extend(
-        inputs
-            .validations
-            .iter()
-            .map(|(_, v)| (v.data.as_str(), "validation", v.zeroed)),
-    );
+    // The records the reports name, read here at their kinematic parameters, each on its
+    // set-up; one that cannot be read, or predicted, is named with why.
+    let mut named: Vec<(String, &'static str, CampaignRecordSpec)> = Vec::new();
+    for (r, data) in values
+        .layout
+        .records
+        .iter()
+        .zip(id.records.iter().map(|x| &x.data))
+    {
+        named.push((
+            data.clone(),
+            "fitted",
+            CampaignRecordSpec {
+                label: r.label.clone(),
+                setup: values.layout.setups[r.setup].clone(),
+                params: r.params.clone(),
+                zeroed: r.zeroed,
+                start_s: r.start_s,
+            },
+        ));
+    }
+    let sole_setup = match values.layout.setups.as_slice() {
+        [s] => Some(s.clone()),
+        _ => None,
+    };
+    for (_, v) in &inputs.validations {
+        for x in &v.records {
+            let mut params = m.default_parameters();
+            for (k, value) in &x.params.0 {
+                if let Some(s) = m.symbol_by_name(k) {
+                    params[s] = *value;
+                }
+            }
+            let setup = if x.setup.is_empty() {
+                sole_setup.clone().unwrap_or_else(|| x.label.clone())
+            } else {
+                x.setup.clone()
+            };
+            named.push((
+                x.data.clone(),
+                "validation",
+                CampaignRecordSpec {
+                    label: x.label.clone(),
+                    setup,
+                    params,
+                    zeroed: x.zeroed,
+                    start_s: None,
+                },
+            ));
+        }
+    }
     let mut read = Vec::new();
     let mut not_drawn = Vec::new();
-    for (name, role, zeroed) in named {
+    for (name, role, spec) in named {
         match solver::io::campaign::read_record_at(
-            Path::new(name),
+            Path::new(&name),
             &m,
-            &params,
+            &spec.params,
             &solver::io::csv::ReadOptions::default(),
             None,
         ) {
-            Ok(record) => read.push((name, role, zeroed, record)),
+            Ok(record) => {
+                let mut r = solver::fitting::campaign::CampaignRecord::new(
+                    spec.label,
+                    record,
+                    spec.params,
+                    spec.setup,
+                    spec.zeroed,
+                );
+                r.start_s = spec.start_s;
+                read.push((name, role, r));
+            }
             Err(e) => not_drawn.push(format!(
                 "{name} is not drawn: it could not be read here ({e})"
             )),
@@ -189,19 +247,23 @@ fn draw_paths(
     }
     let records: Vec<PathRecord<'_>> = read
         .iter()
-        .map(|(name, role, zeroed, record)| PathRecord {
-            name,
-            role,
-            record,
-            zeroed: *zeroed,
-            params: &params,
-        })
+        .map(|(name, role, record)| PathRecord { name, role, record })
         .collect();
     let (figures, unpredicted) = path_figures("-o", &m, &values, &id.model, &records)?;
     not_drawn.extend(unpredicted);
     inputs.prediction_figures = figures;
     inputs.prediction_not_drawn = not_drawn;
     Ok(())
+}
+
+/// What a record of the reports is, besides its samples: its label, set-up, kinematic
+/// parameters (mm), zeroing and start on the campaign clock.
+struct CampaignRecordSpec {
+    label: String,
+    setup: String,
+    params: Vec<f64>,
+    zeroed: bool,
+    start_s: Option<f64>,
 }
 
 /// The files of a report given to `rtest report`: the JSON reports, the machine file, and
@@ -218,10 +280,14 @@ fn named_files(inputs: &Inputs, reports: &[PathBuf], machine: Option<&Path>) -> 
         }
     };
     if let Some((_, r)) = &inputs.identification {
-        named("identification: fitted record", &r.data);
+        for x in &r.records {
+            named("identification: fitted record", &x.data);
+        }
     }
     for (_, v) in &inputs.validations {
-        named("validation: record", &v.data);
+        for x in &v.records {
+            named("validation: record", &x.data);
+        }
         named("validation: values", &v.params);
     }
     if let Some((_, d)) = &inputs.diagnosis {
@@ -244,39 +310,43 @@ pub struct PathRecord<'a> {
     pub name: &'a str,
     /// Its role in the check (`fitted`, `validation`).
     pub role: &'static str,
-    /// The record, read as the identification read it.
-    pub record: &'a solver::record::Record,
-    /// Whether the prediction is zeroed at the first sample (as the validation was).
-    pub zeroed: bool,
-    /// The kinematic parameters it was read and identified with (mm, symbol order).
-    pub params: &'a [f64],
+    /// The record with its label, set-up, kinematic parameters and zeroing, read as the
+    /// identification (or the validation) read it.
+    pub record: &'a solver::fitting::campaign::CampaignRecord,
 }
 
 /// Measured against predicted error along the path of each record, the prediction that of
-/// the exact virtual machine at the identified `values` (model labelled `label`), drawn
-/// against the axis that moves most. A record that cannot be predicted is not drawn: the
-/// second list says which and why, for the report.
+/// the exact virtual machine at the identified `values` (model labelled `label`), each record
+/// on its set-up (a set-up the identification did not fit refitted on the record, as `rtest
+/// validate` does), drawn against the axis that moves most. A record that cannot be predicted
+/// is not drawn: the second list says which and why, for the report.
 ///
 /// # Errors
 /// A figure that cannot be drawn (exit code 3).
 pub fn path_figures(
     flag: &str,
     m: &model_spec::Machine,
-    values: &solver::io::report::IdentifiedValues,
+    values: &solver::fitting::campaign::CampaignValues,
     label: &str,
     records: &[PathRecord<'_>],
 ) -> CliResult<(Vec<report::Figure>, Vec<String>)> {
     use solver::diagnosis::figures::{Figures, validation_figure};
-    use solver::fitting::{ValidateOptions, validate};
+    use solver::fitting::ValidateOptions;
+    use solver::fitting::campaign::validate_record;
     let mut figures = Figures::default();
     let mut not_drawn = Vec::new();
     let mut taken = Vec::new();
+    let opts = ValidateOptions::new().exact(true);
     for r in records {
-        let mut opts = ValidateOptions::new().zeroed(r.zeroed).exact(true);
-        opts.params = Some(r.params.to_vec());
-        match validate(m, &values.model, &values.values, r.record, &opts) {
+        match validate_record(m, values, r.record, &opts) {
             Ok(v) => figures.paths.push(validation_figure(
-                m, r.name, r.role, r.record, &v, label, &mut taken,
+                m,
+                r.name,
+                r.role,
+                &r.record.record,
+                &v.validation,
+                label,
+                &mut taken,
             )),
             Err(e) => not_drawn.push(format!("{} is not drawn: {e}", r.name)),
         }

@@ -5,50 +5,55 @@ use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
-use solver::fitting::campaign::validate_campaign;
-use solver::fitting::hmatrix::parameter_names;
-use solver::fitting::sanity::check_model_values;
+use solver::fitting::campaign::validate::validate_campaign_with_progress;
 use solver::fitting::validate::Unidentified;
-use solver::fitting::{ValidateError, ValidateOptions, validate};
-use solver::io::report::{
-    CampaignValidationReport, CampaignValidationSource, ReadValues, ValidationReport,
-    ValidationSource, to_json,
-};
-use solver::io::text::campaign::campaign_validation;
-use solver::io::text::validate::{validation, zeroed_note};
+use solver::fitting::{ValidateError, ValidateOptions};
+use solver::io::report::{ValidationReport, ValidationSource, read_identification, to_json};
+use solver::io::text::validate::validation;
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
-Checks identified values on another measurement: the model and values of an `rtest identify` \
-JSON (--params) predict the readings of a measurement CSV (--data: axes in mm and degrees, \
-dx_um,dy_um,dz_um in µm), and the residual (measured minus predicted) is reported per direction \
-x, y, z of the tool frame and overall: RMS and maximum in µm, before (the nominal machine: \
-prediction 0) and after (the identified model). Overall RMS = sqrt(Σ r² / 3N).
+Checks identified values on other measurements: the model and values of an `rtest identify` \
+JSON (--params: one record or a campaign of several) predict the readings of measurement CSVs \
+(--data FILE[,FILE...]: axes in mm and degrees, dx_um,dy_um,dz_um in µm; or the records of \
+--campaign FILE), each record on its set-up, and the residual (measured minus predicted) is \
+reported per record, per direction x, y, z of the tool frame and overall: RMS and maximum in µm, \
+before (the nominal machine: prediction 0) and after (the identified model). Overall RMS = \
+sqrt(Σ r² / 3N).
 
 The values must belong to the machine: the JSON's machine name and fingerprint (topology and \
 machine-side kinematic defaults) must be this machine's, its base model must exist, every \
 parameter must be there, and every value within --max-error-um / --max-error-urad.
 
-The prediction is the exact virtual machine at the identified values (no linearisation); with \
---first-order it is the first-order model H·v (the difference is the second-order terms, about \
-1e-3 µm for errors of tens of µm and µrad). With --zeroed (readings zeroed at the first sample) \
-the prediction is zeroed at the first sample too, so constant effects cancel.
+The prediction is the exact virtual machine at the identified values, at each record's \
+kinematic parameters (no linearisation); with --first-order it is the first-order model H·v \
+(the difference is the second-order terms, about 1e-3 µm for errors of tens of µm and µrad).
+
+Set-ups (docs/campaigns.md): shared values (the machine's errors) come from the identification. \
+A record on a set-up the identification fitted uses that set-up's values XOW YOW ZOW; a record \
+on a new set-up has them refitted on it with everything else held, and the report says which \
+parameters were refitted and their values. Without --setup, the --data records are on the \
+identification's set-up when it fitted one set-up at their kinematic parameters (one ball \
+mounting measured along other paths: the usual check of one record on another), else each on a \
+new set-up named by its file's stem; --setup LABEL puts every --data record on set-up LABEL (a \
+fitted one, or a new one). With --zeroed (readings zeroed at the first sample) each record's \
+zero dx0 dy0 dz0 joins its model and is refitted on it, unless it is the fitted record itself. \
+--instrument reads sensor readings, and a refit weights the samples by their covariances.
 
 Parameters the identification could not determine (value null) are set to 0 and named; \
 --refuse-undetermined makes that an error instead.
 
-Campaigns (docs/campaigns.md): --params may be a campaign identification, and --data a comma list \
-or --campaign FILE a campaign of records to predict. Shared values come from the \
-identification; a record on a fitted set-up (the same set-up label; --setup LABEL puts every \
---data record on one) uses that set-up's values; a record on a new set-up has its set-up errors \
-XOW YOW ZOW (and its zero, when zeroed) refitted on it with everything else held, and the \
-report says which parameters were refitted. A single identification is a campaign of one \
-record labelled by the stem of its data file.
+--json writes (docs/campaigns.md) version 2: {version, machine, model, params, data, samples, \
+prediction, measured_rms_um, residual_rms_um, measured_max_um, residual_max_um, per_direction: \
+{x, y, z: {measured_rms_um, measured_max_um, residual_rms_um, residual_max_um}}, zeroed, \
+unidentified_set_to_zero, records: [{label, data, setup, setup_fitted, record_fitted, zeroed, \
+params, samples, refitted: [{name, value, std, unit}], measured_rms_um, …, per_direction, \
+unidentified_set_to_zero}]}; several records: \"kind\": \"campaign\", without data and zeroed. \
+`--json -` writes it to standard output.
 
---json writes {machine, model, params, data, samples, prediction, measured_rms_um, \
-residual_rms_um, measured_max_um, residual_max_um, per_direction: {x, y, z: {measured_rms_um, \
-measured_max_um, residual_rms_um, residual_max_um}}, zeroed, unidentified_set_to_zero} \
-(docs/identification.md); `--json -` writes it to standard output.";
+Progress: on a terminal, bars on standard error follow the reading and the validation of the \
+records once they have run half a second (RTEST_PROGRESS_DELAY_MS), cleared when they end; never \
+on a pipe or a file, nor with `--json -`.";
 
 /// Flags of `rtest validate`.
 #[derive(Debug, clap::Args)]
@@ -61,7 +66,8 @@ pub struct ValidateArgs {
     /// Built-in machine (see `rtest machines`) or path of a machine TOML file.
     #[arg(long, value_name = "NAME|FILE")]
     machine: String,
-    /// The JSON written by `rtest identify --json` (values in µm and µrad).
+    /// The JSON written by `rtest identify --json`, of one record or a campaign (values in µm
+    /// and µrad).
     #[arg(long, value_name = "FILE")]
     params: PathBuf,
     /// The measurement CSV to predict (axes in mm and degrees, dx_um,dy_um,dz_um in µm), or a
@@ -78,7 +84,8 @@ pub struct ValidateArgs {
     #[arg(long, value_name = "FILE", conflicts_with_all = ["data", "zeroed", "param", "setup"])]
     campaign: Option<PathBuf>,
     /// The set-up label of every --data record: a set-up of the identification (its set-up
-    /// errors are used) or a new one (refitted on each record). Default: each record its own
+    /// errors are used) or a new one (refitted on each record). Default: the identification's
+    /// set-up when it fitted one at the records' kinematic parameters, else each record its own
     /// set-up, named by its file's stem.
     #[arg(long, value_name = "LABEL")]
     setup: Option<String>,
@@ -86,8 +93,8 @@ pub struct ValidateArgs {
     /// overriding the machine's defaults.
     #[arg(long, value_name = "NAME=VALUE,...")]
     param: Option<String>,
-    /// The readings of --data were zeroed at the first sample: zero the prediction there too
-    /// (one record and a single identification), or refit each record's zero (a campaign).
+    /// The readings of --data were zeroed at the first sample: each record's zero dx0 dy0 dz0
+    /// is refitted on it (the fitted record's own is used).
     #[arg(long)]
     zeroed: bool,
     /// Predict with the first-order model H·v instead of the exact machine.
@@ -107,12 +114,18 @@ pub struct ValidateArgs {
     bounds: ValueBounds,
 }
 
-/// Runs `rtest validate`.
+/// Runs `rtest validate`: the identification's values (of one record or several) predict
+/// the records of `--data` or `--campaign`, each on its set-up.
 pub fn run(args: &ValidateArgs) -> CliResult {
     let m = super::load_machine(&args.machine)?;
     let files = match &args.data {
         Some(list) => args::files("--data", list)?,
         None => Vec::new(),
+    };
+    let flag = if args.campaign.is_some() {
+        "--campaign"
+    } else {
+        "--data"
     };
     let mut inputs = vec![("--params", args.params.as_path())];
     inputs.extend(files.iter().map(|f| ("--data", f.as_path())));
@@ -121,80 +134,108 @@ pub fn run(args: &ValidateArgs) -> CliResult {
     inputs.extend(args.instrument.input());
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
-    let read_values = solver::io::report::read_values(&args.params, &m)
+    let id = read_identification(&args.params, &m)
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
-    let single_case =
-        files.len() == 1 && args.campaign.is_none() && args.setup.is_none() && args.param.is_none();
-    match read_values {
-        ReadValues::Single { values, .. } if single_case => run_single(args, &m, &files[0], values),
-        values => run_campaign(args, &m, &files, &values),
+    let values = &id.values;
+    campaign::check_campaign_values(&m, &values.layout, &values.values, &args.bounds.values())
+        .map_err(|e| implausible(args, &e))?;
+    let read = args.records.read_options();
+    let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
+    let instrument = args.instrument.load()?;
+    let through = instrument.as_ref().map(|(i, f)| (i, *f));
+    let file_list = match &args.campaign {
+        Some(path) => solver::io::campaign::read_campaign_file(path, &m)
+            .map_err(|e| CliError::input(format!("--campaign: {e}")))?
+            .records
+            .iter()
+            .map(|r| r.path.clone())
+            .collect(),
+        None => files.clone(),
+    };
+    let mut loaded = {
+        let (_bar, read) = super::progress::reading_all(shown, &file_list, &read);
+        match &args.campaign {
+            Some(path) => campaign::from_file("--campaign", &m, path, &read, through)?,
+            None => {
+                let params = super::pose_args::params(&m, args.param.as_deref())?;
+                campaign::from_files("--data", &m, &files, &params, args.zeroed, &read, through)?
+            }
+        }
+    };
+    if args.campaign.is_none() {
+        let setup = match &args.setup {
+            Some(setup) => {
+                solver::fitting::campaign::check_label("--setup", setup)
+                    .map_err(|e| CliError::usage(e.to_string()))?;
+                Some(setup.clone())
+            }
+            None => fitted_setup(values, &loaded.campaign),
+        };
+        if let Some(setup) = setup {
+            for r in &mut loaded.campaign.records {
+                r.setup = setup.clone();
+            }
+        }
     }
-}
-
-/// One record predicted by a single identification: the prediction as it always was.
-fn run_single(
-    args: &ValidateArgs,
-    m: &model_spec::Machine,
-    data_path: &std::path::Path,
-    params: solver::io::report::IdentifiedValues,
-) -> CliResult {
-    let names = parameter_names(m, &params.model);
-    check_model_values(
-        m,
-        &params.model,
-        &names,
-        &params.values,
-        &args.bounds.values(),
-    )
-    .map_err(|e| implausible(args, &e))?;
-    let record = super::read_record(
-        "--data",
-        m,
-        data_path,
-        &args.records.read_options(),
-        &args.instrument,
-        &m.default_parameters(),
-    )?;
-    super::check_times("--data", data_path, m, &params.model, &record)?;
+    loaded.check_times(flag, &m, &values.model)?;
     let mut opts = ValidateOptions::default();
-    opts.zeroed = args.zeroed;
     opts.exact = !args.first_order;
     if args.refuse_undetermined {
         opts.unidentified = Unidentified::Refuse;
     }
-    let v = validate(m, &params.model, &params.values, &record, &opts)
-        .map_err(|e| validate_error(args, e, false))?;
-    let (params_file, data) = (
-        args.params.display().to_string(),
-        data_path.display().to_string(),
-    );
+    let v = {
+        let bar = super::progress::counting(shown);
+        validate_campaign_with_progress(&m, values, &loaded.campaign, &opts, &bar)
+            .map_err(|e| validate_error(args, e))?
+    };
+    let params_file = args.params.display().to_string();
+    let kinematics: Vec<Vec<f64>> = loaded
+        .campaign
+        .records
+        .iter()
+        .map(|r| r.params.clone())
+        .collect();
     let source = ValidationSource {
-        machine: &m.name,
-        model: &params.model_name,
+        model: &id.model_name,
         params: &params_file,
-        data: &data,
+        data: &loaded.files,
+        kinematics: &kinematics,
         exact: !args.first_order,
     };
-    let report = ValidationReport::new(source, &v)
-        .map_err(|e| CliError::computation(format!("--data: {e}")))?;
+    let report = ValidationReport::new(&m, source, &v)
+        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
     let mut text = validation(&report);
-    text.push_str(zeroed_note(&record, args.zeroed));
-    finish(args, text, to_json(&report))
-}
-
-/// Writes `json` (the report's JSON, when asked) and prints `text`.
-fn finish(
-    args: &ValidateArgs,
-    mut text: String,
-    json: Result<String, serde_json::Error>,
-) -> CliResult {
+    text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {
+        "say `zeroed = true` for it in the campaign file"
+    } else {
+        "give --zeroed"
+    }));
     let mut files = Outputs::new();
     if let Some(target) = &args.json {
-        let json = json.map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
         files.add("--json", target.clone(), json);
     }
     text.push_str(&wrote(&write(files)?));
     print_text(&text, matches!(args.json, Some(Target::Stdout)))
+}
+
+/// The set-up of `--data` records without `--setup`: the identification's, when it fitted one
+/// set-up whose kinematic parameters are every record's (one ball mounting, measured along
+/// other paths: the usual check of one record on another); `None` (each record on a new set-up
+/// of its own, refitted) otherwise.
+fn fitted_setup(
+    values: &solver::fitting::campaign::CampaignValues,
+    c: &solver::fitting::campaign::Campaign,
+) -> Option<String> {
+    let layout = &values.layout;
+    let [setup] = layout.setups.as_slice() else {
+        return None;
+    };
+    let params = &layout.records.first()?.params;
+    c.records
+        .iter()
+        .all(|r| r.params == *params)
+        .then(|| setup.clone())
 }
 
 /// Values that cannot be a machine's, as a verb's error.
@@ -205,78 +246,16 @@ fn implausible(args: &ValidateArgs, e: &solver::fitting::Implausible) -> CliErro
     ))
 }
 
-/// A validation error as a verb's error; `campaign`: a record that does not fit the
-/// identification's campaign (its set-up, its start) is a bad input.
-fn validate_error(args: &ValidateArgs, e: ValidateError, campaign: bool) -> CliError {
+/// A validation error as a verb's error: a record that does not fit the identification (its
+/// set-up, its start) is a bad input.
+fn validate_error(args: &ValidateArgs, e: ValidateError) -> CliError {
     match e {
         ValidateError::Unidentified(names) => CliError::input(format!(
             "--params: {} gave no value for {} (not determined by the identification) and --refuse-undetermined is set (without it they are set to 0)",
             args.params.display(),
             names.join(", ")
         )),
-        ValidateError::Shape(why) if campaign => {
-            CliError::input(format!("--data: cannot validate: {why}"))
-        }
+        ValidateError::Shape(why) => CliError::input(format!("--data: cannot validate: {why}")),
         other => CliError::computation(format!("--data: cannot validate: {other}")),
     }
-}
-
-/// Records predicted with a campaign's values (or a single identification seen as a campaign
-/// of one record), each on its set-up.
-fn run_campaign(
-    args: &ValidateArgs,
-    m: &model_spec::Machine,
-    files: &[PathBuf],
-    read_values: &ReadValues,
-) -> CliResult {
-    campaign::refuse_instrument(&args.instrument)?;
-    let (values, model_name) = read_values
-        .as_campaign(m)
-        .map_err(|e| CliError::input(format!("--params: {e}")))?;
-    campaign::check_campaign_values(m, &values.layout, &values.values, &args.bounds.values())
-        .map_err(|e| implausible(args, &e))?;
-    let read = args.records.read_options();
-    let mut loaded = match &args.campaign {
-        Some(path) => campaign::from_file("--campaign", m, path, &read, None)?,
-        None => {
-            let params = super::pose_args::params(m, args.param.as_deref())?;
-            campaign::from_files("--data", m, files, &params, args.zeroed, &read, None)?
-        }
-    };
-    if let Some(setup) = &args.setup {
-        solver::fitting::campaign::check_label("--setup", setup)
-            .map_err(|e| CliError::usage(e.to_string()))?;
-        for r in &mut loaded.campaign.records {
-            r.setup = setup.clone();
-        }
-    }
-    let flag = if args.campaign.is_some() {
-        "--campaign"
-    } else {
-        "--data"
-    };
-    loaded.check_times(flag, m, &values.model)?;
-    let mut opts = ValidateOptions::default();
-    opts.exact = !args.first_order;
-    if args.refuse_undetermined {
-        opts.unidentified = Unidentified::Refuse;
-    }
-    let v = validate_campaign(m, &values, &loaded.campaign, &opts)
-        .map_err(|e| validate_error(args, e, true))?;
-    let params_file = args.params.display().to_string();
-    let source = CampaignValidationSource {
-        model: &model_name,
-        params: &params_file,
-        data: &loaded.files,
-        exact: !args.first_order,
-    };
-    let report = CampaignValidationReport::new(m, source, &v)
-        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
-    let mut text = campaign_validation(&report);
-    text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {
-        "say `zeroed = true` for it in the campaign file"
-    } else {
-        "give --zeroed"
-    }));
-    finish(args, text, to_json(&report))
 }

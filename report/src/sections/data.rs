@@ -1,5 +1,5 @@
-//! Section 2: the data: every record the reports name with its samples, and every input file
-//! with its size and SHA-256.
+//! Section 2: the data: every record the reports name with its samples (a campaign's each with
+//! its label and set-up), and every input file with its size and SHA-256.
 
 use crate::html::{Body, Cell};
 use crate::inputs::Inputs;
@@ -18,32 +18,48 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
         ]);
     };
     if let Some((_, r)) = &inputs.identification {
-        row(
-            "identification: fitted",
-            &r.data,
-            r.samples.to_string(),
-            format!(
-                "{} readings{}",
-                r.readings,
-                if r.zeroed {
-                    ", zeroed at the first sample"
-                } else {
-                    ""
-                }
-            ),
-        );
+        for x in &r.records {
+            row(
+                "identification: fitted",
+                &x.data,
+                x.samples.to_string(),
+                format!(
+                    "{} readings{}{}",
+                    3 * x.samples,
+                    if x.zeroed {
+                        ", zeroed at the first sample"
+                    } else {
+                        ""
+                    },
+                    if r.is_campaign() {
+                        format!("; record {}, set-up {}", x.label, x.setup)
+                    } else {
+                        String::new()
+                    }
+                ),
+            );
+        }
     }
     for (_, v) in &inputs.validations {
-        row(
-            "validation",
-            &v.data,
-            v.samples.to_string(),
-            if v.zeroed {
-                "zeroed at the first sample".into()
-            } else {
-                String::new()
-            },
-        );
+        for x in &v.records {
+            let mut note = Vec::new();
+            if x.zeroed {
+                note.push("zeroed at the first sample".to_string());
+            }
+            if !x.setup.is_empty() {
+                note.push(format!(
+                    "set-up {}{}",
+                    x.setup,
+                    if x.setup_fitted { "" } else { " (new)" }
+                ));
+            }
+            row(
+                "validation",
+                &x.data,
+                x.samples.to_string(),
+                note.join("; "),
+            );
+        }
     }
     if let Some((_, d)) = &inputs.diagnosis {
         row(

@@ -43,6 +43,16 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
     }
     if let Some((_, r)) = &inputs.identification {
         facts.push(("Identified model", r.model.clone()));
+        if r.is_campaign() {
+            facts.push((
+                "Campaign",
+                format!(
+                    "{} records on {} set-ups: the machine's errors shared, each set-up its ball set-up errors, each record its R-test zero",
+                    r.records.len(),
+                    r.setups.len()
+                ),
+            ));
+        }
         if let Some(base) = &r.base_model {
             facts.push(("Base model", base.clone()));
         }

@@ -1,8 +1,10 @@
-//! Section 4: the validations: residual RMS and maximum per direction, on the nominal machine
-//! and with the identified model, µm, and their figure; the measured error against the
-//! identified model's prediction along each path.
+//! Section 4: the validations: residual RMS and maximum per direction of every validated record,
+//! on the nominal machine and with the identified model, µm, and their figure; for each record
+//! its set-up (fitted, or new: its set-up errors refitted on it, the machine's values held) and
+//! what was refitted; the measured error against the identified model's prediction along each
+//! path.
 
-use super::num;
+use super::{num, unit, value_std};
 use crate::html::{Body, Cell};
 use crate::inputs::{Figure, Inputs};
 
@@ -23,15 +25,17 @@ pub fn write(
     }
     let mut rows: Vec<Vec<Cell>> = Vec::new();
     for (_, v) in &inputs.validations {
-        for (dir, d) in v.rows() {
-            rows.push(vec![
-                Cell::text(v.data.clone()),
-                Cell::text(dir),
-                Cell::number(num(d.measured_rms_um, 3)),
-                Cell::number(num(d.measured_max_um, 3)),
-                Cell::number(num(d.residual_rms_um, 3)),
-                Cell::number(num(d.residual_max_um, 3)),
-            ]);
+        for x in &v.records {
+            for (dir, d) in x.rows() {
+                rows.push(vec![
+                    Cell::text(x.data.clone()),
+                    Cell::text(dir),
+                    Cell::number(num(d.measured_rms_um, 3)),
+                    Cell::number(num(d.measured_max_um, 3)),
+                    Cell::number(num(d.residual_rms_um, 3)),
+                    Cell::number(num(d.residual_max_um, 3)),
+                ]);
+            }
         }
     }
     b.table(
@@ -48,32 +52,35 @@ pub fn write(
     );
     let mut notes = Vec::new();
     for (file, v) in &inputs.validations {
-        let mut s = format!(
-            "{}: {} samples, predicted by {}{} (values of {}, report {})",
-            v.data,
-            v.samples,
-            if v.prediction == "exact" {
-                "the exact virtual machine at the identified values"
-            } else {
-                "the first-order model H·v"
-            },
-            if v.zeroed {
-                ", zeroed at the first sample"
-            } else {
-                ""
-            },
-            v.params,
-            file
-        );
-        if !v.unidentified_set_to_zero.is_empty() {
-            s.push_str(&format!(
-                "; not determined by the identification and set to 0: {}",
-                v.unidentified_set_to_zero.join(", ")
-            ));
+        for x in &v.records {
+            let mut s = format!(
+                "{}: {} samples, predicted by {}{} (values of {}, report {})",
+                x.data,
+                x.samples,
+                if v.prediction == "exact" {
+                    "the exact virtual machine at the identified values"
+                } else {
+                    "the first-order model H·v"
+                },
+                if x.zeroed {
+                    ", zeroed at the first sample"
+                } else {
+                    ""
+                },
+                v.params,
+                file
+            );
+            if !x.unidentified_set_to_zero.is_empty() {
+                s.push_str(&format!(
+                    "; not determined by the identification and set to 0: {}",
+                    x.unidentified_set_to_zero.join(", ")
+                ));
+            }
+            notes.push(s);
         }
-        notes.push(s);
     }
     b.list(&notes);
+    setups(b, inputs);
     if let Some(f) = figure {
         crate::place_figure(b, f)?;
     }
@@ -96,4 +103,60 @@ fn paths(b: &mut Body, inputs: &Inputs) -> Result<(), crate::RenderError> {
         crate::place_figure(b, f)?;
     }
     Ok(())
+}
+
+/// Each validated record's set-up: one the identification fitted (its values used), or a new
+/// one whose set-up errors (and the record's zero) were refitted on the record with the
+/// machine's values held, with the refitted values.
+fn setups(b: &mut Body, inputs: &Inputs) {
+    let records: Vec<_> = inputs
+        .validations
+        .iter()
+        .flat_map(|(_, v)| v.records.iter())
+        .filter(|x| !x.setup.is_empty())
+        .collect();
+    if records.is_empty() {
+        return;
+    }
+    b.subheading("Set-ups of the validated records");
+    let rows: Vec<Vec<Cell>> = records
+        .iter()
+        .map(|x| {
+            let from = match (x.setup_fitted, x.record_fitted) {
+                (true, true) => "a fitted record: every value from the identification".to_string(),
+                (true, false) => "fitted: its set-up values from the identification".to_string(),
+                (false, _) => {
+                    "new: its set-up errors refitted on the record, the machine's values held"
+                        .to_string()
+                }
+            };
+            let refitted = if x.refitted.is_empty() {
+                "none".to_string()
+            } else {
+                x.refitted
+                    .iter()
+                    .map(|p| {
+                        format!(
+                            "{} = {} {}",
+                            p.name,
+                            value_std(p.value, p.std),
+                            unit(&p.unit)
+                        )
+                    })
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            };
+            vec![
+                Cell::text(x.label.clone()),
+                Cell::text(x.setup.clone()),
+                Cell::text(from),
+                Cell::text(refitted),
+            ]
+        })
+        .collect();
+    b.table(
+        "Where each record's values came from: the identification's set-up, or a new set-up refitted on the record (the residual is then after those parameters: smaller than an independent prediction's by about √(1 − k/3N) for k refitted parameters)",
+        &["Record", "Set-up", "Set-up values", "Refitted on the record"],
+        &rows,
+    );
 }

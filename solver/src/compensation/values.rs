@@ -16,6 +16,16 @@
 //! controller's feed-forward takes it) and `reversal` terms (backlash: it depends on the
 //! direction of approach, and the controller's backlash compensation takes it).
 //!
+//! **Campaigns.** The values are those of an identification of one record or several
+//! ([`CampaignValues`]: a record is a campaign of one). Only the machine's shared values are
+//! compensated; every parameter that belongs to a set-up or a record (`XOW[k4]`, `dx0[k1]`,
+//! `XOC@time:1[k4]`, a ball position `Xw[high]`) is left out and listed under its name. The
+//! records' ball positions (kinematic symbols of the workpiece side) do not matter to
+//! compensation; the other kinematic symbols (the tool's length, the axes' positions) are the
+//! machine's, and the records must agree on them: records modelled with different values of
+//! one are refused, the symbol named ([`CompensationError::RecordsDiffer`]). The correction
+//! itself takes those symbols from its caller (`--param`).
+//!
 //! **Undetermined values are refused.** A compensated term whose value the report has as
 //! `null` (the data could not determine it: a rank-deficient fit) is an error naming the terms
 //! and what to do. A constrained fit gives every parameter a value: `zero: NAME, …` fixes the
@@ -25,7 +35,7 @@
 //!
 //! Units inside: mm and rad, as everywhere in the solver.
 
-use crate::io::report::IdentifiedValues;
+use crate::fitting::campaign::{CampaignValues, Owner};
 use crate::model::{Basis, BasisContext, Effect, Term};
 use model_spec::{ErrorId, ErrorKind, Machine};
 
@@ -64,6 +74,21 @@ pub enum CompensationError {
         /// Their parameter names, as `--constraint zero:` takes them (`XOC`,
         /// `ECC@harmonic:2:cos`).
         parameters: Vec<String>,
+    },
+    /// Records of the identification modelled with different values of a kinematic symbol of
+    /// the machine's side (not the ball's position): which value the machine has is not known.
+    #[error(
+        "{file}: {records} were modelled with different values of the machine's kinematic symbol `{symbol}` ({values} mm): the identification does not say which the machine has; compensate with values identified on records of one `{symbol}`"
+    )]
+    RecordsDiffer {
+        /// The file of the values.
+        file: String,
+        /// The symbol.
+        symbol: String,
+        /// Two records that differ: "records `a` and `b`".
+        records: String,
+        /// Their values: "200 and 210".
+        values: String,
     },
     /// Identified values whose parts do not fit together (built by hand, not read).
     #[error("{file}: {why}")]
@@ -152,7 +177,8 @@ pub struct LeftOut {
     pub reason: String,
     /// Its values as identified, one per H-matrix column (two for `harmonic:K` and
     /// `period:P`), in the term's unit inside: mm or rad, ms for `velocity`, 1 for instrument
-    /// terms; `None` where the data did not determine it.
+    /// terms; `None` where the data did not determine it. A length of the machine (a
+    /// kinematic symbol identified as a term) is its change from the description's default.
     pub values: Vec<Option<f64>>,
 }
 
@@ -170,6 +196,46 @@ pub struct MachineErrors {
     slots: Vec<usize>,
     /// +1 per axis: the direction of motion the bases see (no compensated basis reads it).
     motion: Vec<i8>,
+    /// The kinematic parameters the records were modelled with (mm, symbol order; the first
+    /// record's, every record's for the symbols of the machine's side).
+    params: Vec<f64>,
+}
+
+/// The kinematic parameters of the records of `values` (the first record's), after checking
+/// that every record has the same value of each symbol of the machine's side (every symbol but
+/// the workpiece's: the ball's position does not matter to compensation).
+fn machine_params(
+    m: &Machine,
+    values: &CampaignValues,
+    file: &str,
+) -> Result<Vec<f64>, CompensationError> {
+    let records = &values.layout.records;
+    let Some(first) = records.first() else {
+        return Ok(m.default_parameters());
+    };
+    let workpiece = m.workpiece_symbols();
+    for r in &records[1..] {
+        for (s, sym) in m.symbols.iter().enumerate() {
+            if workpiece.contains(&s) {
+                continue;
+            }
+            let (a, b) = (first.params.get(s), r.params.get(s));
+            if a != b {
+                let mm = |x: Option<&f64>| x.map_or("?".into(), |x| model_spec::units::short(*x));
+                return Err(CompensationError::RecordsDiffer {
+                    file: file.to_string(),
+                    symbol: sym.name.clone(),
+                    records: format!("records `{}` and `{}`", first.label, r.label),
+                    values: format!("{} and {}", mm(a), mm(b)),
+                });
+            }
+        }
+    }
+    if first.params.len() == m.symbols.len() {
+        Ok(first.params.clone())
+    } else {
+        Ok(m.default_parameters())
+    }
 }
 
 /// Why a term is left out of compensation; `None` for a term that is compensated.
@@ -202,97 +268,128 @@ fn left_out_reason(m: &Machine, term: &Term) -> Option<String> {
 }
 
 impl MachineErrors {
-    /// Reads the machine errors of an identification; the left-out terms are listed.
+    /// The machine errors of an identification (`values`, of one record or several, read from
+    /// `file`: the file names it in messages); the left-out terms are listed, each parameter
+    /// of a set-up or a record under its own name in a campaign (`XOW[k4]`).
     ///
     /// # Errors
-    /// [`CompensationError::OtherMachine`] when `id` was identified on another machine
-    /// description than `m`; [`CompensationError::Undetermined`] when a compensated term has
-    /// no value (see the module documentation); [`CompensationError::Inconsistent`] when the
-    /// values are not one per column of the model.
-    pub fn from_identified(
+    /// [`CompensationError::Undetermined`] when a compensated term has no value (see the
+    /// module documentation); [`CompensationError::RecordsDiffer`] when records were modelled
+    /// with different values of a kinematic symbol of the machine's side;
+    /// [`CompensationError::Inconsistent`] when the values are not one per column of the
+    /// layout.
+    pub fn from_values(
         m: &Machine,
-        id: &IdentifiedValues,
+        values: &CampaignValues,
+        file: &str,
     ) -> Result<(MachineErrors, Vec<LeftOut>), CompensationError> {
-        let own = m.fingerprint();
-        if id.machine != m.name || id.fingerprint != own {
-            return Err(CompensationError::OtherMachine {
-                file: id.file.clone(),
-                machine: id.machine.clone(),
-                fingerprint: id.fingerprint.clone(),
-                expected: m.name.clone(),
-                expected_fingerprint: own,
-            });
-        }
-        let width = id.model.width();
+        let layout = &values.layout;
+        let width = layout.columns.len();
         for (what, len) in [
-            ("values", id.values.len()),
-            ("determined flags", id.determined.len()),
-            ("fixed flags", id.fixed.len()),
+            ("values", values.values.len()),
+            ("determined flags", values.determined.len()),
+            ("fixed flags", values.fixed.len()),
         ] {
             if len != width {
                 return Err(CompensationError::Inconsistent {
-                    file: id.file.clone(),
-                    why: format!("{len} {what} for the {width} parameters of the model"),
+                    file: file.to_string(),
+                    why: format!("{len} {what} for the {width} parameters of the identification"),
                 });
             }
         }
+        let params = machine_params(m, values, file)?;
         let value_source = |cols: std::ops::Range<usize>| {
-            if cols.clone().any(|j| id.fixed[j]) {
+            if cols.clone().any(|j| values.fixed[j]) {
                 ValueSource::FixedToZero
-            } else if cols.clone().any(|j| !id.determined[j]) {
+            } else if cols.clone().any(|j| !values.determined[j]) {
                 ValueSource::MinimumNorm
             } else {
                 ValueSource::Measured
             }
         };
+        let one = layout.records.len() == 1;
+        let nominal = layout.nominal_mm();
         let mut compensated: Vec<CompensatedTerm> = Vec::new();
         let mut kinematic = Vec::new();
         let mut left_out = Vec::new();
         let mut missing = (Vec::new(), Vec::new());
-        let mut column = 0;
-        for term in &id.model.terms {
+        // One record's columns in its model's order (as its report lists them), several
+        // records' in layout order: shared, per set-up, per record.
+        let order: Vec<usize> = match layout.records.as_slice() {
+            [r] => r.columns.clone(),
+            _ => (0..width).collect(),
+        };
+        let mut k = 0;
+        while k < order.len() {
+            let column = order[k];
+            let c = &layout.columns[column];
+            let term = c.term;
             let w = term.basis.width();
             let cols = column..column + w;
-            column += w;
-            let spelling = term.spelling(m);
-            let values = id.values[cols.clone()].to_vec();
+            k += w;
+            let owned = c.owner != Owner::Shared;
+            let spelling = if owned && !one {
+                format!("{}[{}]", term.spelling(m), layout.owner_label(c.owner))
+            } else {
+                term.spelling(m)
+            };
+            let mut term_values = values.values[cols.clone()].to_vec();
             if let Effect::KinematicOffset(symbol) = term.effect {
+                // A length of the machine, as a change from the description's default (the
+                // records may have been modelled with another value of it: the controller's).
+                if !owned && let Some(n) = nominal[column] {
+                    let shift = n - m.symbols[symbol].default;
+                    for v in term_values.iter_mut().flatten() {
+                        *v += shift;
+                    }
+                }
                 kinematic.push(KinematicChange {
-                    term: *term,
+                    term,
                     symbol,
                     spelling: spelling.clone(),
-                    change_mm: values.iter().copied().flatten().next(),
+                    change_mm: term_values.iter().copied().flatten().next(),
                     source: value_source(cols.clone()),
                 });
             }
-            if let Some(reason) = left_out_reason(m, term) {
+            let reason = left_out_reason(m, &term).or_else(|| {
+                owned.then(|| match c.owner {
+                    Owner::Setup(_) => format!(
+                        "belongs to the set-up {} (the workpiece's mounting), not to the machine",
+                        layout.owner_label(c.owner)
+                    ),
+                    _ => format!(
+                        "belongs to the record {} (one recording), not to the machine",
+                        layout.owner_label(c.owner)
+                    ),
+                })
+            });
+            if let Some(reason) = reason {
                 left_out.push(LeftOut {
                     term: spelling,
                     reason,
-                    values,
+                    values: term_values,
                 });
                 continue;
             }
-            if values.iter().any(Option::is_none) {
+            if term_values.iter().any(Option::is_none) {
                 missing.0.push(spelling);
-                missing
-                    .1
-                    .extend(cols.clone().filter(|&j| id.values[j].is_none()).map(|j| {
-                        let k = j - (column - w);
-                        crate::fitting::hmatrix::parameter_name(m, term, k)
-                    }));
+                missing.1.extend(
+                    cols.clone()
+                        .filter(|&j| values.values[j].is_none())
+                        .map(|j| crate::fitting::hmatrix::parameter_name(m, &term, j - cols.start)),
+                );
                 continue;
             }
             compensated.push(CompensatedTerm {
-                term: *term,
+                term,
                 spelling,
-                coefficients: values.into_iter().flatten().collect(),
+                coefficients: term_values.into_iter().flatten().collect(),
                 source: value_source(cols),
             });
         }
         if !missing.0.is_empty() {
             return Err(CompensationError::Undetermined {
-                file: id.file.clone(),
+                file: file.to_string(),
                 terms: missing.0,
                 parameters: missing.1,
             });
@@ -315,17 +412,26 @@ impl MachineErrors {
             .collect();
         Ok((
             MachineErrors {
-                file: id.file.clone(),
+                file: file.to_string(),
                 machine: m.name.clone(),
-                fingerprint: own,
+                fingerprint: m.fingerprint(),
                 errors,
                 terms: compensated,
                 kinematic,
                 slots,
                 motion: vec![1; m.axes.len()],
+                params,
             },
             left_out,
         ))
+    }
+
+    /// The kinematic parameters the identification's records were modelled with (mm, symbol
+    /// order): every record's value of each symbol of the machine's side, the first record's
+    /// ball position. What a correction should use for the machine's symbols unless told
+    /// otherwise (`--param`).
+    pub fn record_params(&self) -> &[f64] {
+        &self.params
     }
 
     /// The catalogue errors that have at least one compensated term, in catalogue order.

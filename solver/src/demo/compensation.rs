@@ -98,8 +98,8 @@ pub(crate) fn compensate_held_out(
     let json = to_json(&report).map_err(failed("compensation"))?;
     let values = parse_identification("identify-recommended.json", &json, m)
         .map_err(failed("compensation"))?;
-    let (errors, left_out) =
-        MachineErrors::from_identified(m, &values).map_err(failed("compensation"))?;
+    let (errors, left_out) = MachineErrors::from_values(m, &values.values, &values.file)
+        .map_err(failed("compensation"))?;
     files.push(DemoFile {
         name: "identify-recommended.json".into(),
         contents: json,

@@ -13,8 +13,11 @@ mod text;
 use crate::diagnosis::figures::{Figures, figures};
 use crate::diagnosis::hidden::hidden_terms;
 use crate::diagnosis::{DiagnoseOptions, diagnose};
+use crate::fitting::campaign::{
+    Campaign, CampaignIdentification, CampaignRecord, CampaignValues, validate_campaign,
+};
 use crate::fitting::sanity::{ValueLimits, check_values};
-use crate::fitting::{IdentifyOptions, RefineOptions, ValidateOptions, identify_refined, validate};
+use crate::fitting::{IdentifyOptions, RefineOptions, ValidateOptions, identify_refined};
 use crate::io::csv::format_record;
 use crate::io::report::{
     DiagnosisReport, DiagnosisSource, IdentificationReport, IdentificationSource, ValidationReport,
@@ -175,17 +178,33 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
     });
 
     // 3. Validation on every path (K4: the fit itself), exact prediction.
+    // Every path was measured on K4's ball set-up: each record on the fitted set-up.
     let exact = ValidateOptions::new().exact(true);
+    let fitted_label = crate::io::campaign::stem_label(std::path::Path::new(&k4_file));
+    let values = CampaignValues::of(
+        &CampaignIdentification::of_record(&m, &ident, &fitted_label, m.default_parameters())
+            .map_err(failed("validation"))?,
+    );
     let mut validations = Vec::new();
     for r in &runs {
-        let v = validate(&m, &ident.model, &ident.fit.values, &r.record, &exact)
-            .map_err(failed("validation"))?;
+        let data = path_of(&r.file);
+        let label = crate::io::campaign::stem_label(std::path::Path::new(&data));
+        let record = CampaignRecord::new(
+            label,
+            r.record.clone(),
+            m.default_parameters(),
+            fitted_label.clone(),
+            false,
+        );
+        let campaign = Campaign::new(vec![record]).map_err(failed("validation"))?;
+        let v = validate_campaign(&m, &values, &campaign, &exact).map_err(failed("validation"))?;
         let report = ValidationReport::new(
+            &m,
             ValidationSource {
-                machine: MACHINE,
                 model: REDUCED,
                 params: &path_of("identify.json"),
-                data: &path_of(&r.file),
+                data: &[data],
+                kinematics: &[m.default_parameters()],
                 exact: true,
             },
             &v,

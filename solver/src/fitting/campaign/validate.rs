@@ -17,7 +17,8 @@
 //!
 //! A parameter without a value (not determined by the identification) is set to 0 and named
 //! ([`crate::fitting::validate::Unidentified`], as for a single record). The refit is least
-//! squares on the refitted columns of the record's H matrix (first order), refined against the
+//! squares on the refitted columns of the record's H matrix (first order; each sample weighted
+//! by its covariance when the record was read through an instrument), refined against the
 //! exact machine by Gauss–Newton when the prediction is exact; the prediction then uses the
 //! refitted values (the minimum-norm solution for those the record cannot separate, which
 //! predicts the record as any other solution would). The residual of a refitted record is
@@ -25,94 +26,28 @@
 //! prediction's by about `√(1 − k/3N)` for `k` refitted parameters, and the report says which
 //! were refitted.
 
+mod values;
+
+pub use values::{CampaignValues, given_model, single_columns};
+
 use super::clock::own_clock_terms;
-use super::design::{Layout, Owner, RecordSpec, block};
-use super::{Campaign, CampaignIdentification, CampaignRecord};
+use super::design::{Owner, block};
+use super::{Campaign, CampaignRecord};
 use crate::fitting::hmatrix::{GainSource, check_model, parameter_name};
-use crate::fitting::identify::{check_readings, with_offsets};
-use crate::fitting::least_squares::{Constraint, EstimateError, Tolerances, least_squares};
+use crate::fitting::identify::{check_readings, fit_rows, with_offsets};
+use crate::fitting::least_squares::{Constraint, Tolerances};
 use crate::fitting::measurement_vector;
+use crate::fitting::noise::SampleWhitening;
 use crate::fitting::refine::{
     GaussNewton, RefineError, RefineOptions, exact_prediction, gauss_newton,
 };
 use crate::fitting::validate::{
     Stats, Unidentified, ValidateError, ValidateOptions, Validation, statistics,
 };
+use crate::io::progress::{Progress, Unwatched};
 use crate::model::{Model, Term};
 use model_spec::Machine;
 use nalgebra::DVector;
-
-/// Identified values as a campaign sees them: the model, the layout it was fitted with, one
-/// value and standard uncertainty per layout column (mm, rad; `None`: not determined).
-#[derive(Clone, Debug, PartialEq)]
-pub struct CampaignValues {
-    /// The model as given.
-    pub model: Model,
-    /// The layout of the identification.
-    pub layout: Layout,
-    /// One value per layout column; `None` where the data did not determine it.
-    pub values: Vec<Option<f64>>,
-    /// One standard uncertainty per layout column.
-    pub std: Vec<Option<f64>>,
-}
-
-impl CampaignValues {
-    /// The values of a campaign identification.
-    pub fn of(ident: &CampaignIdentification) -> CampaignValues {
-        CampaignValues {
-            model: ident.model.clone(),
-            layout: ident.layout.clone(),
-            values: ident.fit.values.clone(),
-            std: ident.fit.std.clone(),
-        }
-    }
-
-    /// A single identification of `model` (its values and uncertainties one per model column)
-    /// seen as a campaign of one record labelled `label` on set-up `label`, at kinematic
-    /// parameters `params` (mm): its set-up terms belong to set-up `label`, its sensor-offset
-    /// and time terms to record `label`.
-    ///
-    /// # Errors
-    /// A model that does not fit `m`; values that are not one per column.
-    pub fn single(
-        m: &Machine,
-        model: &Model,
-        values: &[Option<f64>],
-        std: &[Option<f64>],
-        label: &str,
-        params: Vec<f64>,
-    ) -> Result<CampaignValues, EstimateError> {
-        if values.len() != model.width() || std.len() != model.width() {
-            return Err(EstimateError::Shape(format!(
-                "{} values and {} uncertainties for the {} columns of the model",
-                values.len(),
-                std.len(),
-                model.width()
-            )));
-        }
-        let spec = RecordSpec {
-            label: label.into(),
-            setup: label.into(),
-            params,
-            zeroed: false,
-            start_s: None,
-            samples: 0,
-        };
-        let layout = Layout::of_records(m, model, &[spec], None)?;
-        let n = layout.columns.len();
-        let (mut v, mut s) = (vec![None; n], vec![None; n]);
-        for (k, &c) in layout.records[0].columns.iter().enumerate() {
-            v[c] = values[k];
-            s[c] = std[k];
-        }
-        Ok(CampaignValues {
-            model: model.clone(),
-            layout,
-            values: v,
-            std: s,
-        })
-    }
-}
 
 /// A parameter refitted on a validation record.
 #[derive(Clone, Debug, PartialEq)]
@@ -140,6 +75,9 @@ pub struct RecordValidation {
     pub setup_fitted: bool,
     /// Whether the record itself was fitted (its own values came from the identification).
     pub record_fitted: bool,
+    /// Whether its readings were zeroed at the first sample (its own `dx0 dy0 dz0` in its
+    /// model).
+    pub zeroed: bool,
     /// The parameters refitted on the record (none when every value came from the
     /// identification).
     pub refitted: Vec<Refitted>,
@@ -170,18 +108,33 @@ pub fn validate_campaign(
     campaign: &Campaign,
     opts: &ValidateOptions,
 ) -> Result<CampaignValidation, ValidateError> {
+    validate_campaign_with_progress(m, values, campaign, opts, &Unwatched)
+}
+
+/// As [`validate_campaign`], reporting the records validated to `progress` (`records`, one
+/// unit per record).
+///
+/// # Errors
+/// As [`validate_record`].
+pub fn validate_campaign_with_progress(
+    m: &Machine,
+    values: &CampaignValues,
+    campaign: &Campaign,
+    opts: &ValidateOptions,
+    progress: &dyn Progress,
+) -> Result<CampaignValidation, ValidateError> {
     campaign.check(m).map_err(|e| ValidateError::Shape(e.0))?;
-    campaign
-        .refuse_covariances("a campaign's validation")
-        .map_err(|e| ValidateError::Shape(e.0))?;
     let mut records = Vec::with_capacity(campaign.records.len());
     let (mut measured, mut predicted) = (Vec::new(), Vec::new());
-    for r in &campaign.records {
+    let total = campaign.records.len() as u64;
+    for (i, r) in campaign.records.iter().enumerate() {
+        progress.update("validating records", i as u64, total);
         let v = validate_record(m, values, r, opts)?;
         measured.extend(r.record.measured.iter().copied());
         predicted.extend(v.validation.prediction.iter().copied());
         records.push(v);
     }
+    progress.update("validating records", total, total);
     let (per_direction, overall) = statistics(&measured, &predicted);
     Ok(CampaignValidation {
         records,
@@ -342,11 +295,21 @@ pub fn validate_record(
     let mut defaulted = Vec::new();
     let mut v = vec![0.0; sources.len()];
     let nominal = layout.nominal_mm();
+    // The identification's columns named as its report names them: a record's as a single fit
+    // does (`XOW`), a campaign's with their owners (`XOW[k4]`).
+    let report_name = |c: usize| -> String {
+        let col = &layout.columns[c];
+        if layout.records.len() == 1 {
+            parameter_name(m, &col.term, col.component)
+        } else {
+            col.name.clone()
+        }
+    };
     for (k, s) in sources.iter().enumerate() {
         if let Some(c) = s {
             match values.values[*c] {
                 Some(x) => v[k] = x,
-                None => defaulted.push(layout.columns[*c].name.clone()),
+                None => defaulted.push(report_name(*c)),
             }
             // A kinematic offset's value is a change from the identification's value of its
             // symbol: on a record modelled with another value it is the identified length
@@ -400,12 +363,19 @@ pub fn validate_record(
         let h_r = h.select_columns(&refit);
         let refit_names: Vec<String> = refit.iter().map(|&k| names[k].clone()).collect();
         let tol = Tolerances::default();
-        let first = least_squares(
+        // Readings through an instrument carry their covariances: the refit weights by them,
+        // as the identification does.
+        let weights = SampleWhitening::of(rec)
+            .map_err(|e| ValidateError::Shape(format!("record `{}`: {e}", r.label)))?;
+        let (first, _) = fit_rows(
             &h_r,
             &(&y - predict(&v).map_err(failed)?),
             &refit_names,
             &Constraint::None,
             &tol,
+            None,
+            &[rec.samples.len()],
+            weights.as_ref(),
         )?;
         let fit = if opts.exact {
             let coordinates = r
@@ -420,7 +390,7 @@ pub fn validate_record(
                 tolerances: &tol,
                 noise: None,
                 coordinates,
-                weights: None,
+                weights: weights.as_ref(),
             };
             let start = first;
             let base = v.clone();
@@ -479,6 +449,7 @@ pub fn validate_record(
         setup: r.setup.clone(),
         setup_fitted: setup.is_some(),
         record_fitted: fitted.is_some(),
+        zeroed: r.zeroed,
         refitted,
         validation: Validation {
             samples: rec.samples.len(),

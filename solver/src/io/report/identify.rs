@@ -1,13 +1,36 @@
-//! The identification report (`rtest identify --json`).
+//! The identification report (`rtest identify --json`): one type for one record and for a
+//! campaign of several (a record is a campaign of one).
+//!
+//! A report of **one record** (`--data k4.csv`, or a campaign file of one record) names its
+//! parameters as a single fit does (`XOW`, `dx0`) and has `data` and `zeroed`:
 //!
 //! ```json
-//! {"machine": "seed-ac", "fingerprint": "fa038fe9e24c960a", "model": "reduced", "base_model": "reduced",
-//!  "terms": ["XOW", …, "BOC"],
+//! {"version": 2, "machine": "seed-ac", "fingerprint": "fa038fe9e24c960a", "data": "k4.csv",
+//!  "model": "reduced", "base_model": "reduced", "terms": ["XOW", …, "BOC"],
+//!  "setups": [{"label": "k4", "records": ["k4"]}],
+//!  "records": [{"label": "k4", "data": "k4.csv", "setup": "k4", "params": {"Xw": -217.504, …},
+//!               "zeroed": false, "samples": 241, "residual_rms_um": 0.49}],
 //!  "parameters": [{"name": "XOC", "error": "XOC", "basis": "const", "value": 12.3, "std": 0.05,
 //!                  "unit": "um", "determined": true, "fixed": false}, …],
 //!  "residual_rms_um": 0.49, "rank": 11, "condition": 4.2, "confounded": [["XOC", "dx0"]], …,
-//!  "refinement": {"method": "exact", "iterations": 3, "converged": true, …}, "notes": […]}
+//!  "zeroed": false, "refinement": {"method": "exact", "iterations": 3, "converged": true, …},
+//!  "noise_model": {…}, "notes": […]}
 //! ```
+//!
+//! A report of **several records** has `"kind": "campaign"`, no `data` nor `zeroed` (each record
+//! says its own), and every parameter says whose it is: `owner` `shared` (the machine's errors,
+//! one value for the campaign), `setup` (the ball set-up errors of the set-up `of`) or `record`
+//! (the zero and drift of the R-test, and the terms of a time basis on a record's own clock, of
+//! the record `of`), its name carrying the owner (`XOW[k4]`, `dx0[k1]`). Its `terms` are the
+//! model as given, without the zero offsets its zeroed records add; a record's report lists them
+//! with its terms. `clock` (`{"start_s", "end_s"}`) is there when the records are on one
+//! campaign clock, and then every record has `start_s`.
+//!
+//! `version` is 2. A report without it is version 1, what rtest wrote before: a record's report
+//! without `setups` and `records` (its record is the stem of `data`, on its own set-up, at the
+//! machine's default kinematic parameters), or a campaign's (`"kind": "campaign"`) with them.
+//! Both are read ([`super::read`], [`IdentificationReport::from_json`]).
+//!
 //! `noise_model` says which noise the uncertainties assume: `{"source": "estimated",
 //! "sigma_um": [0.3, 0.3, 0.3], "phi": [0.8, 0.8, 0.8], "whitened_sigma": 1.02, "text": …}`
 //! (`source`: `declared`, `static-record`, `estimated`, or `residual`, white with the σ̂ of an
@@ -17,24 +40,35 @@
 //! `um` (translational errors, sensor offsets, changes of kinematic offsets) or `urad` (angular
 //! errors). A kinematic offset (`"error": "Zt"`, a symbol of the description) also has
 //! `nominal_mm`, the symbol's value its change `value` is from, and `identified_mm`, the
-//! identified length (`null` when the change is not determined). Readers of the values
-//! need `machine`, `fingerprint`, `model`, `base_model`, `terms` and `parameters`
-//! ([`super::read`]).
+//! identified length (`null` when the change is not determined).
 
-use super::{NonFinite, finite, finite_opt};
+mod build;
+
+pub use super::fit_summary::{constraint_text, poly_stroke};
+use super::read::{ReportError, json_error};
+use super::{NonFinite, Ordered};
 use crate::fitting::hmatrix::Backend;
-use crate::fitting::identifiability::Swallowed;
-use crate::fitting::refine::Refinement;
-use crate::fitting::{Constraint, Identification};
-use model_spec::Machine;
-use model_spec::units::UM_PER_MM;
 use serde::{Deserialize, Serialize};
 
-/// One parameter (H-matrix column) of an identification, in its term's unit
+/// The version of the reports this rtest writes.
+pub const REPORT_VERSION: u32 = 2;
+
+/// The value of `"kind"` in a report of several records.
+pub const CAMPAIGN_KIND: &str = "campaign";
+
+/// One parameter (a column of the design matrix), in its term's unit
 /// ([`crate::model::Term::unit`]): µm, µrad, ms (`velocity`) or 1 (instrument terms).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ParameterReport {
-    /// The parameter's name (`XOC`, `ECC@harmonic:2:cos`, `dx0`).
+    /// In a report of several records: `shared`, `setup` or `record`; absent in a record's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub owner: Option<String>,
+    /// In a report of several records: the set-up's or the record's label of a `setup` or
+    /// `record` parameter; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub of: Option<String>,
+    /// The parameter's name (`XOC`, `ECC@harmonic:2:cos`, `dx0`; `XOW[k4]` in a report of
+    /// several records).
     pub name: String,
     /// Effect name (`XOC`, `dx0`).
     pub error: String,
@@ -155,30 +189,93 @@ pub struct SwallowedReport {
     pub errors: Vec<String>,
 }
 
-/// The identification report.
+/// One set-up (one ball mounting): its label and its records.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SetupReport {
+    /// The set-up's label.
+    pub label: String,
+    /// The labels of its records.
+    pub records: Vec<String>,
+}
+
+/// One record of an identification.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordReport {
+    /// Its label.
+    pub label: String,
+    /// The measurement file it was read from.
+    pub data: String,
+    /// Its set-up's label.
+    pub setup: String,
+    /// Its kinematic parameters (the ball's position lives here), every symbol in the
+    /// machine's order, mm. Empty in a version-1 report of one record: the machine's defaults.
+    #[serde(default)]
+    pub params: Ordered<f64>,
+    /// Whether its readings were zeroed at the first sample (its own `dx0 dy0 dz0` fitted).
+    pub zeroed: bool,
+    /// Its time 0 on the campaign clock, s; absent when the records keep their own clocks.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_s: Option<f64>,
+    /// Its samples.
+    pub samples: usize,
+    /// The residual RMS of its readings, `√(RSS_r / 3N_r)`, µm.
+    pub residual_rms_um: f64,
+}
+
+/// The campaign clock's span, s.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClockReport {
+    /// The first sample of all records on the campaign clock, s.
+    pub start_s: f64,
+    /// The last, s.
+    pub end_s: f64,
+}
+
+fn version_1() -> u32 {
+    1
+}
+
+/// The identification report (see the module documentation).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct IdentificationReport {
+    /// The report's version ([`REPORT_VERSION`]; 1 when the file has none).
+    #[serde(default = "version_1")]
+    pub version: u32,
+    /// `campaign` for a report of several records; absent for one record.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kind: Option<String>,
     /// Machine name.
     pub machine: String,
     /// The machine's fingerprint (topology and machine-side kinematic defaults): values are
     /// applied only to a machine with the same fingerprint.
     pub fingerprint: String,
-    /// The measurement file fitted.
-    pub data: String,
+    /// One record: the measurement file fitted; absent for several (see `records`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub data: Option<String>,
     /// The model's label (`reduced`, `reduced + ECC@harmonic:2`, `XOC + EXX@poly:1`).
     pub model: String,
     /// The machine's model it starts from (`--model`); absent when the model is a list of
     /// terms only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub base_model: Option<String>,
-    /// The terms fitted, in order (`XOC`, `ECC@harmonic:2`, `dx0`), offsets of zeroed readings
-    /// included.
+    /// The terms fitted, in order (`XOC`, `ECC@harmonic:2`, `dx0`): one record's with the
+    /// offsets of zeroed readings; several records': the model as given.
     pub terms: Vec<String>,
-    /// Every parameter (H column), in model order.
+    /// The set-ups, in order of first appearance.
+    #[serde(default)]
+    pub setups: Vec<SetupReport>,
+    /// The records, in order.
+    #[serde(default)]
+    pub records: Vec<RecordReport>,
+    /// The campaign clock, when the records are on one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clock: Option<ClockReport>,
+    /// Every parameter: one record's in its model's order; several records' shared, then per
+    /// set-up, then per record.
     pub parameters: Vec<ParameterReport>,
-    /// `√(RSS / 3N)`, µm.
+    /// `√(RSS / 3N)` over every record, µm.
     pub residual_rms_um: f64,
-    /// Numerical rank of the column-scaled H.
+    /// Numerical rank of the column-scaled H (the stacked design matrix).
     pub rank: usize,
     /// Free parameters (not fixed by the constraint).
     pub free_parameters: usize,
@@ -186,14 +283,16 @@ pub struct IdentificationReport {
     pub condition: Option<f64>,
     /// Groups of parameters the data cannot separate (parameter names).
     pub confounded: Vec<Vec<String>>,
-    /// Number of samples fitted.
+    /// Number of samples fitted, over every record.
     pub samples: usize,
     /// Readings fitted (3 per sample).
     pub readings: usize,
     /// Degrees of freedom `3N − rank`.
     pub dof: usize,
-    /// Whether the readings were zeroed at the first sample (then `dx0 dy0 dz0` were fitted).
-    pub zeroed: bool,
+    /// One record: whether its readings were zeroed at the first sample (then `dx0 dy0 dz0`
+    /// were fitted); absent for several (see `records`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zeroed: Option<bool>,
     /// `none`, `minimum-norm` or `zero: NAME, …`.
     pub constraint: String,
     /// σ̂ = √(RSS / (3N − rank)), µm; `null` without degrees of freedom.
@@ -206,33 +305,16 @@ pub struct IdentificationReport {
     pub gains: String,
     /// The refinement against the exact machine.
     pub refinement: RefinementReport,
-    /// The noise model the uncertainties assume; absent in reports written before noise models
-    /// existed.
+    /// The noise model the uncertainties assume (one for every record, records independent);
+    /// absent in reports written before noise models existed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub noise_model: Option<NoiseModelReport>,
     /// How a long record was read in blocks (`--stream`); absent when it was read whole.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub streaming: Option<StreamingReport>,
-    /// Statements for people (what was swallowed, what has no value and why, non-convergence).
+    /// Statements for people (what was swallowed, what has no value and why, non-convergence,
+    /// set-up errors the records cannot tell from the machine's).
     pub notes: Vec<String>,
-}
-
-/// The stroke (mm) a `poly:K` term's polynomial is normalised over: its axis's; `None` for
-/// other bases.
-pub fn poly_stroke(m: &Machine, term: &crate::model::Term) -> Option<[f64; 2]> {
-    match (term.basis, term.effect.carrier(m)) {
-        (crate::model::Basis::Poly(_), crate::model::Carrier::Axis(a)) => Some(m.axes[a].limits),
-        _ => None,
-    }
-}
-
-/// The text of a constraint, as the report writes it.
-pub fn constraint_text(c: &Constraint) -> String {
-    match c {
-        Constraint::None => "none".into(),
-        Constraint::MinimumNorm => "minimum-norm".into(),
-        Constraint::Zero(names) => format!("zero: {}", names.join(", ")),
-    }
 }
 
 /// The name of a gain backend in reports.
@@ -244,7 +326,24 @@ pub fn backend_name(b: Backend) -> &'static str {
     }
 }
 
-/// What an identification report says besides the identification.
+/// Why the report of one record's identification cannot be made.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordReportError {
+    /// A value, uncertainty or statistic that is not finite: the computation failed.
+    #[error(transparent)]
+    NonFinite(#[from] NonFinite),
+    /// The identification does not make a campaign of one record (its model does not fit the
+    /// machine, or the kinematic parameters are not one per symbol).
+    #[error("the record of {data}: {why}")]
+    Record {
+        /// The record's file.
+        data: String,
+        /// What does not fit.
+        why: String,
+    },
+}
+
+/// What an identification report of one record says besides the identification.
 #[derive(Clone, Copy, Debug)]
 pub struct IdentificationSource<'a> {
     /// The measurement file fitted.
@@ -255,294 +354,80 @@ pub struct IdentificationSource<'a> {
     pub base_model: Option<&'a str>,
 }
 
+/// What an identification report says besides the identification: the model's label and base
+/// model, and each record's data file (in order).
+#[derive(Clone, Copy, Debug)]
+pub struct CampaignSource<'a> {
+    /// The model's label.
+    pub label: &'a str,
+    /// The machine's model it starts from, if any.
+    pub base_model: Option<&'a str>,
+    /// Per record, the file it was read from.
+    pub data: &'a [String],
+}
+
 impl IdentificationReport {
-    /// The report of `ident` on machine `m`, refined as `refinement` says (`None`: first
-    /// order).
+    /// Reads a report from its JSON `text` (`file` names it in messages), of either version:
+    /// a version-1 report of one record (without `setups` and `records`) gains them, its
+    /// record labelled by the stem of its `data` file, on a set-up of that label, at the
+    /// machine's default kinematic parameters (`params` empty). The values are not checked
+    /// against a machine ([`super::read`] does that).
     ///
     /// # Errors
-    /// [`NonFinite`] when a value, uncertainty or statistic is not finite.
-    pub fn new(
-        m: &Machine,
-        source: IdentificationSource,
-        ident: &Identification,
-        refinement: Option<&Refinement>,
-    ) -> Result<IdentificationReport, NonFinite> {
-        let fit = &ident.fit;
-        let mut parameters = Vec::with_capacity(fit.names.len());
-        for (j, (t, k)) in ident.model.columns().into_iter().enumerate() {
-            let nominal = ident.nominal_mm.get(j).copied().flatten();
-            parameters.push(parameter_report(
-                m,
-                &ident.model.terms[t],
-                k,
-                fit,
-                j,
-                nominal,
-            )?);
+    /// [`ReportError::Json`] for text that is not JSON, [`ReportError::Field`] for a missing or
+    /// malformed field or a version this rtest does not know.
+    pub fn from_json(file: &str, text: &str) -> Result<IdentificationReport, ReportError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let mut r: IdentificationReport =
+            serde_json::from_str(text).map_err(|e| json_error(file, text, &e))?;
+        if r.version > REPORT_VERSION || r.version == 0 {
+            return Err(ReportError::Field {
+                file: file.to_string(),
+                field: "version".into(),
+                message: format!(
+                    "{}: this rtest reads versions 1 to {REPORT_VERSION} (a newer rtest wrote it?)",
+                    r.version
+                ),
+            });
         }
-        let refinement = refinement_report(refinement, fit)?;
-        let mut report = fit_report(fit)?;
-        report.notes = notes(fit, &ident.swallowed, &refinement);
-        Ok(IdentificationReport {
-            machine: m.name.clone(),
-            fingerprint: m.fingerprint(),
-            data: source.data.to_string(),
-            model: source.label.to_string(),
-            base_model: source.base_model.map(str::to_string),
-            terms: ident.model.terms.iter().map(|t| t.spelling(m)).collect(),
-            parameters,
-            residual_rms_um: report.residual_rms_um,
-            rank: report.rank,
-            free_parameters: report.free_parameters,
-            condition: report.condition,
-            confounded: report.confounded,
-            samples: ident.samples,
-            readings: report.readings,
-            dof: report.dof,
-            zeroed: ident.zeroed,
-            constraint: report.constraint,
-            sigma_um: report.sigma_um,
-            near_confounded: report.near_confounded,
-            swallowed: FitSummary::swallowed_of(&ident.swallowed),
-            gains: backend_name(ident.backend).into(),
-            notes: report.notes,
-            refinement,
-            noise_model: Some(noise_report(&ident.noise, ident.whitened_sigma)?),
-            streaming: None,
-        })
+        if r.records.is_empty() {
+            let data = r.data.clone().unwrap_or_default();
+            let label = crate::io::report::read::single_label(r.data.as_deref());
+            r.records.push(RecordReport {
+                label: label.clone(),
+                data,
+                setup: label.clone(),
+                params: Ordered(Vec::new()),
+                zeroed: r.zeroed.unwrap_or(false),
+                start_s: None,
+                samples: r.samples,
+                residual_rms_um: r.residual_rms_um,
+            });
+            r.setups = vec![SetupReport {
+                label: label.clone(),
+                records: vec![label],
+            }];
+        }
+        Ok(r)
     }
-}
 
-/// The report of column `j` of `fit`, the component `k` of `term` (in the term's unit);
-/// `nominal` (mm) is the value a kinematic offset's change is relative to (`None` for other
-/// terms).
-///
-/// # Errors
-/// [`NonFinite`] for a value or uncertainty that is not finite.
-pub(crate) fn parameter_report(
-    m: &Machine,
-    term: &crate::model::Term,
-    k: usize,
-    fit: &crate::fitting::Fit,
-    j: usize,
-    nominal: Option<f64>,
-) -> Result<ParameterReport, NonFinite> {
-    let f = term.display_factor(m);
-    let names = term.basis.column_names();
-    let field = |what: &str| format!("parameters[{j}].{what}");
-    let nominal = match term.effect.symbol() {
-        Some(_) => finite_opt(|| field("nominal_mm"), nominal)?,
-        None => None,
-    };
-    let identified_mm = match nominal {
-        Some(n) => Some(finite_opt(
-            || field("identified_mm"),
-            fit.values[j].map(|v| n + v),
-        )?),
-        None => None,
-    };
-    Ok(ParameterReport {
-        name: fit.names[j].clone(),
-        error: term.effect.name(m),
-        basis: names.get(k).unwrap_or(&names[0]).clone(),
-        value: finite_opt(|| field("value"), fit.values[j].map(|v| v * f))?,
-        std: finite_opt(|| field("std"), fit.std[j].map(|v| v * f))?,
-        unit: term.unit(m).to_string(),
-        determined: fit.identifiability.determined[j],
-        fixed: fit.fixed[j],
-        over_mm: poly_stroke(m, term),
-        nominal_mm: nominal,
-        identified_mm,
-    })
-}
+    /// `true` for a report of several records (`"kind": "campaign"`).
+    pub fn is_campaign(&self) -> bool {
+        self.kind.as_deref() == Some(CAMPAIGN_KIND)
+    }
 
-/// What every fit report says of its fit, in report units (the fields of
-/// [`IdentificationReport`] of the same names).
-pub(crate) struct FitSummary {
-    /// `√(RSS / 3N)`, µm.
-    pub residual_rms_um: f64,
-    /// Numerical rank.
-    pub rank: usize,
-    /// Free parameters.
-    pub free_parameters: usize,
-    /// Condition number.
-    pub condition: Option<f64>,
-    /// Confounded groups, by name.
-    pub confounded: Vec<Vec<String>>,
-    /// Readings fitted.
-    pub readings: usize,
-    /// Degrees of freedom.
-    pub dof: usize,
-    /// The constraint's text.
-    pub constraint: String,
-    /// σ̂, µm.
-    pub sigma_um: Option<f64>,
-    /// Near-confounded pairs.
-    pub near_confounded: Vec<NearPairReport>,
-    /// Statements for people.
-    pub notes: Vec<String>,
-}
+    /// Whether any record's readings were zeroed at the first sample.
+    pub fn any_zeroed(&self) -> bool {
+        self.zeroed.unwrap_or(false) || self.records.iter().any(|r| r.zeroed)
+    }
 
-impl FitSummary {
-    /// The swallowed groups as reported.
-    pub(crate) fn swallowed_of(swallowed: &[Swallowed]) -> Vec<SwallowedReport> {
-        swallowed
+    /// The parameters of `owner` (`shared`, `setup` or `record`) of `of` (a label; `None` for
+    /// shared), as a report of several records writes them (a record's report names no owner:
+    /// none is found there).
+    pub fn parameters_of(&self, owner: &str, of: Option<&str>) -> Vec<&ParameterReport> {
+        self.parameters
             .iter()
-            .map(|s: &Swallowed| SwallowedReport {
-                offsets: s.offsets.clone(),
-                errors: s.errors.clone(),
-            })
+            .filter(|p| p.owner.as_deref() == Some(owner) && p.of.as_deref() == of)
             .collect()
     }
-}
-
-/// The summary of `fit` (notes left empty).
-///
-/// # Errors
-/// [`NonFinite`] for a statistic that is not finite.
-pub(crate) fn fit_report(fit: &crate::fitting::Fit) -> Result<FitSummary, NonFinite> {
-    let id = &fit.identifiability;
-    let name = |j: usize| fit.names[j].clone();
-    Ok(FitSummary {
-        residual_rms_um: finite(|| "residual_rms_um".into(), fit.residual_rms() * UM_PER_MM)?,
-        rank: fit.rank,
-        free_parameters: fit.fixed.iter().filter(|f| !**f).count(),
-        condition: finite_opt(|| "condition".into(), fit.condition)?,
-        confounded: id
-            .confounded
-            .iter()
-            .map(|g| g.iter().map(|&j| name(j)).collect())
-            .collect(),
-        readings: fit.rows(),
-        dof: fit.dof,
-        constraint: constraint_text(&fit.constraint),
-        sigma_um: finite_opt(|| "sigma_um".into(), fit.sigma.map(|s| s * UM_PER_MM))?,
-        near_confounded: id
-            .near_confounded
-            .iter()
-            .map(|p| {
-                Ok(NearPairReport {
-                    parameters: [name(p.a), name(p.b)],
-                    correlation: finite(|| "near_confounded.correlation".into(), p.correlation)?,
-                })
-            })
-            .collect::<Result<_, NonFinite>>()?,
-        notes: Vec::new(),
-    })
-}
-
-/// The refinement as reported: refined as `refinement` says, or first order (`None`).
-///
-/// # Errors
-/// [`NonFinite`] for a step or RMS that is not finite.
-pub(crate) fn refinement_report(
-    refinement: Option<&Refinement>,
-    fit: &crate::fitting::Fit,
-) -> Result<RefinementReport, NonFinite> {
-    Ok(match refinement {
-        Some(r) => RefinementReport {
-            method: "exact".into(),
-            iterations: r.iterations,
-            converged: r.converged,
-            steps_um: r
-                .steps_mm
-                .iter()
-                .enumerate()
-                .map(|(i, s)| finite(|| format!("refinement.steps_um[{i}]"), s * UM_PER_MM))
-                .collect::<Result<_, _>>()?,
-            tolerance_um: Some(finite(
-                || "refinement.tolerance_um".into(),
-                r.tolerance_mm * UM_PER_MM,
-            )?),
-            first_order_rms_um: finite(
-                || "refinement.first_order_rms_um".into(),
-                r.rms_mm.0 * UM_PER_MM,
-            )?,
-        },
-        None => RefinementReport {
-            method: "first-order".into(),
-            iterations: 0,
-            converged: true,
-            steps_um: Vec::new(),
-            tolerance_um: None,
-            first_order_rms_um: finite(
-                || "refinement.first_order_rms_um".into(),
-                fit.residual_rms() * UM_PER_MM,
-            )?,
-        },
-    })
-}
-
-/// The noise model `n` in µm, with the σ̂ of the whitened residual `whitened`.
-///
-/// # Errors
-/// [`NonFinite`] for a σ that is not finite.
-pub(crate) fn noise_report(
-    n: &crate::fitting::noise::NoiseModel,
-    whitened: Option<f64>,
-) -> Result<NoiseModelReport, NonFinite> {
-    let mut sigma_um = [0.0; 3];
-    for (d, s) in sigma_um.iter_mut().enumerate() {
-        *s = finite(
-            || format!("noise_model.sigma_um[{d}]"),
-            n.sigma_mm[d] * UM_PER_MM,
-        )?;
-    }
-    Ok(NoiseModelReport {
-        source: n.source.keyword().into(),
-        sigma_um,
-        phi: n.phi,
-        whitened_sigma: finite_opt(|| "noise_model.whitened_sigma".into(), whitened)?,
-        text: n.to_string(),
-    })
-}
-
-/// The statements for people: what the offsets swallow, what has no value, no uncertainty,
-/// no convergence.
-pub(crate) fn notes(
-    fit: &crate::fitting::Fit,
-    swallowed: &[Swallowed],
-    refinement: &RefinementReport,
-) -> Vec<String> {
-    let id = &fit.identifiability;
-    let mut notes = Vec::new();
-    if !refinement.converged {
-        notes.push(format!(
-            "the refinement against the exact machine did not converge in {} steps (last step {} µm): these values are not an identification",
-            refinement.iterations,
-            refinement.steps_um.last().map_or("?".into(), |s| format!("{s:.3e}"))
-        ));
-    }
-    for s in swallowed {
-        notes.push(format!(
-            "zeroed readings: the sensor offset{} {} cannot be told from {} (constant gains)",
-            if s.offsets.len() > 1 { "s" } else { "" },
-            s.offsets.join(", "),
-            if s.errors.is_empty() {
-                "each other".to_string()
-            } else {
-                s.errors.join(", ")
-            }
-        ));
-    }
-    let undetermined: Vec<&str> = (0..fit.names.len())
-        .filter(|&j| !id.determined[j])
-        .map(|j| fit.names[j].as_str())
-        .collect();
-    if !undetermined.is_empty() {
-        notes.push(match fit.constraint {
-            Constraint::MinimumNorm => format!(
-                "{} are not determined by the data; their values are the minimum-norm (scaled) solution, not measurements",
-                undetermined.join(", ")
-            ),
-            _ => format!(
-                "no value for {}: the data cannot determine them (see `confounded`)",
-                undetermined.join(", ")
-            ),
-        });
-    }
-    if fit.sigma.is_none() {
-        notes.push("no degree of freedom left (3N = rank): no uncertainties".into());
-    }
-    notes
 }

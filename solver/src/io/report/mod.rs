@@ -1,6 +1,6 @@
-//! The reports of rtest as serde types: what `identify`, `validate` and `diagnose` write as
-//! JSON, what their text for people is rendered from ([`crate::io::text`]), and the gain tables
-//! of `gains --format json`.
+//! The reports of rtest as serde types: what `identify`, `validate`, `diagnose` and
+//! `compensate` write as JSON, what their text for people is rendered from
+//! ([`crate::io::text`]), and the gain tables of `gains --format json`.
 //!
 //! Units: translational values in µm, angular values in µrad, lengths and positions in mm,
 //! rotary positions in degrees (field names carry the unit: `_um`, `_deg`; a parameter has its
@@ -12,18 +12,17 @@
 //! - **`null` means "undetermined".** A value, an uncertainty or a condition number the data do
 //!   not determine is `null`; nothing else is.
 //!
-//! The campaign reports ([`campaign`], [`campaign_validate`]) give per-record and per-set-up
-//! values and residuals; [`campaign_read::read_values`] reads either kind of identification back.
-//!
-//! [`identify::IdentificationReport`] can be read back ([`read::IdentifiedValues`]): `validate`
-//! takes its model and values, after checking that it belongs to the machine.
+//! A record is a campaign of one: one identification report
+//! ([`identify::IdentificationReport`]) and one validation report
+//! ([`validate::ValidationReport`]) hold one record or several, each with its set-up. An
+//! identification is read back by one reader ([`read::read_identification`]), whatever its
+//! version and number of records: `validate` and `compensate` take its model and values, after
+//! checking that it belongs to the machine.
 
-pub mod campaign;
 pub mod campaign_diagnose;
-pub mod campaign_read;
-pub mod campaign_validate;
 pub mod compensate;
 pub mod diagnose;
+pub mod fit_summary;
 pub mod gains;
 pub mod identify;
 pub mod plan;
@@ -31,16 +30,14 @@ pub mod read;
 pub mod validate;
 pub mod verdict;
 
-pub use campaign::{CampaignReport, CampaignSource};
-pub use campaign_read::{CampaignRead, ReadValues, read_values};
-pub use campaign_validate::{CampaignValidationReport, CampaignValidationSource};
 pub use diagnose::{DiagnosisReport, DiagnosisSource};
 pub use gains::{GainTableReport, PoseGains, PoseGainsReport};
-pub use identify::{IdentificationReport, IdentificationSource};
+pub use identify::{CampaignSource, IdentificationReport, IdentificationSource};
 pub use read::{IdentifiedValues, ReportError, read_identification};
 pub use validate::{ValidationReport, ValidationSource};
 
 use serde::Serialize;
+use serde::de::{Deserialize, Deserializer, MapAccess, Visitor};
 use serde::ser::{SerializeMap, Serializer};
 
 /// A number that is not finite where a report needs one: the computation behind it failed.
@@ -74,9 +71,29 @@ pub(crate) fn finite_opt(
 }
 
 /// A JSON object whose keys keep the given order (the model's error order, the machine's
-/// axis order).
-#[derive(Clone, Debug, PartialEq)]
+/// axis order), written and read in that order.
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct Ordered<T>(pub Vec<(String, T)>);
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Ordered<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Ordered<T>, D::Error> {
+        struct Entries<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for Entries<T> {
+            type Value = Ordered<T>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an object")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Ordered<T>, A::Error> {
+                let mut out = Vec::new();
+                while let Some((k, v)) = map.next_entry::<String, T>()? {
+                    out.push((k, v));
+                }
+                Ok(Ordered(out))
+            }
+        }
+        d.deserialize_map(Entries(std::marker::PhantomData))
+    }
+}
 
 impl<T: Serialize> Serialize for Ordered<T> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {

@@ -1,31 +1,51 @@
-//! An identification for people, like the seed's Table 4: one row per parameter (value ± std in
-//! µm or µrad, or why there is none; a kinematic offset's change in µm with its nominal and
-//! identified lengths in mm), then rank, condition number, residual RMS, σ̂, the
-//! confounded groups, the nearly confounded pairs and what the zero offsets swallow.
+//! An identification for people, like the seed's Table 4, of one record or of a campaign of
+//! several: what is shared and what belongs to a set-up or a record, the records with their
+//! residuals, then one row per parameter (value ± std in µm or µrad, or why there is none; a
+//! kinematic offset's change in µm with its nominal and identified lengths in mm): the shared
+//! values, one block per set-up and per record; then rank, condition number, residual RMS, σ̂,
+//! the confounded groups, the nearly confounded pairs, what the zero offsets swallow and which
+//! set-up errors the records cannot tell from the machine's.
 
-use super::{value, zeroed_text};
+use super::{header, table, value, zeroed_text};
 use crate::io::report::identify::{IdentificationReport, ParameterReport};
 use model_spec::units::plural;
-use model_spec::units::{fixed, symbol};
+use model_spec::units::{fixed, short, symbol};
 
 /// The whole identification text.
 pub fn identification(r: &IdentificationReport) -> String {
     let n = r.parameters.len();
-    let mut out = format!(
-        "Identification on {} ({} samples, readings {}): machine {}, model {} ({n} parameter{})\n",
-        r.data,
-        r.samples,
-        zeroed_text(r.zeroed),
-        r.machine,
-        r.model,
-        plural(n, "s"),
-    );
+    let mut out = match (&r.data, r.is_campaign()) {
+        (Some(data), false) => format!(
+            "Identification on {data} ({} samples, readings {}): machine {}, model {} ({n} parameter{})\n",
+            r.samples,
+            zeroed_text(r.any_zeroed()),
+            r.machine,
+            r.model,
+            plural(n, "s"),
+        ),
+        _ => format!(
+            "Campaign identification: {} record{} on {} set-up{} ({} samples): machine {}, model {} ({n} parameter{})\n",
+            r.records.len(),
+            plural(r.records.len(), "s"),
+            r.setups.len(),
+            plural(r.setups.len(), "s"),
+            r.samples,
+            r.machine,
+            r.model,
+            plural(n, "s"),
+        ),
+    };
     out.push_str(&method(r));
-    if let Some(n) = &r.noise_model {
+    if let Some(nm) = &r.noise_model {
         out.push_str(&format!(
-            "Noise model (the uncertainties assume it): {}{}.\n",
-            n.text,
-            n.whitened_sigma.map_or(String::new(), |w| format!(
+            "Noise model (the uncertainties assume it{}): {}{}.\n",
+            if r.is_campaign() {
+                "; records independent"
+            } else {
+                ""
+            },
+            nm.text,
+            nm.whitened_sigma.map_or(String::new(), |w| format!(
                 "; σ̂ of the whitened residual {}",
                 fixed(w, 2)
             ))
@@ -49,20 +69,152 @@ pub fn identification(r: &IdentificationReport) -> String {
             (n + 1).pow(2)
         ));
     }
-    if r.zeroed {
-        out.push_str(
-            "Zeroed readings: the R-test zero offsets dx0 dy0 dz0 (constant, µm) are fitted with the model.\n",
-        );
+    if r.is_campaign() {
+        out.push_str(&ownership(r));
+        out.push('\n');
+        out.push_str(&records(r));
+        let shared = r.parameters_of("shared", None);
+        if !shared.is_empty() {
+            out.push_str("\nShared (the machine's errors, one value for the campaign)\n");
+            out.push_str(&parameter_table(&shared, &r.confounded));
+        }
+        for s in &r.setups {
+            let p = r.parameters_of("setup", Some(&s.label));
+            if p.is_empty() {
+                continue;
+            }
+            out.push_str(&format!(
+                "\nSet-up {} (records {})\n",
+                s.label,
+                s.records.join(", ")
+            ));
+            out.push_str(&parameter_table(&p, &r.confounded));
+        }
+        for rec in &r.records {
+            let p = r.parameters_of("record", Some(&rec.label));
+            if p.is_empty() {
+                continue;
+            }
+            out.push_str(&format!(
+                "\nRecord {} (readings {})\n",
+                rec.label,
+                zeroed_text(rec.zeroed)
+            ));
+            out.push_str(&parameter_table(&p, &r.confounded));
+        }
+    } else {
+        if r.any_zeroed() {
+            out.push_str(
+                "Zeroed readings: the R-test zero offsets dx0 dy0 dz0 (constant, µm) are fitted with the model.\n",
+            );
+        }
+        out.push('\n');
+        let all: Vec<&ParameterReport> = r.parameters.iter().collect();
+        out.push_str(&parameter_table(&all, &r.confounded));
     }
     out.push('\n');
-    out.push_str(&parameters(r));
-    out.push('\n');
     out.push_str(&summary(r));
+    for note in r.notes.iter().filter(|n| n.starts_with("the set-up error")) {
+        out.push_str(&format!("{note}\n"));
+    }
     out
 }
 
+/// What is shared and what belongs to a set-up or a record, in a campaign.
+fn ownership(r: &IdentificationReport) -> String {
+    let distinct = |owner: &str| -> Vec<String> {
+        let mut v: Vec<String> = Vec::new();
+        for p in r
+            .parameters
+            .iter()
+            .filter(|p| p.owner.as_deref() == Some(owner))
+        {
+            let bare = p.name.split('[').next().unwrap_or("").to_string();
+            if !v.contains(&bare) {
+                v.push(bare);
+            }
+        }
+        v
+    };
+    let mut out = String::new();
+    let setup = distinct("setup");
+    if !setup.is_empty() {
+        out.push_str(&format!(
+            "Per set-up (the ball's set-up errors, one set per set-up; records with the same set-up label share it): {}.\n",
+            setup.join(" ")
+        ));
+    }
+    let record = distinct("record");
+    if !record.is_empty() {
+        out.push_str(&format!(
+            "Per record (the R-test's zero of zeroed records{}): {}.\n",
+            if r.clock.is_some() {
+                ", its drift"
+            } else {
+                ", drifts on each record's own clock"
+            },
+            record.join(" ")
+        ));
+    }
+    out.push_str("Shared: every other term, the machine's errors.\n");
+    if let Some(c) = &r.clock {
+        out.push_str(&format!(
+            "Campaign clock: the time bases run over {} .. {} s, every record placed by its start.\n",
+            short(c.start_s),
+            short(c.end_s)
+        ));
+    }
+    out
+}
+
+/// The records: set-up, samples, zeroing, kinematic parameters that differ between them,
+/// residual RMS.
+fn records(r: &IdentificationReport) -> String {
+    let head = header(&[
+        "record",
+        "set-up",
+        "data",
+        "samples",
+        "readings",
+        "residual RMS µm",
+        "parameters (mm)",
+    ]);
+    let rows: Vec<Vec<String>> = r
+        .records
+        .iter()
+        .map(|x| {
+            // The parameters that differ between the records (the ball's position).
+            let params: Vec<String> = x
+                .params
+                .0
+                .iter()
+                .filter(|(k, v)| {
+                    r.records
+                        .iter()
+                        .any(|o| o.params.0.iter().any(|(ok, ov)| ok == k && ov != v))
+                })
+                .map(|(k, v)| format!("{k} = {}", short(*v)))
+                .collect();
+            vec![
+                x.label.clone(),
+                x.setup.clone(),
+                x.data.clone(),
+                x.samples.to_string(),
+                if x.zeroed { "zeroed" } else { "not zeroed" }.into(),
+                value(x.residual_rms_um),
+                if params.is_empty() {
+                    "as the others".into()
+                } else {
+                    params.join(", ")
+                },
+            ]
+        })
+        .collect();
+    table(&head, &rows)
+}
+
 /// How the values were computed, one line.
-pub(crate) fn method(r: &IdentificationReport) -> String {
+fn method(r: &IdentificationReport) -> String {
     let gains = match r.gains.as_str() {
         "compiled" => "the compiled (generated) code",
         "evaluator" => "the in-process evaluator",
@@ -97,15 +249,9 @@ pub(crate) fn method(r: &IdentificationReport) -> String {
     )
 }
 
-/// The table of parameters.
-fn parameters(r: &IdentificationReport) -> String {
-    let all: Vec<&ParameterReport> = r.parameters.iter().collect();
-    parameter_table(&all, &r.confounded)
-}
-
 /// The table of `params` (value ± std, or why there is none), `confounded` the fit's groups by
 /// name.
-pub(crate) fn parameter_table(params: &[&ParameterReport], confounded: &[Vec<String>]) -> String {
+pub fn parameter_table(params: &[&ParameterReport], confounded: &[Vec<String>]) -> String {
     let w = params
         .iter()
         .map(|p| p.name.chars().count())
@@ -185,7 +331,7 @@ fn confounded_with(confounded: &[Vec<String>], name: &str) -> Option<String> {
 }
 
 /// Rank, condition, residual, σ̂, confounded groups, near pairs, swallowed errors.
-pub(crate) fn summary(r: &IdentificationReport) -> String {
+fn summary(r: &IdentificationReport) -> String {
     let n = r.parameters.len();
     let mut out = format!(
         "rank {} of {}{}; condition number {} (column-scaled H)\n",

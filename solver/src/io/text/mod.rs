@@ -2,7 +2,6 @@
 //! so that the text and the JSON say the same thing. Numbers are written with
 //! [`model_spec::units`].
 
-pub mod campaign;
 pub mod compensate;
 pub mod diagnose;
 pub mod gains;

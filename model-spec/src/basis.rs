@@ -10,6 +10,10 @@
 //! - `step:V`: 0 below the own axis's position V, 1 from V on (mm, or degrees for a rotary axis);
 //! - `exp:TAU`: 1 − exp(−(t − t₀)/TAU) of the time t since the record's first sample t₀, TAU in
 //!   s (a warm-up, a settling set-up), for effects of no axis;
+//! - `rate`: the time since the stated start, s: its coefficient is a rate (mm/s or rad/s
+//!   inside, µm/s or µrad/s for people), the same physical drift on records of any length;
+//! - `warmup:TAU`: 1 − exp(−(t − start)/TAU) of the time since the stated start, TAU in s: its
+//!   coefficient is the warm-up's asymptotic amplitude;
 //! - `velocity`: −v, the own axis's velocity (mm/ms, rad/ms) with the sign of a lag, for the
 //!   axis's positioning error; its coefficient is the servo lag τ in ms.
 //!
@@ -17,9 +21,18 @@
 //! (cos, then sin). Every basis is evaluated in one place, [`Basis::values`], at a
 //! [`BasisContext`] that the H-matrix builder and the simulator fill alike.
 //!
-//! The scanned parameters of `period`, `step` and `exp` are kept as whole numbers of thousandths
-//! (µm, thousandths of mm or degree, ms), so that a basis is `Copy + Eq + Hash + Ord`; they are
-//! written with at most three decimals and printed as the shortest decimal (`period:2.5`).
+//! **The stated start** of `rate` and `warmup:TAU` is time 0 of the clock the term is on: on a
+//! record's own clock its `t_s = 0` (the instant the record's times count from, whether or not
+//! a sample was taken then), on a campaign clock `T = 0` (the instant the records' starts count
+//! from). `time:K` and `exp:TAU` keep their meaning: normalised over the record, and from its
+//! first sample. A `rate` before its start continues its line (its value there is negative
+//! times the rate); a warm-up before its start is not defined, and a record with a sample there
+//! is refused for a `warmup:TAU` term ([`Basis::counts_from_start`]).
+//!
+//! The scanned parameters of `period`, `step`, `exp` and `warmup` are kept as whole numbers of
+//! thousandths (µm, thousandths of mm or degree, ms), so that a basis is `Copy + Eq + Hash +
+//! Ord`; they are written with at most three decimals and printed as the shortest decimal
+//! (`period:2.5`).
 
 use crate::limits::{MAX_BASIS_ORDER, MAX_LENGTH_MM};
 use crate::{AxisKind, Machine};
@@ -28,7 +41,7 @@ use std::fmt;
 /// Thousandths per unit: the scanned parameters are kept in thousandths of mm, degree or s.
 const MILLI: f64 = 1000.0;
 
-/// The largest time constant of `exp:TAU`, s (about 11.6 days).
+/// The largest time constant of `exp:TAU` and `warmup:TAU`, s (about 11.6 days).
 pub const MAX_TAU_S: f64 = 1e6;
 
 /// One basis of the vocabulary.
@@ -55,6 +68,12 @@ pub enum Basis {
     Exp(u32),
     /// −v, v the own axis's velocity (mm/ms or rad/ms); its coefficient is a lag in ms.
     Velocity,
+    /// t − start, the time since the stated start (s); its coefficient is a rate, mm/s or
+    /// rad/s.
+    Rate,
+    /// 1 − exp(−(t − start)/TAU), t − start the time since the stated start; TAU in ms,
+    /// TAU > 0. Its coefficient is the asymptotic amplitude of the warm-up (mm or rad).
+    Warmup(u32),
 }
 
 /// What a basis needs to know about the effect it multiplies.
@@ -82,6 +101,9 @@ pub struct BasisContext<'a> {
     pub tau: f64,
     /// The time since the record's first sample, s (`exp:TAU`).
     pub elapsed_s: f64,
+    /// The time since the stated start of `rate` and `warmup:TAU`, s: the sample's time on the
+    /// clock the terms are on (a record's own `t_s`, or its time `T` on a campaign clock).
+    pub since_start_s: f64,
     /// The velocity of every axis, mm/ms or rad/ms (`velocity`); empty when no term needs it.
     pub velocity: &'a [f64],
     /// The measured reading x, y, z (mm): to first order the displacement the R-test's
@@ -132,8 +154,8 @@ fn decimal(v: i64) -> String {
 
 impl Basis {
     /// Parses `const`, `harmonic:K`, `poly:K`, `reversal`, `time:K` (K ≥ 1), `period:P`
-    /// (P > 0 mm), `step:V` (mm or degrees), `exp:TAU` (TAU > 0 s) and `velocity`. P, V and TAU
-    /// are decimals with at most three decimals.
+    /// (P > 0 mm), `step:V` (mm or degrees), `exp:TAU` (TAU > 0 s), `velocity`, `rate` and
+    /// `warmup:TAU` (TAU > 0 s). P, V and TAU are decimals with at most three decimals.
     pub fn parse(s: &str) -> Result<Basis, BasisError> {
         let s = s.trim();
         let order = |k: &str, name: &str| -> Result<u32, BasisError> {
@@ -167,6 +189,7 @@ impl Basis {
             None if s == "const" => Ok(Basis::Const),
             None if s == "reversal" => Ok(Basis::Reversal),
             None if s == "velocity" => Ok(Basis::Velocity),
+            None if s == "rate" => Ok(Basis::Rate),
             Some(("harmonic", k)) => Ok(Basis::Harmonic(order(k, "harmonic")?)),
             Some(("poly", k)) => Ok(Basis::Poly(order(k, "poly")?)),
             Some(("time", k)) => Ok(Basis::Time(order(k, "time")?)),
@@ -185,8 +208,14 @@ impl Basis {
                 "the time constant TAU of `exp:TAU` (s)",
                 MAX_TAU_S,
             )?)),
+            Some(("warmup", t)) => Ok(Basis::Warmup(positive(
+                t,
+                "the time constant TAU of `warmup:TAU` (s)",
+                MAX_TAU_S,
+            )?)),
             _ => Err(BasisError(format!(
-                "unknown basis `{s}` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU or velocity)"
+                "unknown basis `{s}` (expected {})",
+                VOCABULARY
             ))),
         }
     }
@@ -211,10 +240,34 @@ impl Basis {
         }
     }
 
-    /// `true` for bases that need the real sample times (`velocity`, `exp:TAU`), not sample
-    /// numbers.
+    /// `true` for bases that need the real sample times (`velocity`, `exp:TAU`, `rate`,
+    /// `warmup:TAU`), not sample numbers.
     pub fn needs_times(self) -> bool {
-        matches!(self, Basis::Velocity | Basis::Exp(_))
+        matches!(
+            self,
+            Basis::Velocity | Basis::Exp(_) | Basis::Rate | Basis::Warmup(_)
+        )
+    }
+
+    /// `true` for bases of time (`time:K`, `exp:TAU`, `rate`, `warmup:TAU`): the effect changes
+    /// over the record, not with the pose; on a campaign clock they run on it.
+    pub fn of_time(self) -> bool {
+        matches!(
+            self,
+            Basis::Time(_) | Basis::Exp(_) | Basis::Rate | Basis::Warmup(_)
+        )
+    }
+
+    /// `true` for the bases that count from the stated start, time 0 of their clock (`rate`,
+    /// `warmup:TAU`), rather than from the record's samples (see the module documentation).
+    pub fn counts_from_start(self) -> bool {
+        matches!(self, Basis::Rate | Basis::Warmup(_))
+    }
+
+    /// `true` for a basis that is not defined before its start (`warmup:TAU`): a record with a
+    /// sample before time 0 of the term's clock is refused for it.
+    pub fn starts_at_zero(self) -> bool {
+        matches!(self, Basis::Warmup(_))
     }
 
     /// The period P of `period:P`, mm.
@@ -225,10 +278,10 @@ impl Basis {
         }
     }
 
-    /// The time constant TAU of `exp:TAU`, s.
+    /// The time constant TAU of `exp:TAU` and `warmup:TAU`, s.
     pub fn tau_s(self) -> Option<f64> {
         match self {
-            Basis::Exp(t) => Some(f64::from(t) / MILLI),
+            Basis::Exp(t) | Basis::Warmup(t) => Some(f64::from(t) / MILLI),
             _ => None,
         }
     }
@@ -243,15 +296,16 @@ impl Basis {
 
     /// Checks that the basis fits an effect carried by `carrier` of machine `m`: harmonics need
     /// a rotary axis, polynomials and periods a linear axis, reversal, steps and velocity an
-    /// axis, `exp:TAU` an effect of no axis. (That `velocity` needs the positioning error, and
-    /// that instrument terms are constants, is checked by [`crate::terms::Term::new`].)
+    /// axis, `exp:TAU` an effect of no axis; `const`, `time:K`, `rate` and `warmup:TAU` fit
+    /// every effect. (That `velocity` needs the positioning error, and that instrument terms
+    /// and kinematic offsets are constants, is checked by [`crate::terms::Term::new`].)
     pub fn check(self, m: &Machine, carrier: Carrier) -> Result<(), BasisError> {
         let kind = match carrier {
             Carrier::Axis(a) => Some(m.axes[a].kind),
             Carrier::None => None,
         };
         match (self, kind) {
-            (Basis::Const | Basis::Time(_), _) => Ok(()),
+            (Basis::Const | Basis::Time(_) | Basis::Rate | Basis::Warmup(_), _) => Ok(()),
             (Basis::Harmonic(_), Some(AxisKind::Rotary)) => Ok(()),
             (Basis::Poly(_) | Basis::Period(_), Some(AxisKind::Linear)) => Ok(()),
             (Basis::Reversal | Basis::Step(_) | Basis::Velocity, Some(_)) => Ok(()),
@@ -307,9 +361,14 @@ impl Basis {
             }
             Basis::Exp(t) => [-(-cx.elapsed_s * MILLI / f64::from(t)).exp_m1(), 0.0],
             Basis::Velocity => [-cx.velocity[axis], 0.0],
+            Basis::Rate => [cx.since_start_s, 0.0],
+            Basis::Warmup(t) => [-(-cx.since_start_s * MILLI / f64::from(t)).exp_m1(), 0.0],
         }
     }
 }
+
+/// The vocabulary as error messages list it.
+const VOCABULARY: &str = "const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate or warmup:TAU";
 
 impl fmt::Display for Basis {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -323,6 +382,8 @@ impl fmt::Display for Basis {
             Basis::Step(v) => write!(f, "step:{}", decimal(*v)),
             Basis::Exp(t) => write!(f, "exp:{}", decimal(i64::from(*t))),
             Basis::Velocity => write!(f, "velocity"),
+            Basis::Rate => write!(f, "rate"),
+            Basis::Warmup(t) => write!(f, "warmup:{}", decimal(i64::from(*t))),
         }
     }
 }
@@ -376,6 +437,10 @@ mod tests {
             ("exp:20", Basis::Exp(20_000)),
             ("exp:0.5", Basis::Exp(500)),
             ("velocity", Basis::Velocity),
+            ("rate", Basis::Rate),
+            ("warmup:40", Basis::Warmup(40_000)),
+            ("warmup:0.125", Basis::Warmup(125)),
+            ("warmup:1000000", Basis::Warmup(1_000_000_000)),
         ] {
             assert_eq!(Basis::parse(s).unwrap(), b, "{s}");
             assert_eq!(b.to_string(), s);
@@ -386,6 +451,13 @@ mod tests {
             "period:2.5"
         );
         assert_eq!(Basis::parse("step:+7.000").unwrap().to_string(), "step:7");
+        assert_eq!(
+            Basis::parse("warmup:40.500").unwrap().to_string(),
+            "warmup:40.5"
+        );
+        assert_eq!(Basis::Rate.column_names(), ["rate"]);
+        assert_eq!(Basis::Warmup(40_000).width(), 1);
+        assert_eq!(Basis::Warmup(40_000).tau_s(), Some(40.0));
         assert_eq!(
             Basis::Period(2500).column_names(),
             ["period:2.5:cos", "period:2.5:sin"]
@@ -408,10 +480,60 @@ mod tests {
             ("step:1000000", "at most"),
             ("exp:2000000", "at most"),
             ("velocity:2", "unknown basis"),
+            ("rate:1", "unknown basis"),
+            ("Rate", "unknown basis"),
+            ("warmup", "unknown basis"),
+            ("warmup:", "three decimals"),
+            ("warmup:0", "positive"),
+            ("warmup:-40", "positive"),
+            ("warmup:4e1", "three decimals"),
+            ("warmup:40.0001", "three decimals"),
+            ("warmup:2000000", "at most"),
         ] {
             let e = Basis::parse(s).unwrap_err().0;
             assert!(e.contains(why), "{s}: {e}");
         }
+    }
+
+    #[test]
+    fn rate_and_warmup_count_from_the_start() {
+        let m = crate::builtin("seed-ac").unwrap().unwrap();
+        let (commands, motion) = (vec![0.0; m.axes.len()], vec![1i8; m.axes.len()]);
+        let at = |since_start_s: f64| BasisContext {
+            commands: &commands,
+            motion: &motion,
+            tau: 0.3,
+            elapsed_s: 7.0,
+            since_start_s,
+            velocity: &[],
+            reading: [0.0; 3],
+        };
+        let v = |b: Basis, t: f64| b.values(&m, Carrier::None, &at(t))[0];
+        assert_eq!(v(Basis::Rate, 125.5), 125.5);
+        assert_eq!(v(Basis::Rate, -2.0), -2.0);
+        assert_eq!(v(Basis::Warmup(40_000), 0.0), 0.0);
+        assert!((v(Basis::Warmup(40_000), 40.0) - (1.0 - (-1.0f64).exp())).abs() < 1e-15);
+        // `time:K` and `exp:TAU` keep their own clocks: the start does not enter them.
+        assert_eq!(v(Basis::Exp(40_000), 1e6), -(-7.0f64 / 40.0).exp_m1());
+        assert_eq!(v(Basis::Time(1), 1e6), 0.3);
+        for b in [Basis::Rate, Basis::Warmup(1)] {
+            assert!(b.needs_times() && b.of_time() && b.counts_from_start());
+        }
+        assert!(Basis::Warmup(1).starts_at_zero() && !Basis::Rate.starts_at_zero());
+        assert!(!Basis::Exp(1).counts_from_start() && Basis::Exp(1).of_time());
+    }
+
+    #[test]
+    fn rate_and_warmup_fit_every_effect() {
+        let m = crate::builtin("seed-ac").unwrap().unwrap();
+        for b in [Basis::Rate, Basis::Warmup(40_000)] {
+            assert!(b.check(&m, Carrier::None).is_ok());
+            for a in 0..m.axes.len() {
+                assert!(b.check(&m, Carrier::Axis(a)).is_ok());
+            }
+        }
+        // `exp:TAU` keeps its carriers.
+        assert!(Basis::Exp(1).check(&m, Carrier::Axis(0)).is_err());
     }
 
     #[test]

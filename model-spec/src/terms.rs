@@ -228,8 +228,9 @@ impl Term {
 
     /// Checks that the basis fits the effect ([`Basis::check`]: harmonics of rotary axes'
     /// component errors, polynomials and periods of linear axes', reversal and steps of any
-    /// axis's, `exp:TAU` of effects of no axis), that `velocity` multiplies a positioning error
-    /// and that an instrument term or a kinematic offset (a symbol of `m`) is a constant.
+    /// axis's, `exp:TAU` of effects of no axis; `time:K`, `rate` and `warmup:TAU` of any
+    /// error or sensor offset), that `velocity` multiplies a positioning error and that an
+    /// instrument term or a kinematic offset (a symbol of `m`) is a constant.
     pub fn check(&self, m: &Machine) -> Result<(), BasisError> {
         if let Effect::KinematicOffset(s) = self.effect {
             if s >= m.symbols.len() {
@@ -263,17 +264,22 @@ impl Term {
         Ok(())
     }
 
-    /// The unit people see of its coefficient: `ms` for `velocity` (the lag τ), `1` for an
-    /// instrument term, else the effect's `um` or `urad`.
+    /// The unit people see of its coefficient: `ms` for `velocity` (the lag τ), `um/s` or
+    /// `urad/s` for `rate` (a rate of the effect per second), `1` for an instrument term, else
+    /// the effect's `um` or `urad`.
     pub fn unit(&self, m: &Machine) -> &'static str {
         match self.basis {
             Basis::Velocity => "ms",
+            Basis::Rate => match self.effect.unit(m) {
+                "urad" => "urad/s",
+                _ => "um/s",
+            },
             _ => self.effect.unit(m),
         }
     }
 
-    /// Decimal places between the unit of its coefficient inside (mm, rad; ms for `velocity`;
-    /// 1 for an instrument term) and [`Term::unit`]: 3, 6 or 0.
+    /// Decimal places between the unit of its coefficient inside (mm, rad; mm/s, rad/s for
+    /// `rate`; ms for `velocity`; 1 for an instrument term) and [`Term::unit`]: 3, 6 or 0.
     pub fn places(&self, m: &Machine) -> i32 {
         match self.basis {
             Basis::Velocity => 0,
@@ -281,8 +287,8 @@ impl Term {
         }
     }
 
-    /// The factor from its coefficient inside to [`Term::unit`]: 1000 (mm → µm), 1e6
-    /// (rad → µrad), 1 (ms, instrument terms).
+    /// The factor from its coefficient inside to [`Term::unit`]: 1000 (mm → µm, mm/s →
+    /// µm/s), 1e6 (rad → µrad, rad/s → µrad/s), 1 (ms, instrument terms).
     pub fn display_factor(&self, m: &Machine) -> f64 {
         10f64.powi(self.places(m))
     }
@@ -496,6 +502,11 @@ pub fn describe_basis(basis: Basis) -> String {
             basis.to_string().trim_start_matches("exp:")
         ),
         Basis::Velocity => "with the axis velocity (servo lag, coefficient in ms)".into(),
+        Basis::Rate => "drifting at a constant rate from the start (per second)".into(),
+        Basis::Warmup(_) => format!(
+            "warming up from the start, time constant {} s (coefficient: the amplitude it tends to)",
+            basis.to_string().trim_start_matches("warmup:")
+        ),
     }
 }
 

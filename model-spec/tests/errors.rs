@@ -997,7 +997,7 @@ fn submodel_term_errors_are_located() {
             r#"errors = ["XOC", "ECC@cubic:2"]"#,
         ),
         &format!(
-            "m.toml:{line}:18: model `reduced`: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU or velocity)"
+            "m.toml:{line}:18: model `reduced`: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate or warmup:TAU)"
         ),
     );
     check(
@@ -1101,6 +1101,88 @@ fn submodels_take_the_new_vocabulary() {
             "{term}: {e}"
         );
     }
+}
+
+#[test]
+fn submodels_take_rates_and_warm_ups() {
+    let text = edit(
+        r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+        r#"errors = ["XOC@rate", "dz0@rate", "ECC@rate", "EXZ@warmup:40", "dx0@warmup:12.500", "BOA@warmup:0.5"]"#,
+    );
+    let m = parse_machine("m.toml", &text).unwrap();
+    let terms = &m.models["reduced"].terms;
+    let spelled: Vec<String> = terms.iter().map(|t| t.spelling(&m)).collect();
+    assert_eq!(
+        spelled,
+        [
+            "XOC@rate",
+            "dz0@rate",
+            "ECC@rate",
+            "EXZ@warmup:40",
+            "dx0@warmup:12.5",
+            "BOA@warmup:0.5"
+        ]
+    );
+    // A rate is per second; a warm-up's value is the amplitude, in the effect's unit.
+    let units: Vec<&str> = terms.iter().map(|t| t.unit(&m)).collect();
+    assert_eq!(units, ["um/s", "um/s", "urad/s", "um", "um", "urad"]);
+    assert_eq!(terms[0].display_factor(&m), 1e3);
+    assert_eq!(terms[2].display_factor(&m), 1e6);
+    let line = BASE
+        .lines()
+        .position(|l| l.contains(r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#))
+        .unwrap()
+        + 1;
+    for (term, col, why) in [
+        ("XOC@rate:1", 11, "unknown basis `rate:1`"),
+        ("XOC@Rate", 11, "unknown basis `Rate`"),
+        ("XOC@warmup", 11, "unknown basis `warmup`"),
+        (
+            "XOC@warmup:0",
+            11,
+            "`warmup:0`: the time constant TAU of `warmup:TAU` (s) must be positive",
+        ),
+        (
+            "XOC@warmup:-5",
+            11,
+            "`warmup:-5`: the time constant TAU of `warmup:TAU` (s) must be positive",
+        ),
+        (
+            "XOC@warmup:1.0001",
+            11,
+            "`warmup:1.0001`: the time constant TAU of `warmup:TAU` (s) must be a decimal number with at most three decimals",
+        ),
+        (
+            "XOC@warmup:2000000",
+            11,
+            "`warmup:2000000`: the time constant TAU of `warmup:TAU` (s) must be at most 1000000 in magnitude",
+        ),
+        (
+            "SXY@rate",
+            11,
+            "SXY: `SXY` is an instrument term of the R-test: constants only, not `rate`",
+        ),
+        (
+            "SZZ@warmup:40",
+            11,
+            "SZZ: `SZZ` is an instrument term of the R-test: constants only, not `warmup:40`",
+        ),
+    ] {
+        let e = err(&edit(
+            r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+            &format!(r#"errors = ["{term}"]"#),
+        ));
+        assert!(
+            e.starts_with(&format!("m.toml:{line}:{col}: model `reduced`: ")) && e.contains(why),
+            "{term}: {e}"
+        );
+    }
+    // A kinematic symbol is a length: constants only.
+    let e = err(&edit(
+        r#"errors = ["XOC", "YOC", "AOC", "BOC"]"#,
+        r#"errors = ["Zc@rate"]"#,
+    ));
+    assert!(e.contains("constants only, not `rate`"), "{e}");
 }
 
 #[test]

@@ -2,8 +2,10 @@
 //! direction of motion of every axis, and (for measured records) the error vector read.
 //!
 //! Times are real (a `t_s` column, or a simulated path) or only sample numbers (a CSV without
-//! `t_s`): [`Sample::timed`] says which. Terms that need real times (`velocity`, `exp:TAU`)
-//! refuse a record whose samples are numbered ([`Record::check_times`]).
+//! `t_s`): [`Sample::timed`] says which. Terms that need real times (`velocity`, `exp:TAU`,
+//! `rate`, `warmup:TAU`) refuse a record whose samples are numbered ([`Record::check_times`]);
+//! a warm-up, which starts at time 0, refuses a record with a sample before it
+//! ([`Record::check_started`]).
 //!
 //! Axis velocities ([`Record::velocities`]) are central differences of the commands over the
 //! times, `v_i = (q_{i+1} − q_{i−1}) / (t_{i+1} − t_{i−1})`, one-sided at the two ends
@@ -112,6 +114,23 @@ impl Record {
             Err(TimesError(format!(
                 "term `{term}` needs the real sample times (a `t_s` column, s), but the record has none: its samples are only numbered"
             )))
+        }
+    }
+
+    /// Checks that `term` (its name, for the message), a warm-up that starts at time 0 of the
+    /// record's clock, can be evaluated on this record: no sample before time 0.
+    ///
+    /// # Errors
+    /// [`TimesError`] naming the term and the first sample before time 0 (its line when the
+    /// record was read from a file).
+    pub fn check_started(&self, term: &str) -> Result<(), TimesError> {
+        match self.samples.iter().position(|s| s.t < 0.0) {
+            None => Ok(()),
+            Some(i) => Err(TimesError(format!(
+                "term `{term}` is a warm-up from time 0 of the record's clock (`t_s` = 0, or T = 0 on a campaign clock), but {} is at {} s, before it: a warm-up before its start is not defined; give the times from the start",
+                self.place(i),
+                model_spec::units::short(self.samples[i].t)
+            ))),
         }
     }
 

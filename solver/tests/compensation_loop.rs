@@ -216,6 +216,7 @@ fn rtest_view(
             motion: &motion,
             tau: 0.0,
             elapsed_s: 0.0,
+            since_start_s: 0.0,
             velocity: &[],
             reading: [0.0; 3],
         };

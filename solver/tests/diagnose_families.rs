@@ -1,6 +1,6 @@
 //! The scanned and new candidate families are found when hidden: a ballscrew period of X, a
-//! step of C, a warm-up of the R-test zero, servo lag of A, cross-talk of the R-test, thermal
-//! drift of an axis line.
+//! step of C, a warm-up of the R-test zero (`warmup:TAU`), servo lag of A, cross-talk of the
+//! R-test, thermal drift of an axis line (`rate`).
 //!
 //! Set-up as `tests/diagnose.rs` (helpers shared): `seed-ac`, the 11 reduced errors, 0.5 µm
 //! white noise, exact virtual machine, fitted on K4, held out K1 and K2, three noise seeds.
@@ -137,8 +137,8 @@ fn a_step_of_c() {
 
 #[test]
 fn a_warm_up_of_the_r_test_zero() {
-    let d = check_scan_free_basis("dz0@exp:20", &[3e-3]);
-    assert!(matches!(d.findings[0].term.basis, Basis::Exp(_)));
+    let d = check_scan_free_basis("dz0@warmup:20", &[3e-3]);
+    assert!(matches!(d.findings[0].term.basis, Basis::Warmup(_)));
 }
 
 /// A warm-up: its time constant is hard to pin on one record; named by family, TAU within a
@@ -177,11 +177,12 @@ fn cross_talk_of_the_r_test() {
     });
 }
 
+/// 10 µm over K4's 240 s (mm/s).
 #[test]
 fn thermal_drift_of_an_axis_line() {
     check_seeds(&Case {
-        term: "YOA@time:1",
-        coefficients: &[5e-3],
+        term: "YOA@rate",
+        coefficients: &[4.17e-5],
         tolerance: None,
     });
 }

@@ -36,10 +36,11 @@ of motion (reversal); the largest components in µm.
 4. Candidates: every term of the machine's topology the model lacks: harmonic:1..K of rotary-axis \
 component errors, poly:1..P of linear-axis component errors (and const of their angular ones), \
 reversal of positioning errors (backlash), const location, squareness and ball set-up errors, \
-the R-test's zero offsets dx0 dy0 dz0 (const and time:1..T: drift); and scanned: period:P \
-(ballscrew, scale) and step:V of positioning errors, exp:TAU (warm-up) of the zero offsets and \
-location errors, time:1 of location errors, velocity (servo lag, records with t_s) of \
-positioning errors, and the instrument terms SXX..SZY (sensor gain and cross-talk).
+the R-test's zero offsets dx0 dy0 dz0 (const, a drift as rate in µm/s, or time:1 on a record \
+without t_s, and time:2..T); and scanned: period:P (ballscrew, scale) and step:V of positioning \
+errors, warmup:TAU (warm-up from t_s = 0) of the zero offsets and location errors, rate of \
+location errors, velocity (servo lag, records with t_s) of positioning errors, and the \
+instrument terms SXX..SZY (sensor gain and cross-talk).
 5. Selection: one candidate at a time, the one that explains most of what is left; kept if its \
 F-test is significant at --alpha after a correction for the number of candidates tried, every \
 scanned value counted (Bonferroni, else a Monte-Carlo null of the selection itself). Candidates \
@@ -147,13 +148,14 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "P", default_value = "3",
           value_parser = clap::value_parser!(u32).range(0..=12))]
     poly: u32,
-    /// Highest Legendre order T in time of the zero-offset drift candidates (time:1..T).
+    /// Highest order T of the zero-offset drift candidates: a linear drift (rate, or time:1 on
+    /// a record without t_s) and time:2..T.
     #[arg(long, value_name = "T", default_value = "2",
           value_parser = clap::value_parser!(u32).range(0..=12))]
     time: u32,
-    /// Largest plausible size of a finding, per unit (`um=100,urad=200,ms=20,1=0.05`; any
-    /// subset, the others keep these defaults): a larger finding fits, but is not named as a
-    /// cause and is left out of the extended model.
+    /// Largest plausible size of a finding, per unit (`um=100,urad=200,ms=20,1=0.05,um/s=0.5,
+    /// urad/s=1`; any subset, the others keep these defaults): a larger finding fits, but is
+    /// not named as a cause and is left out of the extended model.
     #[arg(long, value_name = "UNIT=SIZE,…")]
     budget: Option<String>,
     /// What the fits do with parameters the data cannot determine: `none` (no value),

@@ -32,12 +32,14 @@ pub const UM_PER_MM: f64 = 1e3;
 /// µrad per rad.
 pub const URAD_PER_RAD: f64 = 1e6;
 
-/// The unit symbol people read for an ASCII unit name: `um` → `µm`, `urad` → `µrad`; any
-/// other name unchanged.
+/// The unit symbol people read for an ASCII unit name: `um` → `µm`, `urad` → `µrad`,
+/// `um/s` → `µm/s`, `urad/s` → `µrad/s` (the unit of a `rate` term); any other name unchanged.
 pub fn symbol(unit: &str) -> &str {
     match unit {
         "um" => "µm",
         "urad" => "µrad",
+        "um/s" => "µm/s",
+        "urad/s" => "µrad/s",
         other => other,
     }
 }
@@ -136,6 +138,8 @@ mod tests {
         assert_eq!(p_value(0.0341), "0.034");
         assert_eq!(symbol("um"), "µm");
         assert_eq!(symbol("urad"), "µrad");
+        assert_eq!(symbol("um/s"), "µm/s");
+        assert_eq!(symbol("urad/s"), "µrad/s");
         assert_eq!(symbol("mm"), "mm");
         assert_eq!(compact(1e308), "1e308");
         assert_eq!(compact(-2400.0), "-2400");

@@ -12,7 +12,7 @@
 //! **Left out and listed** ([`LeftOut`], with the value): the workpiece set-up errors
 //! `XOW YOW ZOW` (where the ball was placed), the R-test's zero offsets `dx0 dy0 dz0` and
 //! instrument terms `SXX` … `SZY` (the instrument, not the machine), terms on time bases
-//! (`time:K`, `exp:TAU`: a drift is no function of the pose), `velocity` terms (servo lag: the
+//! (`time:K`, `exp:TAU`, `rate`, `warmup:TAU`: a drift is no function of the pose), `velocity` terms (servo lag: the
 //! controller's feed-forward takes it) and `reversal` terms (backlash: it depends on the
 //! direction of approach, and the controller's backlash compensation takes it).
 //!
@@ -253,8 +253,8 @@ fn left_out_reason(m: &Machine, term: &Term) -> Option<String> {
         (Effect::Error(e), _) if matches!(m.catalogue[e].kind, ErrorKind::Setup { .. }) => {
             "a set-up error of the workpiece (where the ball was placed), not an error of the machine"
         }
-        (_, Basis::Time(_) | Basis::Exp(_)) => {
-            "it changes with time over the record (a drift, a warm-up, a settling), not with the pose: no geometric compensation holds it"
+        (_, b) if b.of_time() => {
+            "it changes with time over the record (a drift, a rate, a warm-up, a settling), not with the pose: no geometric compensation holds it"
         }
         (_, Basis::Velocity) => {
             "servo lag (the coefficient is the lag in ms): the controller's feed-forward takes it, not a geometric compensation"
@@ -495,6 +495,7 @@ impl MachineErrors {
             motion: &self.motion,
             tau: 0.0,
             elapsed_s: 0.0,
+            since_start_s: 0.0,
             velocity: &[],
             reading: [0.0; 3],
         };

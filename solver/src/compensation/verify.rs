@@ -16,6 +16,7 @@ pub fn machine_errors_at(m: &Machine, truth: &Truth, commands: &[f64]) -> Vec<f6
         motion: &motion,
         tau: 0.0,
         elapsed_s: 0.0,
+        since_start_s: 0.0,
         velocity: &[],
         reading: [0.0; 3],
     };

@@ -6,10 +6,19 @@
 //!   constant pitch, yaw or roll is a misalignment, and its gains vary with the pose);
 //! - positioning errors of every axis (`EXX`, `ECC`, …): also `reversal`;
 //! - location, squareness and set-up errors: `const`;
-//! - the R-test's zero offsets `dx0 dy0 dz0`: `const` and `time:1..T` (drift).
+//! - the R-test's zero offsets `dx0 dy0 dz0`: `const` and `time:2..T` (a curved drift); their
+//!   linear drift depends on the record ([`scanned`]).
 //!
 //! Constant translational component errors, and constant angular component errors of rotary
 //! axes, are not candidates: they are the location and set-up errors under other names.
+//!
+//! The record-dependent candidates ([`scanned`]):
+//! - the linear drift of `dx0 dy0 dz0` (when T ≥ 1) and, with the scanned families, of every
+//!   location error (thermal drift of an axis line): `rate` on a record with real times, so
+//!   that a finding reads as a physical rate (µm/s, µrad/s) that means the same on a record of
+//!   any length; `time:1` on a record whose samples are only numbered (a drift over the
+//!   record, normalised to it). Given a constant in the same direction, the two have one span:
+//!   `rate` is `time:1` renamed, with a value that does not depend on the record's length.
 //!
 //! Families with a scanned parameter ([`scanned`], when [`DictionaryOptions::scans`] is on):
 //! every scanned value is a candidate of its own, so the multiple-testing correction counts
@@ -22,10 +31,12 @@
 //!   [`PERIOD_RANGE_MM`];
 //! - `step:V` of the positioning error of every axis that moves: [`STEPS`] positions evenly
 //!   between the 5 % and 95 % quantiles of the positions the record covers;
-//! - `exp:TAU` of `dx0 dy0 dz0` and of every location error (records with real times only):
-//!   [`TAUS`] time constants, geometric from two sample intervals to half the record's
-//!   duration (a longer warm-up is a linear drift over the record: `time:1`);
-//! - `time:1` of every location error (thermal drift of an axis line);
+//! - `warmup:TAU` of `dx0 dy0 dz0` and of every location error (records with real times
+//!   only): [`TAUS`] time constants, geometric from two sample intervals to half the record's
+//!   duration (a longer warm-up is a linear drift over the record: `rate`); the warm-up counts
+//!   from the record's time 0, so that a finding reads as a time constant and the amplitude
+//!   the warm-up tends to. A record with samples before its time 0 gets `exp:TAU` instead
+//!   (from its first sample: a warm-up before its start is not defined);
 //! - `velocity` of the positioning error of every axis that moves (records with real times);
 //! - the R-test's instrument terms `SXX … SZY`, constant.
 
@@ -41,7 +52,8 @@ pub struct DictionaryOptions {
     pub harmonics: u32,
     /// Highest Legendre order P of linear-axis errors.
     pub poly: u32,
-    /// Highest Legendre order T in time of the sensor offsets.
+    /// Highest order T of the sensor offsets' drift: the linear drift (`rate`, or `time:1` on a
+    /// record without real times) when T ≥ 1, and `time:2..T`.
     pub time: u32,
     /// The scanned families (period, step, warm-up), servo lag, thermal drift of axis lines
     /// and the instrument terms.
@@ -50,7 +62,7 @@ pub struct DictionaryOptions {
 
 impl DictionaryOptions {
     /// Harmonics 1..`harmonics` of rotary-axis errors, Legendre orders 1..`poly` of
-    /// linear-axis errors, orders 1..`time` in time of the sensor offsets.
+    /// linear-axis errors, drifts of orders 1..`time` of the sensor offsets.
     pub fn new(harmonics: u32, poly: u32, time: u32) -> DictionaryOptions {
         DictionaryOptions {
             harmonics,
@@ -77,7 +89,7 @@ fn bases(m: &Machine, effect: Effect, o: &DictionaryOptions) -> Vec<Basis> {
     let e = match effect {
         Effect::SensorOffset(_) => {
             return std::iter::once(Basis::Const)
-                .chain((1..=o.time).map(Basis::Time))
+                .chain((2..=o.time).map(Basis::Time))
                 .collect();
         }
         Effect::Instrument { .. } | Effect::KinematicOffset(_) => return vec![Basis::Const],
@@ -134,7 +146,7 @@ pub const PERIOD_RANGE_MM: [f64; 2] = [1.0, 100.0];
 /// Positions scanned per axis for `step:V`.
 pub const STEPS: usize = 24;
 
-/// Time constants scanned for `exp:TAU`.
+/// Time constants scanned for `warmup:TAU`.
 pub const TAUS: usize = 8;
 
 /// Sorted copy.
@@ -151,8 +163,23 @@ pub fn scanned(
     record: &crate::record::Record,
     o: &DictionaryOptions,
 ) -> Vec<Term> {
+    // A linear drift: a rate where the record has real times, else over the record.
+    let drift = if record.has_times() {
+        Basis::Rate
+    } else {
+        Basis::Time(1)
+    };
+    let offsets: Vec<Term> = Dir::ALL
+        .into_iter()
+        .filter(|_| o.time >= 1)
+        .map(|d| Term {
+            effect: Effect::SensorOffset(d),
+            basis: drift,
+        })
+        .filter(|t| !model_terms.contains(t))
+        .collect();
     if !o.scans || record.samples.len() < 3 {
-        return Vec::new();
+        return offsets;
     }
     let mut out = Vec::new();
     let positioning = |axis: usize| -> Option<Effect> {
@@ -230,14 +257,26 @@ pub fn scanned(
         .filter(|&e| matches!(m.catalogue[e].kind, ErrorKind::Location { .. }))
         .map(Effect::Error)
         .collect();
+    // The R-test's zero first: where its drift and an axis line's explain alike, the
+    // instrument's is named (the selection takes the first of equals).
+    out.extend(offsets);
     for &effect in &location {
         out.push(Term {
             effect,
-            basis: Basis::Time(1),
+            basis: drift,
         });
     }
     if record.has_times() {
         let t0 = record.samples[0].t;
+        // A warm-up from the record's time 0; from its first sample (`exp:TAU`) when samples
+        // come before time 0, where a warm-up is not defined.
+        let warmup = |ms: u32| {
+            if t0 >= 0.0 {
+                Basis::Warmup(ms)
+            } else {
+                Basis::Exp(ms)
+            }
+        };
         let duration = record.samples[record.samples.len() - 1].t - t0;
         let dt = duration / (record.samples.len() - 1) as f64;
         if duration > 0.0 && dt > 0.0 {
@@ -256,7 +295,7 @@ pub fn scanned(
                 for &ms in &taus {
                     out.push(Term {
                         effect,
-                        basis: Basis::Exp(ms),
+                        basis: warmup(ms),
                     });
                 }
             }

@@ -1,5 +1,5 @@
-//! The scanned parameter of a finding (P of `period:P`, V of `step:V`, TAU of `exp:TAU`),
-//! refined and given an interval from the profile of the fit.
+//! The scanned parameter of a finding (P of `period:P`, V of `step:V`, TAU of `warmup:TAU` and
+//! `exp:TAU`), refined and given an interval from the profile of the fit.
 //!
 //! The selection picks the best value of the coarse grid ([`super::dictionary::scanned`]). Here
 //! the parameter is scanned again on a fine grid around it (41 values: ±1 coarse step in 1/P,
@@ -46,6 +46,7 @@ fn with_parameter(basis: Basis, v: f64) -> Basis {
     match basis {
         Basis::Period(_) => Basis::Period(milli.max(1.0) as u32),
         Basis::Exp(_) => Basis::Exp(milli.max(1.0) as u32),
+        Basis::Warmup(_) => Basis::Warmup(milli.max(1.0) as u32),
         Basis::Step(_) => Basis::Step(milli as i64),
         other => other,
     }
@@ -81,7 +82,7 @@ fn grid(basis: Basis, x: &[f64], tau_range: (f64, f64)) -> Vec<f64> {
             out.dedup();
             out
         }
-        Basis::Exp(_) => {
+        Basis::Exp(_) | Basis::Warmup(_) => {
             let t = basis.tau_s().unwrap_or(1.0);
             let (lo, hi) = tau_range;
             (0..n)

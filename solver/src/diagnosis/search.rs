@@ -125,9 +125,8 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         // and a random-walk drift of the instrument is never named a geometric cause.
         let rank = |t: &Term| -> u8 {
             use model_spec::ErrorKind::{Location, Setup, Squareness};
-            use model_spec::basis::Basis::{Exp, Time};
             match (t.effect, t.basis) {
-                (model_spec::terms::Effect::SensorOffset(_), Time(_) | Exp(_)) => 0,
+                (model_spec::terms::Effect::SensorOffset(_), b) if b.of_time() => 0,
                 (model_spec::terms::Effect::Error(e), _)
                     if matches!(
                         m.catalogue[e].kind,
@@ -258,11 +257,11 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
     // second one (a period 0.3 % off the chosen one only mops up what the coarse grid left):
     // periods within 2 %, warm-ups within a factor 3.
     let same_finding = |a: &Term, b: &Term| -> bool {
-        use model_spec::basis::Basis::{Exp, Period};
+        use model_spec::basis::Basis::{Exp, Period, Warmup};
         a.effect == b.effect
             && match (a.basis, b.basis) {
                 (Period(p), Period(q)) => (f64::from(p) - f64::from(q)).abs() < 0.02 * f64::from(q),
-                (Exp(p), Exp(q)) => {
+                (Exp(p), Exp(q)) | (Warmup(p), Warmup(q)) => {
                     let r = f64::from(p.max(q)) / f64::from(p.min(q).max(1));
                     r < 3.0
                 }

@@ -22,8 +22,12 @@
 //!   tool-minus-workpiece vector with respect to the symbol, mm/mm
 //!   ([`crate::fitting::offsets`]); their coefficient is the symbol's change, mm.
 //! - `velocity` terms need the whole record (central differences across samples) and real
-//!   times; `exp:TAU` needs real times: a record whose samples are numbered is refused
-//!   ([`HMatrixError::Times`]).
+//!   times; `exp:TAU`, `rate` and `warmup:TAU` need real times: a record whose samples are
+//!   numbered is refused ([`HMatrixError::Times`]), and so is, for `warmup:TAU`, a record with
+//!   a sample before time 0 of its clock (the warm-up's start).
+//! - `rate` and `warmup:TAU` count from time 0 of the record's clock: the sample's time `t`
+//!   (s) itself, on the record's own clock or, for a record moved onto a campaign clock, on
+//!   that clock.
 //!
 //! With `p` in mm (translational), rad (angular), ms (`velocity`) and 1 (instrument terms),
 //! `H · p` is in mm.
@@ -480,6 +484,11 @@ fn times_for(
             .check_times(&t.spelling(m))
             .map_err(|e| times_err(t, e.0))?;
     }
+    if let Some(t) = model.terms.iter().find(|t| t.basis.starts_at_zero()) {
+        record
+            .check_started(&t.spelling(m))
+            .map_err(|e| times_err(t, e.0))?;
+    }
     match model.terms.iter().find(|t| t.basis == Basis::Velocity) {
         Some(t) if block => Err(times_err(
             t,
@@ -542,8 +551,8 @@ pub fn h_matrix(
 
 /// [`h_matrix`] of a block of a longer record: `time_span` `(t0, t1)` (s) is the whole
 /// record's, so that `time:K` terms are normalised over the record and `exp:TAU` counts from
-/// its first sample, not the block's. With a `time_span`, `velocity` terms are refused (they
-/// need the whole record).
+/// its first sample, not the block's (`rate` and `warmup:TAU` count from time 0 and need no
+/// span). With a `time_span`, `velocity` terms are refused (they need the whole record).
 pub fn h_matrix_spanned(
     m: &Machine,
     model: &Model,
@@ -613,6 +622,7 @@ pub fn h_matrix_spanned(
             motion: &s.motion,
             tau,
             elapsed_s,
+            since_start_s: s.t,
             velocity: velocities.get(i * n_axes..(i + 1) * n_axes).unwrap_or(&[]),
             reading: record.measured.get(i).copied().unwrap_or([0.0; 3]),
         };

@@ -7,8 +7,9 @@
 //! polynomial's coefficient). Real geometric errors of machine tools are tens of µm and µrad;
 //! the bounds leave two orders of magnitude for set-ups far off nominal. A servo lag
 //! (`velocity`) is bounded by 1000 ms (real lags are tens of ms), an instrument term by 0.5
-//! (real gain errors and cross-talk are below a few per cent). They are a data sanity check,
-//! separate from the diagnosis's plausibility budget of a finding.
+//! (real gain errors and cross-talk are below a few per cent), a `rate` by the bound of its
+//! effect per second (1 mm/s, 10 mrad/s: thermal drifts are µm per minute). They are a data
+//! sanity check, separate from the diagnosis's plausibility budget of a finding.
 
 use super::identify::Identification;
 use crate::model::{Basis, Effect, Model};
@@ -83,6 +84,9 @@ fn other_bounds(values: &[(String, f64, &'static str)], limits: &ValueLimits) ->
     }
     if values.iter().any(|v| v.2 == "1") {
         s += &format!(", {} for instrument terms", short(limits.instrument));
+    }
+    if values.iter().any(|v| v.2.ends_with("/s")) {
+        s += ", the same per s for rates";
     }
     s
 }

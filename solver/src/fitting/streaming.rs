@@ -100,6 +100,7 @@ pub enum StreamingError<E: std::error::Error + 'static> {
     Estimate(#[from] EstimateError),
     /// The record must be read twice (a model with `time:K` or `exp:TAU` terms needs its time
     /// span first) but is not a regular file (a pipe or a device can be read once only).
+    /// `rate` and `warmup:TAU` count from time 0 and need no span.
     #[error(
         "`{0}`: a model with time:K or exp:TAU terms reads the record twice (its time span first), so it must be a regular file, not a pipe or a device"
     )]
@@ -122,7 +123,8 @@ pub struct StreamingIdentification {
 }
 
 /// Identifies `model` from `blocks` of one record (each a [`Record`] with measurements;
-/// `time_span` `(t0, t1)` is the whole record's, s, for `time:K` and `exp:TAU` terms), with
+/// `time_span` `(t0, t1)` is the whole record's, s, for `time:K` and `exp:TAU` terms; `rate`
+/// and `warmup:TAU` count from the record's time 0 and need none), with
 /// gains from `source`. First-order least squares, as [`crate::fitting::identify_with`] without
 /// the refinement (which needs the whole record).
 ///
@@ -189,7 +191,9 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
 /// samples with `read` (never the whole record, never the whole H): first-order least
 /// squares, with the options of [`crate::fitting::identify()`] (zeroed readings add
 /// `dx0 dy0 dz0`). A model with `time:K` or `exp:TAU` terms costs one more pass over the file
-/// for the record's time span; `velocity` terms are refused ([`identify_streaming`]). Fewer readings than parameters plus one is an error, as in memory.
+/// for the record's time span (`rate` and `warmup:TAU` do not: they count from time 0, and
+/// are read from a pipe in one pass); `velocity` terms are refused ([`identify_streaming`]).
+/// Fewer readings than parameters plus one is an error, as in memory.
 pub fn identify_file(
     m: &Machine,
     model: &Model,

@@ -1,8 +1,10 @@
 //! Simulated R-test readings: the exact virtual machine run with a [`Truth`] along a path.
 //!
 //! At every sample `i` of the path, with commands `q` (mm, rad), directions of motion,
-//! normalised time `τ = record.tau(i)`, time since the first sample and (for `velocity` terms)
-//! the axis velocities of [`Record::velocities`] — the [`BasisContext`] the H matrix uses too:
+//! normalised time `τ = record.tau(i)`, time since the first sample, the sample's time `t`
+//! itself (the time since the start of `rate` and `warmup:TAU`: the path's `t = 0`) and (for
+//! `velocity` terms) the axis velocities of [`Record::velocities`] — the [`BasisContext`] the H
+//! matrix uses too:
 //! 1. the truth gives every catalogue error's value and the sensor zero offsets
 //!    ([`Truth::evaluate_into`]);
 //! 2. the exact chains (no linearisation) with the truth's kinematic parameters give the error
@@ -47,8 +49,9 @@ pub enum SimulateError {
         /// The machine's number of axes.
         axes: usize,
     },
-    /// The truth has `velocity` or `exp:TAU` terms and the path has no real times (or too few
-    /// samples, or equal times, for velocities).
+    /// The truth has `velocity`, `exp:TAU`, `rate` or `warmup:TAU` terms and the path has no
+    /// real times (or too few samples, or equal times, for velocities; or, for a warm-up, a
+    /// sample before time 0).
     #[error("truth {source_name}: {why}")]
     Times {
         /// The truth's source.
@@ -85,6 +88,9 @@ pub fn simulate(m: &Machine, truth: &Truth, path: &Record) -> Result<Record, Sim
     if let Some(t) = truth.model.terms.iter().find(|t| t.basis.needs_times()) {
         path.check_times(&t.spelling(m)).map_err(times_err)?;
     }
+    if let Some(t) = truth.model.terms.iter().find(|t| t.basis.starts_at_zero()) {
+        path.check_started(&t.spelling(m)).map_err(times_err)?;
+    }
     let n_axes = m.axes.len();
     let velocities = match truth
         .model
@@ -112,6 +118,7 @@ pub fn simulate(m: &Machine, truth: &Truth, path: &Record) -> Result<Record, Sim
             motion: &s.motion,
             tau: path.tau(i),
             elapsed_s: path.elapsed_s(i),
+            since_start_s: s.t,
             velocity: velocities.get(i * n_axes..(i + 1) * n_axes).unwrap_or(&[]),
             reading: [0.0; 3],
         };

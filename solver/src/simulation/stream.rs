@@ -17,7 +17,9 @@
 //! - **Readings.** At each instant the readings are those of [`crate::simulation::simulate`]
 //!   at the commanded pose: the truth's errors at the pose (its time bases evaluated at the
 //!   program time, normalised over the span from the first to the last measuring window's
-//!   middle; `velocity` terms at the axes' velocities of the moment), the exact error vector,
+//!   middle, `exp:TAU` from the first window's middle, `rate` and `warmup:TAU` from the
+//!   program's start, the plan's time 0, and at their value there, 0, in the lead before it;
+//!   `velocity` terms at the axes' velocities of the moment), the exact error vector,
 //!   the instrument terms and sensor offsets, then the truth's noise per reading (σ, AR(1)
 //!   with φ per log row) and its zeroing at the log's first row. At rest the readings are
 //!   exactly those the static simulation gives at the same pose.
@@ -146,7 +148,7 @@ pub fn write_stream<W: Write>(
         .model
         .terms
         .iter()
-        .any(|t| matches!(t.basis, Basis::Time(_) | Basis::Exp(_) | Basis::Velocity));
+        .any(|t| t.basis.of_time() || t.basis == Basis::Velocity);
     let end = times[n - 1].1;
     let total = opts.lead_s + end + opts.tail_s;
     let count = (total * opts.rate_hz).floor() as usize + 1;
@@ -221,6 +223,7 @@ pub fn write_stream<W: Write>(
                         0.0
                     },
                     elapsed_s: t - first,
+                    since_start_s: t.max(0.0),
                     velocity: &velocity,
                     reading: [0.0; 3],
                 };

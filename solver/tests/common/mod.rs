@@ -97,6 +97,7 @@ pub fn context(s: &Sample, tau: f64) -> BasisContext<'_> {
         motion: &s.motion,
         tau,
         elapsed_s: 0.0,
+        since_start_s: 0.0,
         velocity: &[],
         reading: [0.0; 3],
     }

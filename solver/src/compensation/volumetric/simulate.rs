@@ -133,6 +133,7 @@ pub fn exact_tool(
         motion: &motion,
         tau: 0.0,
         elapsed_s: 0.0,
+        since_start_s: 0.0,
         velocity: &[],
         reading: [0.0; 3],
     };

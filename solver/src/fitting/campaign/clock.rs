@@ -3,11 +3,14 @@
 //! A record's samples carry their time since the record's start (`t`, s). With a start `s_r` on
 //! the campaign clock ([`super::CampaignRecord::start_s`]) sample `i` of record `r` is at
 //! `T = s_r + t_i` on the campaign clock. The campaign's span `[T₀, T₁]` runs from the first
-//! sample of all records to the last. The time bases are then taken on that clock:
+//! sample of all records to the last; the campaign's start is `T = 0`, the instant the records'
+//! starts count from. The time bases are then taken on that clock:
 //!
 //! ```text
-//! time:K   P_K(τ),  τ = 2·(T − T₀)/(T₁ − T₀) − 1      (0 when T₁ = T₀)
-//! exp:TAU  1 − exp(−(T − T₀)/TAU)
+//! time:K      P_K(τ),  τ = 2·(T − T₀)/(T₁ − T₀) − 1      (0 when T₁ = T₀)
+//! exp:TAU     1 − exp(−(T − T₀)/TAU)
+//! rate        T                                          (s since the campaign's start)
+//! warmup:TAU  1 − exp(−T/TAU)
 //! ```
 //!
 //! so that one coefficient describes one drift over the whole campaign (a warm-up that goes on
@@ -16,9 +19,11 @@
 //! The exact machine evaluates time bases on a record's own clock. A term on the campaign clock
 //! is, on record `r`, exactly a combination of terms on the record's own clock
 //! ([`own_clock_terms`]): `τ = a·τ_r + b` is affine in the record's own normalised time `τ_r`,
-//! so `P_K(a·τ_r + b) = Σ_{j≤K} c_j·P_j(τ_r)` (`P_0` the constant), and
+//! so `P_K(a·τ_r + b) = Σ_{j≤K} c_j·P_j(τ_r)` (`P_0` the constant);
 //! `1 − e^{−(T−T₀)/TAU} = (1 − e^{−δ/TAU}) + e^{−δ/TAU}·(1 − e^{−(t−t_first)/TAU})` with
-//! `δ = s_r + t_first − T₀`. The refinement and the exact validation use that rewriting.
+//! `δ = s_r + t_first − T₀`; `T = s_r + t` is a constant plus the record's own `rate`; and
+//! `1 − e^{−T/TAU} = (1 − e^{−s_r/TAU}) + e^{−s_r/TAU}·(1 − e^{−t/TAU})`, a constant plus the
+//! record's own `warmup:TAU`. The refinement and the exact validation use that rewriting.
 
 use crate::model::{Basis, Model, Term};
 use crate::record::Record;
@@ -41,9 +46,10 @@ pub fn span(records: &[(&Record, Option<f64>)]) -> Option<(f64, f64)> {
     out
 }
 
-/// `true` for a basis whose value depends on the clock (`time:K`, `exp:TAU`).
+/// `true` for a basis whose value depends on the clock (`time:K`, `exp:TAU`, `rate`,
+/// `warmup:TAU`: [`Basis::of_time`]).
 pub fn on_clock(b: Basis) -> bool {
-    matches!(b, Basis::Time(_) | Basis::Exp(_))
+    b.of_time()
 }
 
 /// `record` with every sample's time moved to the campaign clock (`t + start`, s).
@@ -166,6 +172,18 @@ pub fn own_clock_terms(
                 let keep = (-delta / tau).exp();
                 add(with(Basis::Const), &[v[0] * -(-delta / tau).exp_m1()]);
                 add(with(t.basis), &[v[0] * keep]);
+            }
+            // T = s_r + t: the rate times the record's start, then the record's own rate.
+            Basis::Rate => {
+                add(with(Basis::Const), &[v[0] * start_s]);
+                add(*t, v);
+            }
+            // 1 − e^{−(s_r + t)/TAU}: the part reached at the record's start, then the rest of
+            // the warm-up, from the record's own time 0, scaled by what is left of it.
+            Basis::Warmup(_) => {
+                let tau = t.basis.tau_s().unwrap_or(1.0);
+                add(with(Basis::Const), &[v[0] * -(-start_s / tau).exp_m1()]);
+                add(*t, &[v[0] * (-start_s / tau).exp()]);
             }
             _ => add(*t, v),
         }

@@ -21,9 +21,14 @@
 //! record must be modelled with the same value of it
 //! ([`crate::fitting::offsets::check_shared_symbols`]).
 //!
+//! The time bases are `time:K`, `exp:TAU`, `rate` and `warmup:TAU` ([`super::clock::on_clock`]).
 //! With a campaign clock (every record has a start, [`super::clock`]) terms of a time basis
-//! other than sensor offsets are shared: one drift over the campaign. Instrument terms
-//! (`SXX` … `SZY`, the sensor's gains) are shared: one instrument.
+//! other than sensor offsets are shared: one drift over the campaign (`XOC@rate`: one rate of
+//! the C axis line; `EXZ@warmup:40`: one warm-up from the campaign's start). On the records'
+//! own clocks they are the record's, as a drift of the R-test's zero always is: a `rate` means
+//! the same µm/s on a record of 60 s and one of 600 s, so the records' values can be compared,
+//! but nothing says the machine drifted alike during both. Instrument terms (`SXX` … `SZY`,
+//! the sensor's gains) are shared: one instrument.
 //!
 //! **Rows**: the records' rows one after the other (three per sample, x y z), in campaign
 //! order. Record `r`'s block is the H matrix of its own model (the model with its zero offsets

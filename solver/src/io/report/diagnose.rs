@@ -412,7 +412,7 @@ impl DiagnosisReport {
                 scan: f.scan.map(|sc| {
                     let (parameter, unit) = match f.term.basis {
                         Basis::Period(_) => ("P", "mm"),
-                        Basis::Exp(_) => ("TAU", "s"),
+                        Basis::Exp(_) | Basis::Warmup(_) => ("TAU", "s"),
                         _ => match f.term.effect.carrier(m) {
                             Carrier::Axis(a) if m.axes[a].kind == model_spec::AxisKind::Rotary => {
                                 ("V", "deg")

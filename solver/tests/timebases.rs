@@ -19,6 +19,7 @@ use common::builtin;
 use model_spec::Machine;
 use nalgebra::DVector;
 use solver::compensation::values::MachineErrors;
+use solver::fitting::campaign::CampaignValues;
 use solver::fitting::campaign::clock::{own_clock_terms, shifted};
 use solver::fitting::campaign::design::block;
 use solver::fitting::campaign::{Campaign, CampaignRecord, identify_campaign_refined};
@@ -27,7 +28,6 @@ use solver::fitting::noise::NoiseChoice;
 use solver::fitting::refine::{RefineOptions, exact_prediction};
 use solver::fitting::streaming::identify_streaming;
 use solver::fitting::{Constraint, IdentifyOptions, Tolerances, identify};
-use solver::io::report::IdentifiedValues;
 use solver::model::{Basis, Model, Term};
 use solver::record::Record;
 use solver::simulation::paths::builtin_path;
@@ -385,20 +385,8 @@ fn compensation_leaves_rates_and_warm_ups_out_and_lists_them() {
     let m = builtin("seed-ac");
     let model = model(&m, &["XOC", "XOC@rate", "BOA@warmup:40", "ECC@rate"]);
     let values = vec![Some(1e-2), Some(2e-5), Some(3e-5), Some(4e-8)];
-    let n = values.len();
-    let id = IdentifiedValues {
-        file: "id.json".into(),
-        machine: m.name.clone(),
-        fingerprint: m.fingerprint(),
-        model_name: "test".into(),
-        model,
-        determined: vec![true; n],
-        std: vec![None; n],
-        fixed: vec![false; n],
-        values,
-        constraint: "none".into(),
-    };
-    let (errors, left_out) = MachineErrors::from_identified(&m, &id).unwrap();
+    let id = CampaignValues::of_model(&m, &model, &values, "k4", m.default_parameters()).unwrap();
+    let (errors, left_out) = MachineErrors::from_values(&m, &id, "id.json").unwrap();
     let out: Vec<&str> = left_out.iter().map(|l| l.term.as_str()).collect();
     assert_eq!(out, ["XOC@rate", "BOA@warmup:40", "ECC@rate"]);
     for l in &left_out {

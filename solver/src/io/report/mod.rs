@@ -19,7 +19,6 @@
 //! takes its model and values, after checking that it belongs to the machine.
 
 pub mod campaign;
-pub mod campaign_diagnose;
 pub mod campaign_read;
 pub mod campaign_validate;
 pub mod compensate;

@@ -767,3 +767,23 @@ fn one_record_is_the_campaign_of_that_record() {
     );
     assert!(!dir.join("r.html").exists());
 }
+
+/// The refinement never throws away a converged fit: K4 and K1 of the full error budget (noise
+/// seeds 1 and 2) fitted together, K2 (seed 3) held out, stopped with exit code 3 when a step
+/// of 3e-9 µm was held against a tolerance of 1e-9 µm; the diagnosis now completes.
+#[test]
+fn the_budget_campaign_whose_refinement_crawled_at_rounding_is_diagnosed() {
+    let dir = temp_dir("budget");
+    simulate_all(&dir, "seed-ac-budget", &[]);
+    let text = ok(
+        &dir,
+        &common::words(
+            "diagnose --machine seed-ac --model reduced --data k4.csv,k1.csv --validate k2.csv \
+             --json d.json",
+        ),
+    );
+    assert!(!text.contains("did not converge"), "{text}");
+    let j = read_json(&dir.join("d.json"));
+    assert!(!j["findings"].as_array().unwrap().is_empty());
+    assert_eq!(j["records"].as_array().unwrap().len(), 3);
+}

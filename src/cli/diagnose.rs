@@ -58,26 +58,34 @@ confirmed' and the text says why.
 
 Values of findings are in µm (translational errors, offsets) and µrad (angular errors); a \
 harmonic is printed as its cos and sin coefficients, its amplitude √(cos² + sin²) and phase φ \
-(cos·cos kθ + sin·sin kθ = amplitude·cos(kθ − φ)). A fit whose refinement does not converge, or \
-whose values are beyond --max-error-um / --max-error-urad, is an error (exit code 3).
+(cos·cos kθ + sin·sin kθ = amplitude·cos(kθ − φ)). Every fit is refined against the exact \
+machine and has converged when its last step moves the prediction by less than max(1e-6 µm, \
+1e-6·σ) or the rounding floor of the evaluation. A base fit whose refinement does not converge, \
+or whose values are beyond --max-error-um / --max-error-urad, is an error (exit code 3); a \
+finding whose extended fit does not converge is dropped, and the text and the JSON say so.
 
 Campaigns (docs/campaigns.md, docs/diagnosis.md): --data a.csv,b.csv or --campaign FILE fits \
 the base model on several records together (each its own ball set-up and R-test zero, the \
-machine's errors shared); held-out records come from --validate (each on a new set-up, whose \
-set-up errors are refitted with the machine held) or --validate-campaign FILE. Scanned \
-parameters keep their grid value and --plot is not available on campaigns.
+machine's errors shared); one file is the campaign of that record, and everything above works \
+alike. Held-out records come from --validate (on the fitted records' set-up when they have one, \
+the ball not moved; else each on a set-up of its own, whose set-up errors are refitted with \
+the machine held) or --validate-campaign FILE; a held-out record's own zero (--zeroed) and \
+drifts are refitted on it. --instrument reads every record through an R-test head: each \
+sample is weighted by the covariance its sensors give it.
 
 --report FILE writes the HTML report of the diagnosis (docs/report.md): findings, gain, what \
-remains, the residual components and, for one record, the measured-against-predicted figures \
-of every record inline.
+remains, the residual components and the measured-against-predicted figures of every record \
+inline.
 
---json writes the report (docs/diagnosis.md): {machine, data, base_model, zeroed, alpha, \
-base_fit, structure, dictionary_size, unexcited, findings: [{error, basis, description, values, \
+--json writes the report (docs/diagnosis.md): {version: 2, machine, data, data_arguments, \
+records: [{label, data, role, setup, setup_fitted, zeroed, samples, params, \
+residual_rms_before_um, residual_rms_after_um, refitted}], base_model, zeroed, alpha, base_fit, \
+structure, dictionary_size, unexcited, findings: [{error, basis, description, values, \
 stds, unit, amplitude, phase_deg, explained_fraction, f, p_value, correction, candidates_tried, \
-alternatives, size, limit, plausible, status, scan, …}], stop, confounded, extended_model, gain: \
-{fit, validation: [{…, estimable, undetermined}]}, outliers, budget, recommended, \
-recommendation, noise_model, adequacy: {records, p_value, consistent_with_noise, …}, \
-unexplained}; `--json -` writes \
+alternatives, size, limit, plausible, status, scan, …}], dropped, stop, confounded, \
+extended_model, gain: {fit, validation: [{…, estimable, undetermined}]}, outliers, budget, \
+recommended, recommendation, noise_model, adequacy: {records, p_value, consistent_with_noise, \
+…}, unexplained, notes}; `--json -` writes \
 it to standard output. --model-out writes the machine description (the text of --machine) with \
 the extended model appended as [models.extended] (extended2, … if that name is taken). --plot \
 DIR writes SVG figures: per record the measured error against the base and extended \
@@ -119,19 +127,20 @@ pub struct DiagnoseArgs {
     /// A campaign file (TOML, docs/campaigns.md) whose records are fitted together.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["data", "zeroed", "param"])]
     campaign: Option<PathBuf>,
-    /// A campaign file of held-out records (their set-ups, ball positions, zeroing), for a
-    /// campaign diagnosis.
+    /// A campaign file of held-out records (their set-ups, ball positions, zeroing): a record
+    /// on a fitted set-up takes its set-up errors from the fit.
     #[arg(long, value_name = "FILE")]
     validate_campaign: Option<PathBuf>,
     /// Kinematic symbols (mm), `NAME=VALUE,...`, of every --data and --validate record (the
-    /// ball's position), for a campaign diagnosis.
+    /// ball's position).
     #[arg(long, value_name = "NAME=VALUE,...")]
     param: Option<String>,
-    /// Held-out measurement CSVs (comma list) on which the gain is measured; not fitted.
+    /// Held-out measurement CSVs (comma list) on which the gain is measured; not fitted. On the
+    /// fitted records' set-up when they have one, else each on a set-up of its own.
     #[arg(long, value_name = "FILE,FILE")]
     validate: Option<String>,
-    /// The readings were zeroed at the first sample: the zero offsets dx0 dy0 dz0 join the base
-    /// model and the held-out predictions are zeroed at their first sample too.
+    /// The readings were zeroed at the first sample: every record's own zero offsets dx0 dy0
+    /// dz0 join the base model (fitted records) or are refitted on it (held-out records).
     #[arg(long)]
     zeroed: bool,
     /// Significance level of each step, after the correction for the candidates tried

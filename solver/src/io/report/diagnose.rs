@@ -492,7 +492,7 @@ fn notes(d: &Diagnosis) -> Vec<String> {
         return Vec::new();
     }
     vec![
-        "every record is fitted with its own kinematic parameters, its set-up's errors and its own zero; the machine's errors are shared, and a candidate's F-test counts every column the campaign gives it".into(),
+        "a candidate's F-test counts every column the campaign gives it (one per record for a drift of the R-test's zero, one per set-up for a set-up error)".into(),
         "the lack-of-fit test fits each fitted record's draws with that record's own columns alone, and draws the held-out records' noise without the fit's uncertainty: it errs towards `not down to the noise` on the fitted records".into(),
     ]
 }

@@ -1,6 +1,6 @@
 //! End-to-end tests of campaigns on the command line: `identify --data a.csv,b.csv` and
-//! `--campaign FILE`, `validate` on fitted and new set-ups, `diagnose` on a campaign, and bad
-//! campaign files (file, line, column and field named; nothing written).
+//! `--campaign FILE`, `validate` on fitted and new set-ups, and bad campaign files (file, line,
+//! column and field named; nothing written). The diagnosis of a campaign: `tests/cli_diagnose.rs`.
 
 use model_spec::Machine;
 use serde_json::Value;
@@ -417,66 +417,6 @@ fn bad_campaign_files_name_file_line_column_and_field() {
     );
     assert!(text.contains("k4-2"), "{text}");
     assert_eq!(entries(&dir), ["c.toml", "k4.csv"]);
-}
-
-#[test]
-fn diagnose_on_a_campaign_finds_the_missing_harmonic() {
-    let dir = temp_dir("diagnose");
-    for (path, out, seed) in [
-        ("K4", "k4.csv", "1"),
-        ("K1", "k1.csv", "2"),
-        ("K2", "k2.csv", "3"),
-    ] {
-        ok(
-            &dir,
-            &[
-                "simulate",
-                "--machine",
-                "seed-ac",
-                "--path",
-                path,
-                "--seed",
-                seed,
-                "-o",
-                out,
-            ],
-        );
-    }
-    let text = ok(
-        &dir,
-        &common::words(
-            "diagnose --machine seed-ac --model reduced --data k4.csv,k1.csv --validate k2.csv \
-             --harmonics 2 --poly 1 --time 1 --json d.json --model-out ext.toml",
-        ),
-    );
-    assert!(
-        text.contains("Campaign: the machine's errors shared"),
-        "{text}"
-    );
-    assert!(text.contains("1. ECC harmonic:2"), "{text}");
-    assert!(text.contains("Held out k2: set-up k2 (new"), "{text}");
-    let j = read_json(&dir.join("d.json"));
-    let c = &j["campaign"];
-    assert_eq!(c["records"].as_array().unwrap().len(), 2);
-    for r in c["records"].as_array().unwrap() {
-        assert!(r["residual_rms_after_um"].as_f64().unwrap() < 0.56, "{r}");
-    }
-    assert_eq!(c["held_out"][0]["setup_fitted"], false);
-    assert!(
-        std::fs::read_to_string(dir.join("ext.toml"))
-            .unwrap()
-            .contains("\"ECC@harmonic:2\"")
-    );
-    // Figures draw one record: refused on a campaign, nothing written.
-    fails(
-        &dir,
-        &common::words(
-            "diagnose --machine seed-ac --model reduced --data k4.csv,k1.csv --plot figs --json e.json",
-        ),
-        2,
-        &["--plot"],
-    );
-    assert!(!dir.join("figs").exists() && !dir.join("e.json").exists());
 }
 
 #[test]

@@ -653,3 +653,137 @@ fn bad_input_is_one_line_with_the_right_exit_code_and_leaves_nothing() {
         "in the way"
     );
 }
+
+// ---------------------------------------------------------------- campaigns
+
+/// K4 and K1 fitted together (each its own set-up), K2 held out on a set-up of its own: the
+/// missing harmonic is found, every fitted record falls to the noise, K2's set-up errors are
+/// refitted on it, and the same outputs as for one record are written (figures of every
+/// record included).
+#[test]
+fn a_campaign_finds_the_missing_harmonic_and_draws_every_record() {
+    let dir = temp_dir("campaign");
+    simulate_all(&dir, "seed-ac-demo", &[]);
+    let text = ok(
+        &dir,
+        &common::words(
+            "diagnose --machine seed-ac --model reduced --data k4.csv,k1.csv --validate k2.csv \
+             --harmonics 2 --poly 1 --time 1 --json d.json --model-out ext.toml --plot figs",
+        ),
+    );
+    for s in [
+        "Campaign: the machine's errors shared",
+        "1. ECC harmonic:2",
+        "Held out k2: set-up k2 (new: its set-up errors refitted on it",
+        "XOW[k2]",
+        "rtest identify --machine seed-ac --model reduced --terms ECC@harmonic:2 --data k4.csv,k1.csv",
+    ] {
+        assert!(text.contains(s), "`{s}` not in:\n{text}");
+    }
+    let j = read_json(&dir.join("d.json"));
+    assert_eq!(j["version"], 2);
+    assert_eq!(j["data"], "k4.csv,k1.csv");
+    let records = j["records"].as_array().unwrap();
+    assert_eq!(records.len(), 3);
+    for r in &records[..2] {
+        assert_eq!(r["role"], "fitted");
+        assert!(num(&r["residual_rms_after_um"]) < 0.56, "{r}");
+    }
+    let k2 = &records[2];
+    assert_eq!(
+        (&k2["label"], &k2["data"], &k2["role"], &k2["setup"]),
+        (
+            &Value::from("k2"),
+            &Value::from("k2.csv"),
+            &Value::from("held out"),
+            &Value::from("k2")
+        )
+    );
+    assert_eq!(k2["setup_fitted"], false);
+    assert_eq!(
+        k2["refitted"],
+        serde_json::json!(["XOW[k2]", "YOW[k2]", "ZOW[k2]"])
+    );
+    assert_eq!(j["gain"]["validation"][0]["data"], "k2.csv");
+    assert_eq!(j["notes"].as_array().unwrap().len(), 2);
+    assert!(
+        std::fs::read_to_string(dir.join("ext.toml"))
+            .unwrap()
+            .contains("\"ECC@harmonic:2\"")
+    );
+    let figs = entries(&dir.join("figs"));
+    for f in [
+        "k4-path.svg",
+        "k1-path.svg",
+        "k2-path.svg",
+        "k1-spectrum.svg",
+    ] {
+        assert!(figs.iter().any(|x| x == f), "{f} not in {figs:?}");
+    }
+}
+
+/// One record's JSON keeps its fields and gains `version` and `records`; a held-out file is on
+/// the fitted record's set-up (the ball not moved) and nothing is refitted on it.
+#[test]
+fn one_record_is_the_campaign_of_that_record() {
+    let dir = temp_dir("one");
+    simulate_all(&dir, "seed-ac-demo", &[]);
+    let text = diagnose(&dir, &["--json", "d.json"]);
+    assert!(!text.contains("Campaign:"), "{text}");
+    let j = read_json(&dir.join("d.json"));
+    assert_eq!(j["version"], 2);
+    assert_eq!(j["data"], "k4.csv");
+    assert_eq!(j["data_arguments"], serde_json::json!(["--data", "k4.csv"]));
+    assert_eq!(
+        j["held_out"],
+        serde_json::json!([["k1.csv", 361], ["k2.csv", 121]])
+    );
+    let records = j["records"].as_array().unwrap();
+    assert_eq!(records.len(), 3);
+    for (r, (label, role)) in
+        records
+            .iter()
+            .zip([("k4", "fitted"), ("k1", "held out"), ("k2", "held out")])
+    {
+        assert_eq!(
+            (r["label"].as_str(), r["role"].as_str()),
+            (Some(label), Some(role))
+        );
+        assert_eq!(r["setup"], "k4");
+        assert_eq!(r["setup_fitted"], true);
+        assert!(r.get("refitted").is_none(), "{r}");
+    }
+    assert!(j["notes"].as_array().unwrap().is_empty());
+    assert!(j.get("campaign").is_none());
+    // A report of another version is refused by the HTML report, with the reason.
+    let mut old = j.clone();
+    old["version"] = Value::from(1);
+    std::fs::write(dir.join("old.json"), old.to_string()).unwrap();
+    fails(
+        &dir,
+        &["report", "old.json", "-o", "r.html"],
+        1,
+        &["version 1"],
+    );
+    assert!(!dir.join("r.html").exists());
+}
+
+/// The refinement never throws away a converged fit: K4 and K1 of the full error budget (noise
+/// seeds 1 and 2) fitted together, K2 (seed 3) held out, stopped with exit code 3 when a step
+/// of 3e-9 µm was held against a tolerance of 1e-9 µm; the diagnosis now completes.
+#[test]
+fn the_budget_campaign_whose_refinement_crawled_at_rounding_is_diagnosed() {
+    let dir = temp_dir("budget");
+    simulate_all(&dir, "seed-ac-budget", &[]);
+    let text = ok(
+        &dir,
+        &common::words(
+            "diagnose --machine seed-ac --model reduced --data k4.csv,k1.csv --validate k2.csv \
+             --json d.json",
+        ),
+    );
+    assert!(!text.contains("did not converge"), "{text}");
+    let j = read_json(&dir.join("d.json"));
+    assert!(!j["findings"].as_array().unwrap().is_empty());
+    assert_eq!(j["records"].as_array().unwrap().len(), 3);
+}

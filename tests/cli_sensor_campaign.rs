@@ -1,7 +1,7 @@
 //! End to end: a campaign of sensor records (an R-test head of three sensors at 45°, two ball
 //! heights) identifies the same machine errors as the ball-centre records of the same runs,
-//! within their uncertainties; its diagnosis refuses sensor records with the reason (it does
-//! not weight them yet).
+//! within their uncertainties, and its diagnosis names what theirs names; a record of ball
+//! centres among sensor records is refused.
 
 mod common;
 use common::{fails, ok, read_json, temp_dir_tagged};
@@ -132,21 +132,31 @@ fn a_campaign_of_sensor_records_identifies_what_the_ball_centre_records_do() {
         1,
         &["s1_um"],
     );
-    // The diagnosis of a campaign does not weight sensor records yet: refused.
-    fails(
-        &dir,
-        &[
+    // The diagnosis weights sensor records by their covariances: the sensor records name what
+    // the ball-centre records of the same runs name first (the demo truth's ECC harmonic:2).
+    for (campaign, json, sensors) in [("s.toml", "ds.json", true), ("b.toml", "db.json", false)] {
+        let mut args = vec![
             "diagnose",
             "--machine",
             "seed-ac",
             "--model",
             "reduced",
             "--campaign",
-            "s.toml",
-            "--instrument",
-            "inclined-45",
-        ],
-        2,
-        &["do not weight records by the per-sample covariances"],
-    );
+            campaign,
+            "--json",
+            json,
+        ];
+        if sensors {
+            args.extend(["--instrument", "inclined-45"]);
+        }
+        ok(&dir, &args);
+        let d = read_json(&dir.join(json));
+        assert_eq!(d["records"].as_array().unwrap().len(), 2, "{campaign}");
+        let f = &d["findings"][0];
+        assert_eq!(
+            (f["error"].as_str(), f["basis"].as_str()),
+            (Some("ECC"), Some("harmonic:2")),
+            "{campaign}: {f}"
+        );
+    }
 }

@@ -476,10 +476,12 @@ fn check_model(model: &str, identified: &str) -> Result<(), String> {
 /// A diagnosis against the identification: the same fitted records, and the identified model
 /// is the diagnosis's base model or its extended model.
 fn check_diagnosis(d: &DiagnosisReport, r: &IdentificationReport) -> Result<(), String> {
-    let diagnosed: Vec<&str> = match &d.campaign {
-        Some(c) => c.records.iter().map(|x| x.data.as_str()).collect(),
-        None => vec![d.data.as_str()],
-    };
+    let diagnosed: Vec<&str> = d
+        .records
+        .iter()
+        .filter(|x| x.role == "fitted")
+        .map(|x| x.data.as_str())
+        .collect();
     let identified: Vec<&str> = r.records.iter().map(|x| x.data.as_str()).collect();
     let same = diagnosed.len() == identified.len()
         && identified

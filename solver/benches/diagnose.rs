@@ -11,7 +11,9 @@
 //! - `diagnose/budget`: truth `seed-ac-budget` (the full error budget; several findings, the
 //!   exchange pass, a Monte-Carlo null at the last step);
 //! - `diagnose/budget-wide`: the same with a wider dictionary (harmonics 1–8, polynomials 1–5,
-//!   time 1–4).
+//!   time 1–4);
+//! - `diagnose/demo-campaign`: truth `seed-ac-demo`, K4 and K1 fitted together (each its own
+//!   set-up), K2 held out on a set-up of its own (its set-up errors refitted on it).
 //!
 //! `cargo bench -p solver --bench diagnose`. The set-up prints the dictionary's size (candidate
 //! terms and H-matrix columns).
@@ -19,7 +21,9 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use model_spec::Machine;
 use solver::diagnosis::dictionary::{DictionaryOptions, dictionary, scanned};
-use solver::diagnosis::{DiagnoseOptions, diagnose};
+use solver::diagnosis::{DiagnoseOptions, diagnose, one_record};
+use solver::fitting::campaign::{Campaign, CampaignRecord};
+use solver::io::progress::Unwatched;
 use solver::model::Model;
 use solver::record::Record;
 use solver::simulation::paths::builtin_path;
@@ -63,7 +67,15 @@ fn bench(c: &mut Criterion) {
         let mut candidates = dictionary(&m, &base.terms, &o.dictionary);
         candidates.extend(scanned(&m, &base.terms, &recs[0].1, &o.dictionary));
         let columns: usize = candidates.iter().map(|t| t.basis.width()).sum();
-        let d = diagnose(&m, &base, &recs[0].1, &recs[1..], &o).expect("diagnosis");
+        let (fitted, held) = one_record(
+            &recs[0].0,
+            recs[0].1.clone(),
+            recs[1..].to_vec(),
+            m.default_parameters(),
+            false,
+        )
+        .expect("campaigns");
+        let d = diagnose(&m, &base, &fitted, &held, &o, &Unwatched).expect("diagnosis");
         println!(
             "{name}: dictionary of {} candidate terms, {columns} H-matrix columns (base: {}), K4 {} rows; {} finding(s): {}",
             candidates.len(),
@@ -81,14 +93,35 @@ fn bench(c: &mut Criterion) {
                 diagnose(
                     black_box(&m),
                     black_box(&base),
-                    black_box(&recs[0].1),
-                    black_box(&recs[1..]),
+                    black_box(&fitted),
+                    black_box(&held),
                     black_box(&o),
+                    &Unwatched,
                 )
                 .expect("diagnosis")
             })
         });
     }
+    // A campaign: K4 and K1 fitted together, each on its own set-up; K2 on a set-up of its own.
+    let recs = records(&m, "seed-ac-demo");
+    let own = |k: usize| CampaignRecord::on_own_setup(&m, &recs[k].0, recs[k].1.clone());
+    let fitted = Campaign::new(vec![own(0), own(1)]).expect("campaign");
+    let held = Campaign::new(vec![own(2)]).expect("campaign");
+    let o = DiagnoseOptions::default();
+    g.sample_size(10);
+    g.bench_function("demo-campaign", |b| {
+        b.iter(|| {
+            diagnose(
+                black_box(&m),
+                black_box(&base),
+                black_box(&fitted),
+                black_box(&held),
+                black_box(&o),
+                &Unwatched,
+            )
+            .expect("diagnosis")
+        })
+    });
     g.finish();
 }
 

@@ -12,8 +12,9 @@
 //! and two figures: the K1 residual along C before and after, and its spectrum against C.
 
 use model_spec::Machine;
-use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose};
+use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose, one_record};
 use solver::fitting::validate::{ValidateOptions, validate};
+use solver::io::progress::Unwatched;
 use solver::model::Model;
 use solver::record::Record;
 
@@ -36,7 +37,15 @@ fn main() {
     let base = Model::of(&m, "reduced").unwrap();
     let o = DiagnoseOptions::default();
     let t = std::time::Instant::now();
-    let d = diagnose(&m, &base, &rec[0].1, &rec[1..], &o).unwrap();
+    let (fitted, held) = one_record(
+        &rec[0].0,
+        rec[0].1.clone(),
+        rec[1..].to_vec(),
+        m.default_parameters(),
+        false,
+    )
+    .unwrap();
+    let d = diagnose(&m, &base, &fitted, &held, &o, &Unwatched).unwrap();
     let elapsed = t.elapsed();
     let columns: usize = solver::diagnosis::dictionary::dictionary(&m, &base.terms, &o.dictionary)
         .iter()
@@ -197,10 +206,11 @@ fn structure(s: &[solver::diagnosis::structure::Component]) {
 
 /// Measured minus predicted (exact machine) on `record`, base or extended model, mm.
 fn residual(m: &Machine, d: &Diagnosis, record: &Record, extended: bool) -> Vec<[f64; 3]> {
+    // The campaign fit as one identification (its columns in the campaign's order).
     let fit = if extended {
-        &d.extended_fit
+        d.extended_fit.as_identification()
     } else {
-        &d.base_fit
+        d.base_fit.as_identification()
     };
     let o = ValidateOptions::new().exact(true);
     validate(m, &fit.model, &fit.fit.values, record, &o)

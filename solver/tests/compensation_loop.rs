@@ -16,10 +16,11 @@ use model_spec::{Machine, builtin};
 use solver::compensation::run::{CommandedPose, compensate_poses};
 use solver::compensation::values::MachineErrors;
 use solver::compensation::verify::machine_error_rms;
-use solver::diagnosis::{DiagnoseOptions, diagnose};
+use solver::diagnosis::{DiagnoseOptions, diagnose, one_record};
 use solver::fitting::{
     IdentifyOptions, RefineOptions, ValidateOptions, identify_refined, validate,
 };
+use solver::io::progress::Unwatched;
 use solver::io::report::read::parse_identification;
 use solver::io::report::{IdentificationReport, IdentificationSource, to_json};
 use solver::model::Model;
@@ -166,7 +167,23 @@ fn demo_truth_error_falls_by_ninety_percent() {
         .iter()
         .map(|(n, r)| (n.to_string(), r.clone()))
         .collect();
-    let diagnosis = diagnose(&m, &reduced, &recs[0].1, &held, &DiagnoseOptions::default()).unwrap();
+    let (fitted, held) = one_record(
+        recs[0].0,
+        recs[0].1.clone(),
+        held,
+        m.default_parameters(),
+        false,
+    )
+    .unwrap();
+    let diagnosis = diagnose(
+        &m,
+        &reduced,
+        &fitted,
+        &held,
+        &DiagnoseOptions::default(),
+        &Unwatched,
+    )
+    .unwrap();
     assert!(
         diagnosis.recommendation.recommended,
         "the diagnosis recommends its extension on the demo truth"

@@ -29,9 +29,9 @@ fn spikes_are_listed_and_do_not_change_the_findings() {
         let base = base_model(&m, &[]);
         let clean = run(&m, &base, &recs, &options());
         assert!(
-            clean.outliers.is_empty(),
+            clean.records[0].outliers.is_empty(),
             "seed {seed}: {:?}",
-            clean.outliers
+            clean.records[0].outliers
         );
         let mut spiked = recs.clone();
         let at = [(20usize, 0usize), (70, 1), (71, 2), (150, 0), (230, 2)];
@@ -39,10 +39,13 @@ fn spikes_are_listed_and_do_not_change_the_findings() {
             spiked[0].1.measured[i][d] += if k % 2 == 0 { 0.02 } else { -0.02 };
         }
         let d = run(&m, &base, &spiked, &options());
-        let found: Vec<(usize, usize)> =
-            d.outliers.iter().map(|o| (o.sample, o.direction)).collect();
+        let found: Vec<(usize, usize)> = d.records[0]
+            .outliers
+            .iter()
+            .map(|o| (o.sample, o.direction))
+            .collect();
         assert_eq!(found, at.to_vec(), "seed {seed}");
-        for o in &d.outliers {
+        for o in &d.records[0].outliers {
             assert!(o.residual_mm.abs() > 0.015, "seed {seed}: {o:?}");
         }
         let terms = |d: &solver::diagnosis::Diagnosis| -> Vec<String> {
@@ -126,14 +129,16 @@ fn held_out_predictions_use_only_what_the_fit_determined() {
         let mut base = base_model(&m, &[]);
         base.terms.push(term(&m, extra));
         let d = run(&m, &base, &recs, &options());
-        let fit = &d.base_fit.fit;
+        // The campaign fit as one identification (its columns in the campaign's order).
+        let base_fit = d.base_fit.as_identification();
+        let fit = &base_fit.fit;
         assert!(
             !fit.identifiability.confounded.is_empty(),
             "the base model is rank-deficient on {}",
             paths[0]
         );
         let params = m.default_parameters();
-        let mut source = GainSource::new(&m, &d.base_fit.model.errors(), &params).unwrap();
+        let mut source = GainSource::new(&m, &base_fit.model.errors(), &params).unwrap();
         let opts = ValidateOptions::new().exact(false);
         let solution: Vec<Option<f64>> = fit.solution.iter().map(|&v| Some(v)).collect();
         // The same fit moved along its first null direction by one scaled unit.
@@ -145,9 +150,8 @@ fn held_out_predictions_use_only_what_the_fit_determined() {
             .map(|(j, v)| Some(v + null[j] / fit.column_norms[j]))
             .collect();
         for (h, (_, rec)) in d.validation.iter().zip(&recs[1..]) {
-            let a =
-                validate_with(&m, &d.base_fit.model, &solution, rec, &mut source, &opts).unwrap();
-            let b = validate_with(&m, &d.base_fit.model, &moved, rec, &mut source, &opts).unwrap();
+            let a = validate_with(&m, &base_fit.model, &solution, rec, &mut source, &opts).unwrap();
+            let b = validate_with(&m, &base_fit.model, &moved, rec, &mut source, &opts).unwrap();
             let change = a
                 .prediction
                 .iter()

@@ -13,6 +13,7 @@ mod helpers;
 
 use helpers::*;
 use solver::diagnosis::Diagnosis;
+use solver::fitting::campaign::{Campaign, CampaignRecord};
 use solver::fitting::noise::{NoiseChoice, NoiseModel, NoiseSource};
 use solver::record::Record;
 use solver::simulation::rng::Rng;
@@ -52,18 +53,21 @@ fn with_ar1(recs: &[(String, Record)], phi: f64, sigma: f64, seed: u64) -> Vec<(
 }
 
 /// The residual RMS (mm) of the base and of the extended model of `d` on a third path the
-/// diagnosis did not see (`K1R`: C out and back at A = −30°), from `recs`' truth: `third`.
+/// diagnosis did not see (`K1R`: C out and back at A = −30°, on the fitted record's set-up),
+/// from `recs`' truth: `third`.
 fn on_third_path(m: &model_spec::Machine, d: &Diagnosis, third: &Record) -> (f64, f64) {
-    let rms = |fit: &solver::fitting::Identification| {
-        let v = solver::fitting::validate(
-            m,
-            &fit.model,
-            &solver::diagnosis::heldout::estimable_values(fit),
-            third,
-            &solver::fitting::ValidateOptions::new().exact(true),
-        )
-        .expect("validation");
-        v.overall.residual_rms
+    let held = Campaign {
+        records: vec![CampaignRecord::new(
+            "third",
+            third.clone(),
+            m.default_parameters(),
+            d.records[0].setup.clone(),
+            false,
+        )],
+    };
+    let rms = |fit: &solver::fitting::campaign::CampaignIdentification| {
+        let v = solver::diagnosis::heldout::predict(m, fit, &held).expect("validation");
+        v[0].validation.overall.residual_rms
     };
     (rms(&d.base_fit), rms(&d.extended_fit))
 }
@@ -92,7 +96,7 @@ fn false_findings(phi: f64, sigma: f64, alpha: f64, declared: bool) -> (u64, u64
                 "seed {s}: {} findings; {}; outliers {} {:?}",
                 d.findings.len(),
                 d.noise,
-                d.outliers.len(),
+                d.records[0].outliers.len(),
                 d.validation
                     .iter()
                     .map(|h| h.outliers.len())

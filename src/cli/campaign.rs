@@ -14,17 +14,6 @@ use solver::io::csv::ReadOptions;
 use solver::model::Model;
 use std::path::{Path, PathBuf};
 
-/// Refuses `--instrument` for a campaign's diagnosis: it does not weight records by the
-/// covariances sensor readings carry (identification and validation do).
-pub fn refuse_instrument(instrument: &super::args::InstrumentArgs) -> CliResult<()> {
-    if instrument.instrument.is_some() {
-        return Err(CliError::usage(
-            "--instrument: diagnoses of a campaign (several files or --campaign) do not weight records by the per-sample covariances of sensor readings yet: identify and validate the campaign (which do), or diagnose one sensor record at a time",
-        ));
-    }
-    Ok(())
-}
-
 /// A campaign read from the command line, with the file of each record.
 pub struct Loaded {
     /// The campaign.

@@ -6,15 +6,15 @@ use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
-use solver::diagnosis::campaign::diagnose_campaign;
 use solver::diagnosis::dictionary::DictionaryOptions;
 use solver::diagnosis::figures::figures;
-use solver::diagnosis::{DiagnoseError, DiagnoseOptions, diagnose_with_progress};
+use solver::diagnosis::{DiagnoseError, DiagnoseOptions, diagnose};
+use solver::fitting::campaign::{Campaign, CampaignRecord};
 use solver::fitting::check_values;
-use solver::io::report::campaign_diagnose::CampaignDiagnosisReport;
+use solver::io::campaign::{labels_from_files, stem_label, unique_label};
 use solver::io::report::{DiagnosisReport, DiagnosisSource, to_json};
 use solver::io::text::diagnose::diagnosis;
-use solver::io::text::validate::zeroed_note;
+use solver::record::Record;
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
@@ -59,26 +59,34 @@ confirmed' and the text says why.
 
 Values of findings are in µm (translational errors, offsets) and µrad (angular errors); a \
 harmonic is printed as its cos and sin coefficients, its amplitude √(cos² + sin²) and phase φ \
-(cos·cos kθ + sin·sin kθ = amplitude·cos(kθ − φ)). A fit whose refinement does not converge, or \
-whose values are beyond --max-error-um / --max-error-urad, is an error (exit code 3).
+(cos·cos kθ + sin·sin kθ = amplitude·cos(kθ − φ)). Every fit is refined against the exact \
+machine and has converged when its last step moves the prediction by less than max(1e-6 µm, \
+1e-6·σ) or the rounding floor of the evaluation. A base fit whose refinement does not converge, \
+or whose values are beyond --max-error-um / --max-error-urad, is an error (exit code 3); a \
+finding whose extended fit does not converge is dropped, and the text and the JSON say so.
 
 Campaigns (docs/campaigns.md, docs/diagnosis.md): --data a.csv,b.csv or --campaign FILE fits \
 the base model on several records together (each its own ball set-up and R-test zero, the \
-machine's errors shared); held-out records come from --validate (each on a new set-up, whose \
-set-up errors are refitted with the machine held) or --validate-campaign FILE. Scanned \
-parameters keep their grid value and --plot is not available on campaigns.
+machine's errors shared); one file is the campaign of that record, and everything above works \
+alike. Held-out records come from --validate (on the fitted records' set-up when they have one, \
+the ball not moved; else each on a set-up of its own, whose set-up errors are refitted with \
+the machine held) or --validate-campaign FILE; a held-out record's own zero (--zeroed) and \
+drifts are refitted on it. --instrument reads every record through an R-test head: each \
+sample is weighted by the covariance its sensors give it.
 
 --report FILE writes the HTML report of the diagnosis (docs/report.md): findings, gain, what \
-remains, the residual components and, for one record, the measured-against-predicted figures \
-of every record inline.
+remains, the residual components and the measured-against-predicted figures of every record \
+inline.
 
---json writes the report (docs/diagnosis.md): {machine, data, base_model, zeroed, alpha, \
-base_fit, structure, dictionary_size, unexcited, findings: [{error, basis, description, values, \
+--json writes the report (docs/diagnosis.md): {version: 2, machine, data, data_arguments, \
+records: [{label, data, role, setup, setup_fitted, zeroed, samples, params, \
+residual_rms_before_um, residual_rms_after_um, refitted}], base_model, zeroed, alpha, base_fit, \
+structure, dictionary_size, unexcited, findings: [{error, basis, description, values, \
 stds, unit, amplitude, phase_deg, explained_fraction, f, p_value, correction, candidates_tried, \
-alternatives, size, limit, plausible, status, scan, …}], stop, confounded, extended_model, gain: \
-{fit, validation: [{…, estimable, undetermined}]}, outliers, budget, recommended, \
-recommendation, noise_model, adequacy: {records, p_value, consistent_with_noise, …}, \
-unexplained}; `--json -` writes \
+alternatives, size, limit, plausible, status, scan, …}], dropped, stop, confounded, \
+extended_model, gain: {fit, validation: [{…, estimable, undetermined}]}, outliers, budget, \
+recommended, recommendation, noise_model, adequacy: {records, p_value, consistent_with_noise, \
+…}, unexplained, notes}; `--json -` writes \
 it to standard output. --model-out writes the machine description (the text of --machine) with \
 the extended model appended as [models.extended] (extended2, … if that name is taken). --plot \
 DIR writes SVG figures: per record the measured error against the base and extended \
@@ -120,19 +128,20 @@ pub struct DiagnoseArgs {
     /// A campaign file (TOML, docs/campaigns.md) whose records are fitted together.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["data", "zeroed", "param"])]
     campaign: Option<PathBuf>,
-    /// A campaign file of held-out records (their set-ups, ball positions, zeroing), for a
-    /// campaign diagnosis.
+    /// A campaign file of held-out records (their set-ups, ball positions, zeroing): a record
+    /// on a fitted set-up takes its set-up errors from the fit.
     #[arg(long, value_name = "FILE")]
     validate_campaign: Option<PathBuf>,
     /// Kinematic symbols (mm), `NAME=VALUE,...`, of every --data and --validate record (the
-    /// ball's position), for a campaign diagnosis.
+    /// ball's position).
     #[arg(long, value_name = "NAME=VALUE,...")]
     param: Option<String>,
-    /// Held-out measurement CSVs (comma list) on which the gain is measured; not fitted.
+    /// Held-out measurement CSVs (comma list) on which the gain is measured; not fitted. On the
+    /// fitted records' set-up when they have one, else each on a set-up of its own.
     #[arg(long, value_name = "FILE,FILE")]
     validate: Option<String>,
-    /// The readings were zeroed at the first sample: the zero offsets dx0 dy0 dz0 join the base
-    /// model and the held-out predictions are zeroed at their first sample too.
+    /// The readings were zeroed at the first sample: every record's own zero offsets dx0 dy0
+    /// dz0 join the base model (fitted records) or are refitted on it (held-out records).
     #[arg(long)]
     zeroed: bool,
     /// Significance level of each step, after the correction for the candidates tried
@@ -195,7 +204,9 @@ fn parse_alpha(s: &str) -> Result<f64, String> {
     }
 }
 
-/// Runs `rtest diagnose`.
+/// Runs `rtest diagnose`: the fitted records (`--data`, or `--campaign`) and the held-out
+/// records (`--validate`, or `--validate-campaign`) read as two campaigns, one record being the
+/// campaign of that record, and diagnosed by [`diagnose`].
 pub fn run(args: &DiagnoseArgs) -> CliResult {
     let (m, machine_text) = super::load_machine_and_text(&args.machine)?;
     let (label, model) = args::model(&m, Some(&args.model), None)?;
@@ -207,86 +218,124 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         Some(list) => args::files("--data", list)?,
         None => Vec::new(),
     };
-    if args.campaign.is_some()
-        || files.len() > 1
-        || args.validate_campaign.is_some()
-        || args.param.is_some()
-    {
-        return run_campaign(args, &m, &machine_text, &label, &model, &files, &held_files);
+    if args.validate.is_some() && args.validate_campaign.is_some() {
+        return Err(CliError::usage(
+            "--validate and --validate-campaign both give held-out records: give one",
+        ));
     }
-    let data_path = files[0].as_path();
-    let mut inputs: Vec<(&str, &Path)> = vec![("--data", data_path)];
-    inputs.extend(held_files.iter().map(|f| ("--validate", f.as_path())));
-    inputs.extend(args.noise.input());
-    inputs.extend(args.instrument.input());
-    inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
+    // Every output is checked before any work, against every input known so far (the records
+    // of campaign files are checked again once the files are read).
     let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     outputs.extend(args.model_out.iter().map(|t| ("--model-out", t)));
     outputs.extend(args.report.iter().map(|t| ("--report", t)));
     let dirs: Vec<(&str, &Path)> = args.plot.iter().map(|d| ("--plot", d.as_path())).collect();
-    check_outputs(&inputs, &outputs, &dirs)?;
+    let mut given: Vec<(&str, &Path)> = files.iter().map(|f| ("--data", f.as_path())).collect();
+    given.extend(args.campaign.iter().map(|f| ("--campaign", f.as_path())));
+    given.extend(held_files.iter().map(|f| ("--validate", f.as_path())));
+    given.extend(
+        args.validate_campaign
+            .iter()
+            .map(|f| ("--validate-campaign", f.as_path())),
+    );
+    given.extend(args.noise.input());
+    given.extend(args.instrument.input());
+    given.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
+    check_outputs(&given, &outputs, &dirs)?;
 
     let read = args.records.read_options();
+    let params = super::pose_args::params(&m, args.param.as_deref())?;
+    let instrument = args.instrument.load()?;
+    let through = instrument.as_ref().map(|(i, f)| (i, *f));
     // Progress bars on a terminal's standard error, unless the JSON report takes standard output.
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
-    let record = {
-        let (_bar, read) = super::progress::reading(shown, data_path, &read);
-        super::read_record(
-            "--data",
-            &m,
-            data_path,
-            &read,
-            &args.instrument,
-            &m.default_parameters(),
-        )?
+    let fitted = match &args.campaign {
+        Some(path) => campaign::from_file("--campaign", &m, path, &read, through)?,
+        None => {
+            let labels = labels_from_files(&files);
+            let records = read_records("--data", &m, &files, &params, args, shown)?
+                .into_iter()
+                .zip(&labels)
+                .map(|(r, l)| CampaignRecord::new(l, r, params.clone(), l, args.zeroed))
+                .collect();
+            loaded(records, &files)?
+        }
     };
-    let mut held = Vec::new();
-    for f in &held_files {
-        let (_bar, read) = super::progress::reading(shown, f, &read);
-        held.push((
-            f.display().to_string(),
-            super::read_record(
-                "--validate",
-                &m,
-                f,
-                &read,
-                &args.instrument,
-                &m.default_parameters(),
-            )?,
-        ));
+    // Held-out `--validate` files: on the fitted records' set-up when they have one (the ball
+    // not moved), else each on a set-up of its own; labelled by their stems, unique among the
+    // fitted records' labels.
+    let held = match &args.validate_campaign {
+        Some(path) => campaign::from_file("--validate-campaign", &m, path, &read, through)?,
+        None => {
+            let setups = fitted.campaign.setups();
+            let mut taken: Vec<String> = fitted
+                .campaign
+                .records
+                .iter()
+                .map(|r| r.label.clone())
+                .collect();
+            let mut labels = Vec::with_capacity(held_files.len());
+            for f in &held_files {
+                let l = unique_label(&stem_label(f), &taken);
+                taken.push(l.clone());
+                labels.push(l);
+            }
+            let records = read_records("--validate", &m, &held_files, &params, args, shown)?
+                .into_iter()
+                .zip(&labels)
+                .map(|(r, l)| {
+                    let setup = match setups.as_slice() {
+                        [one] => one.clone(),
+                        _ => l.clone(),
+                    };
+                    CampaignRecord::new(l, r, params.clone(), setup, args.zeroed)
+                })
+                .collect();
+            loaded(records, &held_files)?
+        }
+    };
+    let (fitted_inputs, held_inputs) = (fitted.inputs(), held.inputs());
+    let mut inputs: Vec<(&str, &Path)> = fitted_inputs
+        .iter()
+        .map(|p| ("--data", p.as_path()))
+        .collect();
+    inputs.extend(held_inputs.iter().map(|p| ("--validate", p.as_path())));
+    inputs.extend(args.noise.input());
+    inputs.extend(args.instrument.input());
+    inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
+    if args.campaign.is_some() || args.validate_campaign.is_some() {
+        check_outputs(&inputs, &outputs, &dirs)?;
     }
-    let mut opts = DiagnoseOptions::default();
-    opts.dictionary = DictionaryOptions::new(args.harmonics, args.poly, args.time);
-    opts.alpha = args.alpha;
-    opts.zeroed = args.zeroed;
-    opts.constraint = args::constraint(args.constraint.as_deref())?;
-    opts.noise = args.noise.choice(&m, &read, &args.instrument)?;
-    if let Some(b) = &args.budget {
-        opts.budget = solver::diagnosis::plausible::Budget::parse(b)
-            .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
-    }
-    let data = data_path.display().to_string();
-    opts.data_name = data.clone();
+    let flag = if args.campaign.is_some() {
+        "--campaign"
+    } else {
+        "--data"
+    };
+    fitted.check_times(flag, &m, &model)?;
+    held.check_times("--validate", &m, &model)?;
+
+    let opts = options(args, &m, &read)?;
     let bar = super::progress::Bar::new(shown, false);
-    let d = diagnose_with_progress(&m, &model, &record, &held, &opts, &bar);
+    let d = diagnose(&m, &model, &fitted.campaign, &held.campaign, &opts, &bar);
     drop(bar);
     let d = d.map_err(|e| match e {
         DiagnoseError::Estimate(e)
         | DiagnoseError::Refine(solver::fitting::RefineError::Estimate(e)) => {
             super::identify::estimate_error(e)
         }
-        other => CliError::computation(format!("--data: cannot diagnose: {other}")),
+        DiagnoseError::Campaign(e) => CliError::usage(format!("{flag}: {e}")),
+        other => CliError::computation(format!("{flag}: cannot diagnose: {other}")),
     })?;
     for fit in [&d.base_fit, &d.extended_fit] {
-        check_values(&m, fit, &args.bounds.values()).map_err(|e| {
+        check_values(&m, &fit.as_identification(), &args.bounds.values()).map_err(|e| {
             CliError::computation(format!(
-                "--data: implausible result: {e}; the fit does not describe this machine (--max-error-um, --max-error-urad change the bounds)"
+                "{flag}: implausible result: {e}; the fit does not describe this machine (--max-error-um, --max-error-urad change the bounds)"
             ))
         })?;
     }
 
     // Everything is computed before anything is written.
-    let mut files = Outputs::new();
+    let data = fitted.files.join(",");
+    let mut out = Outputs::new();
     let mut model_out = None;
     if let Some(target) = &args.model_out {
         let (name, contents) = d
@@ -297,45 +346,50 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
                 &format!("rtest diagnose on {data}"),
             )
             .map_err(|e| CliError::computation(format!("--model-out: {e}")))?;
-        files.add("--model-out", target.clone(), contents);
+        out.add("--model-out", target.clone(), contents);
         model_out = Some((name, target.to_string()));
     }
     let source = DiagnosisSource {
         machine_source: &args.machine,
         label: &label,
-        data: &data,
-        samples: record.samples.len(),
-        held_out: held
-            .iter()
-            .map(|(n, r)| (n.clone(), r.samples.len()))
-            .collect(),
+        data: fitted.files.clone(),
+        held_out: held.files.clone(),
+        data_arguments: data_arguments(args, &data),
         opts: &opts,
         model_out,
     };
     let report = DiagnosisReport::new(&m, &source, &d)
-        .map_err(|e| CliError::computation(format!("--data: {e}")))?;
+        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
     if let Some(target) = &args.json {
         let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
-        files.add("--json", target.clone(), json);
+        out.add("--json", target.clone(), json);
     }
     let figs = if args.plot.is_some() || args.report.is_some() {
-        let mut records = vec![(data.clone(), &record, true)];
-        records.extend(held.iter().map(|(n, r)| (n.clone(), r, false)));
-        let flag = if args.plot.is_some() {
+        let what = if args.plot.is_some() {
             "--plot"
         } else {
             "--report"
         };
+        let mut names = fitted.files.clone();
+        names.extend(held.files.iter().cloned());
         Some(
-            figures(&m, &d, &label, &opts, &records)
-                .map_err(|e| CliError::computation(format!("{flag}: {e}")))?,
+            figures(
+                &m,
+                &d,
+                &label,
+                &opts,
+                &fitted.campaign,
+                &held.campaign,
+                &names,
+            )
+            .map_err(|e| CliError::computation(format!("{what}: {e}")))?,
         )
     } else {
         None
     };
     if let (Some(dir), Some(figs)) = (&args.plot, &figs) {
         for (name, _, svg) in super::figures::svgs(figs)? {
-            files.add_in_dir("--plot", dir, &name, svg);
+            out.add_in_dir("--plot", dir, &name, svg);
         }
     }
     if let Some(target) = &args.report {
@@ -345,182 +399,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
                 .map_err(|e| CliError::computation(format!("--report: {e}")))?;
         }
         add_diagnosis(&mut i, &report)?;
-        files.add(
-            "--report",
-            target.clone(),
-            super::report::render("--report", &i)?,
-        );
-    }
-    let mut text = diagnosis(&report);
-    text.push_str(zeroed_note(&record, args.zeroed));
-    let stdout_taken = outputs.iter().any(|(_, t)| matches!(t, Target::Stdout));
-    text.push_str(&wrote(&write(files)?));
-    print_text(&text, stdout_taken)
-}
-
-/// The options of a diagnosis from the flags (all but the data).
-fn options(
-    args: &DiagnoseArgs,
-    m: &model_spec::Machine,
-    read: &solver::io::csv::ReadOptions,
-) -> CliResult<DiagnoseOptions> {
-    let mut opts = DiagnoseOptions::default();
-    opts.dictionary = DictionaryOptions::new(args.harmonics, args.poly, args.time);
-    opts.alpha = args.alpha;
-    opts.zeroed = args.zeroed;
-    opts.constraint = args::constraint(args.constraint.as_deref())?;
-    opts.noise = args.noise.choice(m, read, &args.instrument)?;
-    if let Some(b) = &args.budget {
-        opts.budget = solver::diagnosis::plausible::Budget::parse(b)
-            .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
-    }
-    Ok(opts)
-}
-
-/// `rtest diagnose` on a campaign: `--data a.csv,b.csv` or `--campaign FILE`, held out
-/// `--validate` files (each on a set-up of its own) or `--validate-campaign FILE`.
-fn run_campaign(
-    args: &DiagnoseArgs,
-    m: &model_spec::Machine,
-    machine_text: &str,
-    label: &str,
-    model: &solver::model::Model,
-    files: &[PathBuf],
-    held_files: &[PathBuf],
-) -> CliResult {
-    campaign::refuse_instrument(&args.instrument)?;
-    if args.plot.is_some() {
-        return Err(CliError::usage(
-            "--plot draws one fitted record; a campaign diagnosis writes no figures: drop --plot",
-        ));
-    }
-    if args.validate.is_some() && args.validate_campaign.is_some() {
-        return Err(CliError::usage(
-            "--validate and --validate-campaign both give held-out records: give one",
-        ));
-    }
-    let read = args.records.read_options();
-    let params = super::pose_args::params(m, args.param.as_deref())?;
-    let fitted = match &args.campaign {
-        Some(path) => campaign::from_file("--campaign", m, path, &read, None)?,
-        None => campaign::from_files("--data", m, files, &params, args.zeroed, &read, None)?,
-    };
-    let held = match &args.validate_campaign {
-        Some(path) => campaign::from_file("--validate-campaign", m, path, &read, None)?,
-        None if held_files.is_empty() => campaign::Loaded {
-            campaign: solver::fitting::campaign::Campaign {
-                records: Vec::new(),
-            },
-            files: Vec::new(),
-            source: None,
-        },
-        None => campaign::from_files(
-            "--validate",
-            m,
-            held_files,
-            &params,
-            args.zeroed,
-            &read,
-            None,
-        )?,
-    };
-    if let Some(r) = held
-        .campaign
-        .records
-        .iter()
-        .find(|r| fitted.campaign.records.iter().any(|f| f.label == r.label))
-    {
-        return Err(CliError::usage(format!(
-            "held-out record `{}` has the label of a fitted record: a held-out record is not fitted (rename one)",
-            r.label
-        )));
-    }
-    let (fitted_inputs, held_inputs) = (fitted.inputs(), held.inputs());
-    let mut inputs: Vec<(&str, &Path)> = fitted_inputs
-        .iter()
-        .map(|p| ("--data", p.as_path()))
-        .collect();
-    inputs.extend(held_inputs.iter().map(|p| ("--validate", p.as_path())));
-    inputs.extend(args.noise.input());
-    inputs.extend(args.instrument.input());
-    inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
-    let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
-    outputs.extend(args.model_out.iter().map(|t| ("--model-out", t)));
-    outputs.extend(args.report.iter().map(|t| ("--report", t)));
-    check_outputs(&inputs, &outputs, &[])?;
-    let flag = if args.campaign.is_some() {
-        "--campaign"
-    } else {
-        "--data"
-    };
-    fitted.check_times(flag, m, model)?;
-    held.check_times("--validate", m, model)?;
-    let mut opts = options(args, m, &read)?;
-    let data = fitted.files.join(",");
-    opts.data_name = data.clone();
-    let (d, part) = diagnose_campaign(m, model, &fitted.campaign, &held.campaign, &opts).map_err(
-        |e| match e {
-            DiagnoseError::Estimate(e)
-            | DiagnoseError::Refine(solver::fitting::RefineError::Estimate(e)) => {
-                super::identify::estimate_error(e)
-            }
-            other => CliError::computation(format!("{flag}: cannot diagnose: {other}")),
-        },
-    )?;
-    for fit in [&d.base_fit, &d.extended_fit] {
-        check_values(m, fit, &args.bounds.values()).map_err(|e| {
-            CliError::computation(format!(
-                "{flag}: implausible result: {e}; the fit does not describe this machine (--max-error-um, --max-error-urad change the bounds)"
-            ))
-        })?;
-    }
-    let mut files_out = Outputs::new();
-    let mut model_out = None;
-    if let Some(target) = &args.model_out {
-        let (name, contents) = d
-            .extended_machine(m, machine_text, label, &format!("rtest diagnose on {data}"))
-            .map_err(|e| CliError::computation(format!("--model-out: {e}")))?;
-        files_out.add("--model-out", target.clone(), contents);
-        model_out = Some((name, target.to_string()));
-    }
-    let held_names: Vec<String> = held
-        .campaign
-        .records
-        .iter()
-        .map(|r| r.label.clone())
-        .collect();
-    let source = DiagnosisSource {
-        machine_source: &args.machine,
-        label,
-        data: &data,
-        samples: fitted.campaign.samples(),
-        held_out: held
-            .campaign
-            .records
-            .iter()
-            .map(|r| (r.label.clone(), r.record.samples.len()))
-            .collect(),
-        opts: &opts,
-        model_out,
-    };
-    let mut report = DiagnosisReport::new(m, &source, &d)
-        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
-    report.campaign = Some(
-        CampaignDiagnosisReport::new(&part, &fitted.files, &held_names)
-            .map_err(|e| CliError::computation(format!("{flag}: {e}")))?,
-    );
-    if let Some(target) = &args.json {
-        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
-        files_out.add("--json", target.clone(), json);
-    }
-    if let Some(target) = &args.report {
-        let mut i = super::report::inputs_for(m, &inputs);
-        i.no_path_figures = Some(
-            "No path figures: a campaign diagnosis draws none (diagnose one record for them)."
-                .into(),
-        );
-        add_diagnosis(&mut i, &report)?;
-        files_out.add(
+        out.add(
             "--report",
             target.clone(),
             super::report::render("--report", &i)?,
@@ -533,8 +412,84 @@ fn run_campaign(
         "give --zeroed"
     }));
     let stdout_taken = outputs.iter().any(|(_, t)| matches!(t, Target::Stdout));
-    text.push_str(&wrote(&write(files_out)?));
+    text.push_str(&wrote(&write(out)?));
     print_text(&text, stdout_taken)
+}
+
+/// The records of `files` (given by `flag`) at kinematic parameters `params` (mm), read through
+/// `--instrument` when it is given, each with a progress bar while it is read (`shown`).
+fn read_records(
+    flag: &str,
+    m: &model_spec::Machine,
+    files: &[PathBuf],
+    params: &[f64],
+    args: &DiagnoseArgs,
+    shown: bool,
+) -> CliResult<Vec<Record>> {
+    let read = args.records.read_options();
+    files
+        .iter()
+        .map(|f| {
+            let (_bar, read) = super::progress::reading(shown, f, &read);
+            super::read_record(flag, m, f, &read, &args.instrument, params)
+        })
+        .collect()
+}
+
+/// The campaign of `records` read from `files` (an empty campaign for no records).
+fn loaded(records: Vec<CampaignRecord>, files: &[PathBuf]) -> CliResult<campaign::Loaded> {
+    let campaign = if records.is_empty() {
+        Campaign {
+            records: Vec::new(),
+        }
+    } else {
+        Campaign::new(records).map_err(|e| CliError::usage(e.0))?
+    };
+    Ok(campaign::Loaded {
+        campaign,
+        files: files.iter().map(|f| f.display().to_string()).collect(),
+        source: None,
+    })
+}
+
+/// The command-line words that give the fitted records of `args` to another command (`data`
+/// the `--data` files as given).
+fn data_arguments(args: &DiagnoseArgs, data: &str) -> Vec<String> {
+    let mut out = match &args.campaign {
+        Some(c) => vec!["--campaign".to_string(), c.display().to_string()],
+        None => vec!["--data".to_string(), data.to_string()],
+    };
+    if args.zeroed {
+        out.push("--zeroed".into());
+    }
+    if let Some(p) = &args.param {
+        out.extend(["--param".to_string(), p.clone()]);
+    }
+    if let Some(i) = &args.instrument.instrument {
+        out.extend(["--instrument".to_string(), i.clone()]);
+    }
+    if let Some(f) = &args.instrument.readings_frame {
+        out.extend(["--readings-frame".to_string(), f.clone()]);
+    }
+    out
+}
+
+/// The options of a diagnosis from the flags (all but the data).
+fn options(
+    args: &DiagnoseArgs,
+    m: &model_spec::Machine,
+    read: &solver::io::csv::ReadOptions,
+) -> CliResult<DiagnoseOptions> {
+    let mut opts = DiagnoseOptions::default();
+    opts.dictionary = DictionaryOptions::new(args.harmonics, args.poly, args.time);
+    opts.alpha = args.alpha;
+    opts.constraint = args::constraint(args.constraint.as_deref())?;
+    opts.noise = args.noise.choice(m, read, &args.instrument)?;
+    if let Some(b) = &args.budget {
+        opts.budget = solver::diagnosis::plausible::Budget::parse(b)
+            .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
+    }
+    Ok(opts)
 }
 
 /// Adds the diagnosis just computed to the inputs of its HTML report (`--report`).

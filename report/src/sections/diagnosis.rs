@@ -6,7 +6,7 @@ use super::{num, unit, value_std};
 use crate::html::{Body, Cell};
 use crate::inputs::{Figure, Inputs};
 use model_spec::units::{fixed, p_value, short};
-use solver::io::report::diagnose::FindingReport;
+use solver::io::report::diagnose::{DiagnosisReport, FindingReport};
 
 /// A finding's value(s) with uncertainties; a harmonic with its amplitude and phase.
 fn finding_value(f: &FindingReport) -> String {
@@ -59,9 +59,17 @@ pub fn write(
         b.end_section();
         return Ok(());
     };
+    let fitted = d.records.iter().filter(|r| r.role == "fitted").count();
     b.facts(&[
         ("Report", file.clone()),
-        ("Fitted record", format!("{} ({} samples)", d.data, d.samples)),
+        (
+            if fitted > 1 {
+                "Fitted records"
+            } else {
+                "Fitted record"
+            },
+            format!("{} ({} samples)", d.data, d.samples),
+        ),
         (
             "Base model",
             format!(
@@ -85,6 +93,10 @@ pub fn write(
         ),
         ("Stopped", d.stop.reason.clone()),
     ]);
+    records(b, d);
+    if !d.notes.is_empty() {
+        b.list(&d.notes);
+    }
     b.subheading("Findings");
     if d.findings.is_empty() {
         b.paragraph("No significant effect beyond the base model.");
@@ -121,6 +133,17 @@ pub fn write(
             ],
             &rows,
         );
+    }
+    if !d.dropped.is_empty() {
+        let lines: Vec<String> = d
+            .dropped
+            .iter()
+            .map(|x| format!("{}: {}", x.term, x.why))
+            .collect();
+        b.paragraph(
+            "Selected, but left out: the fit of the extended model with them did not converge (the other findings were selected with them in the model):",
+        );
+        b.list(&lines);
     }
     if !d.confounded.is_empty() {
         let lines: Vec<String> = d
@@ -258,6 +281,54 @@ pub fn write(
     }
     b.end_section();
     Ok(())
+}
+
+/// The records, when there is more to say than their files: several fitted records, or held-out
+/// records with parameters refitted on them (a new set-up's errors, their own zero and drifts).
+fn records(b: &mut Body, d: &DiagnosisReport) {
+    let fitted = d.records.iter().filter(|r| r.role == "fitted").count();
+    let refitted = d.records.iter().any(|r| !r.refitted.is_empty());
+    if fitted < 2 && !refitted {
+        return;
+    }
+    let rows: Vec<Vec<Cell>> = d
+        .records
+        .iter()
+        .map(|r| {
+            vec![
+                Cell::text(r.label.clone()),
+                Cell::text(r.data.clone()),
+                Cell::text(r.role.clone()),
+                Cell::text(if r.setup_fitted || r.role == "fitted" {
+                    r.setup.clone()
+                } else {
+                    format!("{} (new: refitted)", r.setup)
+                }),
+                Cell::number(r.samples.to_string()),
+                Cell::number(num(r.residual_rms_before_um, 3)),
+                Cell::number(num(r.residual_rms_after_um, 3)),
+                Cell::text(if r.refitted.is_empty() {
+                    "–".to_string()
+                } else {
+                    r.refitted.join(", ")
+                }),
+            ]
+        })
+        .collect();
+    b.table(
+        "Records: the machine's errors shared; each record with its own kinematic parameters, its set-up's errors and its own zero (residual RMS in µm)",
+        &[
+            "Record",
+            "File",
+            "Role",
+            "Set-up",
+            "Samples",
+            "Base",
+            "Extended",
+            "Refitted on it",
+        ],
+        &rows,
+    );
 }
 
 fn gain_row(role: &str, g: &solver::io::report::diagnose::GainRow) -> Vec<Cell> {

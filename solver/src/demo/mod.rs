@@ -12,13 +12,14 @@ mod text;
 
 use crate::diagnosis::figures::{Figures, figures};
 use crate::diagnosis::hidden::hidden_terms;
-use crate::diagnosis::{DiagnoseOptions, diagnose};
+use crate::diagnosis::{DiagnoseOptions, diagnose, one_record};
 use crate::fitting::campaign::{
     Campaign, CampaignIdentification, CampaignRecord, CampaignValues, validate_campaign,
 };
 use crate::fitting::sanity::{ValueLimits, check_values};
 use crate::fitting::{IdentifyOptions, RefineOptions, ValidateOptions, identify_refined};
 use crate::io::csv::format_record;
+use crate::io::progress::Unwatched;
 use crate::io::report::{
     DiagnosisReport, DiagnosisSource, IdentificationReport, IdentificationSource, ValidationReport,
     ValidationSource, to_json,
@@ -228,16 +229,24 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
     let hidden =
         hidden_terms(&m, &truth, &model, &k4.record, &records).map_err(failed("hidden terms"))?;
 
-    // 5. The diagnosis of the reduced model on K4, K1 and K2 held out, from the data alone.
-    let opts = DiagnoseOptions {
-        data_name: path_of(&k4.file),
-        ..Default::default()
-    };
+    // 5. The diagnosis of the reduced model on K4, K1 and K2 held out (on K4's set-up), from
+    // the data alone.
+    let opts = DiagnoseOptions::default();
+    let label = |r: &Run| r.name.to_ascii_lowercase();
     let held: Vec<(String, Record)> = runs[1..]
         .iter()
-        .map(|r| (path_of(&r.file), r.record.clone()))
+        .map(|r| (label(r), r.record.clone()))
         .collect();
-    let diagnosis = diagnose(&m, &model, &k4.record, &held, &opts).map_err(failed("diagnosis"))?;
+    let (fitted, held_out) = one_record(
+        &label(k4),
+        k4.record.clone(),
+        held,
+        m.default_parameters(),
+        false,
+    )
+    .map_err(failed("diagnosis"))?;
+    let diagnosis =
+        diagnose(&m, &model, &fitted, &held_out, &opts, &Unwatched).map_err(failed("diagnosis"))?;
     let machine_text = model_spec::write::source_text(MACHINE).map_err(failed("extended model"))?;
     let (ext_name, ext_text) = diagnosis
         .extended_machine(
@@ -247,24 +256,22 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
             "rtest demo: the diagnosis of the reduced model on K4",
         )
         .map_err(failed("extended model"))?;
+    let held_files: Vec<String> = runs[1..].iter().map(|r| path_of(&r.file)).collect();
     let source = DiagnosisSource {
         machine_source: MACHINE,
         label: REDUCED,
-        data: &k4_file,
-        samples: k4.record.samples.len(),
-        held_out: held
-            .iter()
-            .map(|(n, r)| (n.clone(), r.samples.len()))
-            .collect(),
+        data: vec![k4_file.clone()],
+        held_out: held_files.clone(),
+        data_arguments: vec!["--data".into(), k4_file.clone()],
         opts: &opts,
         model_out: Some((ext_name, path_of(EXTENDED_FILE))),
     };
     let diagnosis_report =
         DiagnosisReport::new(&m, &source, &diagnosis).map_err(failed("diagnosis"))?;
-    let mut figure_records = vec![(k4_file.clone(), &k4.record, true)];
-    figure_records.extend(held.iter().map(|(n, r)| (n.clone(), r, false)));
-    let figures =
-        figures(&m, &diagnosis, REDUCED, &opts, &figure_records).map_err(failed("figures"))?;
+    let mut names = vec![k4_file.clone()];
+    names.extend(held_files);
+    let figures = figures(&m, &diagnosis, REDUCED, &opts, &fitted, &held_out, &names)
+        .map_err(failed("figures"))?;
 
     // 6. The recommended model put back onto the machine: K1 and K2 compensated.
     let compensation = compensation::compensate_held_out(

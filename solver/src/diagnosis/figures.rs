@@ -3,9 +3,11 @@
 //! residual components before and after the extension, and what remains unexplained against what
 //! it follows.
 
+use super::heldout::estimable;
 use super::structure::{self, Component};
 use super::{DiagnoseOptions, Diagnosis};
-use crate::fitting::{Identification, ValidateError, ValidateOptions, Validation, validate};
+use crate::fitting::campaign::{Campaign, validate_record};
+use crate::fitting::{ValidateError, ValidateOptions, Validation};
 use crate::record::Record;
 use model_spec::{AxisKind, Machine};
 use std::path::Path;
@@ -204,22 +206,25 @@ pub fn abscissa(m: &Machine, record: &Record) -> (String, Vec<f64>) {
     }
 }
 
-/// The x, y and z panels of a record (µm): the measured error (prediction plus residual of
-/// `v`) against each labelled prediction (mm per sample).
-fn panels(v: &Validation, predictions: &[(String, &Vec<[f64; 3]>)]) -> Vec<Panel> {
-    let um = |v: &[[f64; 3]], k: usize| v.iter().map(|r| r[k] * 1e3).collect::<Vec<f64>>();
-    let measured: Vec<[f64; 3]> = v
-        .prediction
+/// The measured error of a validation: its prediction plus its residual (mm per sample).
+fn measured(v: &Validation) -> Vec<[f64; 3]> {
+    v.prediction
         .iter()
         .zip(&v.residual)
         .map(|(p, r)| [p[0] + r[0], p[1] + r[1], p[2] + r[2]])
-        .collect();
+        .collect()
+}
+
+/// The x, y and z panels of a record (µm): the measured error (mm per sample) against each
+/// labelled prediction (mm per sample).
+fn panels(measured: &[[f64; 3]], predictions: &[(String, &[[f64; 3]])]) -> Vec<Panel> {
+    let um = |v: &[[f64; 3]], k: usize| v.iter().map(|r| r[k] * 1e3).collect::<Vec<f64>>();
     (0..3)
         .map(|k| Panel {
             name: format!("{} error", ["x", "y", "z"][k]),
             measured: Series {
                 label: "measured".into(),
-                values: um(&measured, k),
+                values: um(measured, k),
             },
             predictions: predictions
                 .iter()
@@ -253,12 +258,65 @@ pub fn validation_figure(
         title: format!("{name} ({role}): measured and predicted error, µm"),
         x_label,
         x,
-        panels: panels(v, &[(format!("identified model ({label})"), &v.prediction)]),
+        panels: panels(
+            &measured(v),
+            &[(format!("identified model ({label})"), &v.prediction)],
+        ),
     }
 }
 
-/// The figures of diagnosis `d` of the model labelled `label`, for every record (name,
-/// record, fitted?): the fitted record first, then the held-out ones.
+/// A record's path figure and spectrum: `measured` against the base and extended predictions,
+/// the residual components `before` and `after` (base and extended model).
+#[allow(clippy::too_many_arguments)]
+fn record_figures(
+    m: &Machine,
+    out: &mut Figures,
+    taken: &mut Vec<String>,
+    (name, role): (&str, &str),
+    record: &Record,
+    measured: &[[f64; 3]],
+    predictions: [&[[f64; 3]]; 2],
+    (before, after): (Vec<Component>, Vec<Component>),
+    (label, ext_label): (&str, &str),
+) {
+    let (x_label, x) = abscissa(m, record);
+    let panels = panels(
+        measured,
+        &[
+            (format!("base model ({label})"), predictions[0]),
+            (format!("extended model ({ext_label})"), predictions[1]),
+        ],
+    );
+    let s = stem(name, taken);
+    out.paths.push(PathFigure {
+        file_name: format!("{s}-path.svg"),
+        what:
+            "figure: measured and predicted error along the path (base and extended model), x, y, z"
+                .into(),
+        title: format!("{name} ({role}): measured and predicted error, µm"),
+        x_label,
+        x,
+        panels,
+    });
+    let rows = component_rows(&before, &after, SPECTRUM_ROWS);
+    if !rows.is_empty() {
+        out.spectra.push(SpectrumFigure {
+            file_name: format!("{s}-spectrum.svg"),
+            what: "figure: residual components before and after the extension".into(),
+            title: format!("{name} ({role}): residual components, µm"),
+            before_label: format!("base model ({label})"),
+            after_label: format!("extended model ({ext_label})"),
+            rows,
+        });
+    }
+}
+
+/// The figures of diagnosis `d` of the model labelled `label` on the records of `fitted` and
+/// `held_out` (as given to [`super::diagnose`]), named `names` (the fitted records', then the
+/// held-out records', in order: their files): per record the measured error against the base
+/// and extended predictions (a fitted record: the fits' own prediction, outliers drawn; a
+/// held-out record: the predictions the gain was measured with) and its residual components;
+/// then what remains unexplained, against what it follows.
 ///
 /// # Errors
 /// A prediction that fails.
@@ -267,78 +325,93 @@ pub fn figures(
     d: &Diagnosis,
     label: &str,
     o: &DiagnoseOptions,
-    records: &[(String, &Record, bool)],
+    fitted: &Campaign,
+    held_out: &Campaign,
+    names: &[String],
 ) -> Result<Figures, ValidateError> {
     let mut out = Figures::default();
     let mut taken = Vec::new();
     let ext_label = d.extended_label(m, label);
-    for (name, record, fitted) in records {
-        // The fitted record: the fits' own prediction (the minimum-norm solution, so that
-        // confounded groups keep their combined effect), not zeroed: the offsets of zeroed
-        // readings are in the models. Held out: the values, zeroed like the readings.
-        let predict = |fit: &Identification| {
-            let values: Vec<Option<f64>> = if *fitted {
-                fit.fit.solution.iter().map(|&v| Some(v)).collect()
-            } else {
-                super::heldout::estimable_values(fit)
-            };
-            let mut opts = ValidateOptions::new()
-                .zeroed(o.zeroed && !fitted)
-                .exact(true);
-            opts.params = o.params.clone();
-            validate(m, &fit.model, &values, record, &opts)
-        };
-        let before = predict(&d.base_fit)?;
-        let after = predict(&d.extended_fit)?;
-        let (x_label, x) = abscissa(m, record);
-        let panels = panels(
-            &before,
-            &[
-                (format!("base model ({label})"), &before.prediction),
-                (format!("extended model ({ext_label})"), &after.prediction),
-            ],
+    let name = |i: usize| names.get(i).cloned().unwrap_or_else(|| "data".into());
+    let k = &o.dictionary;
+    let analyse = |record: &Record, r: &[[f64; 3]]| {
+        structure::analyse(m, record, r, k.harmonics, k.poly, k.time)
+    };
+    let exact = ValidateOptions::new().exact(true);
+    let (base, extended) = (estimable(&d.base_fit), estimable(&d.extended_fit));
+    for (r, rec) in fitted.records.iter().enumerate() {
+        // The fits' own prediction (the minimum-norm solution, so that confounded groups keep
+        // their combined effect), on every sample, outliers included.
+        let before = validate_record(m, &base, rec, &exact)?.validation;
+        let after = validate_record(m, &extended, rec, &exact)?.validation;
+        let drop = d
+            .records
+            .get(r)
+            .map_or(Vec::new(), |x| super::outliers::samples(&x.outliers));
+        let cleaned = rec.record.without(&drop);
+        let components = (
+            analyse(&cleaned, &d.base_fit.record_residual(r)),
+            analyse(&cleaned, &d.extended_fit.record_residual(r)),
         );
-        let role = if *fitted { "fitted" } else { "held out" };
-        let s = stem(name, &mut taken);
-        out.paths.push(PathFigure {
-            file_name: format!("{s}-path.svg"),
-            what: "figure: measured and predicted error along the path (base and extended model), x, y, z".into(),
-            title: format!("{name} ({role}): measured and predicted error, µm"),
-            x_label,
-            x,
-            panels,
-        });
-        let k = &o.dictionary;
-        let (sb, sa) = if *fitted {
-            (d.structure_before.clone(), d.structure_after.clone())
-        } else {
-            (
-                structure::analyse(m, record, &before.residual, k.harmonics, k.poly, k.time),
-                structure::analyse(m, record, &after.residual, k.harmonics, k.poly, k.time),
-            )
+        record_figures(
+            m,
+            &mut out,
+            &mut taken,
+            (&name(r), "fitted"),
+            &rec.record,
+            &measured(&before),
+            [&before.prediction, &after.prediction],
+            components,
+            (label, &ext_label),
+        );
+    }
+    for (h, (rec, v)) in held_out.records.iter().zip(&d.validation).enumerate() {
+        let minus = |res: &[[f64; 3]]| -> Vec<[f64; 3]> {
+            rec.record
+                .measured
+                .iter()
+                .zip(res)
+                .map(|(y, e)| std::array::from_fn(|k| y[k] - e[k]))
+                .collect()
         };
-        let rows = component_rows(&sb, &sa, SPECTRUM_ROWS);
-        if !rows.is_empty() {
-            out.spectra.push(SpectrumFigure {
-                file_name: format!("{s}-spectrum.svg"),
-                what: "figure: residual components before and after the extension".into(),
-                title: format!("{name} ({role}): residual components, µm"),
-                before_label: format!("base model ({label})"),
-                after_label: format!("extended model ({ext_label})"),
-                rows,
-            });
-        }
+        let components = (
+            analyse(&rec.record, &v.residual_before),
+            analyse(&rec.record, &v.residual_after),
+        );
+        record_figures(
+            m,
+            &mut out,
+            &mut taken,
+            (&name(fitted.records.len() + h), "held out"),
+            &rec.record,
+            &rec.record.measured,
+            [&minus(&v.residual_before), &minus(&v.residual_after)],
+            components,
+            (label, &ext_label),
+        );
     }
     // What remains unexplained, against what it follows (sorted by it).
     for u in &d.unexplained {
-        let residual: Vec<f64> = if u.data == records[0].0 {
-            let r = &d.extended_fit.fit.residual;
-            (0..r.len() / 3).map(|i| r[3 * i + u.direction]).collect()
-        } else {
-            match d.validation.iter().find(|h| h.name == u.data) {
-                Some(h) => h.residual_after.iter().map(|v| v[u.direction]).collect(),
-                None => continue,
-            }
+        let fitted_at = d.records.iter().position(|r| r.label == u.data);
+        let held_at = d.validation.iter().position(|h| h.name == u.data);
+        let (residual, data): (Vec<f64>, String) = match (fitted_at, held_at) {
+            (Some(r), _) => (
+                d.extended_fit
+                    .record_residual(r)
+                    .iter()
+                    .map(|v| v[u.direction])
+                    .collect(),
+                name(r),
+            ),
+            (None, Some(h)) => (
+                d.validation[h]
+                    .residual_after
+                    .iter()
+                    .map(|v| v[u.direction])
+                    .collect(),
+                name(fitted.records.len() + h),
+            ),
+            (None, None) => continue,
         };
         if residual.len() != u.x.len() {
             continue;
@@ -347,20 +420,14 @@ pub fn figures(
         order.sort_by(|&a, &b| u.x[a].total_cmp(&u.x[b]));
         let dir = ["x", "y", "z"][u.direction];
         let follows = u.follows.clone().unwrap_or_else(|| "sample".into());
-        let base = Path::new(&u.data)
+        let base = Path::new(&data)
             .file_stem()
             .map_or("data".to_string(), |s| s.to_string_lossy().into_owned());
         let s = stem(&format!("{base}-unexplained-{dir}"), &mut taken);
         out.paths.push(PathFigure {
             file_name: format!("{s}.svg"),
-            what: format!(
-                "figure: what remains in {dir} on {}, against {follows}",
-                u.data
-            ),
-            title: format!(
-                "{}: residual in {dir} of the extended model against {follows}, µm",
-                u.data
-            ),
+            what: format!("figure: what remains in {dir} on {data}, against {follows}"),
+            title: format!("{data}: residual in {dir} of the extended model against {follows}, µm"),
             x_label: if u.unit.is_empty() {
                 follows.clone()
             } else {

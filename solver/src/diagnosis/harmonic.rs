@@ -25,13 +25,9 @@ pub struct Harmonic {
 
 /// The columns of `term` in the extended fit.
 fn columns_of(d: &Diagnosis, term: &Term) -> Vec<usize> {
-    let model = &d.extended_fit.model;
-    model
-        .columns()
-        .iter()
-        .enumerate()
-        .filter(|(_, (t, _))| model.terms[*t] == *term)
-        .map(|(j, _)| j)
+    let layout = &d.extended_fit.layout;
+    (0..layout.columns.len())
+        .filter(|&j| layout.columns[j].term == *term)
         .collect()
 }
 

@@ -1,28 +1,40 @@
 //! Held-out records: what the base and the extended model predict there, with only what the
-//! fit determined.
+//! fits determined, each record with its own set-up.
 //!
+//! - **Values.** A held-out record takes the machine's errors from the fit; its set-up's errors
+//!   from the fit when its set-up was fitted (the same set-up label: the ball not moved), else
+//!   they are **refitted** on the record itself with every other value held; its own
+//!   parameters (its zero when its readings were zeroed, the drifts of a recording) are always
+//!   refitted: they are the state of that recording
+//!   ([`crate::fitting::campaign::validate_record`]). Its residual is then after those
+//!   parameters, and the report names them.
 //! - **Estimable predictions.** A fit of a rank-deficient model determines combinations of its
 //!   parameters, not every parameter. The prediction uses the values the fit gave, and for the
 //!   parameters it could not determine the minimum-norm solution (which carries exactly the
 //!   determined combinations: its undetermined part is zero). Setting undetermined values to
 //!   0, as a plain validation does, would throw away the combinations the fit did determine.
-//! - **What the prediction needs.** With `N` the null space of the fit's scaled H (`A = H·S⁻¹`)
-//!   and `B = H_h·S⁻¹` the same model on the held-out record, a null direction `n` changes the
-//!   held-out prediction by `B·n`: the fit cannot say what that part is. When `‖B·n‖` exceeds
-//!   `NEEDS_TOLERANCE` times the largest column norm of `B`, the held-out record needs an
-//!   undetermined combination, and the confounded groups `n` involves are named; that
-//!   record's RMS is then not the model's error and does not count in the gain.
+//! - **What the prediction needs.** With `N` the null space of the fit's scaled H and `B` the
+//!   held-out record's columns of the same parameters (scaled alike), a null direction `n`
+//!   changes the held-out prediction by `B·n`, less what the refitted columns take of it: the
+//!   fit cannot say what that part is. When it exceeds [`NEEDS_TOLERANCE`] times the largest
+//!   column norm of `B`, the held-out record needs an undetermined combination, and the
+//!   confounded groups `n` involves are named; that record's RMS is then not the model's error
+//!   and does not count in the gain.
 //! - **Outliers** of the held-out record (from the base prediction's residual,
 //!   [`super::outliers`]) are listed and left out of both RMS.
 
+use super::DiagnoseError;
 use super::outliers::{self, Outlier};
-use crate::fitting::Identification;
-use crate::fitting::hmatrix::{GainSource, h_matrix};
-use crate::fitting::validate::{
-    ValidateError, ValidateOptions, Validation, statistics, validate_with,
+use super::select::Span;
+use crate::fitting::campaign::design::block;
+use crate::fitting::campaign::{
+    Campaign, CampaignIdentification, CampaignRecord, CampaignValues, RecordValidation,
+    record_plan, validate_record,
 };
-use crate::record::Record;
+use crate::fitting::hmatrix::GainSource;
+use crate::fitting::validate::{ValidateError, ValidateOptions, statistics};
 use model_spec::Machine;
+use nalgebra::DMatrix;
 
 /// Relative size of `‖B·n‖` above which a held-out record needs a null direction of the fit.
 pub const NEEDS_TOLERANCE: f64 = 1e-6;
@@ -30,8 +42,22 @@ pub const NEEDS_TOLERANCE: f64 = 1e-6;
 /// One held-out record's gain.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HeldOut {
-    /// Its name (file).
+    /// Its label in the held-out campaign.
     pub name: String,
+    /// Its set-up's label.
+    pub setup: String,
+    /// Whether its set-up was fitted (its set-up errors come from the fit); otherwise they were
+    /// refitted on it.
+    pub setup_fitted: bool,
+    /// Whether its readings were zeroed at the first sample.
+    pub zeroed: bool,
+    /// Its kinematic parameters, mm (symbol order).
+    pub params: Vec<f64>,
+    /// Its samples, outliers included.
+    pub samples: usize,
+    /// The parameters of the extended model refitted on it (`XOW[k2]`, `dx0[k2]`); none when
+    /// every value came from the fit.
+    pub refitted: Vec<String>,
     /// Readings counted in the RMS (three per sample, outliers' samples left out).
     pub readings: usize,
     /// Residual RMS of the base model's prediction, mm (outliers left out).
@@ -70,49 +96,84 @@ impl HeldOut {
     }
 }
 
-/// The values a prediction uses: the fit's values, the minimum-norm solution where the fit
-/// gave none.
-pub fn estimable_values(ident: &Identification) -> Vec<Option<f64>> {
-    let fit = &ident.fit;
-    fit.values
+/// The values a prediction uses: every column's minimum-norm solution (the fit's values where
+/// it has them; the determined combinations carried where it does not).
+pub fn estimable(ident: &CampaignIdentification) -> CampaignValues {
+    let mut v = CampaignValues::of(ident);
+    v.values = ident
+        .fit
+        .values
         .iter()
-        .zip(&fit.solution)
+        .zip(&ident.fit.solution)
         .map(|(v, s)| Some(v.unwrap_or(*s)))
+        .collect();
+    v
+}
+
+/// The exact predictions of `ident` on every record of `held` (see the module documentation).
+///
+/// # Errors
+/// A record the fit's values cannot predict (named).
+pub fn predict(
+    m: &Machine,
+    ident: &CampaignIdentification,
+    held: &Campaign,
+) -> Result<Vec<RecordValidation>, ValidateError> {
+    let values = estimable(ident);
+    let opts = ValidateOptions {
+        exact: true,
+        ..Default::default()
+    };
+    held.records
+        .iter()
+        .map(|r| validate_record(m, &values, r, &opts))
         .collect()
 }
 
-/// The confounded groups of `ident` (parameter names) the prediction on `record` needs
-/// (`zeroed`: the prediction is zeroed at the first sample, so constant directions cancel).
+/// The confounded groups of `ident` (by name) the prediction on held-out record `r` needs: a
+/// null direction of the fit that changes the prediction, once the record's refitted columns
+/// have taken what they can.
+///
+/// # Errors
+/// A record whose columns cannot be built.
 pub fn needed_groups(
     m: &Machine,
-    ident: &Identification,
-    record: &Record,
-    source: &mut GainSource,
-    zeroed: bool,
-) -> Result<Vec<Vec<String>>, ValidateError> {
+    ident: &CampaignIdentification,
+    r: &CampaignRecord,
+) -> Result<Vec<Vec<String>>, DiagnoseError> {
     let fit = &ident.fit;
     let null = &fit.identifiability.null_space;
     if null.ncols() == 0 {
         return Ok(Vec::new());
     }
-    let mut b = h_matrix(m, &ident.model, record, source)?;
-    if zeroed {
-        let first = b.rows(0, 3).into_owned();
-        for i in 0..b.nrows() / 3 {
-            let mut rows = b.rows_mut(3 * i, 3);
-            rows -= &first;
+    let values = estimable(ident);
+    let plan = record_plan(m, &values, r)?;
+    let mut source = GainSource::new(m, &plan.model.errors(), &r.params)?;
+    let h = block(m, &plan.model, &r.record, &mut source, plan.clock)?;
+    let rows = h.nrows();
+    let mut b = DMatrix::zeros(rows, fit.names.len());
+    let mut refit = Vec::new();
+    for (k, s) in plan.sources.iter().enumerate() {
+        match s {
+            Some(c) => {
+                let col = h.column(k) / fit.column_norms[*c];
+                let mut target = b.column_mut(*c);
+                target += col;
+            }
+            None => refit.push(k),
         }
     }
-    for (j, s) in fit.column_norms.iter().enumerate() {
-        b.column_mut(j).scale_mut(1.0 / s);
-    }
+    let refit_span = Span::of_groups(rows, 0..refit.len(), &|i| {
+        h.columns(refit[i], 1).into_owned()
+    });
     let scale = (0..b.ncols())
         .map(|j| b.column(j).norm())
         .fold(0.0, f64::max);
     let mut groups: Vec<usize> = Vec::new();
     for k in 0..null.ncols() {
         let n = null.column(k);
-        if (&b * n).norm() <= NEEDS_TOLERANCE * scale {
+        let moved = refit_span.project_out(&(&b * n));
+        if moved.norm() <= NEEDS_TOLERANCE * scale {
             continue;
         }
         for (g, members) in fit.identifiability.confounded.iter().enumerate() {
@@ -133,9 +194,8 @@ pub fn needed_groups(
         .collect())
 }
 
-/// The RMS of `residual` without the readings of `outliers`' samples, mm.
-fn rms_without(residual: &[[f64; 3]], outliers: &[Outlier]) -> f64 {
-    let drop = outliers::samples(outliers);
+/// RMS of `residual` without the samples of `drop`, mm.
+fn rms_without(residual: &[[f64; 3]], drop: &[usize]) -> f64 {
     let kept: Vec<[f64; 3]> = (0..residual.len())
         .filter(|i| !drop.contains(i))
         .map(|i| residual[i])
@@ -145,52 +205,39 @@ fn rms_without(residual: &[[f64; 3]], outliers: &[Outlier]) -> f64 {
         .measured_rms
 }
 
-/// The prediction of `fit` on every held-out record (exact machine, estimable values).
-pub fn predict(
-    m: &Machine,
-    fit: &Identification,
-    held_out: &[(String, Record)],
-    source: &mut GainSource,
-    opts: &ValidateOptions,
-) -> Result<Vec<Validation>, ValidateError> {
-    held_out
-        .iter()
-        .map(|(_, rec)| validate_with(m, &fit.model, &estimable_values(fit), rec, source, opts))
-        .collect()
-}
-
-/// The gain on every held-out record: the base predictions `before` ([`predict`]) and the
+/// The gain on every record of `held`: the base predictions `before` ([`predict`]) and the
 /// extended ones, outliers left out, undetermined needs named.
+///
+/// # Errors
+/// A prediction that cannot be made.
 pub fn held_out_gain(
     m: &Machine,
-    base: &Identification,
-    before: &[Validation],
-    extended: &Identification,
-    held_out: &[(String, Record)],
-    source: &mut GainSource,
-    opts: &ValidateOptions,
-) -> Result<Vec<HeldOut>, ValidateError> {
-    let mut out = Vec::new();
-    for ((name, rec), before) in held_out.iter().zip(before) {
-        let after = validate_with(
-            m,
-            &extended.model,
-            &estimable_values(extended),
-            rec,
-            source,
-            opts,
-        )?;
-        let outliers = outliers::find_in(rec, &before.residual);
+    base: &CampaignIdentification,
+    before: &[RecordValidation],
+    extended: &CampaignIdentification,
+    held: &Campaign,
+) -> Result<Vec<HeldOut>, DiagnoseError> {
+    let after = predict(m, extended, held)?;
+    let mut out = Vec::with_capacity(held.records.len());
+    for ((rec, b), a) in held.records.iter().zip(before).zip(after) {
+        let found = outliers::find_in(&rec.record, &b.validation.residual);
+        let drop = outliers::samples(&found);
         out.push(HeldOut {
-            name: name.clone(),
-            readings: 3 * (rec.samples.len() - outliers::samples(&outliers).len()),
-            before_rms: rms_without(&before.residual, &outliers),
-            after_rms: rms_without(&after.residual, &outliers),
-            residual_after: after.residual,
-            residual_before: before.residual.clone(),
-            outliers,
-            undetermined_before: needed_groups(m, base, rec, source, opts.zeroed)?,
-            undetermined_after: needed_groups(m, extended, rec, source, opts.zeroed)?,
+            name: rec.label.clone(),
+            setup: rec.setup.clone(),
+            setup_fitted: a.setup_fitted,
+            zeroed: rec.zeroed,
+            params: rec.params.clone(),
+            samples: rec.record.samples.len(),
+            refitted: a.refitted.iter().map(|r| r.name.clone()).collect(),
+            readings: 3 * (rec.record.samples.len() - drop.len()),
+            before_rms: rms_without(&b.validation.residual, &drop),
+            after_rms: rms_without(&a.validation.residual, &drop),
+            residual_after: a.validation.residual,
+            residual_before: b.validation.residual.clone(),
+            outliers: found,
+            undetermined_before: needed_groups(m, base, rec)?,
+            undetermined_after: needed_groups(m, extended, rec)?,
         });
     }
     Ok(out)

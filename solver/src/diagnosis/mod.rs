@@ -1,9 +1,16 @@
 //! Diagnosis: where the model and the measurement disagree, which missing effect explains it,
 //! the model extended with it, and the gain measured on data that were not fitted.
 //!
-//! 1. Fit the base model; analyse the structure of its residual ([`structure`]).
+//! The fitted records and the held-out records are each a [`Campaign`]: a single record is the
+//! campaign of that record, and every stage below is the campaign's (docs/diagnosis.md).
+//!
+//! 1. Fit the base model on the fitted records together ([`crate::fitting::campaign`]: the
+//!    machine's errors shared, each record with its own kinematic parameters, its set-up's
+//!    errors and its own zero); find the outliers of every record ([`outliers`]) and leave them
+//!    out; choose the noise model with the held-out residuals ([`noise_model`]).
 //! 2. Build the candidate dictionary ([`mod@dictionary`]): every term of the topology the model
-//!    lacks.
+//!    lacks, each a group of the campaign's columns (one set for a machine error, one column
+//!    per record for a drift of the R-test's zero, one per set-up for a set-up error).
 //! 3. Forward selection ([`select`]): add the candidate that explains most of what is left,
 //!    if it is significant (F-test against the noise, corrected for the number of candidates
 //!    tried); refuse candidates the model spans and report them with what they are confounded
@@ -13,21 +20,25 @@
 //!    one's extra directions (parsimony); and the candidates the data cannot tell from it, as
 //!    its alternatives. Then an exchange pass: each finding is selected again given all the
 //!    others (renamed, or dropped when no longer significant), and the selection goes on while
-//!    that changes something.
-//! 4. Refit the extended model (refined against the exact machine), and measure the residual
-//!    RMS before and after on the fitted record and on every held-out record.
-//!
-//! [`campaign::diagnose_campaign`] does the same on a campaign (several records, each with its
-//! own set-up and zero).
+//!    that changes something. A scanned parameter is refined on a fine grid ([`profile`]).
+//! 4. Refit the extended model (refined against the exact machine; a finding whose refinement
+//!    does not converge is dropped with a note, [`Dropped`]), and measure the residual RMS
+//!    before and after on every fitted record and every held-out record ([`heldout`]: a
+//!    held-out record on a set-up that was not fitted has its set-up errors refitted on it, and
+//!    its own zero and drifts always are).
+//! 5. The lack-of-fit test of what remains against the noise ([`adequacy`]), what remains
+//!    described ([`unexplained`]), and the verdict ([`verdict`]).
 
 pub mod adequacy;
-pub mod campaign;
+mod columns;
 mod confounded;
 pub mod dictionary;
+mod extend;
 pub mod figures;
 pub mod harmonic;
 pub mod heldout;
 pub mod hidden;
+mod lack_of_fit;
 mod noise_model;
 mod options;
 pub mod outliers;
@@ -39,25 +50,24 @@ pub mod structure;
 pub mod tones;
 pub mod unexplained;
 pub mod verdict;
+mod weights;
 
-use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
+use crate::fitting::campaign::{Campaign, CampaignIdentification, CampaignRecord};
+use crate::fitting::hmatrix::HMatrixError;
 use crate::fitting::noise::{NoiseChoice, NoiseError, NoiseModel, NoiseSource};
-use crate::fitting::refine::{RefineError, RefineOptions, identify_refined_with_noise};
-use crate::fitting::validate::{ValidateError, ValidateOptions};
-use crate::fitting::{
-    EstimateError, Identification, IdentifyOptions, measurement_vector, with_offsets,
-};
-use crate::io::progress::{Progress, Unwatched};
-use crate::model::{Effect, Model};
+use crate::fitting::refine::RefineError;
+use crate::fitting::validate::ValidateError;
+use crate::fitting::{EstimateError, with_offsets};
+use crate::io::progress::Progress;
+use crate::model::Model;
 use crate::record::Record;
 use confounded::confounded_with;
 use dictionary::dictionary;
 use model_spec::Machine;
 use model_spec::terms::Term;
-use nalgebra::DVector;
 pub use options::DiagnoseOptions;
-
 use select::Span;
+use std::borrow::Cow;
 use structure::Component;
 
 /// How the corrected p-value of a step was obtained.
@@ -81,8 +91,10 @@ pub struct Finding {
     /// it explains, as far as the data can tell). The finding may be any of them.
     pub alternatives: Vec<Term>,
     /// Its value(s) in the extended model, mm or rad (`[cos, sin]` for a harmonic; ms for a
-    /// velocity term, a fraction for an instrument term); `None` where the fit cannot determine
-    /// it. For an implausible finding, its value(s) with every finding fitted together.
+    /// velocity term, a fraction for an instrument term; one value per record or set-up for a
+    /// term a record or set-up owns, in the order of the campaign's columns); `None` where the
+    /// fit cannot determine it. For an implausible finding, its value(s) with every finding
+    /// fitted together.
     pub values: Vec<Option<f64>>,
     /// Their standard uncertainties (same units).
     pub stds: Vec<Option<f64>>,
@@ -130,42 +142,76 @@ pub struct Stop {
     pub reason: String,
 }
 
+/// A finding of the selection left out because the fit of the extended model with it did not
+/// converge: the diagnosis goes on without it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Dropped {
+    /// The term.
+    pub term: Term,
+    /// Why, for people (the refinement's failure).
+    pub why: String,
+}
+
+/// One fitted record of a diagnosis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordDiagnosis {
+    /// Its label in the campaign.
+    pub label: String,
+    /// Its set-up's label.
+    pub setup: String,
+    /// Its samples, outliers included.
+    pub samples: usize,
+    /// Whether its readings were zeroed at the first sample (its own `dx0 dy0 dz0` fitted).
+    pub zeroed: bool,
+    /// Its kinematic parameters, mm (symbol order).
+    pub params: Vec<f64>,
+    /// Isolated readings far outside the base residual's scale; their samples are left out of
+    /// every fit and test (`sample` indexes the record as given).
+    pub outliers: Vec<outliers::Outlier>,
+    /// Its residual RMS under the base model and under the extended one (mm, outliers left
+    /// out).
+    pub rms: (f64, f64),
+}
+
 /// A diagnosis.
 #[derive(Clone, Debug)]
 pub struct Diagnosis {
     /// The base model as given (without the offsets of zeroed readings).
     pub base_given: Model,
-    /// The base model as fitted (with the offsets when zeroed).
+    /// The base model's terms as fitted: with `dx0 dy0 dz0` when a fitted record is zeroed.
     pub base: Model,
-    /// The base model's fit (refined against the exact machine).
-    pub base_fit: Identification,
-    /// Residual structure of the base fit, largest first.
+    /// The base model's fit on the fitted records (refined against the exact machine, outliers
+    /// left out).
+    pub base_fit: CampaignIdentification,
+    /// The fitted records, in the campaign's order.
+    pub records: Vec<RecordDiagnosis>,
+    /// Residual structure of the base fit (the records one after the other), largest first.
     pub structure_before: Vec<Component>,
     /// Candidates in the dictionary.
     pub dictionary_size: usize,
     /// The findings, in the order they were added.
     pub findings: Vec<Finding>,
+    /// Findings left out because the extended fit with them did not converge.
+    pub dropped: Vec<Dropped>,
     /// Candidates spanned by the final model.
     pub confounded: Vec<Confounded>,
-    /// Candidates that do not vary at all on the fitted path.
+    /// Candidates that do not vary at all on the fitted paths.
     pub unexcited: Vec<Term>,
     /// Why the selection stopped.
     pub stop: Stop,
-    /// The extended model (base + the plausible findings).
+    /// The extended model as fitted: the base model as given plus the plausible findings (each
+    /// zeroed record adds its own offsets).
     pub extended: Model,
     /// Its fit (refined).
-    pub extended_fit: Identification,
+    pub extended_fit: CampaignIdentification,
     /// Residual structure after the extension.
     pub structure_after: Vec<Component>,
-    /// Residual RMS on the fitted record (outliers left out), before and after (mm).
+    /// Residual RMS over the fitted records (outliers left out), before and after (mm).
     pub fit_rms: (f64, f64),
     /// Residual RMS of the base fit with the outliers in the fit, mm.
     pub fit_rms_with_outliers: f64,
-    /// Isolated readings of the fitted record far outside the base residual's scale; their
-    /// samples are left out of every fit and test (`sample` indexes the record as given).
-    pub outliers: Vec<outliers::Outlier>,
     /// Per held-out record: the residual RMS before and after, what it needs that the fits do
-    /// not determine, its outliers.
+    /// not determine, what was refitted on it, its outliers.
     pub validation: Vec<heldout::HeldOut>,
     /// Whether the extended model is recommended, and why (not).
     pub recommendation: verdict::Recommendation,
@@ -202,69 +248,7 @@ pub enum DiagnoseError {
     Campaign(String),
 }
 
-/// The refined fit of `model` on `record`, by generalized least squares under `noise`.
-fn fit(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    source: &mut GainSource,
-    o: &DiagnoseOptions,
-    noise: &NoiseChoice,
-) -> Result<Identification, DiagnoseError> {
-    let opts = IdentifyOptions {
-        zeroed: false,
-        constraint: o.constraint.clone(),
-        tolerances: o.tolerances,
-        params: None,
-    };
-    let (mut ident, _) = identify_refined_with_noise(
-        m,
-        model,
-        record,
-        source,
-        &opts,
-        &RefineOptions::default(),
-        noise,
-    )?;
-    ident.zeroed = o.zeroed;
-    Ok(ident)
-}
-
-fn residual_rows(ident: &Identification) -> Vec<[f64; 3]> {
-    let r = &ident.fit.residual;
-    (0..r.len() / 3)
-        .map(|i| [r[3 * i], r[3 * i + 1], r[3 * i + 2]])
-        .collect()
-}
-
-/// The values and standard uncertainties of term `t` of a fit (mm or rad).
-fn term_values(ident: &Identification, t: usize) -> (Vec<Option<f64>>, Vec<Option<f64>>) {
-    let cols: Vec<usize> = ident
-        .model
-        .columns()
-        .iter()
-        .enumerate()
-        .filter(|(_, (ti, _))| *ti == t)
-        .map(|(j, _)| j)
-        .collect();
-    (
-        cols.iter().map(|&j| ident.fit.values[j]).collect(),
-        cols.iter().map(|&j| ident.fit.std[j]).collect(),
-    )
-}
-
-/// Diagnoses `base` on `record`, checking the gain on the `held_out` records.
-pub fn diagnose(
-    m: &Machine,
-    base: &Model,
-    record: &Record,
-    held_out: &[(String, Record)],
-    o: &DiagnoseOptions,
-) -> Result<Diagnosis, DiagnoseError> {
-    diagnose_with_progress(m, base, record, held_out, o, &Unwatched)
-}
-
-/// The stages of a diagnosis, in order, as [`diagnose_with_progress`] reports them.
+/// The stages of a diagnosis, in order, as [`diagnose`] reports them.
 pub const STAGES: [&str; 7] = [
     "base fit",
     "noise model",
@@ -275,63 +259,164 @@ pub const STAGES: [&str; 7] = [
     "lack of fit",
 ];
 
-/// [`diagnose`], telling `progress` where it is: `diagnosis` with the number of [`STAGES`]
-/// begun (done of total), and within the selection every candidate scored (`selection`, done
-/// of the candidates of the step; each step starts again from 0).
+/// The campaigns of a single record `record` labelled `label` (at kinematic parameters
+/// `params`, mm; zeroed or not) and of the records `held_out` (name, record) measured on its
+/// set-up, the ball not moved: what [`diagnose`] takes for the diagnosis of one record.
 ///
 /// # Errors
-/// As [`diagnose`].
-pub fn diagnose_with_progress(
+/// [`DiagnoseError::Campaign`] for a label that is not one (letters, digits and `- _ . + :`)
+/// or given twice.
+pub fn one_record(
+    label: &str,
+    record: Record,
+    held_out: Vec<(String, Record)>,
+    params: Vec<f64>,
+    zeroed: bool,
+) -> Result<(Campaign, Campaign), DiagnoseError> {
+    let fitted = Campaign::new(vec![CampaignRecord::new(
+        label,
+        record,
+        params.clone(),
+        label,
+        zeroed,
+    )])
+    .map_err(|e| DiagnoseError::Campaign(e.0))?;
+    let held = held_out
+        .into_iter()
+        .map(|(name, r)| CampaignRecord::new(name, r, params.clone(), label, zeroed))
+        .collect();
+    let held = Campaign { records: held };
+    check_held_out(&fitted, &held)?;
+    Ok((fitted, held))
+}
+
+/// Refuses held-out records that are not a campaign (labels) or that bear a fitted record's
+/// label (a held-out record is not fitted).
+fn check_held_out(fitted: &Campaign, held: &Campaign) -> Result<(), DiagnoseError> {
+    if held.records.is_empty() {
+        return Ok(());
+    }
+    Campaign::new(held.records.clone()).map_err(|e| DiagnoseError::Campaign(e.0))?;
+    if let Some(r) = held
+        .records
+        .iter()
+        .find(|r| fitted.records.iter().any(|f| f.label == r.label))
+    {
+        return Err(DiagnoseError::Campaign(format!(
+            "held-out record `{}` has the label of a fitted record: a held-out record is not fitted (rename one)",
+            r.label
+        )));
+    }
+    Ok(())
+}
+
+/// The records of `c` one after the other as one record (times continued), for the residual
+/// structure and the scanned candidates' grids: the record itself for a campaign of one.
+fn joined(c: &Campaign) -> Cow<'_, Record> {
+    if let [only] = c.records.as_slice() {
+        return Cow::Borrowed(&only.record);
+    }
+    let mut out = Record::default();
+    let mut offset = 0.0;
+    for r in &c.records {
+        let (first, last) = match (r.record.samples.first(), r.record.samples.last()) {
+            (Some(a), Some(b)) => (a.t, b.t),
+            _ => continue,
+        };
+        for s in &r.record.samples {
+            let mut s = s.clone();
+            s.t = s.t - first + offset;
+            out.samples.push(s);
+        }
+        out.measured.extend(r.record.measured.iter().copied());
+        offset += last - first + 1.0;
+    }
+    Cow::Owned(out)
+}
+
+/// The residuals of every record of `fit`, one after the other (mm, one `[x, y, z]` per sample).
+fn flat_residual(fit: &CampaignIdentification) -> Vec<[f64; 3]> {
+    (0..fit.records.len())
+        .flat_map(|r| fit.record_residual(r))
+        .collect()
+}
+
+/// Diagnoses `base` on the records of `fitted`, checking the gain on the records of `held_out`
+/// (see the module documentation), telling `progress` where it is: `diagnosis` with the number
+/// of [`STAGES`] begun (done of total), and within the selection every candidate scored
+/// (`selection`, done of the candidates of the step; each step starts again from 0). The
+/// records carry their zeroing, set-ups and kinematic parameters.
+///
+/// # Errors
+/// A campaign that does not fit `m`; the base model's fit failing (its refinement not
+/// converging included: without it there is nothing to diagnose); a noise model that cannot
+/// whiten; a held-out prediction that cannot be made. A finding whose extended fit does not
+/// converge is no error: it is dropped ([`Diagnosis::dropped`]).
+pub fn diagnose(
     m: &Machine,
     base: &Model,
-    record: &Record,
-    held_out: &[(String, Record)],
+    fitted: &Campaign,
+    held_out: &Campaign,
     o: &DiagnoseOptions,
     progress: &dyn Progress,
 ) -> Result<Diagnosis, DiagnoseError> {
     let stage = |k: usize| progress.update("diagnosis", k as u64, STAGES.len() as u64);
     stage(0);
+    fitted.check(m).map_err(|e| DiagnoseError::Campaign(e.0))?;
+    if !held_out.records.is_empty() {
+        held_out
+            .check(m)
+            .map_err(|e| DiagnoseError::Campaign(e.0))?;
+    }
+    check_held_out(fitted, held_out)?;
     let base_given = base.clone();
-    let base = if o.zeroed {
+    // The dictionary leaves out what the base model has; with zeroed records the constant zero
+    // offsets are base columns (each zeroed record's own).
+    let base_terms = if fitted.records.iter().any(|r| r.zeroed) {
         with_offsets(base)
     } else {
         base.clone()
     };
-    let mut candidates = dictionary(m, &base.terms, &o.dictionary);
-    candidates.extend(dictionary::scanned(m, &base.terms, record, &o.dictionary));
-    // One gain source for every error the base model and the dictionary use.
-    let mut all = base.clone();
-    all.terms.extend(candidates.iter().copied());
-    let params = o.params.clone().unwrap_or_else(|| m.default_parameters());
-    let mut source = GainSource::new(m, &all.errors(), &params)?;
+    let mut candidates = dictionary(m, &base_terms.terms, &o.dictionary);
+    candidates.extend(dictionary::scanned(
+        m,
+        &base_terms.terms,
+        &joined(fitted),
+        &o.dictionary,
+    ));
 
-    // Outliers of the fitted record, from the base fit's residual: everything after works
+    // Outliers of every fitted record, from the base fit's residual: everything after works
     // without their samples.
-    let first_fit = fit(m, &base, record, &mut source, o, &NoiseChoice::Ordinary)?;
-    let outliers = outliers::find_in(record, &residual_rows(&first_fit));
-    let fit_rms_with_outliers = first_fit.fit.residual_rms();
-    let cleaned;
-    let (record, base_fit) = if outliers.is_empty() {
-        (record, first_fit)
+    let first = extend::fit(m, base, fitted, o, &NoiseChoice::Ordinary)?;
+    let fit_rms_with_outliers = first.fit.residual_rms();
+    let mut record_outliers = Vec::with_capacity(fitted.records.len());
+    let mut cleaned = fitted.clone();
+    for (r, rec) in fitted.records.iter().enumerate() {
+        let found = outliers::find_in(&rec.record, &first.record_residual(r));
+        if !found.is_empty() {
+            cleaned.records[r].record = rec.record.without(&outliers::samples(&found));
+        }
+        record_outliers.push(found);
+    }
+    let base_fit = if record_outliers.iter().all(Vec::is_empty) {
+        first
     } else {
-        cleaned = record.without(&outliers::samples(&outliers));
-        let f = fit(m, &base, &cleaned, &mut source, o, &NoiseChoice::Ordinary)?;
-        (&cleaned, f)
+        extend::fit(m, base, &cleaned, o, &NoiseChoice::Ordinary)?
     };
+    let weights = weights::Weights::of(&cleaned, held_out, &o.noise)?;
 
     stage(1);
-    // The noise model, and the readings and columns whitened by it: every test after is the
-    // textbook one on white noise of unit variance.
-    let vopts = ValidateOptions {
-        zeroed: o.zeroed,
-        exact: true,
-        params: Some(params.clone()),
-        ..Default::default()
-    };
-    let before = heldout::predict(m, &base_fit, held_out, &mut source, &vopts)?;
-    let (noise, estimated) = noise_model::choose(&o.noise, &base_fit, held_out, &before);
-    // Every fit from here on is the generalized least-squares fit under that model, so that
-    // the standard uncertainties assume it.
+    // The noise model, from every fitted record's residual and every clean held-out residual;
+    // every fit from here on is the generalized least-squares fit under it.
+    let before = heldout::predict(m, &base_fit, held_out)?;
+    let mut series = weights.fitted_rows(&base_fit)?;
+    for (rec, v) in held_out.records.iter().zip(&before) {
+        if outliers::find_in(&rec.record, &v.validation.residual).is_empty() {
+            series.push(weights.held_rows(&rec.record, &v.validation.residual)?);
+        }
+    }
+    let refs: Vec<&[[f64; 3]]> = series.iter().map(Vec::as_slice).collect();
+    let (noise, estimated) = noise_model::choose(&o.noise, base_fit.fit.sigma, &refs);
     let gls = match noise.source {
         NoiseSource::Residual { .. } => NoiseChoice::Ordinary,
         _ => NoiseChoice::Model(noise.clone()),
@@ -339,92 +424,62 @@ pub fn diagnose_with_progress(
     let (base_fit, before) = if gls == NoiseChoice::Ordinary {
         (base_fit, before)
     } else {
-        let f = fit(m, &base, record, &mut source, o, &gls)?;
-        let b = heldout::predict(m, &f, held_out, &mut source, &vopts)?;
+        let f = extend::fit(m, base, &cleaned, o, &gls)?;
+        let b = heldout::predict(m, &f, held_out)?;
         (f, b)
     };
-    stage(2);
-    let layout = [record.samples.len()];
-    let mut y = measurement_vector(record)?;
-    let mut h_raw = h_matrix(m, &all, record, &mut source)?;
-    // The instrument candidates act on the displacement, which the H matrix takes from the
-    // readings; those carry the very misfit the selection looks for, so that a gain term
-    // "explains" a share of any residual. Here the displacement is the base model's
-    // prediction instead (first order in S all the same).
-    let predicted = &y - &base_fit.fit.residual;
-    let mut at = 0;
-    for t in &all.terms {
-        if let Effect::Instrument {
-            reading,
-            displacement,
-        } = t.effect
-        {
-            let mut col = h_raw.column_mut(at);
-            col.fill(0.0);
-            for i in 0..predicted.len() / 3 {
-                col[3 * i + reading.index()] = predicted[3 * i + displacement.index()];
-            }
-        }
-        at += t.basis.width();
-    }
-    let mut h_all = h_raw.clone();
+    // The selection whitens with φ raised when the noise was estimated.
     let whitening = if estimated {
         noise_model::conservative(&noise)
     } else {
         noise.clone()
     };
-    whitening.whiten(&layout, &mut h_all, &mut y)?;
-    let n = y.len();
 
-    // Column ranges: base terms first, then one group per candidate.
-    let widths: Vec<usize> = all.terms.iter().map(|t| t.basis.width()).collect();
-    let starts: Vec<usize> = widths
-        .iter()
-        .scan(0, |s, &w| {
-            let a = *s;
-            *s += w;
-            Some(a)
-        })
-        .collect();
-    let group = |t: usize| h_all.columns(starts[t], widths[t]).into_owned();
-    let nb = base.terms.len();
-
+    stage(2);
+    let cols = columns::Columns::new(
+        m,
+        base,
+        &candidates,
+        &cleaned,
+        &base_fit,
+        &weights,
+        &whitening,
+    )?;
+    let nb = cols.nb;
+    let group = |t: usize| cols.group(t);
+    let n = cols.y.len();
     let rss_base = Span::of_groups(n, 0..nb, &group)
-        .project_out(&y)
+        .project_out(&cols.y)
         .norm_squared();
     let unexcited: Vec<Term> = (0..candidates.len())
-        .filter(|&c| {
-            h_raw
-                .columns(starts[nb + c], widths[nb + c])
-                .iter()
-                .all(|v| v.abs() < 1e-15)
-        })
+        .filter(|&c| cols.unexcited(nb + c))
         .map(|c| candidates[c])
         .collect();
-    let candidates_live: Vec<usize> = (0..candidates.len())
+    let live: Vec<usize> = (0..candidates.len())
         .filter(|&c| !unexcited.contains(&candidates[c]))
         .collect();
-
     let problem = search::Problem {
         m,
         candidates: &candidates,
         nb,
         group: &group,
-        y: &y,
+        y: &cols.y,
         rss_base,
-        live: &candidates_live,
+        live: &live,
         o,
         progress,
     };
     stage(3);
     let (chosen, stop) = search::select(&problem);
     // A scanned parameter refined on a fine grid, with every other finding in place.
-    let mut refined = Vec::new();
+    let grid_record = joined(&cleaned);
+    let mut refined = Vec::with_capacity(chosen.len());
     for k in 0..chosen.len() {
         let q = search::basis_of(&problem, &chosen, Some(k));
         let coarse = candidates[chosen[k].index];
+        let mut columns = |t: Term| cols.term_columns(m, t, &cleaned, &weights, &whitening);
         refined.push(
-            match profile::refine(m, coarse, record, &mut source, &whitening, &q, &y)? {
+            match profile::refine(m, coarse, &grid_record, &mut columns, &q, &cols.y)? {
                 Some((t, scan)) => (t, Some(scan)),
                 None => (coarse, None),
             },
@@ -432,17 +487,20 @@ pub fn diagnose_with_progress(
     }
 
     stage(4);
-    // Every finding fitted together; the implausible ones are then left out of the extended
-    // model, which is fitted again.
-    let mut with_all = base.clone();
-    with_all.terms.extend(refined.iter().map(|r| r.0));
-    let all_fit = fit(m, &with_all, record, &mut source, o, &gls)?;
-    let mut findings: Vec<Finding> = chosen
+    // Every finding fitted together; a finding whose fit does not converge is dropped, the
+    // implausible ones are then left out of the extended model, which is fitted again.
+    let mut fit_model = |model: &Model| extend::fit(m, model, &cleaned, o, &gls);
+    let terms: Vec<Term> = refined.iter().map(|r| r.0).collect();
+    let (all_fit, mut dropped) = extend::fit_dropping(&mut fit_model, base, &terms, &base_fit)?;
+    let kept_chosen: Vec<usize> = (0..chosen.len())
+        .filter(|&k| !dropped.iter().any(|d| d.term == refined[k].0))
+        .collect();
+    let mut findings: Vec<Finding> = kept_chosen
         .iter()
-        .enumerate()
-        .map(|(k, c)| {
+        .map(|&k| {
+            let c = &chosen[k];
             let (term, scan) = refined[k];
-            let (values, stds) = term_values(&all_fit, nb + k);
+            let (values, stds) = extend::term_values(&all_fit, &term);
             let known: Vec<f64> = values.iter().map(|v| v.unwrap_or(0.0)).collect();
             let (size, limit) = plausible::size_and_limit(m, &term, &known, &o.budget);
             Finding {
@@ -463,32 +521,41 @@ pub fn diagnose_with_progress(
             }
         })
         .collect();
+    let plausible: Vec<Term> = findings
+        .iter()
+        .filter(|f| f.plausible)
+        .map(|f| f.term)
+        .collect();
+    let extended_fit = if plausible.len() == findings.len() {
+        all_fit
+    } else {
+        let (e, more) = extend::fit_dropping(&mut fit_model, base, &plausible, &base_fit)?;
+        findings.retain(|f| !more.iter().any(|d| d.term == f.term));
+        dropped.extend(more);
+        for f in findings.iter_mut().filter(|f| f.plausible) {
+            (f.values, f.stds) = extend::term_values(&e, &f.term);
+        }
+        e
+    };
     let mut extended = base.clone();
     extended
         .terms
         .extend(findings.iter().filter(|f| f.plausible).map(|f| f.term));
-    let extended_fit = if extended.terms.len() == with_all.terms.len() {
-        all_fit
-    } else {
-        let e = fit(m, &extended, record, &mut source, o, &gls)?;
-        for f in findings.iter_mut().filter(|f| f.plausible) {
-            let t = e.model.terms.iter().position(|t| *t == f.term);
-            if let Some(t) = t {
-                (f.values, f.stds) = term_values(&e, t);
-            }
-        }
-        e
-    };
 
     // The extended model's findings as candidates (their coarse grid values: the spans the
     // selection saw).
-    let kept: Vec<usize> = chosen
+    let kept: Vec<usize> = kept_chosen
         .iter()
-        .zip(&findings)
-        .filter(|(_, f)| f.plausible)
-        .map(|(c, _)| c.index)
+        .filter(|&&k| {
+            findings
+                .iter()
+                .any(|f| f.plausible && f.term == refined[k].0)
+        })
+        .map(|&k| chosen[k].index)
         .collect();
-    let mut as_candidates = base.clone();
+    let mut as_candidates = Model {
+        terms: cols.terms[..nb].to_vec(),
+    };
     as_candidates
         .terms
         .extend(kept.iter().map(|&c| candidates[c]));
@@ -500,119 +567,76 @@ pub fn diagnose_with_progress(
         &Span::of_groups(n, (0..nb).chain(kept.iter().map(|&c| nb + c)), &group),
         &|t| group(t),
         nb,
-        &h_all,
-        &starts,
-        &widths,
+        &cols.h_all,
+        &cols.starts,
+        &cols.widths,
     );
 
     stage(5);
-    let validation = heldout::held_out_gain(
-        m,
-        &base_fit,
-        &before,
-        &extended_fit,
-        held_out,
-        &mut source,
-        &vopts,
-    )?;
+    let validation = heldout::held_out_gain(m, &base_fit, &before, &extended_fit, held_out)?;
     stage(6);
     // Lack of fit of the extended model against the noise on every record, and what remains
     // where it fails, described.
-    let adequacy = match &noise.source {
-        NoiseSource::Residual { why } => Err(why.clone()),
-        _ if o.adequacy_draws == 0 => Err("not asked for (no bootstrap draws)".into()),
-        _ => {
-            let cols: Vec<usize> = (0..nb)
-                .chain(kept.iter().map(|&c| nb + c))
-                .flat_map(|g| starts[g]..starts[g] + widths[g])
-                .collect();
-            let h_ext = h_raw.select_columns(&cols);
-            let held: Vec<DVector<f64>> = validation
-                .iter()
-                .map(heldout::HeldOut::residual_after_without_outliers)
-                .collect();
-            // The extended model's columns on every held-out record (outliers' samples left
-            // out): the bootstrap carries the fit's own uncertainty into those predictions.
-            let mut predicted = Vec::new();
-            for (h, (_, rec)) in validation.iter().zip(held_out) {
-                let drop = outliers::samples(&h.outliers);
-                match h_matrix(m, &as_candidates, &rec.without(&drop), &mut source) {
-                    Ok(hh) => predicted.push(hh),
-                    Err(e) => return Err(DiagnoseError::HMatrix(e)),
-                }
-            }
-            let data = o.data_name.as_str();
-            let mut residuals = vec![adequacy::Residual {
-                name: data,
-                residual: &extended_fit.fit.residual,
-                fitted: Some(&h_ext),
-                predicted: None,
-                zeroed: false,
-            }];
-            residuals.extend(validation.iter().zip(held.iter().zip(&predicted)).map(
-                |(h, (r, p))| adequacy::Residual {
-                    name: &h.name,
-                    residual: r,
-                    fitted: None,
-                    predicted: Some(p),
-                    zeroed: o.zeroed,
-                },
-            ));
-            // Drawn with φ raised as for the selection: an estimate of φ that runs low would make
-            // the draws too tame and the test too eager.
-            adequacy::adequacy(
-                &whitening,
-                estimated,
-                &residuals,
-                o.alpha,
-                o.seed,
-                o.adequacy_draws,
-            )
-            .map_err(|e| e.to_string())
-        }
-    };
-    let unexplained = match &adequacy {
-        Ok(a) => {
-            let mut records = vec![(o.data_name.as_str(), record, residual_rows(&extended_fit))];
-            records.extend(
-                validation
-                    .iter()
-                    .zip(held_out)
-                    .map(|(h, (_, rec))| (h.name.as_str(), rec, h.residual_after.clone())),
-            );
-            unexplained::describe_failures(m, a, &records, o.alpha)
-        }
-        Err(_) => Vec::new(),
-    };
+    let groups: Vec<usize> = (0..nb).chain(kept.iter().map(|&c| nb + c)).collect();
+    let (adequacy, unexplained) = lack_of_fit::test(&lack_of_fit::Inputs {
+        m,
+        o,
+        noise: &noise,
+        whitening: &whitening,
+        estimated,
+        cols: &cols,
+        groups: &groups,
+        as_candidates: &as_candidates,
+        cleaned: &cleaned,
+        extended_fit: &extended_fit,
+        held_out,
+        validation: &validation,
+        weights: &weights,
+    })?;
     let rows = n.max(1) as f64;
     let fit_rms = (
         (base_fit.fit.rss / rows).sqrt(),
         (extended_fit.fit.rss / rows).sqrt(),
     );
-    // The verdict under the noise the tests assume (φ raised when estimated), with σ the
-    // lack-of-fit test's reference.
-    let verdict_noise = adequacy.as_ref().ok().map(|a| {
-        let mut n = whitening.clone();
-        if let Some(r) = a.records.first() {
-            n.sigma_mm = r.noise_sigma_mm;
-        }
-        n
-    });
-    let consistent = adequacy.as_ref().ok().map(|a| a.consistent_with_noise);
-    let recommendation =
-        verdict::recommend(&findings, &validation, verdict_noise.as_ref(), consistent);
+    let labels: Vec<String> = validation.iter().map(|h| h.name.clone()).collect();
+    let recommendation = recommend(&findings, &validation, &adequacy, &labels);
     let (k, p, t) = (o.dictionary.harmonics, o.dictionary.poly, o.dictionary.time);
+    let records = cleaned
+        .records
+        .iter()
+        .enumerate()
+        .map(|(r, rec)| RecordDiagnosis {
+            label: rec.label.clone(),
+            setup: rec.setup.clone(),
+            samples: fitted.records[r].record.samples.len(),
+            zeroed: rec.zeroed,
+            params: rec.params.clone(),
+            outliers: record_outliers[r].clone(),
+            rms: (
+                base_fit.records[r].residual_rms(),
+                extended_fit.records[r].residual_rms(),
+            ),
+        })
+        .collect();
     Ok(Diagnosis {
-        structure_before: structure::analyse(m, record, &residual_rows(&base_fit), k, p, t),
-        structure_after: structure::analyse(m, record, &residual_rows(&extended_fit), k, p, t),
+        structure_before: structure::analyse(m, &grid_record, &flat_residual(&base_fit), k, p, t),
+        structure_after: structure::analyse(
+            m,
+            &grid_record,
+            &flat_residual(&extended_fit),
+            k,
+            p,
+            t,
+        ),
+        records,
         fit_rms,
         fit_rms_with_outliers,
-        outliers,
         base_given,
-        base,
+        base: base_terms,
         base_fit,
         dictionary_size: candidates.len(),
         findings,
+        dropped,
         confounded,
         unexcited,
         stop,
@@ -626,7 +650,33 @@ pub fn diagnose_with_progress(
     })
 }
 
+/// The verdict on the extension, the held-out records named `names` (one per record, in
+/// order), under the noise the tests assume (φ raised when estimated), with σ the lack-of-fit
+/// test's reference.
+fn recommend(
+    findings: &[Finding],
+    validation: &[heldout::HeldOut],
+    adequacy: &Result<adequacy::Adequacy, String>,
+    names: &[String],
+) -> verdict::Recommendation {
+    let noise = adequacy.as_ref().ok().map(|a| {
+        let mut n = a.noise.clone();
+        if let Some(r) = a.records.first() {
+            n.sigma_mm = r.noise_sigma_mm;
+        }
+        n
+    });
+    let consistent = adequacy.as_ref().ok().map(|a| a.consistent_with_noise);
+    verdict::recommend(findings, validation, names, noise.as_ref(), consistent)
+}
+
 impl Diagnosis {
+    /// [`Diagnosis::recommendation`] with the held-out records named `names` (their files, one
+    /// per record in order) instead of their labels: the same verdict, for a report.
+    pub fn recommendation_named(&self, names: &[String]) -> verdict::Recommendation {
+        recommend(&self.findings, &self.validation, &self.adequacy, names)
+    }
+
     /// The extended model as a sub-model lists it: the base model's terms as given (without
     /// the offsets zeroed readings add) followed by the plausible findings.
     pub fn extended_terms(&self) -> Model {

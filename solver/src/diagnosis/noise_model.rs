@@ -1,10 +1,8 @@
 //! The noise model of a diagnosis: where it comes from, and the one the selection whitens
 //! with.
 
-use super::{adequacy, outliers};
-use crate::fitting::Identification;
+use super::adequacy;
 use crate::fitting::noise::{self, NoiseChoice, NoiseModel, NoiseSource};
-use crate::record::Record;
 
 /// The noise model the selection whitens with when the noise was estimated: φ raised by two
 /// standard errors of its estimate, `2·√((1 − φ²)/N)` with N the samples pooled (twice the
@@ -27,40 +25,27 @@ pub(super) fn conservative(noise: &NoiseModel) -> NoiseModel {
 }
 
 /// The noise model of a diagnosis, and whether it was estimated from the records: declared or
-/// from a static record as given; estimated from the base model's residual on the fitted record
-/// and its prediction residual on every held-out record without outliers (independent
-/// realisations of the same instrument; [`adequacy::estimate_records`]: in a direction where
-/// the records disagree, the cleanest record's); white with the base fit's σ̂ when it cannot be
-/// estimated (noise-free data) or ordinary least squares was asked for.
+/// from a static record as given; estimated from `series`, the base model's residual on every
+/// fitted record and its prediction residual on every held-out record without outliers
+/// (independent realisations of the same instrument; [`adequacy::estimate_records`]: in a
+/// direction where the records disagree, the cleanest record's); white with the base fit's σ̂
+/// `sigma` (mm) when it cannot be estimated (noise-free data) or ordinary least squares was
+/// asked for.
 pub(super) fn choose(
     choice: &NoiseChoice,
-    base_fit: &Identification,
-    held_out: &[(String, Record)],
-    before: &[crate::fitting::Validation],
+    sigma: Option<f64>,
+    series: &[&[[f64; 3]]],
 ) -> (NoiseModel, bool) {
-    let sigma = base_fit
-        .fit
-        .sigma
-        .filter(|s| *s > 0.0)
-        .unwrap_or(noise::NOISE_FLOOR_MM);
+    let sigma = sigma.filter(|s| *s > 0.0).unwrap_or(noise::NOISE_FLOOR_MM);
     match choice {
         NoiseChoice::Model(model) => (model.clone(), false),
         NoiseChoice::Ordinary => (NoiseModel::residual(sigma, "ordinary least squares"), false),
-        NoiseChoice::Estimate => {
-            let fitted = super::residual_rows(base_fit);
-            let mut series: Vec<&[[f64; 3]]> = vec![&fitted];
-            for ((_, rec), v) in held_out.iter().zip(before) {
-                if outliers::find_in(rec, &v.residual).is_empty() {
-                    series.push(&v.residual);
-                }
-            }
-            match adequacy::estimate_records(&series) {
-                Ok(model) => (model, true),
-                Err(e) => (
-                    NoiseModel::residual(sigma, format!("the noise cannot be estimated: {e}")),
-                    false,
-                ),
-            }
-        }
+        NoiseChoice::Estimate => match adequacy::estimate_records(series) {
+            Ok(model) => (model, true),
+            Err(e) => (
+                NoiseModel::residual(sigma, format!("the noise cannot be estimated: {e}")),
+                false,
+            ),
+        },
     }
 }

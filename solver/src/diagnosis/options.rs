@@ -5,7 +5,9 @@ use super::plausible::Budget;
 use crate::fitting::noise::NoiseChoice;
 use crate::fitting::{Constraint, Tolerances};
 
-/// Options of [`super::diagnose()`] (`DiagnoseOptions::default()`, then set the fields wanted).
+/// Options of [`super::diagnose()`] (`DiagnoseOptions::default()`, then set the fields wanted;
+/// new fields come with defaults that keep today's behaviour). The records carry their own
+/// zeroing, set-ups and kinematic parameters ([`crate::fitting::campaign::CampaignRecord`]).
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct DiagnoseOptions {
@@ -19,11 +21,6 @@ pub struct DiagnoseOptions {
     pub draws: usize,
     /// Seed of the Monte-Carlo draws.
     pub seed: u64,
-    /// The readings were zeroed at the first sample (the offsets dx0 dy0 dz0 join the base
-    /// model).
-    pub zeroed: bool,
-    /// Kinematic parameters (mm, symbol order); `None`: the machine's defaults.
-    pub params: Option<Vec<f64>>,
     /// Rank and identifiability tolerances of the fits.
     pub tolerances: Tolerances,
     /// What the fits do with parameters the data cannot determine (as `identify
@@ -35,8 +32,6 @@ pub struct DiagnoseOptions {
     /// a static record, or ordinary least squares (white, σ from the residual: no lack-of-fit
     /// test is then possible).
     pub noise: NoiseChoice,
-    /// The fitted record's name in reports (default `fitted`).
-    pub data_name: String,
     /// Bootstrap draws of the lack-of-fit test (default 400); 0: no test.
     pub adequacy_draws: usize,
 }
@@ -49,13 +44,10 @@ impl Default for DiagnoseOptions {
             max_findings: 8,
             draws: 1000,
             seed: 0x5eed,
-            zeroed: false,
-            params: None,
             tolerances: Tolerances::default(),
             constraint: Constraint::None,
             budget: Budget::default(),
             noise: NoiseChoice::Estimate,
-            data_name: "fitted".into(),
             adequacy_draws: super::adequacy::DRAWS,
         }
     }
@@ -94,18 +86,6 @@ impl DiagnoseOptions {
     /// With the seed of the Monte-Carlo draws.
     pub fn seed(mut self, seed: u64) -> DiagnoseOptions {
         self.seed = seed;
-        self
-    }
-
-    /// With readings zeroed at the first sample (or not).
-    pub fn zeroed(mut self, zeroed: bool) -> DiagnoseOptions {
-        self.zeroed = zeroed;
-        self
-    }
-
-    /// With the kinematic parameters `params` (mm, symbol order).
-    pub fn params(mut self, params: Vec<f64>) -> DiagnoseOptions {
-        self.params = Some(params);
         self
     }
 }

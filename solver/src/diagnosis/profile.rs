@@ -4,16 +4,15 @@
 //! The selection picks the best value of the coarse grid ([`super::dictionary::scanned`]). Here
 //! the parameter is scanned again on a fine grid around it (41 values: ±1 coarse step in 1/P,
 //! every distinct position between the neighbouring grid steps for V, ±half a coarse ratio
-//! in ln TAU within the coarse grid's range), with every other term of the model in place, in the whitened rows: the value
-//! that explains most (largest ΔRSS) is the finding's, and its 95 % interval is the set of
+//! in ln TAU within the coarse grid's range), with every other term of the model in place, in
+//! the whitened rows of every fitted record (a term's columns as the campaign gives them): the
+//! value that explains most (largest ΔRSS) is the finding's, and its 95 % interval is the set of
 //! values whose ΔRSS lies within `3.84·s²` of the best (`s²` the whitened residual variance of
 //! the model with the finding: the profile-likelihood interval of one parameter). The
 //! amplitudes' standard uncertainties are then those of the fit at that value: conditional
 //! on it.
 
-use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
-use crate::fitting::noise::NoiseModel;
-use crate::model::{Basis, Model, Term};
+use crate::model::{Basis, Term};
 use crate::record::Record;
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
@@ -94,43 +93,29 @@ fn grid(basis: Basis, x: &[f64], tau_range: (f64, f64)) -> Vec<f64> {
     }
 }
 
-/// What a term explains beyond `q` in the whitened rows: ΔRSS, or `None` when it adds no
-/// direction.
-#[allow(clippy::too_many_arguments)]
-fn explains(
-    m: &Machine,
-    term: Term,
-    record: &Record,
-    source: &mut GainSource,
-    whitening: &NoiseModel,
-    q: &Span,
-    y: &DVector<f64>,
-) -> Result<Option<f64>, HMatrixError> {
-    let model = Model { terms: vec![term] };
-    let mut h: DMatrix<f64> = h_matrix(m, &model, record, source)?;
-    whitening
-        .whiten_matrix(&[record.samples.len()], &mut h)
-        .map_err(|e| HMatrixError::Term {
-            term: term.spelling(m),
-            message: e.to_string(),
-        })?;
-    let d = q.new_directions(&h);
-    Ok((d.ncols() > 0).then(|| d.tr_mul(&q.project_out(y)).norm_squared()))
+/// What a term explains beyond `q` in the whitened rows, from its whitened columns `h`:
+/// ΔRSS, or `None` when it adds no direction.
+fn explains(h: &DMatrix<f64>, q: &Span, y: &DVector<f64>) -> Option<f64> {
+    let d = q.new_directions(h);
+    (d.ncols() > 0).then(|| d.tr_mul(&q.project_out(y)).norm_squared())
 }
 
-/// The refined term and its interval: `term`'s scanned parameter on the fine grid, with the
-/// model `q` (orthonormal, whitened, every other term) in place; `y` the whitened readings.
-/// `None` for a term without a scanned parameter.
-#[allow(clippy::too_many_arguments)]
-pub fn refine(
+/// The refined term and its interval: `term`'s scanned parameter on the fine grid around its
+/// value, with the model `q` (orthonormal, whitened, every other term) in place; `columns`
+/// gives the whitened columns of a term in the rows of `y` (the whitened readings); `record`
+/// is the fitted records one after the other (the positions and times the grid is built
+/// from). `None` for a term without a scanned parameter.
+///
+/// # Errors
+/// The error of `columns`.
+pub fn refine<E>(
     m: &Machine,
     term: Term,
     record: &Record,
-    source: &mut GainSource,
-    whitening: &NoiseModel,
+    columns: &mut dyn FnMut(Term) -> Result<DMatrix<f64>, E>,
     q: &Span,
     y: &DVector<f64>,
-) -> Result<Option<(Term, Scan)>, HMatrixError> {
+) -> Result<Option<(Term, Scan)>, E> {
     if parameter(term.basis).is_none() {
         return Ok(None);
     }
@@ -170,7 +155,7 @@ pub fn refine(
         if t.check(m).is_err() {
             continue;
         }
-        if let Some(gain) = explains(m, t, record, source, whitening, q, y)? {
+        if let Some(gain) = explains(&columns(t)?, q, y) {
             profile.push((parameter(t.basis).unwrap_or(v), t, gain));
         }
     }

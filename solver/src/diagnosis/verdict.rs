@@ -39,15 +39,24 @@ fn um(v: f64) -> String {
     format!("{:.3} µm", v * UM_PER_MM)
 }
 
-/// The verdict on the extension of `findings`, from the held-out gain `held`; `noise_mm` the
-/// noise's σ over the three directions and `consistent` the lack-of-fit test's verdict, when
-/// there is one.
+/// The verdict on the extension of `findings`, from the held-out gain `held` (the records
+/// named `names` in the reasons, one per record; their labels where a name is missing);
+/// `noise` the noise model the tests assume and `consistent` the lack-of-fit test's verdict,
+/// when there is one.
 pub fn recommend(
     findings: &[Finding],
     held: &[HeldOut],
+    names: &[String],
     noise: Option<&NoiseModel>,
     consistent: Option<bool>,
 ) -> Recommendation {
+    let name = |h: &HeldOut| -> String {
+        held.iter()
+            .position(|x| std::ptr::eq(x, h))
+            .and_then(|i| names.get(i))
+            .unwrap_or(&h.name)
+            .clone()
+    };
     let noise_mm = noise.map(|n| (n.sigma_mm.iter().map(|s| s * s).sum::<f64>() / 3.0).sqrt());
     let mut reasons = Vec::new();
     let implausible = findings.iter().filter(|f| !f.plausible).count();
@@ -81,7 +90,7 @@ pub fn recommend(
             .collect();
         reasons.push(format!(
             "{}: its prediction needs what the fit does not determine ({}); its RMS is not counted",
-            h.name,
+            name(h),
             groups.join("; ")
         ));
     }
@@ -92,7 +101,7 @@ pub fn recommend(
         if h.after_rms > h.before_rms {
             reasons.push(format!(
                 "{} is predicted worse: {} → {}",
-                h.name,
+                name(h),
                 um(h.before_rms),
                 um(h.after_rms)
             ));
@@ -121,7 +130,7 @@ pub fn recommend(
             if a > 0.5 * b {
                 reasons.push(format!(
                     "on {} the residual does not move toward the noise: its excess over the noise falls {} → {}, less than half, and what remains is not the noise",
-                    h.name,
+                    name(h),
                     um(b),
                     um(a)
                 ));

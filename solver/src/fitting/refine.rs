@@ -20,12 +20,21 @@
 //! linear model has it.
 //!
 //! A step is measured by the largest change of the prediction it makes, `‖H·Δ‖∞` (mm), and the
-//! iteration has converged when a step is below [`RefineOptions::tolerance_mm`] (1e-12 mm), or
-//! below the rounding floor `64·ε·κ·‖y‖∞` of an ill-conditioned fit when that is larger (a
-//! least-squares solution is rounded by about ε·κ relative). Under a noise model κ is
-//! multiplied by the whitening's amplification `a = (1 + φ)/√(1 − φ²)`, and the floor is at
-//! least `64·ε·a·L`, L the largest coordinate of the machine and the path (mm): the exact
-//! prediction is rounded at that scale, and whitening with φ near 1 no longer averages it away. Otherwise, after
+//! iteration has converged when a step moves the prediction by less than
+//!
+//! ```text
+//! max(1e-6 µm, 1e-6·σ, rounding floor)
+//! ```
+//!
+//! ([`RefineOptions::tolerance_mm`], [`RefineOptions::relative`]; σ the noise model's σ under a
+//! noise model, else the first-order fit's residual RMS): a change a million times below the
+//! noise moves no value by a meaningful amount, while the exact prediction's own rounding can
+//! keep later steps at 1e-9 µm to 1e-7 µm on noisy records of some hundred samples. The
+//! rounding floor is `64·ε·κ·‖y‖∞` of an ill-conditioned fit (a least-squares solution is
+//! rounded by about ε·κ relative); under a noise model κ is multiplied by the whitening's
+//! amplification `a = (1 + φ)/√(1 − φ²)`, and the floor is at least `64·ε·a·L`, L the largest
+//! coordinate of the machine and the path (mm): the exact prediction is rounded at that scale,
+//! and whitening with φ near 1 no longer averages it away. Otherwise, after
 //! [`RefineOptions::max_iterations`] steps (8), it has not converged: a slow or diverging
 //! iteration (noisy readings of a few samples give first-order values far from any machine,
 //! where the second-order terms are no longer small), which is reported as such, never as a
@@ -62,19 +71,30 @@ use nalgebra::{DMatrix, DVector};
 /// a few samples, the steps settle at 5–20 of these units; 64 leaves a margin.
 pub const ROUNDING_FLOOR_FACTOR: f64 = 64.0;
 
+/// The absolute tolerance of a refinement step by default: 1e-6 µm (mm).
+pub const TOLERANCE_MM: f64 = 1e-9;
+
+/// The tolerance of a refinement step relative to the noise by default: a step that moves the
+/// prediction by less than 1e-6 of the noise's σ has converged.
+pub const RELATIVE_TOLERANCE: f64 = 1e-6;
+
 /// How far to refine (`RefineOptions::default()`, then set the fields wanted).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct RefineOptions {
     /// Most Gauss–Newton steps.
     pub max_iterations: usize,
-    /// Stop when no correction moves the prediction by more than this (mm), or by more than the
-    /// rounding floor ([`ROUNDING_FLOOR_FACTOR`]) when that is larger.
+    /// Converged when a correction moves the prediction by less than this (mm), or by less than
+    /// [`RefineOptions::relative`] times the noise's σ, or than the rounding floor
+    /// ([`ROUNDING_FLOOR_FACTOR`]), whichever is largest.
     pub tolerance_mm: f64,
+    /// The tolerance relative to the noise's σ (the noise model's, else the first-order fit's
+    /// residual RMS): unitless.
+    pub relative: f64,
 }
 
 impl RefineOptions {
-    /// The defaults: at most 8 steps, down to 1e-12 mm.
+    /// The defaults: at most 8 steps, down to max(1e-6 µm, 1e-6·σ).
     pub fn new() -> RefineOptions {
         RefineOptions::default()
     }
@@ -85,9 +105,16 @@ impl RefineOptions {
         self
     }
 
-    /// Stopping when no correction moves the prediction by more than `mm`.
+    /// Converged when no correction moves the prediction by more than `mm`, nor by more than
+    /// the relative tolerance times σ.
     pub fn tolerance_mm(mut self, mm: f64) -> RefineOptions {
         self.tolerance_mm = mm;
+        self
+    }
+
+    /// With the tolerance `r` relative to the noise's σ (0: the absolute tolerance alone).
+    pub fn relative(mut self, r: f64) -> RefineOptions {
+        self.relative = r;
         self
     }
 }
@@ -96,7 +123,8 @@ impl Default for RefineOptions {
     fn default() -> Self {
         RefineOptions {
             max_iterations: 8,
-            tolerance_mm: 1e-12,
+            tolerance_mm: TOLERANCE_MM,
+            relative: RELATIVE_TOLERANCE,
         }
     }
 }
@@ -108,8 +136,9 @@ pub struct Refinement {
     pub iterations: usize,
     /// Per step, the largest change of the prediction at any reading: `‖H·Δ‖∞` (mm).
     pub steps_mm: Vec<f64>,
-    /// The tolerance the steps were compared with: [`RefineOptions::tolerance_mm`], or the
-    /// rounding floor of an ill-conditioned fit when that is larger (mm).
+    /// The tolerance the steps were compared with: the largest of
+    /// [`RefineOptions::tolerance_mm`], [`RefineOptions::relative`] times the noise's σ and the
+    /// rounding floor of the fit (mm).
     pub tolerance_mm: f64,
     /// `true` when the last step was below the tolerance. `false` when the iteration limit was
     /// reached first (a slow or diverging iteration): the values are then not an
@@ -298,7 +327,6 @@ pub(crate) fn gauss_newton(
         coordinates,
         weights,
     } = *problem;
-    // The fit of a residual: ordinary, or generalized under the noise model.
     // The fit of a residual: ordinary, or generalized under the noise model, rows weighted by
     // the samples' covariances when there are any.
     let fit_of = |h: &nalgebra::DMatrix<f64>,
@@ -332,7 +360,12 @@ pub(crate) fn gauss_newton(
         0.0
     };
     let floor = (ROUNDING_FLOOR_FACTOR * f64::EPSILON * kappa * y.amax()).max(prediction_floor);
-    let tolerance = opts.tolerance_mm.max(floor);
+    // The noise's scale: the noise model's σ (RMS over the directions), else the first-order
+    // fit's residual RMS.
+    let sigma = noise.map_or(linear_rms, |n| {
+        (n.sigma_mm.iter().map(|s| s * s).sum::<f64>() / 3.0).sqrt()
+    });
+    let tolerance = opts.tolerance_mm.max(opts.relative * sigma).max(floor);
     // Iterate on the whole minimum-norm solution, undetermined parameters included: it is what
     // the linear model's prediction is made of. Which values are reported is decided at the end.
     let mut x = start.solution.clone();
@@ -497,4 +530,84 @@ pub fn identify_refined_with_noise(
             rms_mm: (ordinary.rms_mm.0, r.rms_mm.1),
         },
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fitting::least_squares::least_squares;
+    use crate::fitting::{Constraint, Tolerances};
+
+    /// A linear system of 40 rows and 2 parameters, readings `H·[3, −2] + r` with `r` a
+    /// residual of RMS `sigma` (mm) orthogonal to nothing in particular.
+    fn system(sigma: f64) -> (DMatrix<f64>, DVector<f64>) {
+        let h = DMatrix::from_fn(40, 2, |i, j| ((i + 1) as f64 * (j + 1) as f64 * 0.37).sin());
+        let r = DVector::from_fn(40, |i, _| sigma * ((i as f64) * 1.7).cos() * 2f64.sqrt());
+        let y = &h * DVector::from_column_slice(&[3.0, -2.0]) + r;
+        (h, y)
+    }
+
+    /// Refines the first-order fit of `system(sigma)` against an "exact" prediction that is
+    /// `H·x` plus a jitter of `jitter` mm whose sign flips at every evaluation: the rounding of
+    /// an exact machine, which keeps every correction at about the jitter's size.
+    fn refine_jittered(sigma: f64, jitter: f64, opts: &RefineOptions) -> Refinement {
+        let (h, y) = system(sigma);
+        let names = vec!["a".to_string(), "b".to_string()];
+        let tol = Tolerances::default();
+        let start = least_squares(&h, &y, &names, &Constraint::None, &tol).unwrap();
+        let problem = GaussNewton {
+            h: &h,
+            y: &y,
+            layout: &[y.len() / 3],
+            tolerances: &tol,
+            noise: None,
+            coordinates: 1.0,
+            weights: None,
+        };
+        let mut calls = 0usize;
+        let shape = DVector::from_fn(40, |i, _| if i % 2 == 0 { 1.0 } else { 0.3 });
+        let mut predict = |x: &[f64]| -> Result<DVector<f64>, RefineError> {
+            calls += 1;
+            let sign = if calls % 2 == 0 { 1.0 } else { -1.0 };
+            Ok(&h * DVector::from_column_slice(x) + &shape * (sign * jitter))
+        };
+        gauss_newton(&problem, &start, opts, &mut predict)
+            .unwrap()
+            .2
+    }
+
+    #[test]
+    fn a_step_below_a_millionth_of_a_micrometre_has_converged() {
+        // Steps that settle at a few 1e-12 mm (3e-9 µm): rounding, converged by default.
+        let r = refine_jittered(0.5e-3, 1e-11, &RefineOptions::default());
+        assert!(r.converged, "{r:?}");
+        assert!(r.iterations <= 2, "{r:?}");
+        assert_eq!(r.tolerance_mm, TOLERANCE_MM);
+        // The same steps against the former 1e-12 mm: never converged.
+        let strict = RefineOptions::default().tolerance_mm(1e-12).relative(0.0);
+        let r = refine_jittered(0.5e-3, 1e-11, &strict);
+        assert!(!r.converged, "{r:?}");
+        assert_eq!(r.iterations, 8);
+    }
+
+    #[test]
+    fn the_tolerance_grows_with_the_noise() {
+        // Residual RMS 1 mm: the tolerance is 1e-6 mm, and steps of about 7e-8 mm converge.
+        let r = refine_jittered(1.0, 2e-7, &RefineOptions::default());
+        assert!(r.converged, "{r:?}");
+        assert!((r.tolerance_mm - 1e-6).abs() < 2e-8, "{r:?}");
+        // The same steps on 0.5 µm of noise are 500 times the tolerance: not converged.
+        let r = refine_jittered(0.5e-3, 2e-7, &RefineOptions::default());
+        assert!(!r.converged, "{r:?}");
+        assert_eq!(r.tolerance_mm, TOLERANCE_MM);
+    }
+
+    #[test]
+    fn a_crawling_iteration_does_not_converge() {
+        // Steps of about 1e-6 mm (1e-3 µm) never settle: eight steps, not converged.
+        let r = refine_jittered(0.5e-3, 5e-6, &RefineOptions::default());
+        assert!(!r.converged, "{r:?}");
+        assert_eq!(r.iterations, 8);
+        assert!(r.steps_mm.iter().all(|s| *s > 5e-7), "{r:?}");
+    }
 }

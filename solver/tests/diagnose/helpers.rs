@@ -4,7 +4,8 @@
 #![allow(dead_code)]
 
 use model_spec::Machine;
-use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose};
+use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose, one_record};
+use solver::io::progress::Unwatched;
 use solver::model::{Model, Term};
 use solver::record::Record;
 use solver::simulation::paths::{builtin_path, fill_linear_ik, record_from_commands};
@@ -175,9 +176,17 @@ pub fn records(m: &Machine, truth: &Truth, paths: &[&str], seed: u64) -> Vec<(St
         .collect()
 }
 
-/// The diagnosis of `base` on the first record, the others held out.
+/// The diagnosis of `base` on the first record, the others held out on its set-up.
 pub fn run(m: &Machine, base: &Model, recs: &[(String, Record)], o: &DiagnoseOptions) -> Diagnosis {
-    diagnose(m, base, &recs[0].1, &recs[1..], o).expect("diagnosis")
+    let (fitted, held) = one_record(
+        &recs[0].0,
+        recs[0].1.clone(),
+        recs[1..].to_vec(),
+        m.default_parameters(),
+        false,
+    )
+    .expect("campaigns");
+    diagnose(m, base, &fitted, &held, o, &Unwatched).expect("diagnosis")
 }
 
 /// Pooled residual RMS over the held-out records, before and after (µm): the square root of the

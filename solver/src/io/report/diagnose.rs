@@ -1,6 +1,8 @@
-//! The diagnosis report (`rtest diagnose --json`): the base fit, the residual structure, the
-//! findings with their significance, what the data cannot see, the extended model and its gain
-//! on the fitted and the held-out records. Values in µm and µrad.
+//! The diagnosis report (`rtest diagnose --json`, `"version": 2`): the records (fitted and held
+//! out, each with its set-up), the base fit, the residual structure, the findings with their
+//! significance, what the data cannot see, the extended model and its gain on the fitted and
+//! the held-out records. One report for one record or a campaign: a single record is the
+//! campaign of that record. Values in µm and µrad.
 
 use super::verdict::{
     AdequacyReport, BudgetReport, OutlierReport, UnexplainedReport, adequacy, outliers, unexplained,
@@ -12,7 +14,22 @@ use crate::diagnosis::{Correction, DiagnoseOptions, Diagnosis};
 use crate::model::{Basis, Carrier, Term};
 use model_spec::Machine;
 use model_spec::units::UM_PER_MM;
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
+use std::collections::BTreeMap;
+
+/// The version of the diagnosis report this code writes and reads.
+pub const VERSION: u32 = 2;
+
+/// Reads `version`, refusing any other than [`VERSION`].
+fn version<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    let v = u32::deserialize(d)?;
+    if v != VERSION {
+        return Err(serde::de::Error::custom(format!(
+            "a diagnosis report of version {v}; this rtest reads version {VERSION} (run rtest diagnose again)"
+        )));
+    }
+    Ok(v)
+}
 
 /// How many residual components the report lists, before and after.
 pub const COMPONENTS_LISTED: usize = 12;
@@ -210,22 +227,70 @@ pub struct GainReport {
     pub validation: Vec<GainRow>,
 }
 
+/// One record of the diagnosis, fitted or held out.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RecordReport {
+    /// Its label (names its own parameters: `dx0[k4]`).
+    pub label: String,
+    /// Its file.
+    pub data: String,
+    /// `fitted` or `held out`.
+    pub role: String,
+    /// Its set-up's label (records on one set-up share the ball's set-up errors).
+    pub setup: String,
+    /// Whether its set-up was fitted: always for a fitted record; for a held-out record, whether
+    /// its set-up errors come from the fit (else they were refitted on it).
+    pub setup_fitted: bool,
+    /// Whether its readings were zeroed at the first sample.
+    pub zeroed: bool,
+    /// Its samples, outliers included.
+    pub samples: usize,
+    /// Its kinematic parameters, mm.
+    pub params: BTreeMap<String, f64>,
+    /// Its residual RMS under the base model, µm (outliers left out; a held-out record: the
+    /// prediction's).
+    pub residual_rms_before_um: f64,
+    /// Under the extended model, µm.
+    pub residual_rms_after_um: f64,
+    /// The extended model's parameters refitted on a held-out record (a new set-up's errors,
+    /// its own zero and drifts); absent when none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub refitted: Vec<String>,
+}
+
+/// A finding left out because the fit of the extended model with it did not converge.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DroppedReport {
+    /// `NAME@BASIS`.
+    pub term: String,
+    /// The refinement's failure.
+    pub why: String,
+}
+
 /// The diagnosis report.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DiagnosisReport {
+    /// The report's version, [`VERSION`].
+    #[serde(deserialize_with = "version")]
+    pub version: u32,
     /// Machine name.
     pub machine: String,
     /// `--machine` as given (a built-in name or a file), for the commands it suggests.
     pub machine_source: String,
-    /// The fitted record's file.
+    /// The fitted records' files, comma-separated.
     pub data: String,
-    /// Its samples.
+    /// The command-line words that give the same fitted records to another command (`--data
+    /// k4.csv --zeroed`, `--campaign c.toml`), for the commands it suggests.
+    pub data_arguments: Vec<String>,
+    /// Their samples, outliers included.
     pub samples: usize,
     /// The held-out records: file and samples.
     pub held_out: Vec<(String, usize)>,
+    /// Every record, fitted ones first.
+    pub records: Vec<RecordReport>,
     /// The base model's label.
     pub base_model: String,
-    /// Whether the readings were zeroed at the first sample.
+    /// Whether the readings of a fitted record were zeroed at the first sample.
     pub zeroed: bool,
     /// Significance level of each step.
     pub alpha: f64,
@@ -243,6 +308,11 @@ pub struct DiagnosisReport {
     pub unexcited: Vec<String>,
     /// The findings, in the order they were added.
     pub findings: Vec<FindingReport>,
+    /// Findings the selection made but left out because the fit of the extended model with
+    /// them did not converge (the other findings were selected with them in the model);
+    /// absent when none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dropped: Vec<DroppedReport>,
     /// Why the selection stopped.
     pub stop: StopReport,
     /// Candidates the extended model spans.
@@ -269,10 +339,9 @@ pub struct DiagnosisReport {
     pub adequacy_unavailable: Option<String>,
     /// What remains unexplained, per direction the test finds inconsistent with the noise.
     pub unexplained: Vec<UnexplainedReport>,
-    /// The campaign's records and held-out set-ups, for a diagnosis on a campaign; absent for
-    /// one record.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub campaign: Option<super::campaign_diagnose::CampaignDiagnosisReport>,
+    /// What a reader should know of how this diagnosis was made (several fitted records), one
+    /// sentence each.
+    pub notes: Vec<String>,
 }
 
 /// What the report says besides the diagnosis: where things come from and go.
@@ -282,16 +351,32 @@ pub struct DiagnosisSource<'a> {
     pub machine_source: &'a str,
     /// The base model's label.
     pub label: &'a str,
-    /// The fitted record's file.
-    pub data: &'a str,
-    /// Its samples.
-    pub samples: usize,
-    /// The held-out records: file and samples.
-    pub held_out: Vec<(String, usize)>,
+    /// The fitted records' files, one per record in order.
+    pub data: Vec<String>,
+    /// The held-out records' files, one per record in order.
+    pub held_out: Vec<String>,
+    /// The command-line words that give the fitted records to another command.
+    pub data_arguments: Vec<String>,
     /// The options of the diagnosis.
     pub opts: &'a DiagnoseOptions,
     /// The extended machine description written: the model's name and the file.
     pub model_out: Option<(String, String)>,
+}
+
+impl DiagnosisSource<'_> {
+    /// The file of the record labelled `label` (fitted or held out) in diagnosis `d`; the label
+    /// itself when it has none.
+    pub fn file_of(&self, d: &Diagnosis, label: &str) -> String {
+        let fitted = d.records.iter().position(|r| r.label == label);
+        let held = d.validation.iter().position(|h| h.name == label);
+        match (fitted, held) {
+            (Some(i), _) => self.data.get(i),
+            (None, Some(i)) => self.held_out.get(i),
+            (None, None) => None,
+        }
+        .cloned()
+        .unwrap_or_else(|| label.to_string())
+    }
 }
 
 fn spell(m: &Machine, ts: &[Term]) -> Vec<String> {
@@ -349,6 +434,67 @@ fn gain_row(
             after * UM_PER_MM,
         )?,
     })
+}
+
+/// Every record of `d`: the fitted ones, then the held-out ones, with their files.
+fn records(
+    m: &Machine,
+    d: &Diagnosis,
+    file_of: &dyn Fn(&str) -> String,
+) -> Result<Vec<RecordReport>, NonFinite> {
+    let params = |p: &[f64]| -> BTreeMap<String, f64> {
+        m.symbols
+            .iter()
+            .zip(p)
+            .map(|(s, v)| (s.name.clone(), *v))
+            .collect()
+    };
+    let um =
+        |i: usize, what: &str, v: f64| finite(|| format!("records[{i}].{what}"), v * UM_PER_MM);
+    let mut out = Vec::with_capacity(d.records.len() + d.validation.len());
+    for (i, r) in d.records.iter().enumerate() {
+        out.push(RecordReport {
+            label: r.label.clone(),
+            data: file_of(&r.label),
+            role: "fitted".into(),
+            setup: r.setup.clone(),
+            setup_fitted: true,
+            zeroed: r.zeroed,
+            samples: r.samples,
+            params: params(&r.params),
+            residual_rms_before_um: um(i, "residual_rms_before_um", r.rms.0)?,
+            residual_rms_after_um: um(i, "residual_rms_after_um", r.rms.1)?,
+            refitted: Vec::new(),
+        });
+    }
+    for h in &d.validation {
+        let i = out.len();
+        out.push(RecordReport {
+            label: h.name.clone(),
+            data: file_of(&h.name),
+            role: "held out".into(),
+            setup: h.setup.clone(),
+            setup_fitted: h.setup_fitted,
+            zeroed: h.zeroed,
+            samples: h.samples,
+            params: params(&h.params),
+            residual_rms_before_um: um(i, "residual_rms_before_um", h.before_rms)?,
+            residual_rms_after_um: um(i, "residual_rms_after_um", h.after_rms)?,
+            refitted: h.refitted.clone(),
+        });
+    }
+    Ok(out)
+}
+
+/// What a reader should know of how `d` was made when several records were fitted.
+fn notes(d: &Diagnosis) -> Vec<String> {
+    if d.records.len() < 2 {
+        return Vec::new();
+    }
+    vec![
+        "a candidate's F-test counts every column the campaign gives it (one per record for a drift of the R-test's zero, one per set-up for a set-up error)".into(),
+        "the lack-of-fit test fits each fitted record's draws with that record's own columns alone, and draws the held-out records' noise without the fit's uncertainty: it errs towards `not down to the noise` on the fitted records".into(),
+    ]
 }
 
 impl DiagnosisReport {
@@ -441,14 +587,23 @@ impl DiagnosisReport {
             None => (None, None),
         };
         let fit = &d.base_fit.fit;
+        let data = source.data.join(",");
+        let file_of = |label: &str| source.file_of(d, label);
         Ok(DiagnosisReport {
+            version: VERSION,
             machine: m.name.clone(),
             machine_source: source.machine_source.into(),
-            data: source.data.into(),
-            samples: source.samples,
-            held_out: source.held_out.clone(),
+            data: data.clone(),
+            data_arguments: source.data_arguments.clone(),
+            samples: d.records.iter().map(|r| r.samples).sum(),
+            held_out: d
+                .validation
+                .iter()
+                .map(|h| (file_of(&h.name), h.samples))
+                .collect(),
+            records: records(m, d, &file_of)?,
             base_model: source.label.into(),
-            zeroed: o.zeroed,
+            zeroed: d.records.iter().any(|r| r.zeroed),
             alpha: o.alpha,
             draws: o.draws,
             dictionary_extent: [o.dictionary.harmonics, o.dictionary.poly, o.dictionary.time],
@@ -502,13 +657,7 @@ impl DiagnosisReport {
                 file,
             },
             gain: GainReport {
-                fit: gain_row(
-                    "gain.fit",
-                    source.data,
-                    d.fit_rms.0,
-                    d.fit_rms.1,
-                    Vec::new(),
-                )?,
+                fit: gain_row("gain.fit", &data, d.fit_rms.0, d.fit_rms.1, Vec::new())?,
                 validation: d
                     .validation
                     .iter()
@@ -522,7 +671,7 @@ impl DiagnosisReport {
                         }
                         gain_row(
                             &format!("gain.validation[{i}]"),
-                            &h.name,
+                            &file_of(&h.name),
                             h.before_rms,
                             h.after_rms,
                             groups,
@@ -530,7 +679,7 @@ impl DiagnosisReport {
                     })
                     .collect::<Result<_, _>>()?,
             },
-            outliers: outliers(source.data, d)?,
+            outliers: outliers(d, &file_of)?,
             budget: BudgetReport {
                 um: o.budget.um,
                 urad: o.budget.urad,
@@ -538,10 +687,10 @@ impl DiagnosisReport {
                 fraction: o.budget.fraction,
             },
             recommended: d.recommendation.recommended,
-            recommendation: d.recommendation.reasons.clone(),
+            recommendation: d.recommendation_named(&source.held_out).reasons,
             noise_model: d.noise.to_string(),
             adequacy: match &d.adequacy {
-                Ok(a) => Some(adequacy(a)?),
+                Ok(a) => Some(adequacy(a, &file_of)?),
                 Err(_) => None,
             },
             adequacy_unavailable: d.adequacy.as_ref().err().cloned(),
@@ -549,9 +698,17 @@ impl DiagnosisReport {
                 .unexplained
                 .iter()
                 .enumerate()
-                .map(|(i, u)| unexplained(i, u))
+                .map(|(i, u)| unexplained(i, u, &file_of))
                 .collect::<Result<_, _>>()?,
-            campaign: None,
+            dropped: d
+                .dropped
+                .iter()
+                .map(|x| DroppedReport {
+                    term: x.term.spelling(m),
+                    why: x.why.clone(),
+                })
+                .collect(),
+            notes: notes(d),
         })
     }
 }

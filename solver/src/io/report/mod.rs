@@ -19,7 +19,6 @@
 //! version and number of records: `validate` and `compensate` take its model and values, after
 //! checking that it belongs to the machine.
 
-pub mod campaign_diagnose;
 pub mod compensate;
 pub mod diagnose;
 pub mod fit_summary;

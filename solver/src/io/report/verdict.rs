@@ -107,7 +107,11 @@ pub struct UnexplainedReport {
     pub explained_rms_um: f64,
 }
 
-pub(super) fn adequacy(a: &Adequacy) -> Result<AdequacyReport, NonFinite> {
+/// The lack-of-fit test `a`, its records named by their files (`file_of` a label).
+pub(super) fn adequacy(
+    a: &Adequacy,
+    file_of: &dyn Fn(&str) -> String,
+) -> Result<AdequacyReport, NonFinite> {
     let records = a
         .records
         .iter()
@@ -120,7 +124,7 @@ pub(super) fn adequacy(a: &Adequacy) -> Result<AdequacyReport, NonFinite> {
                 Ok(v.map(|x| x * k))
             };
             Ok(RecordAdequacyReport {
-                data: r.name.clone(),
+                data: file_of(&r.name),
                 fitted: r.fitted,
                 noise_sigma_um: three("noise_sigma_um", r.noise_sigma_mm, UM_PER_MM)?,
                 residual_sigma_um: three("residual_sigma_um", r.residual_sigma_mm, UM_PER_MM)?,
@@ -141,7 +145,12 @@ pub(super) fn adequacy(a: &Adequacy) -> Result<AdequacyReport, NonFinite> {
     })
 }
 
-pub(super) fn unexplained(i: usize, u: &Unexplained) -> Result<UnexplainedReport, NonFinite> {
+/// What remains, `u` (the `i`-th), its record named by its file (`file_of` a label).
+pub(super) fn unexplained(
+    i: usize,
+    u: &Unexplained,
+    file_of: &dyn Fn(&str) -> String,
+) -> Result<UnexplainedReport, NonFinite> {
     let um = |what: &str, v: f64| finite(|| format!("unexplained[{i}].{what}"), v * UM_PER_MM);
     let (shape, period, at, samples) = match u.shape {
         Shape::Smooth => ("smooth", None, None, None),
@@ -151,7 +160,7 @@ pub(super) fn unexplained(i: usize, u: &Unexplained) -> Result<UnexplainedReport
         Shape::Irregular => ("irregular", None, None, None),
     };
     Ok(UnexplainedReport {
-        data: u.data.clone(),
+        data: file_of(&u.data),
         direction: ["x", "y", "z"][u.direction].into(),
         rms_um: um("rms_um", u.rms_mm)?,
         follows: u.follows.clone(),
@@ -164,18 +173,26 @@ pub(super) fn unexplained(i: usize, u: &Unexplained) -> Result<UnexplainedReport
     })
 }
 
-/// The outliers of the fitted record (`data`) and of every held-out record.
-pub(super) fn outliers(data: &str, d: &Diagnosis) -> Result<Vec<OutlierReport>, NonFinite> {
-    let all = d.outliers.iter().map(|o| (data, o)).chain(
-        d.validation
-            .iter()
-            .flat_map(|h| h.outliers.iter().map(move |o| (h.name.as_str(), o))),
-    );
+/// The outliers of every fitted record and of every held-out record, named by their files
+/// (`file_of` a label).
+pub(super) fn outliers(
+    d: &Diagnosis,
+    file_of: &dyn Fn(&str) -> String,
+) -> Result<Vec<OutlierReport>, NonFinite> {
+    let all = d
+        .records
+        .iter()
+        .flat_map(|r| r.outliers.iter().map(move |o| (r.label.as_str(), o)))
+        .chain(
+            d.validation
+                .iter()
+                .flat_map(|h| h.outliers.iter().map(move |o| (h.name.as_str(), o))),
+        );
     all.enumerate()
-        .map(|(i, (file, o))| {
+        .map(|(i, (label, o))| {
             let um = |what: &str, v: f64| finite(|| format!("outliers[{i}].{what}"), v * UM_PER_MM);
             Ok(OutlierReport {
-                data: file.into(),
+                data: file_of(label),
                 line: o.line,
                 sample: o.sample + 1,
                 direction: ["x", "y", "z"][o.direction].into(),

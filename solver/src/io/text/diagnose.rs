@@ -3,7 +3,7 @@
 //! commands that use the extended model.
 
 use super::{header, indent, shell, table, value, wrap, zeroed_text};
-use crate::io::report::diagnose::{DiagnosisReport, FindingReport, GainRow};
+use crate::io::report::diagnose::{DiagnosisReport, FindingReport, GainRow, RecordReport};
 use model_spec::units::{fixed, p_value, symbol};
 
 /// `ECC harmonic:2` from `ECC@harmonic:2` (a constant term is its name).
@@ -258,7 +258,8 @@ pub fn outliers(r: &DiagnosisReport) -> String {
 /// What to do with the result: the commands that use the extended model, or that nothing was
 /// found.
 pub fn next_steps(r: &DiagnosisReport) -> String {
-    let zeroed = if r.zeroed { " --zeroed" } else { "" };
+    let data: Vec<String> = r.data_arguments.iter().map(|w| shell(w)).collect();
+    let data = data.join(" ");
     let mut out = String::new();
     let plausible: Vec<&FindingReport> = r.findings.iter().filter(|f| f.plausible).collect();
     if r.findings.is_empty() {
@@ -298,18 +299,16 @@ pub fn next_steps(r: &DiagnosisReport) -> String {
             })
             .collect();
         out.push_str(&format!(
-            "Use the extended model: rtest identify --machine {} --model {} --terms {} --data {}{zeroed}\n",
+            "Use the extended model: rtest identify --machine {} --model {} --terms {} {data}\n",
             shell(&r.machine_source),
             shell(&r.base_model),
             terms.join(","),
-            shell(&r.data)
         ));
     }
     if let (Some(name), Some(file)) = (&r.extended_model.name, &r.extended_model.file) {
         out.push_str(&format!(
-            "The extended model is `{name}` of {file}: rtest identify --machine {} --model {name} --data {}{zeroed}; rtest generate --machine {} --model {name}\n",
+            "The extended model is `{name}` of {file}: rtest identify --machine {} --model {name} {data}; rtest generate --machine {} --model {name}\n",
             shell(file),
-            shell(&r.data),
             shell(file)
         ));
     }
@@ -374,8 +373,9 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
             .collect();
         out.push_str(&format!("Held out (not fitted): {}\n", h.join(", ")));
     }
-    if let Some(c) = &r.campaign {
-        out.push_str(&campaign(c));
+    out.push_str(&records(r));
+    for n in &r.notes {
+        out.push_str(&format!("Note: {n}.\n"));
     }
     out.push_str(&outliers(r));
     out.push_str(&format!("Noise model of every test: {}\n", r.noise_model));
@@ -418,6 +418,13 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
         out.push_str(&findings(r));
     }
     out.push_str(&stop(r));
+    for x in &r.dropped {
+        out.push_str(&format!(
+            "Dropped: {} (selected, but the fit of the extended model with it failed: {}).\n",
+            words(&x.term),
+            x.why
+        ));
+    }
     if r.confounded.is_empty() {
         out.push_str("\nConfounded: none (the model spans no candidate)\n");
     } else {
@@ -444,66 +451,67 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
     out
 }
 
-/// The records of a campaign diagnosis: set-up, samples, outliers, residual RMS before and after;
-/// the held-out records' set-ups; what differs from one record.
-fn campaign(c: &crate::io::report::campaign_diagnose::CampaignDiagnosisReport) -> String {
-    let head = super::header(&[
-        "record",
-        "set-up",
-        "data",
-        "samples",
-        "outliers",
-        "base RMS µm",
-        "extended RMS µm",
-    ]);
-    let rows: Vec<Vec<String>> = c
-        .records
-        .iter()
-        .map(|r| {
-            vec![
-                r.label.clone(),
-                r.setup.clone(),
-                r.data.clone(),
-                r.samples.to_string(),
-                r.outliers.len().to_string(),
-                value(r.residual_rms_before_um),
-                value(r.residual_rms_after_um),
-            ]
-        })
-        .collect();
-    let mut out = String::from(
-        "Campaign: the machine's errors shared; each record with its own kinematic parameters, its set-up's errors and its own zero.\n",
-    );
-    out.push_str(&super::table(&head, &rows));
-    for r in &c.records {
-        for o in &r.outliers {
-            out.push_str(&format!(
-                "Outlier of record {}: {}, {} {} µm (left out)\n",
-                r.label,
-                o.line
-                    .map_or(format!("sample {}", o.sample + 1), |l| format!(
-                        "{}:{l}",
-                        r.data
-                    )),
-                o.direction,
-                value(o.residual_um)
-            ));
+/// The records of the diagnosis, when there is more to say than the file names: several fitted
+/// records (set-up, samples, outliers, residual RMS before and after), or held-out records with
+/// parameters refitted on them (a new set-up's errors, their own zero and drifts).
+fn records(r: &DiagnosisReport) -> String {
+    let fitted: Vec<&RecordReport> = r.records.iter().filter(|x| x.role == "fitted").collect();
+    let held: Vec<&RecordReport> = r.records.iter().filter(|x| x.role != "fitted").collect();
+    let mut out = String::new();
+    if fitted.len() > 1 {
+        let head = header(&[
+            "record",
+            "set-up",
+            "data",
+            "samples",
+            "outliers",
+            "base RMS µm",
+            "extended RMS µm",
+        ]);
+        let rows: Vec<Vec<String>> = fitted
+            .iter()
+            .map(|x| {
+                vec![
+                    x.label.clone(),
+                    x.setup.clone(),
+                    x.data.clone(),
+                    x.samples.to_string(),
+                    r.outliers
+                        .iter()
+                        .filter(|o| o.data == x.data)
+                        .count()
+                        .to_string(),
+                    value(x.residual_rms_before_um),
+                    value(x.residual_rms_after_um),
+                ]
+            })
+            .collect();
+        out.push_str(
+            "Campaign: the machine's errors shared; each record with its own kinematic parameters, its set-up's errors and its own zero.\n",
+        );
+        out.push_str(&table(&head, &rows));
+    }
+    for h in &held {
+        if fitted.len() < 2 && h.refitted.is_empty() {
+            continue;
         }
-    }
-    for h in &c.held_out {
-        out.push_str(&format!(
-            "Held out {}: set-up {}{}\n",
-            h.name,
-            h.setup,
-            if h.setup_fitted {
-                " (fitted: its values predict)"
-            } else {
-                " (new: its set-up errors refitted on it, the machine's values held)"
-            }
-        ));
-    }
-    for n in &c.notes {
-        out.push_str(&format!("Note: {n}.\n"));
+        let setup = if h.setup_fitted {
+            format!("set-up {} (fitted: its values predict)", h.setup)
+        } else {
+            format!(
+                "set-up {} (new: its set-up errors refitted on it, the machine's values held)",
+                h.setup
+            )
+        };
+        let refitted = if h.refitted.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; refitted on it (its residual is after them): {}",
+                h.refitted.join(", ")
+            )
+        };
+        out.push_str(&format!("Held out {}: {setup}{refitted}\n", h.label));
     }
     out
 }

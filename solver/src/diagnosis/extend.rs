@@ -1,0 +1,160 @@
+//! The fits of a diagnosis: a model refined against the exact machine on the fitted records,
+//! and the extended model, from which a finding whose refinement does not converge is dropped
+//! (the diagnosis goes on without it; only the base model's fit failing stops it).
+
+use super::{DiagnoseError, DiagnoseOptions, Dropped};
+use crate::fitting::IdentifyOptions;
+use crate::fitting::campaign::{Campaign, CampaignIdentification, identify_campaign_refined};
+use crate::fitting::noise::NoiseChoice;
+use crate::fitting::refine::{RefineError, RefineOptions};
+use crate::model::{Model, Term};
+use model_spec::Machine;
+
+/// The refined fit of `model` on `c` under `noise` (the records carry their zeroing and
+/// kinematic parameters).
+///
+/// # Errors
+/// As [`identify_campaign_refined`].
+pub(super) fn fit(
+    m: &Machine,
+    model: &Model,
+    c: &Campaign,
+    o: &DiagnoseOptions,
+    noise: &NoiseChoice,
+) -> Result<CampaignIdentification, DiagnoseError> {
+    let opts = IdentifyOptions {
+        zeroed: false,
+        constraint: o.constraint.clone(),
+        tolerances: o.tolerances,
+        params: None,
+    };
+    Ok(identify_campaign_refined(m, model, c, &opts, &RefineOptions::default(), noise)?.0)
+}
+
+/// The values and standard uncertainties of `term` in `fit` (mm or rad; every owner's columns
+/// in the campaign's column order).
+pub(super) fn term_values(
+    fit: &CampaignIdentification,
+    term: &Term,
+) -> (Vec<Option<f64>>, Vec<Option<f64>>) {
+    let cols: Vec<usize> = (0..fit.layout.columns.len())
+        .filter(|&j| fit.layout.columns[j].term == *term)
+        .collect();
+    (
+        cols.iter().map(|&j| fit.fit.values[j]).collect(),
+        cols.iter().map(|&j| fit.fit.std[j]).collect(),
+    )
+}
+
+/// `Some(why)` when `e` is a refinement that did not converge (or diverged): a fit without a
+/// result, which a candidate may cause and the diagnosis survives.
+fn not_converged(e: &DiagnoseError) -> Option<String> {
+    match e {
+        DiagnoseError::Refine(
+            r @ (RefineError::NotConverged { .. } | RefineError::NotFinite { .. }),
+        ) => Some(r.to_string()),
+        _ => None,
+    }
+}
+
+/// The fit of `base` plus `terms` (in order) by `fit`, and the terms dropped: when the fit with
+/// every term does not converge, the terms are added one at a time and each one whose fit does
+/// not converge is dropped with the reason. `base_fit` is the fit of `base` alone (the result
+/// when every term is dropped).
+///
+/// # Errors
+/// Any other failure of `fit`.
+pub(super) fn fit_dropping(
+    fit: &mut dyn FnMut(&Model) -> Result<CampaignIdentification, DiagnoseError>,
+    base: &Model,
+    terms: &[Term],
+    base_fit: &CampaignIdentification,
+) -> Result<(CampaignIdentification, Vec<Dropped>), DiagnoseError> {
+    let with = |kept: &[Term]| {
+        let mut model = base.clone();
+        model.terms.extend_from_slice(kept);
+        model
+    };
+    if terms.is_empty() {
+        return Ok((base_fit.clone(), Vec::new()));
+    }
+    match fit(&with(terms)) {
+        Ok(f) => return Ok((f, Vec::new())),
+        Err(e) if not_converged(&e).is_some() => {}
+        Err(e) => return Err(e),
+    }
+    let mut kept: Vec<Term> = Vec::new();
+    let mut dropped = Vec::new();
+    let mut last = None;
+    for &t in terms {
+        let mut trial = kept.clone();
+        trial.push(t);
+        match fit(&with(&trial)) {
+            Ok(f) => {
+                kept = trial;
+                last = Some(f);
+            }
+            Err(e) => match not_converged(&e) {
+                Some(why) => dropped.push(Dropped { term: t, why }),
+                None => return Err(e),
+            },
+        }
+    }
+    Ok((last.unwrap_or_else(|| base_fit.clone()), dropped))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fitting::campaign::CampaignRecord;
+    use crate::simulation::paths::builtin_path;
+    use crate::simulation::readings::simulate;
+    use crate::simulation::truth::builtin_truth;
+
+    #[test]
+    fn a_finding_whose_fit_does_not_converge_is_dropped_and_the_others_kept() {
+        let m = model_spec::builtin("seed-ac").unwrap().unwrap();
+        let mut t = builtin_truth("seed-ac-demo", &m).unwrap().unwrap();
+        t.seed = 1;
+        let record = simulate(&m, &t, &builtin_path(&m, "K4").unwrap().unwrap()).unwrap();
+        let c = Campaign::new(vec![CampaignRecord::on_own_setup(&m, "k4", record)]).unwrap();
+        let base = Model::of(&m, "reduced").unwrap();
+        let o = DiagnoseOptions::default();
+        let ecc2 = Term::parse(&m, "ECC@harmonic:2").unwrap();
+        let eyc3 = Term::parse(&m, "EYC@harmonic:3").unwrap();
+        let base_fit = fit(&m, &base, &c, &o, &NoiseChoice::Ordinary).unwrap();
+        // A fit that "does not converge" whenever EYC harmonic:3 is in the model.
+        let calls = std::cell::RefCell::new(Vec::new());
+        let mut fake = |model: &Model| {
+            calls.borrow_mut().push(model.terms.len());
+            if model.terms.contains(&eyc3) {
+                return Err(DiagnoseError::Refine(RefineError::NotConverged {
+                    iterations: 8,
+                    last_step_mm: 3e-6,
+                    tolerance_mm: 1e-9,
+                }));
+            }
+            fit(&m, model, &c, &o, &NoiseChoice::Ordinary)
+        };
+        let (f, dropped) = fit_dropping(&mut fake, &base, &[eyc3, ecc2], &base_fit).unwrap();
+        assert_eq!(dropped.len(), 1);
+        assert_eq!(dropped[0].term, eyc3);
+        assert!(
+            dropped[0].why.contains("did not converge"),
+            "{}",
+            dropped[0].why
+        );
+        assert!(f.model.terms.contains(&ecc2) && !f.model.terms.contains(&eyc3));
+        // All together, then one at a time.
+        assert_eq!(*calls.borrow(), vec![13, 12, 12]);
+        // Every term dropped: the base fit.
+        let (f, dropped) = fit_dropping(&mut fake, &base, &[eyc3], &base_fit).unwrap();
+        assert_eq!(dropped.len(), 1);
+        assert_eq!(f.fit.values, base_fit.fit.values);
+        // Another error is an error.
+        let mut failing = |_: &Model| -> Result<CampaignIdentification, DiagnoseError> {
+            Err(DiagnoseError::Campaign("no".into()))
+        };
+        assert!(fit_dropping(&mut failing, &base, &[ecc2], &base_fit).is_err());
+    }
+}

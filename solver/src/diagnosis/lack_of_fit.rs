@@ -50,6 +50,9 @@ pub(super) struct Inputs<'a> {
     pub as_candidates: &'a Model,
     /// The fitted records, outliers left out.
     pub cleaned: &'a Campaign,
+    /// The base model's fit (its residual on the fitted records is described too when the
+    /// extended model fails).
+    pub base_fit: &'a CampaignIdentification,
     /// The extended model's fit.
     pub extended_fit: &'a CampaignIdentification,
     /// The held-out records.
@@ -112,6 +115,7 @@ pub(super) fn test(
         groups,
         as_candidates,
         cleaned,
+        base_fit,
         extended_fit,
         held_out,
         validation,
@@ -221,7 +225,17 @@ pub(super) fn test(
                     .zip(&held_out.records)
                     .map(|(h, rec)| (h.name.as_str(), &rec.record, h.residual_after.clone())),
             );
-            unexplained::describe_failures(m, a, &records, o.alpha)
+            let mut described = unexplained::describe_failures(m, a, &records, o.alpha);
+            // The findings may have absorbed on the fitted records what the held-out records
+            // then mispredict: the base model's residual there is described where it is.
+            let base: Vec<(&str, &Record, Vec<[f64; 3]>)> = cleaned
+                .records
+                .iter()
+                .enumerate()
+                .map(|(r, rec)| (rec.label.as_str(), &rec.record, base_fit.record_residual(r)))
+                .collect();
+            described.extend(unexplained::describe_base(m, a, &base));
+            described
         }
         Err(_) => Vec::new(),
     };

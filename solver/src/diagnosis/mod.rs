@@ -588,6 +588,7 @@ pub fn diagnose(
         groups: &groups,
         as_candidates: &as_candidates,
         cleaned: &cleaned,
+        base_fit: &base_fit,
         extended_fit: &extended_fit,
         held_out,
         validation: &validation,

@@ -58,6 +58,14 @@ pub struct RecordAdequacyReport {
     pub statistic: [f64; 3],
     /// Per direction, the bootstrap p-value.
     pub p_values: [f64; 3],
+    /// The RMS the null gives this residual per direction, µm: the noise and, on a held-out
+    /// record, the fit's own uncertainty carried into the prediction (the draws' mean square).
+    #[serde(default)]
+    pub null_rms_um: [f64; 3],
+    /// The directions (`x`, `y`, `z`) whose residual RMS is more than twice the larger of the
+    /// noise's σ and `null_rms_um`: never consistent with the noise, whatever the p-value.
+    #[serde(default)]
+    pub over_noise: Vec<String>,
 }
 
 /// The lack-of-fit test of the extended model's residuals against the noise model.
@@ -103,8 +111,21 @@ pub struct UnexplainedReport {
     /// The first and last sample (1-based) of a local deviation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub samples: Option<[usize; 2]>,
+    /// For a step in a source that moves one way along the record (time, an axis turning one
+    /// way): the first sample (1-based) past the jump.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sample: Option<usize>,
+    /// Whose residual this describes: `extended` (the extended model's, on every record), or
+    /// `base` (the base model's on a fitted record, described because the findings may have
+    /// absorbed there what the held-out records mispredict).
+    #[serde(default = "extended_residual")]
+    pub residual: String,
     /// RMS of what the shape explains, µm.
     pub explained_rms_um: f64,
+}
+
+fn extended_residual() -> String {
+    "extended".into()
 }
 
 /// The lack-of-fit test `a`, its records named by their files (`file_of` a label).
@@ -128,6 +149,13 @@ pub(super) fn adequacy(
                 fitted: r.fitted,
                 noise_sigma_um: three("noise_sigma_um", r.noise_sigma_mm, UM_PER_MM)?,
                 residual_sigma_um: three("residual_sigma_um", r.residual_sigma_mm, UM_PER_MM)?,
+                null_rms_um: three("null_rms_um", r.null_rms_mm, UM_PER_MM)?,
+                over_noise: a
+                    .over_noise
+                    .iter()
+                    .filter(|(k, _)| *k == i)
+                    .map(|(_, d)| ["x", "y", "z"][*d].to_string())
+                    .collect(),
                 statistic: three("statistic", r.statistic, 1.0)?,
                 p_values: r.p_values,
             })
@@ -135,7 +163,7 @@ pub(super) fn adequacy(
         .collect::<Result<_, NonFinite>>()?;
     Ok(AdequacyReport {
         test: format!(
-            "per record and direction, the residual's mean square over the noise variance, against a parametric bootstrap of the fit and its predictions under the noise model ({} draws); family-wise by the maximum of the standardised statistics (max-T)",
+            "per record and direction, the residual's mean square over the noise variance, against a parametric bootstrap of the fit and its predictions under the noise model ({} draws); family-wise by the maximum of the standardised statistics (max-T), its tail beyond the draws from the Gumbel law of the drawn maxima; a residual more than twice what the null gives is never consistent",
             a.draws
         ),
         records,
@@ -169,6 +197,8 @@ pub(super) fn unexplained(
         period,
         at,
         samples,
+        sample: u.sample.map(|i| i + 1),
+        residual: if u.base { "base" } else { "extended" }.into(),
         explained_rms_um: um("explained_rms_um", u.explained_rms_mm)?,
     })
 }

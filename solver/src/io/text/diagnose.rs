@@ -195,11 +195,28 @@ pub fn adequacy(r: &DiagnosisReport) -> String {
         ));
         return out;
     }
-    out.push_str(&format!(
-        "  NOT consistent with the noise (p = {} < α = {}). Unexplained:\n",
-        p_value(a.p_value),
-        r.alpha
-    ));
+    let over: Vec<String> = a
+        .records
+        .iter()
+        .flat_map(|rec| {
+            rec.over_noise
+                .iter()
+                .map(move |d| format!("{} {d}", rec.data))
+        })
+        .collect();
+    if a.p_value >= r.alpha && !over.is_empty() {
+        out.push_str(&format!(
+            "  NOT consistent with the noise: the residual is more than twice the noise in {} (p = {}). Unexplained:\n",
+            over.join(", "),
+            p_value(a.p_value)
+        ));
+    } else {
+        out.push_str(&format!(
+            "  NOT consistent with the noise (p = {} < α = {}). Unexplained:\n",
+            p_value(a.p_value),
+            r.alpha
+        ));
+    }
     for u in &r.unexplained {
         let what = match (u.follows.as_deref(), u.shape.as_str()) {
             (None, _) | (_, "irregular") => "follows nothing simple (no shape of an axis position, velocity, direction of motion or time beats the noise)".to_string(),
@@ -213,14 +230,22 @@ pub fn adequacy(r: &DiagnosisReport) -> String {
                 u.unit
             ),
             (Some(f), "step") => format!(
-                "follows {f}: a step near {} {}",
+                "follows {f}: a step near {} {}{}",
                 fixed(u.at.unwrap_or(f64::NAN), 3),
-                u.unit
+                u.unit,
+                u.sample
+                    .map(|i| format!(" (a jump at sample {i})"))
+                    .unwrap_or_default()
             ),
             (Some(f), shape) => format!("follows {f}: {shape}"),
         };
+        let whose = if u.residual == "base" {
+            " (base model, fitted record)"
+        } else {
+            ""
+        };
         out.push_str(&format!(
-            "  {} {}: {} µm RMS; {what} (explains {} µm RMS)\n",
+            "  {} {}{whose}: {} µm RMS; {what} (explains {} µm RMS)\n",
             u.data,
             u.direction,
             fixed(u.rms_um, 3),

@@ -9,7 +9,10 @@
 //!   failed.
 //!
 //! The records go through the measurement CSV as `rtest simulate` writes them and `rtest
-//! diagnose` reads them, so that these are the very records of the failures.
+//! diagnose` reads them, so that these are the very records of the failures. In those, an
+//! extended fit with a sensor gain (`SYY`) settled at 3e-8 µm and 5e-7 µm, below the tolerance
+//! now: at 1/2/3 and 24/21/22 nothing is dropped. A fit that really crawls (`SZZ` at 64/61/62
+//! moves the prediction by 1.5e-5 µm at its eighth step) drops its finding with the reason.
 
 use model_spec::Machine;
 use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose, one_record};
@@ -52,7 +55,8 @@ fn check(m: &Machine, fitted: &Campaign, held: &Campaign, what: &str) -> Diagnos
     assert!(!d.findings.is_empty(), "{what}: the budget has effects");
     assert!(d.fit_rms.1 < d.fit_rms.0, "{what}: {:?}", d.fit_rms);
     for x in &d.dropped {
-        assert!(x.why.contains("refinement"), "{what}: {}", x.why);
+        assert!(x.why.contains("did not converge"), "{what}: {}", x.why);
+        assert!(!d.findings.iter().any(|f| f.term == x.term), "{what}");
     }
     println!(
         "{what}: findings {}; dropped [{}]; fitted {:.3} -> {:.3} µm",
@@ -89,6 +93,9 @@ fn a_campaign_of_the_budget_is_diagnosed_at_every_seed() {
         );
         assert_eq!(d.records.len(), 2);
         assert!(!d.validation[0].setup_fitted);
+        if seeds == [1, 2, 3] {
+            assert!(d.dropped.is_empty(), "{:?}", d.dropped);
+        }
     }
 }
 
@@ -121,5 +128,8 @@ fn one_record_of_the_budget_is_diagnosed_at_every_seed() {
             &format!("K4, K1 and K2 held out, seeds {seeds:?}"),
         );
         assert!(d.validation.iter().all(|h| h.setup_fitted));
+        if seeds == [24, 21, 22] {
+            assert!(d.dropped.is_empty(), "{:?}", d.dropped);
+        }
     }
 }

@@ -140,20 +140,26 @@ impl Columns {
             .all(|v| v.abs() < 1e-15)
     }
 
-    /// The columns of the groups `groups` of `h` (`h_raw`'s columns, weighted or not) in the
-    /// rows of record `r` that belong to it (its owners': shared, its set-up's, its own): what
-    /// a fit of that record alone has.
-    pub fn record_block(&self, h: &DMatrix<f64>, r: usize, groups: &[usize]) -> DMatrix<f64> {
-        let rc = &self.layout.records[r];
-        let first: usize = self.layout.records[..r].iter().map(|x| 3 * x.samples).sum();
-        let cols: Vec<usize> = groups
+    /// The columns of `groups`, in order: the indices of their columns in `h_raw`.
+    pub fn columns_of(&self, groups: &[usize]) -> Vec<usize> {
+        groups
             .iter()
             .flat_map(|&g| self.starts[g]..self.starts[g] + self.widths[g])
-            .filter(|&k| rc.columns.contains(&self.order[k]))
+            .collect()
+    }
+
+    /// The rows of record `r` of `h` (the columns `columns` of `h_raw`, weighted or not), with
+    /// the columns that belong to it (its owners': shared, its set-up's, its own): what a fit
+    /// of that record alone has.
+    pub fn record_block(&self, h: &DMatrix<f64>, columns: &[usize], r: usize) -> DMatrix<f64> {
+        let rc = &self.layout.records[r];
+        let first: usize = self.layout.records[..r].iter().map(|x| 3 * x.samples).sum();
+        let own: Vec<usize> = (0..columns.len())
+            .filter(|&k| rc.columns.contains(&self.order[columns[k]]))
             .collect();
         h.rows(first, 3 * rc.samples)
             .into_owned()
-            .select_columns(&cols)
+            .select_columns(&own)
     }
 
     /// The whitened columns of `term` (any term of the machine, a scanned value of a

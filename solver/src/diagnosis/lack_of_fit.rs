@@ -131,7 +131,8 @@ pub(super) fn test(
     // The fitted records: residuals and their own columns, whitened per sample.
     let mut residual = extended_fit.fit.residual.clone();
     weights.fitted_vector(&mut residual)?;
-    let mut h_fitted = cols.h_raw.clone();
+    let columns = cols.columns_of(groups);
+    let mut h_fitted = cols.h_raw.select_columns(&columns);
     weights.fitted_matrix(&mut h_fitted)?;
     let mut fitted_residuals = Vec::with_capacity(cleaned.records.len());
     let mut blocks = Vec::with_capacity(cleaned.records.len());
@@ -139,18 +140,17 @@ pub(super) fn test(
     for (r, rec) in cleaned.records.iter().enumerate() {
         let rows = 3 * rec.record.samples.len();
         fitted_residuals.push(residual.rows(at, rows).into_owned());
-        blocks.push(cols.record_block(&h_fitted, r, groups));
+        blocks.push(cols.record_block(&h_fitted, &columns, r));
         at += rows;
     }
     // The held-out records: residuals after the extended model (outliers left out) and, with
     // one fitted record, their columns of the parameters taken from its fit.
     let single = cleaned.records.len() == 1;
     let owners: Vec<(usize, Owner)> = if single {
-        groups
+        columns
             .iter()
-            .flat_map(|&g| cols.starts[g]..cols.starts[g] + cols.widths[g])
             .enumerate()
-            .map(|(k, j)| (k, cols.layout.columns[cols.order[j]].owner))
+            .map(|(k, &j)| (k, cols.layout.columns[cols.order[j]].owner))
             .collect()
     } else {
         Vec::new()

@@ -568,7 +568,7 @@ mod tests {
         let shape = DVector::from_fn(40, |i, _| if i % 2 == 0 { 1.0 } else { 0.3 });
         let mut predict = |x: &[f64]| -> Result<DVector<f64>, RefineError> {
             calls += 1;
-            let sign = if calls % 2 == 0 { 1.0 } else { -1.0 };
+            let sign = if calls.is_multiple_of(2) { 1.0 } else { -1.0 };
             Ok(&h * DVector::from_column_slice(x) + &shape * (sign * jitter))
         };
         gauss_newton(&problem, &start, opts, &mut predict)

@@ -131,6 +131,55 @@ fn two_files_are_two_set_ups_sharing_the_machine_errors() {
     );
     let s = read_json(&dir.join("s.json"));
     assert!(s.get("kind").is_none() && s["parameters"][0]["name"] == "XOW");
+    // A record's report: the fields of a single identification, plus its version, set-up and
+    // record.
+    let mut keys: Vec<&str> = s.as_object().unwrap().keys().map(String::as_str).collect();
+    keys.sort_unstable();
+    let mut want = vec![
+        "machine",
+        "fingerprint",
+        "data",
+        "model",
+        "base_model",
+        "terms",
+        "parameters",
+        "residual_rms_um",
+        "rank",
+        "free_parameters",
+        "condition",
+        "confounded",
+        "samples",
+        "readings",
+        "dof",
+        "zeroed",
+        "constraint",
+        "sigma_um",
+        "near_confounded",
+        "swallowed",
+        "gains",
+        "refinement",
+        "noise_model",
+        "notes",
+        "version",
+        "setups",
+        "records",
+    ];
+    want.sort_unstable();
+    assert_eq!(keys, want);
+    assert_eq!(s["version"], 2);
+    assert_eq!(
+        s["setups"],
+        serde_json::json!([{"label": "k4", "records": ["k4"]}])
+    );
+    assert_eq!(s["records"][0]["data"], "k4.csv");
+    assert_eq!(s["records"][0]["params"]["Zw"], 211.537);
+    assert!(
+        s["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|p| p.get("owner").is_none())
+    );
 }
 
 #[test]

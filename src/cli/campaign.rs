@@ -99,21 +99,21 @@ impl Loaded {
             .collect()
     }
 
-    /// Refuses a record without real times for a term that needs them, naming the record and
-    /// its file.
+    /// Refuses a record without real times for a term that needs them, naming the record (of
+    /// several) and its file.
     pub fn check_times(&self, flag: &str, m: &Machine, model: &Model) -> CliResult<()> {
+        let one = self.campaign.records.len() == 1;
         for (r, f) in self.campaign.records.iter().zip(&self.files) {
             let mut local = model.clone();
             if r.zeroed {
                 local = solver::fitting::with_offsets(&local);
             }
-            super::check_times(
-                &format!("{flag} (record `{}`)", r.label),
-                Path::new(f),
-                m,
-                &local,
-                &r.record,
-            )?;
+            let named = if one {
+                flag.to_string()
+            } else {
+                format!("{flag} (record `{}`)", r.label)
+            };
+            super::check_times(&named, Path::new(f), m, &local, &r.record)?;
         }
         Ok(())
     }

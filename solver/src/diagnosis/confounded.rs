@@ -1,11 +1,93 @@
-//! What the data cannot see apart: candidates of one span, the size of the change a candidate
-//! needs, and the candidates the final model spans with the terms they are a combination of.
+//! What the data cannot see apart: scanned candidates that are the same finding, candidates of
+//! one span, the size of the change a candidate needs, and the candidates the final model spans
+//! with the terms they are a combination of.
 
 use super::Confounded;
 use super::projected::{orthonormalise, project_out, unit_columns};
 use super::select::{SPAN_TOLERANCE, Scored, Span, gram};
-use crate::model::{Model, Term};
+use crate::model::{Basis, Effect, Model, Term};
 use nalgebra::{DMatrix, DVector};
+use std::collections::HashMap;
+
+/// When two scanned candidates of one family are the same effect, and so never two findings:
+/// the scanned grids' spacings, taken from the candidates (the dictionary's grids,
+/// [`super::dictionary::scanned`]).
+///
+/// - `step:V` of one error: V within one spacing of the error's step grid (the refinement of
+///   either reaches the other, [`super::profile`]: a jump between two grid values is explained
+///   by both, and both refine to it);
+/// - `period:P` of one error: 1/P within one spacing of the error's period grid in 1/P (the
+///   other's refinement interval), or P within 2 % (a period 0.3 % off the chosen one only
+///   mops up what the coarse grid left);
+/// - `exp:TAU` of one effect: TAU within a factor 3.
+///
+/// A spacing is the grid's extent over its number of intervals, with 1 % slack (and, for
+/// steps, two thousandths) for the values' rounding to thousandths.
+#[derive(Clone, Debug, Default)]
+pub(super) struct SameFinding {
+    /// Per effect, the spacing of its `step:V` grid (mm or degrees).
+    step: HashMap<Effect, f64>,
+    /// Per effect, the spacing of its `period:P` grid in 1/P (1/mm).
+    period: HashMap<Effect, f64>,
+}
+
+impl SameFinding {
+    /// The grids of the scanned candidates among `candidates`.
+    pub fn of(candidates: &[Term]) -> SameFinding {
+        let mut steps: HashMap<Effect, Vec<f64>> = HashMap::new();
+        let mut periods: HashMap<Effect, Vec<f64>> = HashMap::new();
+        for t in candidates {
+            if let Some(v) = t.basis.step_at() {
+                steps.entry(t.effect).or_default().push(v);
+            } else if let Some(p) = t.basis.period_mm() {
+                periods.entry(t.effect).or_default().push(1.0 / p);
+            }
+        }
+        let spacings = |m: HashMap<Effect, Vec<f64>>| -> HashMap<Effect, f64> {
+            m.into_iter()
+                .filter_map(|(e, mut v)| {
+                    v.sort_by(f64::total_cmp);
+                    v.dedup();
+                    let (lo, hi) = (v.first()?, v.last()?);
+                    (v.len() > 1).then(|| (e, (hi - lo) / (v.len() - 1) as f64))
+                })
+                .collect()
+        };
+        SameFinding {
+            step: spacings(steps),
+            period: spacings(periods),
+        }
+    }
+
+    /// `true` when `a` and `b` are the same effect (see the type).
+    pub fn test(&self, a: &Term, b: &Term) -> bool {
+        if a.effect != b.effect {
+            return false;
+        }
+        match (a.basis, b.basis) {
+            (Basis::Step(_), Basis::Step(_)) => {
+                let (Some(u), Some(v)) = (a.basis.step_at(), b.basis.step_at()) else {
+                    return false;
+                };
+                self.step
+                    .get(&a.effect)
+                    .is_some_and(|&s| (u - v).abs() <= 1.01 * s + 2e-3)
+            }
+            (Basis::Period(p), Basis::Period(q)) => {
+                let (p, q) = (f64::from(p), f64::from(q));
+                (p - q).abs() < 0.02 * q
+                    || self
+                        .period
+                        .get(&a.effect)
+                        .is_some_and(|&s| (1000.0 / p - 1000.0 / q).abs() <= 1.01 * s)
+            }
+            (Basis::Exp(p), Basis::Exp(q)) => {
+                f64::from(p.max(q)) / f64::from(p.min(q).max(1)) < 3.0
+            }
+            _ => false,
+        }
+    }
+}
 
 /// `true` when two scored candidates add the same directions to the model (`‖aᵀb‖²` above
 /// `q·(1 − 10⁻⁹)`, Frobenius), `rss` the residual sum of squares they were scored on.
@@ -132,4 +214,53 @@ pub(super) fn confounded_with(
         });
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use model_spec::ErrorId;
+
+    fn term(error: ErrorId, basis: Basis) -> Term {
+        Term {
+            effect: Effect::Error(error),
+            basis,
+        }
+    }
+
+    /// Steps within one spacing of their grid are one finding, two spacings apart are two;
+    /// periods within one step of their 1/P grid or 2 % are one; warm-ups within a factor 3.
+    #[test]
+    fn same_finding_follows_the_grids() {
+        // Steps of error 0 every 15° from 7.5°, of error 1 every 1°; periods of error 2 on a
+        // grid in 1/P of spacing 0.001/mm from 1/100 mm.
+        let mut candidates: Vec<Term> = (0..24)
+            .map(|k| term(0, Basis::Step(7_500 + 15_000 * k)))
+            .collect();
+        candidates.extend((0..10).map(|k| term(1, Basis::Step(1000 * k))));
+        candidates.extend((0..40).map(|k| {
+            let p = 1.0 / (0.01 + 0.001 * k as f64);
+            term(2, Basis::Period((p * 1000.0).round() as u32))
+        }));
+        let same = SameFinding::of(&candidates);
+        let step = |e, v: f64| term(e, Basis::Step((v * 1000.0).round() as i64));
+        assert!(same.test(&step(0, 217.5), &step(0, 232.5)));
+        assert!(same.test(&step(0, 224.25), &step(0, 232.5)));
+        assert!(!same.test(&step(0, 217.5), &step(0, 247.5)));
+        assert!(!same.test(&step(0, 217.5), &step(1, 217.5)));
+        assert!(same.test(&step(1, 3.0), &step(1, 4.0)));
+        assert!(!same.test(&step(1, 3.0), &step(1, 5.0)));
+        let period = |e, p: f64| term(e, Basis::Period((p * 1000.0).round() as u32));
+        // 1/100 and 1/90.909: 0.001/mm apart (10 %, beyond 2 %).
+        assert!(same.test(&period(2, 100.0), &period(2, 90.909)));
+        assert!(!same.test(&period(2, 100.0), &period(2, 83.333)));
+        // Near 20 mm one step of the grid is 2 %: the 2 % rule.
+        assert!(same.test(&period(2, 20.0), &period(2, 20.3)));
+        assert!(!same.test(&period(2, 20.0), &period(2, 21.0)));
+        let exp = |e, t: u32| term(e, Basis::Exp(t));
+        assert!(same.test(&exp(3, 10_000), &exp(3, 25_000)));
+        assert!(!same.test(&exp(3, 10_000), &exp(3, 35_000)));
+        // Different families are never the same finding.
+        assert!(!same.test(&step(0, 217.5), &term(0, Basis::Harmonic(2))));
+    }
 }

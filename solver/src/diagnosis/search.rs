@@ -9,7 +9,7 @@
 //! so a step already taken on a model (the exchange pass repeats forward steps) is not computed
 //! again.
 
-use super::confounded::{same_span, scaled_size};
+use super::confounded::{SameFinding, same_span, scaled_size};
 use super::projected::{Model, Projected};
 use super::select::{SPAN_TOLERANCE, Scored, Span, beyond, f_p_value, f_statistic, monte_carlo_p};
 use super::{Correction, DiagnoseOptions, Stop};
@@ -281,22 +281,10 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             p,
         })
     };
-    // The candidates a step may take: the excited ones that are not chosen (but `skip`).
-    // A scanned candidate next to a chosen one of the same effect is the same finding, not a
-    // second one (a period 0.3 % off the chosen one only mops up what the coarse grid left):
-    // periods within 2 %, warm-ups within a factor 3.
-    let same_finding = |a: &Term, b: &Term| -> bool {
-        use model_spec::basis::Basis::{Exp, Period};
-        a.effect == b.effect
-            && match (a.basis, b.basis) {
-                (Period(p), Period(q)) => (f64::from(p) - f64::from(q)).abs() < 0.02 * f64::from(q),
-                (Exp(p), Exp(q)) => {
-                    let r = f64::from(p.max(q)) / f64::from(p.min(q).max(1));
-                    r < 3.0
-                }
-                _ => false,
-            }
-    };
+    // The candidates a step may take: the excited ones that are not chosen (but `skip`), nor
+    // the same finding as a chosen one: a scanned candidate next to a chosen one of the same
+    // effect only mops up what the coarse grid left ([`SameFinding`]).
+    let same = SameFinding::of(candidates);
     let pool_of = |chosen: &[Chosen], skip: Option<usize>| -> Vec<usize> {
         candidates_live
             .iter()
@@ -304,7 +292,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             .filter(|&c| {
                 !chosen.iter().enumerate().any(|(k, x)| {
                     Some(k) != skip
-                        && (x.index == c || same_finding(&candidates[c], &candidates[x.index]))
+                        && (x.index == c || same.test(&candidates[c], &candidates[x.index]))
                 })
             })
             .collect()

@@ -15,6 +15,12 @@
 //! - `diagnose/demo-campaign`: truth `seed-ac-demo`, K4 and K1 fitted together (each its own
 //!   set-up), K2 held out on a set-up of its own (its set-up errors refitted on it).
 //!
+//! And a campaign (`diagnose-campaign/budget-five`): five records of `seed-ac-budget` (noise
+//! seeds 1–5) fitted together, no record held out: K4, K1 and K2 with the ball at the
+//! description's position and K4 and K1 with the ball 50 mm higher (`Zw + 50`), each ball
+//! position its own set-up; 1325 samples, 3975 rows. The diagnosis's default options, as
+//! `rtest diagnose --campaign` runs them.
+//!
 //! `cargo bench -p solver --bench diagnose`. The set-up prints the dictionary's size (candidate
 //! terms and H-matrix columns).
 
@@ -49,6 +55,86 @@ fn records(m: &Machine, name: &str) -> Vec<(String, Record)> {
             (p.to_string(), simulate(m, &truth, &path).expect("simulate"))
         })
         .collect()
+}
+
+/// The five records of the campaign bench: (path, noise seed, ball raised) on `seed-ac-budget`,
+/// each simulated with the path planned at its ball position and the truth's real parameters
+/// moved by as much.
+fn campaign(m: &Machine) -> Campaign {
+    let truth = builtin_truth("seed-ac-budget", m)
+        .expect("built in")
+        .expect("valid");
+    let zw = m.symbol_by_name("Zw").expect("Zw");
+    let records = [
+        ("K4", 1, false),
+        ("K1", 2, false),
+        ("K2", 3, false),
+        ("K4", 4, true),
+        ("K1", 5, true),
+    ]
+    .into_iter()
+    .map(|(path, seed, raised)| {
+        let mut params = m.default_parameters();
+        let mut t = truth.clone();
+        t.seed = seed;
+        if raised {
+            params[zw] += 50.0;
+            t.params[zw] += 50.0;
+        }
+        let at = solver::io::campaign::machine_at(m, &params);
+        let planned = builtin_path(&at, path).expect("built in").expect("path");
+        let record = simulate(&at, &t, &planned).expect("simulate");
+        let (label, setup) = if raised {
+            (format!("{}-high", path.to_lowercase()), "high")
+        } else {
+            (path.to_lowercase(), "low")
+        };
+        CampaignRecord::new(label, record, params, setup, false)
+    })
+    .collect();
+    Campaign::new(records).expect("campaign")
+}
+
+fn bench_campaign(c: &mut Criterion) {
+    let m = seed_ac();
+    let base = Model::of(&m, "reduced").expect("reduced model");
+    let o = DiagnoseOptions::default();
+    let fitted = campaign(&m);
+    let none = Campaign {
+        records: Vec::new(),
+    };
+    let d = diagnose(&m, &base, &fitted, &none, &o, &Unwatched).expect("diagnosis");
+    println!(
+        "budget-five: {} records, {} samples; {} finding(s): {}",
+        fitted.records.len(),
+        fitted
+            .records
+            .iter()
+            .map(|r| r.record.samples.len())
+            .sum::<usize>(),
+        d.findings.len(),
+        d.findings
+            .iter()
+            .map(|f| format!("{} (p = {:.3e})", f.term.spelling(&m), f.p_value))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let mut g = c.benchmark_group("diagnose-campaign");
+    g.sample_size(10);
+    g.bench_function("budget-five", |b| {
+        b.iter(|| {
+            diagnose(
+                black_box(&m),
+                black_box(&base),
+                black_box(&fitted),
+                black_box(&none),
+                black_box(&o),
+                &Unwatched,
+            )
+            .expect("diagnosis")
+        })
+    });
+    g.finish();
 }
 
 fn bench(c: &mut Criterion) {
@@ -125,5 +211,5 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+criterion_group!(benches, bench, bench_campaign);
 criterion_main!(benches);

@@ -44,6 +44,7 @@ mod options;
 pub mod outliers;
 pub mod plausible;
 pub mod profile;
+mod projected;
 mod search;
 pub mod select;
 pub mod structure;

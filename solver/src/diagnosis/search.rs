@@ -1,14 +1,23 @@
 //! Forward selection with an exchange pass (docs/diagnosis.md §4–5): one candidate at a time,
 //! the one that explains most of what is left, kept when its corrected p-value is below α;
 //! then each finding is selected again given all the others.
+//!
+//! The candidates' columns are held with the model projected out ([`Projected`]) and updated
+//! as the model grows or a finding is exchanged; a step of the exchange pass sees the model
+//! without its finding without changing what is held. A step is a function of the model it
+//! starts from (the set of chosen terms: its candidates, its span and the seed of its draws),
+//! so a step already taken on a model (the exchange pass repeats forward steps) is not computed
+//! again.
 
-use super::confounded::{same_span, scaled_size};
-use super::select::{Scored, Span, f_p_value, f_statistic, monte_carlo_p};
+use super::confounded::{SameFinding, same_span, scaled_size};
+use super::projected::{Model, Projected};
+use super::select::{SPAN_TOLERANCE, Scored, Span, beyond, f_p_value, f_statistic, monte_carlo_p};
 use super::{Correction, DiagnoseOptions, Stop};
 use crate::fitting::distributions::f_upper_tail;
 use crate::model::Term;
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
+use std::collections::HashMap;
 
 /// What the selection works on: the columns of the base model and of every candidate, and the
 /// readings.
@@ -34,6 +43,7 @@ pub(super) struct Problem<'a> {
 }
 
 /// A step of the selection, before the extended fit gives its values.
+#[derive(Clone, Debug)]
 pub(super) struct Chosen {
     /// The candidate's index.
     pub index: usize,
@@ -77,28 +87,32 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         progress,
     } = *p;
     let n = y.len();
-    // One selection step on the model `q` (orthonormal) over the candidates `pool`: the
-    // significant candidate named, or why there is none.
-    let step = |q: &Span, pool: &[usize], seed: u64| -> Result<Chosen, Stop> {
-        let r = q.project_out(y);
+    // One selection step on `model` over the candidates `pool`: the significant candidate
+    // named, or why there is none. The candidates' directions are written into `buffer`.
+    let step = |model: &Model,
+                pool: &[usize],
+                seed: u64,
+                buffer: &mut DMatrix<f64>|
+     -> Result<Chosen, Stop> {
+        let q = model.span();
+        let r = model.residual();
         let rss = r.norm_squared();
         let total = pool.len() as u64;
         progress.update("selection", 0, total);
-        let scored: Vec<Scored> = pool
+        let mut placed = Vec::with_capacity(pool.len());
+        let mut at = 0;
+        for (k, &c) in pool.iter().enumerate() {
+            progress.update("selection", k as u64 + 1, total);
+            let width = model.directions_into(c, buffer, at);
+            if width > 0 {
+                placed.push((c, at, width));
+                at += width;
+            }
+        }
+        let buffer = &*buffer;
+        let scored: Vec<Scored> = placed
             .iter()
-            .enumerate()
-            .filter_map(|(k, &c)| {
-                progress.update("selection", k as u64 + 1, total);
-                let d = q.new_directions(&group(nb + c));
-                (d.ncols() > 0).then(|| {
-                    let delta = d.tr_mul(&r).norm_squared();
-                    Scored {
-                        index: c,
-                        directions: d,
-                        delta_rss: delta,
-                    }
-                })
-            })
+            .map(|&(c, at, width)| Scored::new(c, buffer.columns(at, width), r))
             .collect();
         let Some(best) = scored
             .iter()
@@ -119,7 +133,9 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         // another constant, then the one that needs the smallest change to do it (coefficients
         // of its unit-norm columns): the one least entangled with the model (with a base
         // lacking XOW, ECC@reversal, a constant on K4, spans what XOW spans only through YOW,
-        // with 0.043 rad for 12 µm).
+        // with 0.043 rad for 12 µm), then the first in the dictionary's order (columns that
+        // are the same to rounding need the same change: the straightness EXZ poly:4 rather
+        // than the pitch EBZ poly:4).
         // A drift or warm-up that the zero offsets of the R-test explain as well as an axis
         // line is named as the instrument's: the first suspect of a slow change over a record,
         // and a random-walk drift of the instrument is never named a geometric cause.
@@ -143,22 +159,18 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             scored
                 .iter()
                 .enumerate()
-                .filter(|(_, s)| same_span(one, s))
+                .filter(|(_, s)| same_span(one, s, rss))
                 .map(|(k, s)| {
-                    let g = group(nb + s.index);
+                    let g = model.projected(s.index);
                     (
                         k,
-                        (
-                            g.ncols(),
-                            rank(&candidates[s.index]),
-                            scaled_size(q, &g, &r),
-                        ),
+                        (g.ncols(), rank(&candidates[s.index]), scaled_size(&g, r)),
                     )
                 })
                 .min_by(|a, b| {
                     (a.1.0, a.1.1)
                         .cmp(&(b.1.0, b.1.1))
-                        .then(a.1.2.total_cmp(&b.1.2))
+                        .then(rounded_cmp(a.1.2, b.1.2))
                 })
                 .map_or(0, |(k, _)| k)
         };
@@ -195,24 +207,39 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         // What candidate `a` adds beyond candidate `b` (and the model): the ΔRSS of its
         // directions outside their span, how many, and the RSS left with both.
         let beyond = |a: &Scored, b: &Scored| -> (f64, usize, f64, usize) {
-            let extra = Span {
-                q: b.directions.clone(),
-            }
-            .new_directions(&a.directions);
-            let gain = extra.tr_mul(&r).norm_squared();
-            let dim = b.directions.ncols() + extra.ncols();
-            (gain, extra.ncols(), rss - b.delta_rss - gain, dim)
+            let (gain, extra) = beyond(a, b, r);
+            let dim = b.directions.ncols() + extra;
+            (gain, extra, rss - b.delta_rss - gain, dim)
         };
-        // `true` when that addition is not significant (raw F-test at α).
-        let not_needed = |(gain, extra, rest, dim): (f64, usize, f64, usize)| -> bool {
-            if extra == 0 {
-                return true;
-            }
+        // The raw F-test at α of an addition of `extra` directions explaining `gain`, `dim` in
+        // all with `b`: `true` when it is not significant.
+        let not_significant = |gain: f64, extra: usize, rest: f64, dim: usize| -> bool {
             let Some(dof) = n.checked_sub(q.rank() + dim).filter(|&d| d > 0) else {
                 return false;
             };
             let f = (gain.max(0.0) / extra as f64) / (rest / dof as f64);
             f.is_finite() && f_upper_tail(f, extra as f64, dof as f64) >= o.alpha
+        };
+        // `true` when `a` adds nothing significant to `b` (raw F-test at α).
+        let adds_nothing = |a: &Scored, b: &Scored| -> bool {
+            // What `a` adds is at least `(√ΔRSS_a − δ)² − ΔRSS_b`, δ what directions of `a`
+            // within the span tolerance of `b` can hide (then at least one direction is
+            // added). When that bound is significant whatever the number of directions added
+            // (the F-test's p-value falls as the gain grows), the directions are not made:
+            // most candidates are far from one another.
+            let qa = a.directions.ncols();
+            let delta = 2.0 * (qa as f64).sqrt() * SPAN_TOLERANCE * rss.sqrt();
+            let low = (a.delta_rss.sqrt() - delta).max(0.0).powi(2) - b.delta_rss;
+            let qb = b.directions.ncols();
+            let rest = rss - b.delta_rss - low;
+            if a.delta_rss.sqrt() - b.delta_rss.sqrt() > delta
+                && rest > 0.0
+                && (1..=qa).all(|extra| !not_significant(low, extra, rest, qb + extra))
+            {
+                return false;
+            }
+            let (gain, extra, rest, dim) = beyond(a, b);
+            extra == 0 || not_significant(gain, extra, rest, dim)
         };
         // Parsimony: a narrower candidate that explains what the best one explains, as far as
         // the data can tell, is named instead. (EXX poly:1 lies exactly inside the span of EXC
@@ -223,13 +250,13 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         let named = scored
             .iter()
             .filter(|s| s.index != best.index && s.directions.ncols() < qg)
-            .filter(|s| not_needed(beyond(s, best)) && not_needed(beyond(best, s)))
+            .filter(|s| adds_nothing(best, s) && adds_nothing(s, best))
             .max_by(|a, b| a.delta_rss.total_cmp(&b.delta_rss))
             .map_or(best, |s| &scored[prefer(s)]);
         // Candidates of the named one's span (the extended model spans them).
         let spanned: Vec<usize> = scored
             .iter()
-            .filter(|s| s.index != named.index && same_span(named, s))
+            .filter(|s| s.index != named.index && same_span(named, s, rss))
             .map(|s| s.index)
             .collect();
         // Candidates the data cannot tell from the named one: those of its span, and those to
@@ -238,9 +265,10 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         let mut alike: Vec<&Scored> = scored
             .iter()
             .filter(|s| s.index != named.index)
-            .filter(|s| spanned.contains(&s.index) || not_needed(beyond(named, s)))
+            .filter(|s| spanned.contains(&s.index) || adds_nothing(named, s))
             .collect();
         alike.sort_by(|a, b| b.delta_rss.total_cmp(&a.delta_rss));
+
         let alternatives: Vec<usize> = alike.iter().map(|s| s.index).collect();
         Ok(Chosen {
             index: named.index,
@@ -252,22 +280,10 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             p,
         })
     };
-    // The candidates a step may take: the excited ones that are not chosen (but `skip`).
-    // A scanned candidate next to a chosen one of the same effect is the same finding, not a
-    // second one (a period 0.3 % off the chosen one only mops up what the coarse grid left):
-    // periods within 2 %, warm-ups within a factor 3.
-    let same_finding = |a: &Term, b: &Term| -> bool {
-        use model_spec::basis::Basis::{Exp, Period, Warmup};
-        a.effect == b.effect
-            && match (a.basis, b.basis) {
-                (Period(p), Period(q)) => (f64::from(p) - f64::from(q)).abs() < 0.02 * f64::from(q),
-                (Exp(p), Exp(q)) | (Warmup(p), Warmup(q)) => {
-                    let r = f64::from(p.max(q)) / f64::from(p.min(q).max(1));
-                    r < 3.0
-                }
-                _ => false,
-            }
-    };
+    // The candidates a step may take: the excited ones that are not chosen (but `skip`), nor
+    // the same finding as a chosen one: a scanned candidate next to a chosen one of the same
+    // effect only mops up what the coarse grid left ([`SameFinding`]).
+    let same = SameFinding::of(candidates);
     let pool_of = |chosen: &[Chosen], skip: Option<usize>| -> Vec<usize> {
         candidates_live
             .iter()
@@ -275,25 +291,45 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             .filter(|&c| {
                 !chosen.iter().enumerate().any(|(k, x)| {
                     Some(k) != skip
-                        && (x.index == c || same_finding(&candidates[c], &candidates[x.index]))
+                        && (x.index == c || same.test(&candidates[c], &candidates[x.index]))
                 })
             })
             .collect()
     };
+    // The steps taken, by the model they start from (its `context`): a step is a function of
+    // that model, and the exchange pass repeats forward steps.
+    let mut taken: HashMap<Vec<usize>, Result<Chosen, Stop>> = HashMap::new();
 
     // Forward steps until nothing significant is left; then an exchange pass: each finding in
     // turn is taken out and its slot selected again given all the others, so that a term
     // chosen while another effect was still unexplained (EXC harmonic:1 carrying part of ECC
     // harmonic:2 before it, where EXX poly:1 is the cause) is renamed, or dropped when it is no
     // longer significant. Repeated while the exchange changes something (at most 4 rounds).
+    // `state` holds the model of the base and every chosen term.
+    let mut state = Projected::new(
+        basis_of(p, &[], None),
+        y,
+        candidates.len(),
+        candidates_live,
+        &|c| group(nb + c),
+    );
+    let mut buffer = DMatrix::zeros(n, state.width());
     let mut chosen: Vec<Chosen> = Vec::new();
     let mut stop;
     let mut round = 0;
     loop {
-        let mut q = basis_of(p, &chosen, None);
         loop {
-            let seed = context_seed(o.seed, &chosen, None);
-            match step(&q, &pool_of(&chosen, None), seed) {
+            let context = context(&chosen, None);
+            let result = match taken.get(&context) {
+                Some(known) => known.clone(),
+                None => {
+                    let seed = context_seed(o.seed, &context);
+                    let r = step(&state.model(), &pool_of(&chosen, None), seed, &mut buffer);
+                    taken.insert(context, r.clone());
+                    r
+                }
+            };
+            match result {
                 Err(s) => {
                     stop = s;
                     break;
@@ -307,8 +343,8 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
                     break;
                 }
                 Ok(c) => {
-                    let d = q.new_directions(&group(nb + c.index));
-                    q.extend(&d);
+                    let d = state.model().directions(c.index);
+                    state.grow(&d, y);
                     chosen.push(c);
                 }
             }
@@ -316,18 +352,42 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         let mut changed = false;
         let mut j = 0;
         while j < chosen.len() {
-            let seed = context_seed(o.seed, &chosen, Some(j));
-            match step(
-                &basis_of(p, &chosen, Some(j)),
-                &pool_of(&chosen, Some(j)),
-                seed,
-            ) {
-                Ok(c) => {
-                    changed |= c.index != chosen[j].index;
+            // The model without finding `j`: its span, and what the finding adds to it.
+            let without = || {
+                let span = basis_of(p, &chosen, Some(j));
+                let d = span.new_directions(&group(nb + chosen[j].index));
+                (span, d)
+            };
+            let context = context(&chosen, Some(j));
+            let result = match taken.get(&context) {
+                Some(known) => known.clone(),
+                None => {
+                    let (span, d) = without();
+                    let seed = context_seed(o.seed, &context);
+                    let model = state.without(span, d, y);
+                    let r = step(&model, &pool_of(&chosen, Some(j)), seed, &mut buffer);
+                    taken.insert(context, r.clone());
+                    r
+                }
+            };
+            // The state changes only when the finding does.
+            match result {
+                Ok(c) if c.index == chosen[j].index => {
                     chosen[j] = c;
                     j += 1;
                 }
+                Ok(c) => {
+                    let (span, d) = without();
+                    state.shrink(span, &d, y);
+                    let d = state.model().directions(c.index);
+                    state.grow(&d, y);
+                    chosen[j] = c;
+                    changed = true;
+                    j += 1;
+                }
                 Err(_) => {
+                    let (span, d) = without();
+                    state.shrink(span, &d, y);
                     chosen.remove(j);
                     changed = true;
                 }
@@ -342,11 +402,21 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
     (chosen, stop)
 }
 
-/// The seed of the Monte-Carlo draws of a step: a function of the model the step starts from
-/// (the chosen terms but `skip`, in any order), so that the exchange pass, taking a finding out
-/// of a model, repeats the forward step of that model exactly (the same draws, the same
-/// decision) rather than testing it a second time with other draws.
-fn context_seed(seed: u64, chosen: &[Chosen], skip: Option<usize>) -> u64 {
+/// `a` against `b`, equal when within a relative 10⁻⁹: sizes of candidates whose columns are the
+/// same to rounding (an angular error of Z and a straightness of Z read at the ball) are equal,
+/// and the first candidate in the dictionary's order is named rather than the one rounding
+/// favours.
+fn rounded_cmp(a: f64, b: f64) -> std::cmp::Ordering {
+    if (a - b).abs() <= 1e-9 * a.abs().max(b.abs()) {
+        std::cmp::Ordering::Equal
+    } else {
+        a.total_cmp(&b)
+    }
+}
+
+/// The model a step starts from: the chosen terms but `skip`, sorted (the base is in every
+/// model).
+fn context(chosen: &[Chosen], skip: Option<usize>) -> Vec<usize> {
     let mut terms: Vec<usize> = chosen
         .iter()
         .enumerate()
@@ -354,7 +424,15 @@ fn context_seed(seed: u64, chosen: &[Chosen], skip: Option<usize>) -> u64 {
         .map(|(_, c)| c.index)
         .collect();
     terms.sort_unstable();
-    terms.iter().fold(seed, |h, &t| {
+    terms
+}
+
+/// The seed of the Monte-Carlo draws of a step: a function of the model the step starts from
+/// (its [`context`]), so that the exchange pass, taking a finding out
+/// of a model, repeats the forward step of that model exactly (the same draws, the same
+/// decision) rather than testing it a second time with other draws.
+fn context_seed(seed: u64, context: &[usize]) -> u64 {
+    context.iter().fold(seed, |h, &t| {
         (h ^ (t as u64 + 1)).wrapping_mul(0x9e37_79b9_7f4a_7c15)
     })
 }

@@ -19,9 +19,10 @@
 //! Carlo (a seeded generator, so results are reproducible). Under Gaussian noise this test has
 //! level α exactly, whatever the correlation between candidates.
 
+use super::projected::dot;
 use crate::fitting::distributions::f_upper_tail;
 use crate::simulation::rng::Rng;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DMatrixView, DVector};
 
 /// A column whose part outside the span of the others is below this (relative to its norm) adds
 /// nothing: the model spans it.
@@ -50,10 +51,11 @@ impl Span {
     /// `v` with the span of the basis projected out (twice, for orthogonality to rounding).
     pub fn project_out(&self, v: &DVector<f64>) -> DVector<f64> {
         let mut out = v.clone();
-        for _ in 0..2 {
-            if self.q.ncols() > 0 {
-                let c = self.q.tr_mul(&out);
-                out -= &self.q * c;
+        if self.q.ncols() > 0 {
+            let mut c = DVector::zeros(self.q.ncols());
+            for _ in 0..2 {
+                c.gemv_tr(1.0, &self.q, &out, 0.0);
+                out.gemv(-1.0, &self.q, &c, 1.0);
             }
         }
         out
@@ -65,7 +67,7 @@ impl Span {
     pub fn new_directions(&self, c: &DMatrix<f64>) -> DMatrix<f64> {
         let mut added: Vec<DVector<f64>> = Vec::new();
         for j in 0..c.ncols() {
-            let col = c.column(j).into_owned();
+            let col = DVector::from_column_slice(c.column(j).as_slice());
             let norm = col.norm();
             if norm == 0.0 || !norm.is_finite() {
                 continue;
@@ -124,13 +126,68 @@ impl Span {
 
 /// One candidate at one step: its new directions and what they explain.
 #[derive(Clone, Debug)]
-pub struct Scored {
+pub struct Scored<'a> {
     /// Index in the candidate list.
     pub index: usize,
     /// `Q_g`: its orthonormal directions outside the model (n × q).
-    pub directions: DMatrix<f64>,
-    /// ΔRSS, mm².
+    pub directions: DMatrixView<'a, f64>,
+    /// `Q_gᵀ r`: the residual's coordinates on them (mm; q).
+    pub coordinates: DVector<f64>,
+    /// ΔRSS = ‖Q_gᵀ r‖², mm².
     pub delta_rss: f64,
+}
+
+impl<'a> Scored<'a> {
+    /// Candidate `index` with directions `directions` (orthonormal, outside the model) against
+    /// the model's residual `r`.
+    pub fn new(index: usize, directions: DMatrixView<'a, f64>, r: &DVector<f64>) -> Scored<'a> {
+        let coordinates = DVector::from_iterator(
+            directions.ncols(),
+            directions
+                .column_iter()
+                .map(|d| dot(d.as_slice(), r.as_slice())),
+        );
+        Scored {
+            index,
+            delta_rss: coordinates.norm_squared(),
+            directions,
+            coordinates,
+        }
+    }
+}
+
+/// What the directions of `a` add beyond those of `b` (two candidates scored on one model with
+/// residual `r`): the ΔRSS of `r` on them and their number, as
+/// `Span { q: b.directions }.new_directions(&a.directions)` gives them.
+///
+/// When `b` lies far from `a` (`‖bᵀa‖²` at most ½, Frobenius: every direction of `a` keeps a
+/// part of norm at least 1/√2 outside `b`, so none is dropped) this is computed on the q × q
+/// Gram matrices: with `G = bᵀa`, the part of `a` outside `b` is `M = a − b·G`, `MᵀM = I − GᵀG`
+/// (well conditioned), `Mᵀr = aᵀr − Gᵀ·bᵀr`, and the ΔRSS is `(Mᵀr)ᵀ (MᵀM)⁻¹ (Mᵀr)`.
+/// Otherwise the directions are made explicitly.
+pub fn beyond(a: &Scored, b: &Scored, r: &DVector<f64>) -> (f64, usize) {
+    let g = gram(&b.directions, &a.directions);
+    if g.norm_squared() <= 0.5 {
+        let qa = a.directions.ncols();
+        let t = &a.coordinates - g.tr_mul(&b.coordinates);
+        let gram = DMatrix::identity(qa, qa) - g.tr_mul(&g);
+        if let Some(c) = gram.cholesky() {
+            return (t.dot(&c.solve(&t)), qa);
+        }
+    }
+    let extra = Span {
+        q: b.directions.clone_owned(),
+    }
+    .new_directions(&a.directions.clone_owned());
+    (extra.tr_mul(r).norm_squared(), extra.ncols())
+}
+
+/// `aᵀ·b` of two matrices of contiguous columns (directions of candidates), by dot products of
+/// their columns.
+pub fn gram(a: &DMatrixView<'_, f64>, b: &DMatrixView<'_, f64>) -> DMatrix<f64> {
+    DMatrix::from_fn(a.ncols(), b.ncols(), |i, k| {
+        dot(a.column(i).as_slice(), b.column(k).as_slice())
+    })
 }
 
 /// The F statistic of adding `q` directions that explain `delta_rss` of `rss`, with `n` rows and
@@ -267,11 +324,7 @@ mod tests {
         let n = 200;
         let model = Span::empty(n);
         let dir = DMatrix::from_fn(n, 1, |i, _| if i == 0 { 1.0 } else { 0.0 });
-        let scored = vec![Scored {
-            index: 0,
-            directions: dir,
-            delta_rss: 0.0,
-        }];
+        let scored = vec![Scored::new(0, dir.columns(0, 1), &DVector::zeros(n))];
         for f in [1.0, 4.0, 7.0] {
             let exact = f_p_value(f, 1, n, 0);
             // Stopped sequentially, the p-value is coarser, and never below h / draws.
@@ -287,5 +340,52 @@ mod tests {
                 "F {f}: {mc} vs {exact}"
             );
         }
+    }
+
+    /// `beyond` on the Gram matrices (candidates far apart) gives what the directions made
+    /// explicitly give; near candidates go the explicit way.
+    #[test]
+    fn beyond_agrees_with_explicit_directions() {
+        let n = 60;
+        let mut rng = Rng::new(7);
+        let mut random = |w: usize| DMatrix::from_fn(n, w, |_, _| rng.normal());
+        let r = random(1).column(0).into_owned();
+        let model = Span::empty(n);
+        for (wa, wb, near) in [
+            (1, 1, 0.0),
+            (2, 1, 0.3),
+            (1, 2, 0.0),
+            (2, 2, 0.5),
+            (2, 2, 3.0),
+        ] {
+            let b_cols = random(wb);
+            // `a` leans towards `b` by `near`.
+            let mut a_cols = random(wa);
+            for k in 0..wa {
+                let lean = b_cols.column(k % wb) * near;
+                a_cols.column_mut(k).axpy(1.0, &lean, 1.0);
+            }
+            let da = model.new_directions(&a_cols);
+            let db = model.new_directions(&b_cols);
+            let (a, b) = (
+                Scored::new(0, da.columns(0, wa), &r),
+                Scored::new(1, db.columns(0, wb), &r),
+            );
+            let explicit = Span { q: db.clone() }.new_directions(&da);
+            let want = explicit.tr_mul(&r).norm_squared();
+            let (gain, extra) = beyond(&a, &b, &r);
+            assert_eq!(extra, explicit.ncols());
+            assert!((gain - want).abs() < 1e-10 * want, "{gain} vs {want}");
+        }
+        // `a` inside `b`: nothing added.
+        let b_cols = random(2);
+        let db = model.new_directions(&b_cols);
+        let a_cols = b_cols.column(0) * 2.0 - b_cols.column(1);
+        let da = model.new_directions(&DMatrix::from_columns(&[a_cols]));
+        let (a, b) = (
+            Scored::new(0, da.columns(0, 1), &r),
+            Scored::new(1, db.columns(0, 2), &r),
+        );
+        assert_eq!(beyond(&a, &b, &r).1, 0);
     }
 }

@@ -12,9 +12,10 @@
 //! **Left out and listed** ([`LeftOut`], with the value): the workpiece set-up errors
 //! `XOW YOW ZOW` (where the ball was placed), the R-test's zero offsets `dx0 dy0 dz0` and
 //! instrument terms `SXX` … `SZY` (the instrument, not the machine), terms on time bases
-//! (`time:K`, `exp:TAU`, `rate`, `warmup:TAU`: a drift is no function of the pose), `velocity` terms (servo lag: the
-//! controller's feed-forward takes it) and `reversal` terms (backlash: it depends on the
-//! direction of approach, and the controller's backlash compensation takes it).
+//! (`time:K`, `exp:TAU`, `rate`, `warmup:TAU`: a drift is no function of the pose),
+//! `velocity` terms (servo lag: the controller's feed-forward takes it) and `reversal` terms
+//! (backlash: it depends on the direction of approach, and the controller's backlash
+//! compensation takes it).
 //!
 //! **Undetermined values are refused.** A compensated term whose value the report has as
 //! `null` (the data could not determine it: a rank-deficient fit) is an error naming the terms

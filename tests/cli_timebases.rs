@@ -43,13 +43,14 @@ fn param<'a>(json: &'a Value, name: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no parameter {name} in {json}"))
 }
 
-/// K4's poses every 2.5 s (a path file: rotary axes and times), 600 s in all.
-fn slow_k4(dir: &std::path::Path) {
+/// K4's poses every 2.5 s from `t0` s (a path file: rotary axes and times), 600 s in all,
+/// simulated with `truth.toml` into `out`.
+fn slow_k4(dir: &std::path::Path, t0: f64, out: &str) {
     let mut text = String::from("t_s,A,C\n");
     for i in 0..241 {
         let c = 1.5 * i as f64;
         let a = -45.0 * (1.0 - c.to_radians().cos());
-        text += &format!("{},{a},{c}\n", 2.5 * i as f64);
+        text += &format!("{},{a},{c}\n", t0 + 2.5 * i as f64);
     }
     std::fs::write(dir.join("slow-k4.csv"), text).unwrap();
     ok(
@@ -63,7 +64,7 @@ fn slow_k4(dir: &std::path::Path) {
             "--truth",
             "truth.toml",
             "-o",
-            "k4.csv",
+            out,
         ],
     );
 }
@@ -72,7 +73,7 @@ fn slow_k4(dir: &std::path::Path) {
 fn a_rate_and_a_warm_up_are_simulated_identified_validated_and_left_out_of_compensation() {
     let dir = temp_dir("round-trip");
     std::fs::write(dir.join("truth.toml"), TRUTH).unwrap();
-    slow_k4(&dir);
+    slow_k4(&dir, 0.0, "k4.csv");
     let id = [
         "identify",
         "--machine",
@@ -211,6 +212,43 @@ fn a_rate_and_a_warm_up_are_simulated_identified_validated_and_left_out_of_compe
     assert!(
         left.contains(&"EXZ@warmup:40") && left.contains(&"dx0@rate"),
         "{left:?}"
+    );
+}
+
+#[test]
+fn a_warm_up_refuses_a_record_with_samples_before_its_start() {
+    let dir = temp_dir("before-start");
+    // A drift is defined before its start (its line goes on); a warm-up is not.
+    let drift_only: String = TRUTH
+        .lines()
+        .filter(|l| !l.starts_with("EXZ"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(dir.join("truth.toml"), drift_only).unwrap();
+    slow_k4(&dir, -5.0, "early.csv");
+    let args = |terms: &'static str| {
+        [
+            "identify",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--terms",
+            terms,
+            "--data",
+            "early.csv",
+        ]
+    };
+    ok(&dir, &args("dx0@rate"));
+    fails(
+        &dir,
+        &args("EXZ@warmup:40"),
+        1,
+        &[
+            "--data early.csv",
+            "term `EXZ@warmup:40` is a warm-up from time 0",
+            "is at -5 s, before it",
+        ],
     );
 }
 

@@ -27,7 +27,7 @@
 //! from). `time:K` and `exp:TAU` keep their meaning: normalised over the record, and from its
 //! first sample. A `rate` before its start continues its line (its value there is negative
 //! times the rate); a warm-up before its start is not defined, and a record with a sample there
-//! is refused for a `warmup:TAU` term ([`Basis::counts_from_start`]).
+//! is refused for a `warmup:TAU` term ([`Basis::starts_at_zero`]).
 //!
 //! The scanned parameters of `period`, `step`, `exp` and `warmup` are kept as whole numbers of
 //! thousandths (µm, thousandths of mm or degree, ms), so that a basis is `Copy + Eq + Hash +
@@ -256,12 +256,6 @@ impl Basis {
             self,
             Basis::Time(_) | Basis::Exp(_) | Basis::Rate | Basis::Warmup(_)
         )
-    }
-
-    /// `true` for the bases that count from the stated start, time 0 of their clock (`rate`,
-    /// `warmup:TAU`), rather than from the record's samples (see the module documentation).
-    pub fn counts_from_start(self) -> bool {
-        matches!(self, Basis::Rate | Basis::Warmup(_))
     }
 
     /// `true` for a basis that is not defined before its start (`warmup:TAU`): a record with a
@@ -517,10 +511,10 @@ mod tests {
         assert_eq!(v(Basis::Exp(40_000), 1e6), -(-7.0f64 / 40.0).exp_m1());
         assert_eq!(v(Basis::Time(1), 1e6), 0.3);
         for b in [Basis::Rate, Basis::Warmup(1)] {
-            assert!(b.needs_times() && b.of_time() && b.counts_from_start());
+            assert!(b.needs_times() && b.of_time());
         }
         assert!(Basis::Warmup(1).starts_at_zero() && !Basis::Rate.starts_at_zero());
-        assert!(!Basis::Exp(1).counts_from_start() && Basis::Exp(1).of_time());
+        assert!(!Basis::Exp(1).starts_at_zero() && Basis::Exp(1).of_time());
     }
 
     #[test]

@@ -201,6 +201,31 @@ dx0 = { rate = 0.02 }
 EXZ = { "warmup:40" = 3.0 }
 "#;
 
+#[test]
+fn a_truth_with_a_rate_and_a_warm_up_writes_and_reads_back_the_same() {
+    let m = builtin("seed-ac");
+    let t = truth(&m, 0);
+    let text = t.to_toml(&m);
+    assert!(text.contains("dx0 = { \"rate\" = 0.02 }"), "{text}");
+    assert!(text.contains("\"warmup:40\" = 3"), "{text}");
+    let back = Truth::parse("back.toml", &text, &m).unwrap();
+    assert_eq!(back.model, t.model);
+    assert_eq!(back.coefficients, t.coefficients);
+    let units: Vec<(String, &str)> = t
+        .entries(&m)
+        .into_iter()
+        .filter(|e| e.term.basis != Basis::Const)
+        .map(|e| (e.term.spelling(&m), e.unit))
+        .collect();
+    assert_eq!(
+        units,
+        [
+            ("EXZ@warmup:40".to_string(), "um"),
+            ("dx0@rate".to_string(), "um/s")
+        ]
+    );
+}
+
 fn truth(m: &Machine, seed: u64) -> Truth {
     let mut t = Truth::parse("truth.toml", TRUTH, m).unwrap();
     t.seed = seed;

@@ -136,7 +136,8 @@ pub fn read_record(
 }
 
 /// Refuses `record` (read from `path`, given by `flag`) for `model` when a term needs the real
-/// sample times (`velocity`, `exp:TAU`) and the file had no `t_s` column.
+/// sample times (`velocity`, `exp:TAU`, `rate`, `warmup:TAU`) and the file had no `t_s`
+/// column, or when a warm-up (`warmup:TAU`, from `t_s = 0`) has a sample before its start.
 pub fn check_times(
     flag: &str,
     path: &Path,
@@ -144,6 +145,11 @@ pub fn check_times(
     model: &solver::model::Model,
     record: &Record,
 ) -> CliResult<()> {
+    if let Some(t) = model.terms.iter().find(|t| t.basis.starts_at_zero()) {
+        record
+            .check_started(&t.spelling(m))
+            .map_err(|e| CliError::input(format!("{flag} {}: {e}", path.display())))?;
+    }
     match model.terms.iter().find(|t| t.basis.needs_times()) {
         Some(t) if !record.has_times() => Err(CliError::input(format!(
             "{flag} {}: term `{}` needs the real sample times, but the file has no `t_s` column (its samples are only numbered): add the times in s",

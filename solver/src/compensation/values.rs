@@ -12,9 +12,10 @@
 //! **Left out and listed** ([`LeftOut`], with the value): the workpiece set-up errors
 //! `XOW YOW ZOW` (where the ball was placed), the R-test's zero offsets `dx0 dy0 dz0` and
 //! instrument terms `SXX` … `SZY` (the instrument, not the machine), terms on time bases
-//! (`time:K`, `exp:TAU`, `rate`, `warmup:TAU`: a drift is no function of the pose), `velocity` terms (servo lag: the
-//! controller's feed-forward takes it) and `reversal` terms (backlash: it depends on the
-//! direction of approach, and the controller's backlash compensation takes it).
+//! (`time:K`, `exp:TAU`, `rate`, `warmup:TAU`: a drift is no function of the pose),
+//! `velocity` terms (servo lag: the controller's feed-forward takes it) and `reversal` terms
+//! (backlash: it depends on the direction of approach, and the controller's backlash
+//! compensation takes it).
 //!
 //! **Campaigns.** The values are those of an identification of one record or several
 //! ([`CampaignValues`]: a record is a campaign of one). Only the machine's shared values are

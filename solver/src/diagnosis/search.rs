@@ -11,7 +11,9 @@
 
 use super::confounded::{SameFinding, same_span, scaled_size};
 use super::projected::{Model, Projected};
-use super::select::{SPAN_TOLERANCE, Scored, Span, beyond, f_p_value, f_statistic, monte_carlo_p};
+use super::select::{
+    SPAN_TOLERANCE, Scored, Span, beyond, coordinates, f_p_value, f_statistic, monte_carlo_p,
+};
 use super::{Correction, DiagnoseOptions, Stop};
 use crate::fitting::distributions::f_upper_tail;
 use crate::model::Term;
@@ -105,14 +107,16 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             progress.update("selection", k as u64 + 1, total);
             let width = model.directions_into(c, buffer, at);
             if width > 0 {
-                placed.push((c, at, width));
+                // While the candidate's directions are in cache.
+                let on = coordinates(&buffer.columns(at, width), r);
+                placed.push((c, at, width, on));
                 at += width;
             }
         }
         let buffer = &*buffer;
         let scored: Vec<Scored> = placed
-            .iter()
-            .map(|&(c, at, width)| Scored::new(c, buffer.columns(at, width), r))
+            .into_iter()
+            .map(|(c, at, width, on)| Scored::with_coordinates(c, buffer.columns(at, width), on))
             .collect();
         let Some(best) = scored
             .iter()

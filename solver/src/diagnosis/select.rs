@@ -141,12 +141,17 @@ impl<'a> Scored<'a> {
     /// Candidate `index` with directions `directions` (orthonormal, outside the model) against
     /// the model's residual `r`.
     pub fn new(index: usize, directions: DMatrixView<'a, f64>, r: &DVector<f64>) -> Scored<'a> {
-        let coordinates = DVector::from_iterator(
-            directions.ncols(),
-            directions
-                .column_iter()
-                .map(|d| dot(d.as_slice(), r.as_slice())),
-        );
+        let coordinates = coordinates(&directions, r);
+        Scored::with_coordinates(index, directions, coordinates)
+    }
+
+    /// As [`Scored::new`], with the residual's coordinates on the directions already computed
+    /// ([`coordinates`]).
+    pub fn with_coordinates(
+        index: usize,
+        directions: DMatrixView<'a, f64>,
+        coordinates: DVector<f64>,
+    ) -> Scored<'a> {
         Scored {
             index,
             delta_rss: coordinates.norm_squared(),
@@ -154,6 +159,16 @@ impl<'a> Scored<'a> {
             coordinates,
         }
     }
+}
+
+/// `Dᵀ·r` for directions `D` of contiguous columns.
+pub fn coordinates(directions: &DMatrixView<'_, f64>, r: &DVector<f64>) -> DVector<f64> {
+    DVector::from_iterator(
+        directions.ncols(),
+        directions
+            .column_iter()
+            .map(|d| dot(d.as_slice(), r.as_slice())),
+    )
 }
 
 /// What the directions of `a` add beyond those of `b` (two candidates scored on one model with
@@ -260,13 +275,16 @@ fn monte_carlo_p_stopping(
     while done < draws {
         let b = block.min(draws - done);
         let e = DMatrix::from_fn(n, b, |_, _| rng.normal());
-        let proj = all.tr_mul(&e);
-        let in_model = model.q.tr_mul(&e);
+        // The draws as rows: the products below then go to the blocked matrix multiplication
+        // (`tr_mul` would take one dot product per coefficient).
+        let et = e.transpose();
+        let proj = &et * &all;
+        let in_model = &et * &model.q;
         for d in 0..b {
-            let rss = e.column(d).norm_squared() - in_model.column(d).norm_squared();
+            let rss = e.column(d).norm_squared() - in_model.row(d).norm_squared();
             let (mut best, mut best_q, mut off) = (-1.0f64, 1usize, 0usize);
             for &w in &widths {
-                let s: f64 = (0..w).map(|k| proj[(off + k, d)].powi(2)).sum();
+                let s: f64 = (0..w).map(|k| proj[(d, off + k)].powi(2)).sum();
                 if s > best {
                     best = s;
                     best_q = w;

@@ -23,6 +23,7 @@ pub mod campaign_read;
 pub mod campaign_validate;
 pub mod compensate;
 pub mod diagnose;
+pub mod diagnose_records;
 pub mod gains;
 pub mod identify;
 pub mod plan;

@@ -7,7 +7,7 @@
 //! 1. Fit the base model on the fitted records together ([`crate::fitting::campaign`]: the
 //!    machine's errors shared, each record with its own kinematic parameters, its set-up's
 //!    errors and its own zero); find the outliers of every record ([`outliers`]) and leave them
-//!    out; choose the noise model with the held-out residuals ([`noise_model`]).
+//!    out; choose the noise model with the held-out residuals.
 //! 2. Build the candidate dictionary ([`mod@dictionary`]): every term of the topology the model
 //!    lacks, each a group of the campaign's columns (one set for a machine error, one column
 //!    per record for a drift of the R-test's zero, one per set-up for a set-up error).

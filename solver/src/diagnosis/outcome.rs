@@ -38,7 +38,7 @@ pub struct Finding {
     /// Their standard uncertainties (same units).
     pub stds: Vec<Option<f64>>,
     /// Its size in the unit people see (µm, µrad, ms, 1): `|value|`, or the amplitude of a
-    /// pair ([`plausible`]).
+    /// pair ([`super::plausible`]).
     pub size: f64,
     /// The budget of its unit it was compared with.
     pub limit: f64,

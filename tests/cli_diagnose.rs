@@ -668,7 +668,8 @@ fn a_campaign_finds_the_missing_harmonic_and_draws_every_record() {
         &dir,
         &common::words(
             "diagnose --machine seed-ac --model reduced --data k4.csv,k1.csv --validate k2.csv \
-             --harmonics 2 --poly 1 --time 1 --json d.json --model-out ext.toml --plot figs",
+             --harmonics 2 --poly 1 --time 1 --json d.json --model-out ext.toml --plot figs \
+             --report r.html",
         ),
     );
     for s in [
@@ -719,6 +720,16 @@ fn a_campaign_finds_the_missing_harmonic_and_draws_every_record() {
         "k1-spectrum.svg",
     ] {
         assert!(figs.iter().any(|x| x == f), "{f} not in {figs:?}");
+    }
+    // The HTML report renders the campaign: its records, what was refitted, every path.
+    let html = std::fs::read_to_string(dir.join("r.html")).unwrap();
+    for s in [
+        "Records: the machine",
+        "XOW[k2]",
+        "k1.csv (fitted)",
+        "k2.csv (held out)",
+    ] {
+        assert!(html.contains(s), "`{s}` not in the HTML report");
     }
 }
 

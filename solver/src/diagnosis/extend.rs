@@ -1,8 +1,11 @@
 //! The fits of a diagnosis: a model refined against the exact machine on the fitted records,
 //! and the extended model, from which a finding whose refinement does not converge is dropped
-//! (the diagnosis goes on without it; only the base model's fit failing stops it).
+//! (the diagnosis goes on without it; only the base model's fit failing stops it), and the
+//! findings with their values and sizes.
 
-use super::{DiagnoseError, DiagnoseOptions, Dropped};
+use super::profile::Scan;
+use super::search::Chosen;
+use super::{DiagnoseError, DiagnoseOptions, Dropped, Finding, plausible};
 use crate::fitting::IdentifyOptions;
 use crate::fitting::campaign::{Campaign, CampaignIdentification, identify_campaign_refined};
 use crate::fitting::noise::NoiseChoice;
@@ -101,6 +104,120 @@ pub(super) fn fit_dropping(
         }
     }
     Ok((last.unwrap_or_else(|| base_fit.clone()), dropped))
+}
+
+/// What the selection made: the findings in order (`chosen`, indices into `candidates`) and
+/// each one's term with its scanned parameter refined (`refined`).
+pub(super) struct Selected<'a> {
+    /// The machine.
+    pub m: &'a Machine,
+    /// The options (the size budget).
+    pub o: &'a DiagnoseOptions,
+    /// The base model as given.
+    pub base: &'a Model,
+    /// The candidates.
+    pub candidates: &'a [Term],
+    /// The selection's steps.
+    pub chosen: &'a [Chosen],
+    /// Per step, the term and its refined scan.
+    pub refined: &'a [(Term, Option<Scan>)],
+}
+
+/// The extension: the findings kept (with their values in the extended fit), those dropped,
+/// the extended model's fit, and the plausible findings' candidates (their coarse grid values:
+/// the spans the selection saw).
+pub(super) struct Extension {
+    /// The findings, in order.
+    pub findings: Vec<Finding>,
+    /// The findings dropped.
+    pub dropped: Vec<Dropped>,
+    /// The fit of the base model and the plausible findings.
+    pub fit: CampaignIdentification,
+    /// The candidates (indices) of the plausible findings.
+    pub kept: Vec<usize>,
+}
+
+/// Every finding of `s` fitted together by `fit` (a finding whose fit does not converge is
+/// dropped), each compared with the size budget; the implausible ones are then left out of the
+/// extended model, which is fitted again. `base_fit` is the base model's fit.
+///
+/// # Errors
+/// A fit that fails otherwise than by not converging.
+pub(super) fn extend(
+    s: &Selected,
+    fit: &mut dyn FnMut(&Model) -> Result<CampaignIdentification, DiagnoseError>,
+    base_fit: &CampaignIdentification,
+) -> Result<Extension, DiagnoseError> {
+    let Selected {
+        m,
+        o,
+        base,
+        candidates,
+        chosen,
+        refined,
+    } = *s;
+    let terms: Vec<Term> = refined.iter().map(|r| r.0).collect();
+    let (all_fit, mut dropped) = fit_dropping(fit, base, &terms, base_fit)?;
+    let kept_chosen: Vec<usize> = (0..chosen.len())
+        .filter(|&k| !dropped.iter().any(|d| d.term == refined[k].0))
+        .collect();
+    let mut findings: Vec<Finding> = kept_chosen
+        .iter()
+        .map(|&k| {
+            let c = &chosen[k];
+            let (term, scan) = refined[k];
+            let (values, stds) = term_values(&all_fit, &term);
+            let known: Vec<f64> = values.iter().map(|v| v.unwrap_or(0.0)).collect();
+            let (size, limit) = plausible::size_and_limit(m, &term, &known, &o.budget);
+            Finding {
+                term,
+                description: term.describe(m),
+                alternatives: c.alternatives.iter().map(|&a| candidates[a]).collect(),
+                values,
+                stds,
+                size,
+                limit,
+                plausible: size <= limit,
+                scan,
+                explained_fraction: c.fraction,
+                f: c.f,
+                p_value: c.p,
+                correction: c.correction,
+                candidates_tried: c.tried,
+            }
+        })
+        .collect();
+    let plausible: Vec<Term> = findings
+        .iter()
+        .filter(|f| f.plausible)
+        .map(|f| f.term)
+        .collect();
+    let extended_fit = if plausible.len() == findings.len() {
+        all_fit
+    } else {
+        let (e, more) = fit_dropping(fit, base, &plausible, base_fit)?;
+        findings.retain(|f| !more.iter().any(|d| d.term == f.term));
+        dropped.extend(more);
+        for f in findings.iter_mut().filter(|f| f.plausible) {
+            (f.values, f.stds) = term_values(&e, &f.term);
+        }
+        e
+    };
+    let kept = kept_chosen
+        .iter()
+        .filter(|&&k| {
+            findings
+                .iter()
+                .any(|f| f.plausible && f.term == refined[k].0)
+        })
+        .map(|&k| chosen[k].index)
+        .collect();
+    Ok(Extension {
+        findings,
+        dropped,
+        fit: extended_fit,
+        kept,
+    })
 }
 
 #[cfg(test)]

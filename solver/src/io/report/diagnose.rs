@@ -4,6 +4,8 @@
 //! the held-out records. One report for one record or a campaign: a single record is the
 //! campaign of that record. Values in µm and µrad.
 
+pub use super::diagnose_records::{DroppedReport, RecordReport};
+use super::diagnose_records::{notes, records};
 use super::verdict::{
     AdequacyReport, BudgetReport, OutlierReport, UnexplainedReport, adequacy, outliers, unexplained,
 };
@@ -15,7 +17,6 @@ use crate::model::{Basis, Carrier, Term};
 use model_spec::Machine;
 use model_spec::units::UM_PER_MM;
 use serde::{Deserialize, Deserializer, Serialize};
-use std::collections::BTreeMap;
 
 /// The version of the diagnosis report this code writes and reads.
 pub const VERSION: u32 = 2;
@@ -227,46 +228,6 @@ pub struct GainReport {
     pub validation: Vec<GainRow>,
 }
 
-/// One record of the diagnosis, fitted or held out.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RecordReport {
-    /// Its label (names its own parameters: `dx0[k4]`).
-    pub label: String,
-    /// Its file.
-    pub data: String,
-    /// `fitted` or `held out`.
-    pub role: String,
-    /// Its set-up's label (records on one set-up share the ball's set-up errors).
-    pub setup: String,
-    /// Whether its set-up was fitted: always for a fitted record; for a held-out record, whether
-    /// its set-up errors come from the fit (else they were refitted on it).
-    pub setup_fitted: bool,
-    /// Whether its readings were zeroed at the first sample.
-    pub zeroed: bool,
-    /// Its samples, outliers included.
-    pub samples: usize,
-    /// Its kinematic parameters, mm.
-    pub params: BTreeMap<String, f64>,
-    /// Its residual RMS under the base model, µm (outliers left out; a held-out record: the
-    /// prediction's).
-    pub residual_rms_before_um: f64,
-    /// Under the extended model, µm.
-    pub residual_rms_after_um: f64,
-    /// The extended model's parameters refitted on a held-out record (a new set-up's errors,
-    /// its own zero and drifts); absent when none.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub refitted: Vec<String>,
-}
-
-/// A finding left out because the fit of the extended model with it did not converge.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct DroppedReport {
-    /// `NAME@BASIS`.
-    pub term: String,
-    /// The refinement's failure.
-    pub why: String,
-}
-
 /// The diagnosis report.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DiagnosisReport {
@@ -434,67 +395,6 @@ fn gain_row(
             after * UM_PER_MM,
         )?,
     })
-}
-
-/// Every record of `d`: the fitted ones, then the held-out ones, with their files.
-fn records(
-    m: &Machine,
-    d: &Diagnosis,
-    file_of: &dyn Fn(&str) -> String,
-) -> Result<Vec<RecordReport>, NonFinite> {
-    let params = |p: &[f64]| -> BTreeMap<String, f64> {
-        m.symbols
-            .iter()
-            .zip(p)
-            .map(|(s, v)| (s.name.clone(), *v))
-            .collect()
-    };
-    let um =
-        |i: usize, what: &str, v: f64| finite(|| format!("records[{i}].{what}"), v * UM_PER_MM);
-    let mut out = Vec::with_capacity(d.records.len() + d.validation.len());
-    for (i, r) in d.records.iter().enumerate() {
-        out.push(RecordReport {
-            label: r.label.clone(),
-            data: file_of(&r.label),
-            role: "fitted".into(),
-            setup: r.setup.clone(),
-            setup_fitted: true,
-            zeroed: r.zeroed,
-            samples: r.samples,
-            params: params(&r.params),
-            residual_rms_before_um: um(i, "residual_rms_before_um", r.rms.0)?,
-            residual_rms_after_um: um(i, "residual_rms_after_um", r.rms.1)?,
-            refitted: Vec::new(),
-        });
-    }
-    for h in &d.validation {
-        let i = out.len();
-        out.push(RecordReport {
-            label: h.name.clone(),
-            data: file_of(&h.name),
-            role: "held out".into(),
-            setup: h.setup.clone(),
-            setup_fitted: h.setup_fitted,
-            zeroed: h.zeroed,
-            samples: h.samples,
-            params: params(&h.params),
-            residual_rms_before_um: um(i, "residual_rms_before_um", h.before_rms)?,
-            residual_rms_after_um: um(i, "residual_rms_after_um", h.after_rms)?,
-            refitted: h.refitted.clone(),
-        });
-    }
-    Ok(out)
-}
-
-/// What a reader should know of how `d` was made when several records were fitted.
-fn notes(d: &Diagnosis) -> Vec<String> {
-    if d.records.len() < 2 {
-        return Vec::new();
-    }
-    vec![
-        "a candidate's F-test counts every column the campaign gives it (one per record for a drift of the R-test's zero, one per set-up for a set-up error)".into(),
-        "the lack-of-fit test fits each fitted record's draws with that record's own columns alone, and draws the held-out records' noise without the fit's uncertainty: it errs towards `not down to the noise` on the fitted records".into(),
-    ]
 }
 
 impl DiagnosisReport {

@@ -21,6 +21,7 @@
 
 pub mod compensate;
 pub mod diagnose;
+pub mod diagnose_records;
 pub mod fit_summary;
 pub mod gains;
 pub mod identify;

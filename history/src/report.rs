@@ -291,14 +291,16 @@ impl TrendReport {
 
     /// The rows as CSV: a `# ` comment saying what the series is, then
     /// `check,measured_at,value_U,std_U,change_U,change_z,slope_U_per_day,slope_std_U_per_day,
-    /// slope_t,slope_dof,tolerance_flag,baseline_flag,trend_flag` (`U` the unit; empty where a
-    /// number does not exist; flags 0 or 1).
+    /// slope_t,slope_dof,tolerance_flag,baseline_flag,trend_flag` (`U` the unit, `/` written
+    /// `_per_`: `value_um_per_s`; empty where a number does not exist; flags 0 or 1).
     pub fn csv(&self) -> String {
         let s = &self.series;
         let a = &self.assessment;
         let suffix = match s.unit.as_str() {
             "1" => String::new(),
-            u => format!("_{u}"),
+            // A rate's unit is written with `_per_` for `/` (`value_um_per_s`): a CSV header
+            // name without a slash.
+            u => format!("_{}", u.replace('/', "_per_")),
         };
         let num = |x: f64| format_scaled(x, 0);
         let opt = |x: Option<f64>| x.map_or_else(String::new, num);

@@ -542,3 +542,28 @@ fn the_real_pipeline_flags_a_drifting_location_error() {
     let early = firsts.iter().filter(|&&(b, t)| b < 8 || t < 8).count();
     assert!(early <= 2, "{firsts:?}");
 }
+
+/// A drift's rate (`um/s`) names its CSV columns with `_per_` for the slash, so that every
+/// header name is a plain identifier; a fraction (`1`) has no suffix.
+#[test]
+fn the_csv_header_names_a_rate_unit_without_a_slash() {
+    let header = |unit: &str| {
+        let mut s = series(&[(4.0, 0.3), (4.2, 0.3), (3.9, 0.3)]);
+        s.head.unit = unit.into();
+        let a = assess(&s, &Options::default()).unwrap();
+        let csv = history::report::TrendReport::new("h.db", &s, a, None).csv();
+        csv.lines().nth(1).unwrap().to_string()
+    };
+    let rate = header("um/s");
+    assert!(
+        rate.starts_with("check,measured_at,value_um_per_s,std_um_per_s,change_um_per_s,"),
+        "{rate}"
+    );
+    assert!(rate.contains(",slope_um_per_s_per_day,"), "{rate}");
+    assert!(!rate.contains('/'), "{rate}");
+    let fraction = header("1");
+    assert!(
+        fraction.starts_with("check,measured_at,value,std,change,"),
+        "{fraction}"
+    );
+}

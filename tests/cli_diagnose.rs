@@ -113,6 +113,13 @@ fn finds_the_demo_truths_ecc_twice_per_revolution_and_halves_the_held_out_residu
     // The JSON: the documented fields, values in µrad.
     let j = read_json(&dir.join("d.json"));
     assert_eq!(j["base_model"], "reduced");
+    // The size budget, rates included (µm/s, µrad/s), at its defaults.
+    let b = &j["budget"];
+    for (k, v) in [("um", 100.0), ("urad", 200.0), ("ms", 20.0), ("1", 0.05)] {
+        assert_eq!(b[k].as_f64(), Some(v), "budget {k}: {b}");
+    }
+    assert_eq!(b["um/s"].as_f64(), Some(0.5), "{b}");
+    assert_eq!(b["urad/s"].as_f64(), Some(1.0), "{b}");
     let findings = j["findings"].as_array().expect("findings");
     assert_eq!(findings.len(), 1, "{findings:?}");
     let f = &findings[0];

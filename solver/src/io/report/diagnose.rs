@@ -585,6 +585,8 @@ impl DiagnosisReport {
                 urad: o.budget.urad,
                 ms: o.budget.ms,
                 fraction: o.budget.fraction,
+                um_per_s: o.budget.um_per_s,
+                urad_per_s: o.budget.urad_per_s,
             },
             recommended: d.recommendation.recommended,
             recommendation: d.recommendation_named(&source.held_out).reasons,

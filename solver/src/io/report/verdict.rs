@@ -41,6 +41,21 @@ pub struct BudgetReport {
     /// Instrument gain and cross-talk, a fraction.
     #[serde(rename = "1")]
     pub fraction: f64,
+    /// Rates of translational errors and offsets (`rate`), µm/s (a report written before
+    /// rates were budgeted reads with the default).
+    #[serde(rename = "um/s", default = "default_um_per_s")]
+    pub um_per_s: f64,
+    /// Rates of angular errors (`rate`), µrad/s (the default when the report has none).
+    #[serde(rename = "urad/s", default = "default_urad_per_s")]
+    pub urad_per_s: f64,
+}
+
+fn default_um_per_s() -> f64 {
+    crate::diagnosis::plausible::Budget::default().um_per_s
+}
+
+fn default_urad_per_s() -> f64 {
+    crate::diagnosis::plausible::Budget::default().urad_per_s
 }
 
 /// The lack-of-fit test on one record.

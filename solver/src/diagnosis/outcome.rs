@@ -45,8 +45,8 @@ pub struct Finding {
     /// `size ≤ limit`: a plausible cause, in the extended model. An implausible finding fits
     /// the data but is not named as a cause and is left out of the extended model.
     pub plausible: bool,
-    /// For `period:P`, `step:V`, `exp:TAU`: the refined parameter and its 95 % interval
-    /// ([`profile`]); the values' standard uncertainties are conditional on it.
+    /// For `period:P`, `step:V`, `exp:TAU`, `warmup:TAU`: the refined parameter and its 95 %
+    /// interval ([`profile`]); the values' standard uncertainties are conditional on it.
     pub scan: Option<profile::Scan>,
     /// Share of the base model's residual sum of squares it explains beyond all the other
     /// findings (its step in the final exchange pass).

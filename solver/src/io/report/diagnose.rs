@@ -122,8 +122,9 @@ pub struct FindingReport {
     /// `size ≤ limit`: named as a cause and in the extended model. `false`: it fits, but is
     /// implausible, and is left out of the extended model.
     pub plausible: bool,
-    /// For `period:P`, `step:V`, `exp:TAU`: the refined parameter and its 95 % interval from
-    /// the profile of the fit (the values' stds are conditional on it); absent otherwise.
+    /// For `period:P`, `step:V`, `exp:TAU`, `warmup:TAU`: the refined parameter and its 95 %
+    /// interval from the profile of the fit (the values' stds are conditional on it); absent
+    /// otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scan: Option<ScanReport>,
     /// What the finding is: `cause` (plausible, and the extended model is recommended: the

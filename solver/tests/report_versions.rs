@@ -186,4 +186,7 @@ fn the_report_type_reads_either_version_and_gives_a_record_its_record() {
     assert!(e.to_string().contains("n.json: field `version`: 3"), "{e}");
     let e = parse_identification("n.json", &newer, &builtin("seed-ac")).unwrap_err();
     assert!(e.to_string().contains("n.json: field `version`"), "{e}");
+    let zero = fixture("identify-z4-v2.json").replacen("\"version\": 2", "\"version\": 0", 1);
+    let e = IdentificationReport::from_json("z.json", &zero).unwrap_err();
+    assert!(e.to_string().contains("z.json: field `version`: 0"), "{e}");
 }

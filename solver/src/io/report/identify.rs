@@ -45,7 +45,7 @@
 mod build;
 
 pub use super::fit_summary::{constraint_text, poly_stroke};
-use super::read::{ReportError, json_error};
+use super::read::{ReportError, versioned};
 use super::{NonFinite, Ordered};
 use crate::fitting::hmatrix::Backend;
 use serde::{Deserialize, Serialize};
@@ -377,19 +377,8 @@ impl IdentificationReport {
     /// [`ReportError::Json`] for text that is not JSON, [`ReportError::Field`] for a missing or
     /// malformed field or a version this rtest does not know.
     pub fn from_json(file: &str, text: &str) -> Result<IdentificationReport, ReportError> {
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut r: IdentificationReport =
-            serde_json::from_str(text).map_err(|e| json_error(file, text, &e))?;
-        if r.version > REPORT_VERSION || r.version == 0 {
-            return Err(ReportError::Field {
-                file: file.to_string(),
-                field: "version".into(),
-                message: format!(
-                    "{}: this rtest reads versions 1 to {REPORT_VERSION} (a newer rtest wrote it?)",
-                    r.version
-                ),
-            });
-        }
+            versioned(file, text, |r: &IdentificationReport| r.version)?;
         if r.records.is_empty() {
             let data = r.data.clone().unwrap_or_default();
             let label = crate::io::report::read::single_label(r.data.as_deref());

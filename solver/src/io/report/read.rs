@@ -43,7 +43,7 @@
 
 mod fields;
 
-pub(crate) use fields::{Columns, Reader, json_error};
+pub(crate) use fields::{Columns, Reader, json_error, versioned};
 
 use crate::fitting::campaign::validate::single_columns;
 use crate::fitting::campaign::{CampaignValues, Layout, Owner, RecordSpec};

@@ -30,7 +30,7 @@
 //! both.
 
 use super::identify::{CAMPAIGN_KIND, REPORT_VERSION};
-use super::read::{ReportError, json_error};
+use super::read::{ReportError, versioned};
 use super::{NonFinite, Ordered, finite, finite_opt};
 use crate::fitting::campaign::CampaignValidation;
 use crate::fitting::validate::Stats;
@@ -304,19 +304,7 @@ impl ValidationReport {
     /// [`ReportError::Json`] for text that is not JSON, [`ReportError::Field`] for a missing or
     /// malformed field or a version this rtest does not know.
     pub fn from_json(file: &str, text: &str) -> Result<ValidationReport, ReportError> {
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let mut r: ValidationReport =
-            serde_json::from_str(text).map_err(|e| json_error(file, text, &e))?;
-        if r.version > REPORT_VERSION || r.version == 0 {
-            return Err(ReportError::Field {
-                file: file.to_string(),
-                field: "version".into(),
-                message: format!(
-                    "{}: this rtest reads versions 1 to {REPORT_VERSION} (a newer rtest wrote it?)",
-                    r.version
-                ),
-            });
-        }
+        let mut r: ValidationReport = versioned(file, text, |r: &ValidationReport| r.version)?;
         if r.records.is_empty() {
             let data = r.data.clone().unwrap_or_default();
             r.records.push(RecordValidationReport {

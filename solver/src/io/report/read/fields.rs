@@ -48,6 +48,29 @@ pub(crate) fn json_error(file: &str, text: &str, e: &serde_json::Error) -> Repor
     }
 }
 
+/// A report of type `T` parsed from its JSON `text` (`file` names it in messages; a byte-order
+/// mark is skipped), refused when its version (`version` of it) is not 1 to
+/// [`crate::io::report::identify::REPORT_VERSION`].
+pub(crate) fn versioned<T: serde::de::DeserializeOwned>(
+    file: &str,
+    text: &str,
+    version: impl Fn(&T) -> u32,
+) -> Result<T, ReportError> {
+    use crate::io::report::identify::REPORT_VERSION;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let r: T = serde_json::from_str(text).map_err(|e| json_error(file, text, &e))?;
+    match version(&r) {
+        1..=REPORT_VERSION => Ok(r),
+        v => Err(ReportError::Field {
+            file: file.to_string(),
+            field: "version".into(),
+            message: format!(
+                "{v}: this rtest reads versions 1 to {REPORT_VERSION} (a newer rtest wrote it?)"
+            ),
+        }),
+    }
+}
+
 /// Reads fields of one report, naming its file in errors.
 pub(crate) struct Reader<'a> {
     /// The file, as named in messages.

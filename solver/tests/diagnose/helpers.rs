@@ -189,6 +189,54 @@ pub fn run(m: &Machine, base: &Model, recs: &[(String, Record)], o: &DiagnoseOpt
     diagnose(m, base, &fitted, &held, o, &Unwatched).expect("diagnosis")
 }
 
+/// The sample of K4 at which a knocked ball moves ([`knocked`]).
+pub const KNOCK_AT: usize = 150;
+
+/// `truth` with the term `name` (a ball set-up error `XOW`, `YOW`, `ZOW` of it) moved by `um`
+/// µm.
+pub fn moved(m: &Machine, truth: &Truth, name: &str, um: f64) -> Truth {
+    let t = term(m, name);
+    let mut out = truth.clone();
+    let mut at = 0;
+    for tt in &truth.model.terms {
+        if *tt == t {
+            out.coefficients[at] += um * 1e-3;
+            return out;
+        }
+        at += tt.basis.width();
+    }
+    panic!("{name} is not in the truth");
+}
+
+/// K4, K1, K2 of `truth` (noise seeds `seed`, `seed + 1`, `seed + 2`), K4 with the ball
+/// knocked by `um` µm along the set-up error `name` from sample [`KNOCK_AT`] on (the same noise
+/// before and after); K1 and K2 on the set-up as it was at the start of K4.
+pub fn knocked(
+    m: &Machine,
+    truth: &Truth,
+    name: &str,
+    um: f64,
+    seed: u64,
+) -> Vec<(String, Record)> {
+    let mut recs: Vec<(String, Record)> = ["K4", "K1", "K2"]
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let mut t = truth.clone();
+            t.seed = seed + k as u64;
+            (
+                p.to_string(),
+                simulate(m, &t, &path(m, p)).expect("simulate"),
+            )
+        })
+        .collect();
+    let mut after = moved(m, truth, name, um);
+    after.seed = seed;
+    let shifted = simulate(m, &after, &path(m, "K4")).expect("simulate");
+    recs[0].1.measured[KNOCK_AT..].copy_from_slice(&shifted.measured[KNOCK_AT..]);
+    recs
+}
+
 /// Pooled residual RMS over the held-out records, before and after (µm): the square root of the
 /// sample-weighted mean of the per-record mean squares.
 pub fn held_out_rms(d: &Diagnosis, recs: &[(String, Record)]) -> (f64, f64) {

@@ -5,6 +5,7 @@
 
 use model_spec::Machine;
 use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose, one_record};
+use solver::fitting::campaign::{Campaign, CampaignRecord};
 use solver::io::progress::Unwatched;
 use solver::model::{Model, Term};
 use solver::record::Record;
@@ -235,6 +236,29 @@ pub fn knocked(
     let shifted = simulate(m, &after, &path(m, "K4")).expect("simulate");
     recs[0].1.measured[KNOCK_AT..].copy_from_slice(&shifted.measured[KNOCK_AT..]);
     recs
+}
+
+/// The diagnosis of `base` on the first `fitted` records together (one set-up, the first's
+/// label), the others held out on it.
+pub fn run_fitted(
+    m: &Machine,
+    base: &Model,
+    recs: &[(String, Record)],
+    fitted: usize,
+    o: &DiagnoseOptions,
+) -> Diagnosis {
+    let campaign = |rs: &[(String, Record)]| {
+        Campaign::new(
+            rs.iter()
+                .map(|(label, r)| {
+                    CampaignRecord::new(label, r.clone(), m.default_parameters(), &recs[0].0, false)
+                })
+                .collect(),
+        )
+        .expect("campaign")
+    };
+    let (fit, held) = (campaign(&recs[..fitted]), campaign(&recs[fitted..]));
+    diagnose(m, base, &fit, &held, o, &Unwatched).expect("diagnosis")
 }
 
 /// Pooled residual RMS over the held-out records, before and after (µm): the square root of the

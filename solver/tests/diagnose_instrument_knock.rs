@@ -113,9 +113,11 @@ fn instrument(name: &str, value: f64, seed: u64, fitted: usize) -> Diagnosis {
     let recs = records(&m, &truth, &["K4", "K1", "K2"], seed);
     let d = run_fitted(&m, &base_model(&m, &[]), &recs, fitted, &options());
     let status = statuses(&m, &d);
+    let value_of = |f: &solver::diagnosis::Finding| format!("{:?} ± {:?}", f.values[0], f.stds[0]);
     let what = format!(
-        "{name} {value} seed {seed}: {}; status {status:?}",
-        summary(&m, &d, &recs[fitted - 1..])
+        "{name} {value} seed {seed}: {}; status {status:?}; first {}",
+        summary(&m, &d, &recs[fitted - 1..]),
+        d.findings.first().map(value_of).unwrap_or_default()
     );
     println!("{what}");
     let first = d.findings.first().unwrap_or_else(|| panic!("{what}"));

@@ -24,6 +24,7 @@ use helpers::*;
 use model_spec::Machine;
 use nalgebra::DMatrix;
 use solver::diagnosis::Diagnosis;
+use solver::diagnosis::dictionary::scanned;
 use solver::diagnosis::unexplained::Shape;
 use solver::fitting::hmatrix::h_matrix_auto;
 use solver::io::report::diagnose::{DiagnosisReport, DiagnosisSource};
@@ -262,9 +263,31 @@ fn knock(name: &str, seed: u64) {
     );
     println!("{what}");
     assert!(status.iter().all(|s| s != "cause"), "{what}");
+    // No finding twice: not the same term, nor two steps of one error within one spacing of its
+    // grid on K4 (the same jump).
+    let grid = scanned(
+        &m,
+        &base_model(&m, &[]).terms,
+        &recs[0].1,
+        &options().dictionary,
+    );
+    let spacing = |t: &Term| {
+        let mut v: Vec<f64> = grid
+            .iter()
+            .filter(|g| g.effect == t.effect)
+            .filter_map(|g| g.basis.step_at())
+            .collect();
+        v.sort_by(f64::total_cmp);
+        (v[v.len() - 1] - v[0]) / (v.len() - 1) as f64
+    };
     for (i, a) in d.findings.iter().enumerate() {
         for b in &d.findings[..i] {
             assert_ne!(a.term, b.term, "{what}");
+            if let (Some(u), Some(v)) = (a.term.basis.step_at(), b.term.basis.step_at())
+                && a.term.effect == b.term.effect
+            {
+                assert!((u - v).abs() > spacing(&a.term), "{what}");
+            }
         }
     }
     let at = jumps(&d);

@@ -3,26 +3,27 @@
 //!
 //! Such a jump is no term of the dictionary (a term holds over the whole record), and the base
 //! fit absorbs much of it into the set-up and location errors, so that what the base model
-//! leaves is neither a step nor small: on K4 a 3 µm knock of the ball along x leaves 0.93 µm
+//! leaves is neither a step nor large: on K4 a 3 µm knock of the ball along x leaves 0.93 µm
 //! RMS in x, which follows C and time smoothly, under twice the noise. It is looked for as a
-//! whole: for every sample k between the 5 % and 95 % quantiles of a fitted record, the columns
-//! of the ball's set-up errors (`XOW YOW ZOW`) and of the zero offsets (`dx0 dy0 dz0`) on that
+//! whole: for a sample k between the 5 % and 95 % quantiles of a fitted record, the columns of
+//! the ball's set-up errors (`XOW YOW ZOW`) and of the zero offsets (`dx0 dy0 dz0`) on that
 //! record from sample k on (zero before), whitened as the selection's columns, with the base
-//! model projected out, are fitted to the base model's residual. Only where the base model
-//! leaves more than the noise: the whitened residual sum of squares beyond its degrees of
-//! freedom by more than [`EXCESS`] standard deviations (`√(2·dof)`); a 5 % gain error of the x
-//! sensor, which the base model takes but for 0.045 µm RMS on K4, leaves an excess of 0.65 of
-//! them, and a position where a jump happens to explain part of that is no jump. The best k is
-//! kept when
+//! model projected out, are fitted to the base model's residual; k runs over a grid of at most
+//! [`COARSE`] positions per record, then over every position around the grid's best.
 //!
-//! - its F-test against the base model (raw p-value times the number of positions tried,
-//!   Bonferroni) is below α, and
-//! - it explains at least [`SHARE`] of the base residual's excess over the noise (the whitened
-//!   residual sum of squares minus its degrees of freedom): a smooth misfit is explained in part
-//!   by a jump anywhere, a jump nearly entirely.
+//! Only where the base model leaves more than the noise: the whitened residual sum of squares
+//! beyond its degrees of freedom by more than [`EXCESS`] standard deviations (`√(2·dof)`). (A 5 %
+//! gain error of the x sensor, which the base model takes but for 0.045 µm RMS on K4, leaves an
+//! excess of 0.65 of them, and a position where a jump happens to explain part of it is no
+//! jump.) The best k is kept when
+//!
+//! - its F-test against the base model, its raw p-value times the number of positions within
+//!   the quantiles of every record (Bonferroni), is below α, and
+//! - it explains at least [`SHARE`] of the base residual's excess over the noise: a smooth
+//!   misfit is explained in part by a jump anywhere, a jump nearly entirely.
 //!
 //! The jump is described in every direction it moves by at least a quarter of the largest: a
-//! step in time at the instant between sample k − 1 and sample k, `sample` k.
+//! step in time at the instant between samples k − 1 and k, `sample` k.
 
 use super::DiagnoseError;
 use super::columns::Columns;
@@ -38,6 +39,10 @@ use nalgebra::{DMatrix, DVector};
 
 /// The share of the base residual's excess over the noise a jump must explain.
 pub const SHARE: f64 = 0.75;
+
+/// The positions of a record's coarse scan, at most (every position around the best of them is
+/// then tried).
+pub const COARSE: usize = 120;
 
 /// A jump is looked for only where the base residual's excess over the noise is more than this
 /// many standard deviations of its sum of squares under the noise (`√(2·dof)`, whitened).
@@ -85,49 +90,73 @@ pub(super) fn find(
     if excess <= EXCESS * (2.0 * dof).sqrt() {
         return Ok(Vec::new());
     }
-    // Every record's positions, then the best over all of them.
+    // The raw columns of a jump at sample k of record ri (its rows from `first` on).
+    let raw_columns = |ri: usize, first: usize, k: usize| -> DMatrix<f64> {
+        let own = &design.layout.records[ri].columns;
+        let rows = 3 * c.records[ri].record.samples.len();
+        let mut j = DMatrix::zeros(n, own.len());
+        for (a, &col) in own.iter().enumerate() {
+            for row in first + 3 * k..first + rows {
+                j[(row, a)] = design.h[(row, col)];
+            }
+        }
+        j
+    };
+    // The raw p-value of a jump at sample k of record ri.
+    let p_of = |ri: usize, first: usize, k: usize| -> Result<f64, DiagnoseError> {
+        let mut j = raw_columns(ri, first, k);
+        weights.fitted_matrix(&mut j)?;
+        whitening.whiten_matrix(&design.rows, &mut j)?;
+        let d = base.new_directions(&j);
+        let gain = (d.transpose() * &r).norm_squared();
+        Ok(match f_statistic(gain, rss, d.ncols(), n, base.rank()) {
+            Some(f) if d.ncols() > 0 => f_p_value(f, d.ncols(), n, base.rank()),
+            _ => 1.0,
+        })
+    };
+    // Every record's positions, on a coarse grid of at most [`COARSE`] and then every position
+    // around its best, and the best over all of them; the Bonferroni factor counts every
+    // position within the quantiles.
     let mut tried = 0usize;
-    let mut best: Option<(f64, usize, usize, DMatrix<f64>)> = None;
+    let mut best: Option<(f64, usize, usize, usize)> = None;
     let mut first = 0;
     for (ri, rec) in c.records.iter().enumerate() {
         let samples = rec.record.samples.len();
-        let rows = 3 * samples;
-        let own = &design.layout.records[ri].columns;
-        let edge = (samples / 20).max(1);
         if samples >= 20 {
-            for k in edge..samples - edge {
-                let mut j = DMatrix::zeros(n, own.len());
-                for (a, &col) in own.iter().enumerate() {
-                    for row in first + 3 * k..first + rows {
-                        j[(row, a)] = design.h[(row, col)];
-                    }
-                }
-                let raw = j.clone();
-                weights.fitted_matrix(&mut j)?;
-                whitening.whiten_matrix(&design.rows, &mut j)?;
-                let d = base.new_directions(&j);
-                if d.ncols() == 0 {
-                    continue;
-                }
-                tried += 1;
-                let gain = (d.transpose() * &r).norm_squared();
-                let Some(f) = f_statistic(gain, rss, d.ncols(), n, base.rank()) else {
-                    continue;
-                };
-                let p = f_p_value(f, d.ncols(), n, base.rank());
-                if best.as_ref().is_none_or(|b| p < b.0) {
-                    best = Some((p, ri, k, raw));
+            let edge = (samples / 20).max(1);
+            let (lo, hi) = (edge, samples - edge);
+            tried += hi - lo;
+            let stride = (hi - lo).div_ceil(COARSE).max(1);
+            let mut local: Option<(f64, usize)> = None;
+            for k in (lo..hi).step_by(stride) {
+                let p = p_of(ri, first, k)?;
+                if local.is_none_or(|b| p < b.0) {
+                    local = Some((p, k));
                 }
             }
+            if let Some((_, at)) = local {
+                for k in (at + 1).saturating_sub(stride).max(lo)..(at + stride).min(hi) {
+                    let p = p_of(ri, first, k)?;
+                    if local.is_none_or(|b| p < b.0) {
+                        local = Some((p, k));
+                    }
+                }
+            }
+            if let Some((p, k)) = local
+                && best.is_none_or(|b| p < b.0)
+            {
+                best = Some((p, ri, first, k));
+            }
         }
-        first += rows;
+        first += 3 * samples;
     }
-    let Some((p, ri, k, raw)) = best else {
+    let Some((p, ri, first, k)) = best else {
         return Ok(Vec::new());
     };
     if p * tried as f64 >= alpha {
         return Ok(Vec::new());
     }
+    let raw = raw_columns(ri, first, k);
     // The jump's coefficients: least squares of the base residual on its columns with the base
     // projected out; what it explains.
     let mut j = raw.clone();

@@ -22,8 +22,9 @@
 //! - it explains at least [`SHARE`] of the base residual's excess over the noise: a smooth
 //!   misfit is explained in part by a jump anywhere, a jump nearly entirely.
 //!
-//! The jump is described in every direction it moves by at least a quarter of the largest: a
-//! step in time at the instant between samples k − 1 and k, `sample` k.
+//! The most significant jump over the fitted records is described, in every direction it moves
+//! by at least a quarter of the largest: a step in time at the instant between samples k − 1
+//! and k, `sample` k.
 
 use super::DiagnoseError;
 use super::columns::Columns;
@@ -61,10 +62,11 @@ fn jumping(m: &Machine) -> Vec<Term> {
         .collect()
 }
 
-/// The jumps in time found on the fitted records of `c` (outliers left out, as the selection's
-/// columns `cols` were built), whitened by `weights` and `whitening`, at level `alpha`: per
-/// record with one, its description in each direction it moves (see the module documentation).
-/// `base_residual` gives each record's base residual per sample (mm).
+/// The jump in time found on the fitted records of `c` (outliers left out, as the selection's
+/// columns `cols` were built), whitened by `weights` and `whitening`, at level `alpha`: the most
+/// significant one over the records, described in each direction it moves (see the module
+/// documentation); none when there is none. `base_residual` gives each record's base residual
+/// per sample (mm).
 ///
 /// # Errors
 /// A design that cannot be built; columns that do not whiten.

@@ -18,56 +18,6 @@ use model_spec::basis::Basis;
 use solver::diagnosis::Diagnosis;
 use solver::diagnosis::dictionary::scanned;
 use solver::record::Record;
-use solver::simulation::readings::simulate;
-use solver::simulation::truth::Truth;
-
-/// The sample of K4 at which the ball is knocked.
-const KNOCK_AT: usize = 150;
-
-/// `truth` with the ball set-up error `name` (`XOW`, `YOW`, `ZOW`, a term of it) moved by
-/// `um` µm.
-fn moved(m: &model_spec::Machine, truth: &Truth, name: &str, um: f64) -> Truth {
-    let t = term(m, name);
-    let mut out = truth.clone();
-    let mut at = 0;
-    for tt in &truth.model.terms {
-        if *tt == t {
-            out.coefficients[at] += um * 1e-3;
-            return out;
-        }
-        at += tt.basis.width();
-    }
-    panic!("{name} is not in the truth");
-}
-
-/// K4, K1, K2 of `truth` (noise seeds `seed`, `seed + 1`, `seed + 2`), K4 with the ball
-/// knocked by `um` µm along the set-up error `name` from sample [`KNOCK_AT`] on: the same noise
-/// before and after.
-fn knocked(
-    m: &model_spec::Machine,
-    truth: &Truth,
-    name: &str,
-    um: f64,
-    seed: u64,
-) -> Vec<(String, Record)> {
-    let mut recs: Vec<(String, Record)> = ["K4", "K1", "K2"]
-        .iter()
-        .enumerate()
-        .map(|(k, p)| {
-            let mut t = truth.clone();
-            t.seed = seed + k as u64;
-            (
-                p.to_string(),
-                simulate(m, &t, &path(m, p)).expect("simulate"),
-            )
-        })
-        .collect();
-    let mut after = moved(m, truth, name, um);
-    after.seed = seed;
-    let shifted = simulate(m, &after, &path(m, "K4")).expect("simulate");
-    recs[0].1.measured[KNOCK_AT..].copy_from_slice(&shifted.measured[KNOCK_AT..]);
-    recs
-}
 
 /// The spacing of the `step:V` grid of C on `record` (degrees): the dictionary's.
 fn c_step_spacing(m: &model_spec::Machine, record: &Record) -> f64 {

@@ -162,7 +162,7 @@ pub struct DiagnoseArgs {
     #[arg(long, value_name = "T", default_value = "2",
           value_parser = clap::value_parser!(u32).range(0..=12))]
     time: u32,
-    /// Largest plausible size of a finding, per unit (`um=100,urad=200,ms=20,1=0.05,um/s=0.5,
+    /// Largest plausible size of a finding, per unit (`um=100,urad=200,ms=20,1=0.1,um/s=0.5,
     /// urad/s=1`; any subset, the others keep these defaults): a larger finding fits, but is
     /// not named as a cause and is left out of the extended model.
     #[arg(long, value_name = "UNIT=SIZE,…")]

@@ -16,6 +16,7 @@
 use super::adequacy::{self, Adequacy};
 use super::columns::Columns;
 use super::heldout::HeldOut;
+use super::jump;
 use super::unexplained::{self, Unexplained};
 use super::weights::Weights;
 use super::{DiagnoseError, DiagnoseOptions, outliers};
@@ -227,14 +228,31 @@ pub(super) fn test(
             );
             let mut described = unexplained::describe_failures(m, a, &records, o.alpha);
             // The findings may have absorbed on the fitted records what the held-out records
-            // then mispredict: the base model's residual there is described where it is.
+            // then mispredict: the base model's residual there is described where it is, as a
+            // jump in time of the set-up or the zero where it is one ([`jump`]).
+            let jumps = if a.consistent_with_noise {
+                Vec::new()
+            } else {
+                jump::find(m, cleaned, cols, weights, whitening, o.alpha, &|r| {
+                    base_fit.record_residual(r)
+                })?
+            };
             let base: Vec<(&str, &Record, Vec<[f64; 3]>)> = cleaned
                 .records
                 .iter()
                 .enumerate()
                 .map(|(r, rec)| (rec.label.as_str(), &rec.record, base_fit.record_residual(r)))
                 .collect();
-            described.extend(unexplained::describe_base(m, a, &base));
+            let rest: Vec<Unexplained> = unexplained::describe_base(m, a, &base)
+                .into_iter()
+                .filter(|u| {
+                    !jumps
+                        .iter()
+                        .any(|j| j.data == u.data && j.direction == u.direction)
+                })
+                .collect();
+            described.extend(jumps);
+            described.extend(rest);
             described
         }
         Err(_) => Vec::new(),

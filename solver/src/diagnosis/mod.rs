@@ -38,6 +38,7 @@ pub mod figures;
 pub mod harmonic;
 pub mod heldout;
 pub mod hidden;
+mod jump;
 mod lack_of_fit;
 mod noise_model;
 mod options;

@@ -20,7 +20,9 @@ pub struct Budget {
     pub urad: f64,
     /// Servo lag τ of a velocity term, ms (default 20).
     pub ms: f64,
-    /// Instrument gain and cross-talk, a fraction (default 0.05: 5 %).
+    /// Instrument gain and cross-talk, a fraction (default 0.1: a gain 10 % off, or a sensor 6°
+    /// off its axis; a realistic 5 % must lie well inside, since its estimate scatters around
+    /// it).
     pub fraction: f64,
     /// Rates of translational errors and sensor offsets (`rate`), µm/s (default 0.5: 30 µm
     /// per minute; thermal drifts are a few µm per minute at most).
@@ -35,7 +37,7 @@ impl Default for Budget {
             um: 100.0,
             urad: 200.0,
             ms: 20.0,
-            fraction: 0.05,
+            fraction: 0.1,
             um_per_s: 0.5,
             urad_per_s: 1.0,
         }
@@ -43,7 +45,7 @@ impl Default for Budget {
 }
 
 impl Budget {
-    /// Parses `um=100,urad=200,ms=20,1=0.05,um/s=0.5,urad/s=1` (any subset; the others keep
+    /// Parses `um=100,urad=200,ms=20,1=0.1,um/s=0.5,urad/s=1` (any subset; the others keep
     /// their defaults).
     ///
     /// # Errors
@@ -113,8 +115,8 @@ mod tests {
     #[test]
     fn parse_budgets() {
         assert_eq!(Budget::parse("").unwrap(), Budget::default());
-        let b = Budget::parse("um=50, urad=100,1=0.1").unwrap();
-        assert_eq!((b.um, b.urad, b.ms, b.fraction), (50.0, 100.0, 20.0, 0.1));
+        let b = Budget::parse("um=50, urad=100,1=0.2").unwrap();
+        assert_eq!((b.um, b.urad, b.ms, b.fraction), (50.0, 100.0, 20.0, 0.2));
         assert_eq!(b.limit("urad"), 100.0);
         assert!(Budget::parse("mm=1").unwrap_err().contains("unknown unit"));
         assert!(Budget::parse("um=-1").unwrap_err().contains("positive"));

@@ -5,6 +5,7 @@
 
 use model_spec::Machine;
 use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose, one_record};
+use solver::fitting::campaign::{Campaign, CampaignRecord};
 use solver::io::progress::Unwatched;
 use solver::model::{Model, Term};
 use solver::record::Record;
@@ -187,6 +188,77 @@ pub fn run(m: &Machine, base: &Model, recs: &[(String, Record)], o: &DiagnoseOpt
     )
     .expect("campaigns");
     diagnose(m, base, &fitted, &held, o, &Unwatched).expect("diagnosis")
+}
+
+/// The sample of K4 at which a knocked ball moves ([`knocked`]).
+pub const KNOCK_AT: usize = 150;
+
+/// `truth` with the term `name` (a ball set-up error `XOW`, `YOW`, `ZOW` of it) moved by `um`
+/// µm.
+pub fn moved(m: &Machine, truth: &Truth, name: &str, um: f64) -> Truth {
+    let t = term(m, name);
+    let mut out = truth.clone();
+    let mut at = 0;
+    for tt in &truth.model.terms {
+        if *tt == t {
+            out.coefficients[at] += um * 1e-3;
+            return out;
+        }
+        at += tt.basis.width();
+    }
+    panic!("{name} is not in the truth");
+}
+
+/// K4, K1, K2 of `truth` (noise seeds `seed`, `seed + 1`, `seed + 2`), K4 with the ball
+/// knocked by `um` µm along the set-up error `name` from sample [`KNOCK_AT`] on (the same noise
+/// before and after); K1 and K2 on the set-up as it was at the start of K4.
+pub fn knocked(
+    m: &Machine,
+    truth: &Truth,
+    name: &str,
+    um: f64,
+    seed: u64,
+) -> Vec<(String, Record)> {
+    let mut recs: Vec<(String, Record)> = ["K4", "K1", "K2"]
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let mut t = truth.clone();
+            t.seed = seed + k as u64;
+            (
+                p.to_string(),
+                simulate(m, &t, &path(m, p)).expect("simulate"),
+            )
+        })
+        .collect();
+    let mut after = moved(m, truth, name, um);
+    after.seed = seed;
+    let shifted = simulate(m, &after, &path(m, "K4")).expect("simulate");
+    recs[0].1.measured[KNOCK_AT..].copy_from_slice(&shifted.measured[KNOCK_AT..]);
+    recs
+}
+
+/// The diagnosis of `base` on the first `fitted` records together (one set-up, the first's
+/// label), the others held out on it.
+pub fn run_fitted(
+    m: &Machine,
+    base: &Model,
+    recs: &[(String, Record)],
+    fitted: usize,
+    o: &DiagnoseOptions,
+) -> Diagnosis {
+    let campaign = |rs: &[(String, Record)]| {
+        Campaign::new(
+            rs.iter()
+                .map(|(label, r)| {
+                    CampaignRecord::new(label, r.clone(), m.default_parameters(), &recs[0].0, false)
+                })
+                .collect(),
+        )
+        .expect("campaign")
+    };
+    let (fit, held) = (campaign(&recs[..fitted]), campaign(&recs[fitted..]));
+    diagnose(m, base, &fit, &held, o, &Unwatched).expect("diagnosis")
 }
 
 /// Pooled residual RMS over the held-out records, before and after (µm): the square root of the

@@ -115,7 +115,7 @@ fn finds_the_demo_truths_ecc_twice_per_revolution_and_halves_the_held_out_residu
     assert_eq!(j["base_model"], "reduced");
     // The size budget, rates included (µm/s, µrad/s), at its defaults.
     let b = &j["budget"];
-    for (k, v) in [("um", 100.0), ("urad", 200.0), ("ms", 20.0), ("1", 0.05)] {
+    for (k, v) in [("um", 100.0), ("urad", 200.0), ("ms", 20.0), ("1", 0.1)] {
         assert_eq!(b[k].as_f64(), Some(v), "budget {k}: {b}");
     }
     assert_eq!(b["um/s"].as_f64(), Some(0.5), "{b}");

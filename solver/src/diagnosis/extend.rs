@@ -51,7 +51,7 @@ pub(super) fn term_values(
 
 /// `Some(why)` when `e` is a refinement that did not converge (or diverged): a fit without a
 /// result, which a candidate may cause and the diagnosis survives.
-fn not_converged(e: &DiagnoseError) -> Option<String> {
+pub(super) fn not_converged(e: &DiagnoseError) -> Option<String> {
     match e {
         DiagnoseError::Refine(
             r @ (RefineError::NotConverged { .. } | RefineError::NotFinite { .. }),
@@ -178,6 +178,8 @@ pub(super) fn extend(
                 size,
                 limit,
                 plausible: size <= limit,
+                confirmation: None,
+                in_model: size <= limit,
                 scan,
                 explained_fraction: c.fraction,
                 f: c.f,

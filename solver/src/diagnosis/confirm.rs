@@ -11,16 +11,20 @@
 //!   it: its held-out gain `Σ (r_without² − r_with²)` over the judging readings, in standard
 //!   deviations of the gain of a spurious change of the predictions
 //!   ([`verdict::gain_against_noise`], condition 5 of the verdict for the whole extension). A
-//!   finding is confirmed when that exceeds [`verdict::CONFIRM_SD`]. Backwards: the finding
-//!   with the least gain is taken out when it is not confirmed, and the others are judged again
-//!   without it, until every finding left is confirmed.
-//! - **Alternatives.** A finding not confirmed that has alternatives has its first
-//!   [`ALTERNATIVES_TRIED`] (most explaining on the fitted records first) fitted in its place,
-//!   every confirmed finding kept, and each one's gain measured the same way against the
-//!   confirmed findings alone. The alternative with the largest gain replaces the finding when
-//!   it is confirmed, plausible, and beats every other term tried (the finding itself
-//!   included) by [`verdict::CONFIRM_SD`] standard deviations of their difference (the same
-//!   measure with the other's residual in place of `r_without`): the held-out records chose it.
+//!   finding is confirmed when that exceeds [`verdict::CONFIRM_SD`]. Backwards: the findings
+//!   not confirmed are taken out and the others judged again without them, until every finding
+//!   left is confirmed.
+//! - **Alternatives.** A finding that has alternatives has its first [`ALTERNATIVES_TRIED`]
+//!   (most explaining on the fitted records first) fitted in its place, every other confirmed
+//!   finding kept, and each one's gain measured the same way against the model of those
+//!   findings (the finding itself measured so too). The alternative with the largest gain
+//!   (mm²) replaces the finding when it is confirmed, plausible, and clearly better than the
+//!   finding and than every other alternative the judging records tell from it: the two
+//!   predictions differ by more than the noise hides (`Σ Δp²` above twice
+//!   [`verdict::CONFIRM_SD`] standard deviations: were either right, the other would lose that
+//!   much on average) and its gain over the other exceeds [`verdict::CONFIRM_SD`] of them.
+//!   Alternatives the judging records cannot tell from it stay its alternatives; the finding
+//!   itself must be told apart. The judging records chose it.
 //! - **The extended model** then holds the confirmed findings only. When none is confirmed it
 //!   keeps every plausible finding (and the verdict says that none is confirmed on its own).
 
@@ -30,12 +34,18 @@ use super::verdict::{self, CONFIRM_SD};
 use super::{DiagnoseError, DiagnoseOptions, Finding, outliers, plausible};
 use crate::fitting::campaign::{Campaign, CampaignIdentification, RecordValidation};
 use crate::fitting::noise::{NoiseChoice, NoiseModel};
+use crate::fitting::refine::RefineOptions;
 use crate::model::{Model, Term};
 use model_spec::Machine;
 use std::collections::HashMap;
 
-/// At most this many alternatives of a finding not confirmed are tried in its place.
+/// At most this many alternatives of a finding are tried in its place.
 pub const ALTERNATIVES_TRIED: usize = 5;
+
+/// The fits of the records left in, leaving one out, are refined until a step moves the
+/// prediction by less than this share of the noise's σ (the fits on every fitted record, which
+/// the extended model may take, as every fit of the diagnosis).
+pub const LEFT_OUT_TOLERANCE: f64 = 1e-3;
 
 /// Which records judge the findings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,12 +96,11 @@ pub(super) struct Folds<'a> {
     base: &'a Model,
     folds: Vec<Fold>,
     judges: Judges,
+    refine: RefineOptions,
     cache: HashMap<Vec<Term>, Option<Eval>>,
     /// The outliers' samples of every judging record (folds in order), from the base model's
     /// prediction.
     drops: Vec<Vec<usize>>,
-    /// Fits made.
-    pub fits: usize,
 }
 
 impl<'a> Folds<'a> {
@@ -147,9 +156,12 @@ impl<'a> Folds<'a> {
             base,
             folds,
             judges,
+            refine: match judges {
+                Judges::HeldOut => RefineOptions::default(),
+                Judges::LeftOut => RefineOptions::default().relative(LEFT_OUT_TOLERANCE),
+            },
             cache: HashMap::new(),
             drops: Vec::new(),
-            fits: 0,
         };
         if judges == Judges::HeldOut {
             out.seed(&[], base_fit)?;
@@ -208,8 +220,14 @@ impl<'a> Folds<'a> {
                 predictions: Vec::new(),
             });
             for f in &self.folds {
-                self.fits += 1;
-                match extend::fit(self.m, &model, &f.fitted, self.o, self.noise) {
+                match extend::fit_refined(
+                    self.m,
+                    &model,
+                    &f.fitted,
+                    self.o,
+                    self.noise,
+                    &self.refine,
+                ) {
                     Ok(fit) => {
                         let p = heldout::predict(self.m, &fit, &f.judged)?;
                         if let Some(e) = e.as_mut() {
@@ -317,7 +335,7 @@ impl<'a> Folds<'a> {
 
 /// Confirms every plausible finding of `findings` on its own with the judging records of
 /// `folds` under `noise` (see the module documentation), trying alternatives in the place of
-/// those not confirmed; sets each one's [`Finding::confirmation`], swaps in the alternatives
+/// each; sets each one's [`Finding::confirmation`], swaps in the alternatives
 /// the judging records chose, and returns the terms of the extended model (in the findings'
 /// order).
 ///
@@ -335,12 +353,13 @@ pub(super) fn confirm(
         .map(|f| f.term)
         .collect();
     let judges = folds.judges;
-    // Drop-one, backwards: the finding with the least gain given the others is taken out when
-    // it is not confirmed, and the others judged again without it (a look-alike that makes the
-    // predictions worse would otherwise lend a gain to the finding that makes up for it).
+    // Drop-one, backwards: the findings not confirmed given the others are taken out, and
+    // those left judged again without them (a look-alike that makes the predictions worse
+    // would otherwise lend a gain to the finding that makes up for it), until every finding
+    // left is confirmed.
     let mut set = all.clone();
     while !set.is_empty() {
-        let mut worst: Option<(Term, f64)> = None;
+        let mut out = Vec::new();
         for &t in &set {
             let without: Vec<Term> = set.iter().copied().filter(|&x| x != t).collect();
             let z = folds.gain_sd(&without, &set, noise)?;
@@ -353,14 +372,14 @@ pub(super) fn confirm(
                     tried: Vec::new(),
                 });
             }
-            if worst.is_none_or(|w| z < w.1) {
-                worst = Some((t, z));
+            if z <= CONFIRM_SD {
+                out.push(t);
             }
         }
-        match worst {
-            Some((t, z)) if z <= CONFIRM_SD => set.retain(|&x| x != t),
-            _ => break,
+        if out.is_empty() {
+            break;
         }
+        set.retain(|t| !out.contains(t));
     }
     let confirmed = |f: &Finding| f.confirmation.as_ref().is_some_and(|c| c.confirmed);
     let in_model = |fs: &[Finding]| -> Vec<Term> {

@@ -118,7 +118,7 @@ fn confirmation(f: &FindingReport) -> String {
         return out;
     };
     let by = if c.judged_by == "left-out" {
-        "the fitted records, each left out in turn and predicted by the others"
+        "the fitted records (each left out in turn, predicted by the others)"
     } else {
         "the held-out records"
     };

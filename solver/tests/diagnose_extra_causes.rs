@@ -22,7 +22,7 @@ use solver::model::Term;
 const SEEDS: [u64; 5] = [1, 2, 3, 4, 5];
 
 /// The findings named causes.
-fn causes<'a>(d: &'a Diagnosis) -> Vec<&'a Finding> {
+fn causes(d: &Diagnosis) -> Vec<&Finding> {
     d.findings.iter().filter(|f| d.is_cause(f)).collect()
 }
 

@@ -50,12 +50,16 @@ interval. A finding beyond --budget is 'implausible': not a cause, not in the ex
 6. Gain: the extended model (model + plausible findings) is fitted on --data and predicts every \
 --validate file (exact prediction, with only what the fits determine: a file whose prediction \
 needs an undetermined combination is flagged and not counted); residual RMS before and after, \
-µm.
+µm. Each finding is then confirmed on its own: its held-out gain given the other findings must \
+exceed twice a spurious gain's standard deviation; a finding not confirmed has up to three of \
+its alternatives tried in its place, and one the held-out files confirm clearly better replaces \
+it. The extended model holds the confirmed findings. With no --validate and several --data \
+files, each file is predicted by the fit on the others instead.
 7. Verdict: the residual of the extended model on every file is tested against the noise \
 (parametric bootstrap; 'down to the noise' only when it passes); where it fails, what remains is \
 described (what it follows, its shape, its RMS). The extended model is recommended only when no \
-held-out file gets worse and the held-out residual falls; otherwise the findings are 'not \
-confirmed' and the text says why.
+held-out file gets worse, the held-out residual falls and a finding is confirmed; a finding is \
+a 'cause' only when confirmed and recommended, otherwise 'not confirmed', and the text says why.
 
 Values of findings are in µm (translational errors, offsets) and µrad (angular errors); a \
 harmonic is printed as its cos and sin coefficients, its amplitude √(cos² + sin²) and phase φ \

@@ -25,13 +25,28 @@ pub(super) fn fit(
     o: &DiagnoseOptions,
     noise: &NoiseChoice,
 ) -> Result<CampaignIdentification, DiagnoseError> {
+    fit_refined(m, model, c, o, noise, &RefineOptions::default())
+}
+
+/// [`fit`] refined as `refine` says.
+///
+/// # Errors
+/// As [`identify_campaign_refined`].
+pub(super) fn fit_refined(
+    m: &Machine,
+    model: &Model,
+    c: &Campaign,
+    o: &DiagnoseOptions,
+    noise: &NoiseChoice,
+    refine: &RefineOptions,
+) -> Result<CampaignIdentification, DiagnoseError> {
     let opts = IdentifyOptions {
         zeroed: false,
         constraint: o.constraint.clone(),
         tolerances: o.tolerances,
         params: None,
     };
-    Ok(identify_campaign_refined(m, model, c, &opts, &RefineOptions::default(), noise)?.0)
+    Ok(identify_campaign_refined(m, model, c, &opts, refine, noise)?.0)
 }
 
 /// The values and standard uncertainties of `term` in `fit` (mm or rad; every owner's columns
@@ -51,7 +66,7 @@ pub(super) fn term_values(
 
 /// `Some(why)` when `e` is a refinement that did not converge (or diverged): a fit without a
 /// result, which a candidate may cause and the diagnosis survives.
-fn not_converged(e: &DiagnoseError) -> Option<String> {
+pub(super) fn not_converged(e: &DiagnoseError) -> Option<String> {
     match e {
         DiagnoseError::Refine(
             r @ (RefineError::NotConverged { .. } | RefineError::NotFinite { .. }),
@@ -178,6 +193,8 @@ pub(super) fn extend(
                 size,
                 limit,
                 plausible: size <= limit,
+                confirmation: None,
+                in_model: size <= limit,
                 scan,
                 explained_fraction: c.fraction,
                 f: c.f,

@@ -31,6 +31,7 @@
 
 pub mod adequacy;
 mod columns;
+pub mod confirm;
 mod confounded;
 pub mod dictionary;
 mod extend;
@@ -307,6 +308,21 @@ pub fn diagnose(
     let live: Vec<usize> = (0..candidates.len())
         .filter(|&c| !unexcited.contains(&candidates[c]))
         .collect();
+    // A scanned candidate's parameter refined on a fine grid given a model, in the selection
+    // (after each step) and after it (with every other finding in place).
+    let grid_record = joined(&cleaned);
+    let term_columns = |t: Term| cols.term_columns(m, t, &cleaned, &weights, &whitening);
+    let refine_step = |c: usize, q: &Span| -> Option<search::Refined> {
+        let mut columns = term_columns;
+        let (term, scan) =
+            profile::refine(m, candidates[c], &grid_record, &mut columns, q, &cols.y).ok()??;
+        let columns = term_columns(term).ok()?;
+        Some(search::Refined {
+            term,
+            scan,
+            columns,
+        })
+    };
     let problem = search::Problem {
         m,
         candidates: &candidates,
@@ -317,11 +333,11 @@ pub fn diagnose(
         live: &live,
         o,
         progress,
+        refine: &refine_step,
     };
     stage(3);
     let (chosen, stop) = search::select(&problem);
-    // A scanned parameter refined on a fine grid, with every other finding in place.
-    let grid_record = joined(&cleaned);
+    // A scanned parameter refined again, with every other finding in place.
     let mut refined = Vec::with_capacity(chosen.len());
     for k in 0..chosen.len() {
         let q = search::basis_of(&problem, &chosen, Some(k));
@@ -330,7 +346,10 @@ pub fn diagnose(
         refined.push(
             match profile::refine(m, coarse, &grid_record, &mut columns, &q, &cols.y)? {
                 Some((t, scan)) => (t, Some(scan)),
-                None => (coarse, None),
+                None => chosen[k]
+                    .refined
+                    .as_ref()
+                    .map_or((coarse, None), |r| (r.term, Some(r.scan))),
             },
         );
     }
@@ -338,9 +357,9 @@ pub fn diagnose(
     stage(4);
     let mut fit_model = |model: &Model| extend::fit(m, model, &cleaned, o, &gls);
     let extend::Extension {
-        findings,
-        dropped,
-        fit: extended_fit,
+        mut findings,
+        mut dropped,
+        fit: mut extended_fit,
         kept,
     } = extend::extend(
         &extend::Selected {
@@ -354,10 +373,50 @@ pub fn diagnose(
         &mut fit_model,
         &base_fit,
     )?;
+    // Each finding confirmed on its own by the held-out records (or every fitted record left
+    // out in turn); the extended model holds the confirmed ones.
+    let selected: Vec<(Term, usize)> = findings
+        .iter()
+        .filter(|f| f.plausible)
+        .map(|f| f.term)
+        .zip(kept.iter().copied())
+        .collect();
+    let all: Vec<Term> = selected.iter().map(|s| s.0).collect();
+    let mut left_out = Vec::new();
+    if let Some(mut folds) = confirm::Folds::new(m, o, &gls, base, &cleaned, held_out, &base_fit)? {
+        folds.seed(&all, &extended_fit)?;
+        let terms = confirm::confirm(&mut folds, &mut findings, &whitening)?;
+        for f in findings.iter_mut() {
+            f.in_model = terms.contains(&f.term);
+        }
+        if terms != all {
+            let (e, more) = match folds.whole(&terms) {
+                Some(e) => (e, Vec::new()),
+                None => extend::fit_dropping(&mut fit_model, base, &terms, &base_fit)?,
+            };
+            findings.retain(|f| !more.iter().any(|d| d.term == f.term));
+            dropped.extend(more);
+            extended_fit = e;
+        }
+        for f in findings.iter_mut().filter(|f| f.in_model) {
+            (f.values, f.stds) = extend::term_values(&extended_fit, &f.term);
+            let known: Vec<f64> = f.values.iter().map(|v| v.unwrap_or(0.0)).collect();
+            (f.size, f.limit) = plausible::size_and_limit(m, &f.term, &known, &o.budget);
+        }
+        left_out = folds.left_out_rows(&extended_terms_of(&findings))?;
+    }
+    // The candidates of the findings in the extended model (a finding chosen among the
+    // alternatives by the held-out records is that candidate).
+    let kept: Vec<usize> = findings
+        .iter()
+        .filter(|f| f.in_model)
+        .filter_map(|f| match f.confirmation.as_ref().and_then(|c| c.replaces) {
+            Some(_) => candidates.iter().position(|&c| c == f.term),
+            None => selected.iter().find(|s| s.0 == f.term).map(|s| s.1),
+        })
+        .collect();
     let mut extended = base.clone();
-    extended
-        .terms
-        .extend(findings.iter().filter(|f| f.plausible).map(|f| f.term));
+    extended.terms.extend(extended_terms_of(&findings));
 
     // The extended model's findings as candidates (their coarse grid values: the spans the
     // selection saw).
@@ -407,8 +466,13 @@ pub fn diagnose(
         (base_fit.fit.rss / rows).sqrt(),
         (extended_fit.fit.rss / rows).sqrt(),
     );
-    let labels: Vec<String> = validation.iter().map(|h| h.name.clone()).collect();
-    let recommendation = recommend(&findings, &validation, &adequacy, &labels);
+    let judging = if validation.is_empty() {
+        &left_out
+    } else {
+        &validation
+    };
+    let labels: Vec<String> = judging.iter().map(|h| h.name.clone()).collect();
+    let recommendation = recommend(&findings, judging, &adequacy, &labels);
     let (k, p, t) = (o.dictionary.harmonics, o.dictionary.poly, o.dictionary.time);
     let records = cleaned
         .records
@@ -452,9 +516,19 @@ pub fn diagnose(
         extended,
         extended_fit,
         validation,
+        left_out,
         recommendation,
         noise,
         adequacy,
         unexplained,
     })
+}
+
+/// The terms the findings in the extended model add, in order.
+fn extended_terms_of(findings: &[Finding]) -> Vec<Term> {
+    findings
+        .iter()
+        .filter(|f| f.in_model)
+        .map(|f| f.term)
+        .collect()
 }

@@ -2,7 +2,7 @@
 //! gain, the verdict; and the extended model as a machine description.
 
 use super::structure::Component;
-use super::{adequacy, heldout, outliers, profile, unexplained, verdict};
+use super::{adequacy, confirm, heldout, outliers, profile, unexplained, verdict};
 use crate::fitting::campaign::CampaignIdentification;
 use crate::fitting::noise::NoiseModel;
 use crate::model::Model;
@@ -32,8 +32,8 @@ pub struct Finding {
     /// Its value(s) in the extended model, mm or rad (`[cos, sin]` for a harmonic; ms for a
     /// velocity term, a fraction for an instrument term; one value per record or set-up for a
     /// term a record or set-up owns, in the order of the campaign's columns); `None` where the
-    /// fit cannot determine it. For an implausible finding, its value(s) with every finding
-    /// fitted together.
+    /// fit cannot determine it. For a finding left out of the extended model, its value(s)
+    /// with every finding fitted together.
     pub values: Vec<Option<f64>>,
     /// Their standard uncertainties (same units).
     pub stds: Vec<Option<f64>>,
@@ -42,9 +42,17 @@ pub struct Finding {
     pub size: f64,
     /// The budget of its unit it was compared with.
     pub limit: f64,
-    /// `size ≤ limit`: a plausible cause, in the extended model. An implausible finding fits
-    /// the data but is not named as a cause and is left out of the extended model.
+    /// `size ≤ limit`: a plausible cause. An implausible finding fits the data but is not
+    /// named as a cause and is left out of the extended model.
     pub plausible: bool,
+    /// What the held-out (or left-out) records say of it on its own: its held-out gain given
+    /// the other findings, and whether they chose it among the alternatives; `None` when no
+    /// record judged it (nothing held out and one record fitted) or it is implausible.
+    pub confirmation: Option<confirm::Confirmation>,
+    /// In the extended model: plausible and confirmed on its own, or plausible when no finding
+    /// is confirmed (the extended model then holds every plausible finding and is not
+    /// recommended).
+    pub in_model: bool,
     /// For `period:P`, `step:V`, `exp:TAU`, `warmup:TAU`: the refined parameter and its 95 %
     /// interval ([`profile`]); the values' standard uncertainties are conditional on it.
     pub scan: Option<profile::Scan>,
@@ -152,6 +160,10 @@ pub struct Diagnosis {
     /// Per held-out record: the residual RMS before and after, what it needs that the fits do
     /// not determine, what was refitted on it, its outliers.
     pub validation: Vec<heldout::HeldOut>,
+    /// With nothing held out and several records fitted: every fitted record predicted by the
+    /// fits on the others, base and extended model (the rows the verdict judges); empty
+    /// otherwise.
+    pub left_out: Vec<heldout::HeldOut>,
     /// Whether the extended model is recommended, and why (not).
     pub recommendation: verdict::Recommendation,
     /// The noise model every test assumes (the readings and columns are whitened by it).
@@ -184,18 +196,41 @@ pub(super) fn recommend(
     verdict::recommend(findings, validation, names, noise.as_ref(), consistent)
 }
 
+impl Finding {
+    /// Confirmed on its own by the held-out (or left-out) records.
+    pub fn confirmed(&self) -> bool {
+        self.confirmation.as_ref().is_some_and(|c| c.confirmed)
+    }
+}
+
 impl Diagnosis {
+    /// Whether finding `f` is named a cause: in the extended model, confirmed on its own, and
+    /// the extended model recommended.
+    pub fn is_cause(&self, f: &Finding) -> bool {
+        f.in_model && f.confirmed() && self.recommendation.recommended
+    }
+
+    /// The rows of the records that judged the extension: the held-out records, or with none
+    /// the fitted records each left out in turn.
+    pub fn judging_rows(&self) -> &[heldout::HeldOut] {
+        if self.validation.is_empty() {
+            &self.left_out
+        } else {
+            &self.validation
+        }
+    }
+
     /// [`Diagnosis::recommendation`] with the held-out records named `names` (their files, one
     /// per record in order) instead of their labels: the same verdict, for a report.
     pub fn recommendation_named(&self, names: &[String]) -> verdict::Recommendation {
-        recommend(&self.findings, &self.validation, &self.adequacy, names)
+        recommend(&self.findings, self.judging_rows(), &self.adequacy, names)
     }
 
     /// The extended model as a sub-model lists it: the base model's terms as given (without
-    /// the offsets zeroed readings add) followed by the plausible findings.
+    /// the offsets zeroed readings add) followed by the findings in it.
     pub fn extended_terms(&self) -> Model {
         let mut out = self.base_given.clone();
-        for f in self.findings.iter().filter(|f| f.plausible) {
+        for f in self.findings.iter().filter(|f| f.in_model) {
             if !out.terms.contains(&f.term) {
                 out.terms.push(f.term);
             }
@@ -203,14 +238,14 @@ impl Diagnosis {
         out
     }
 
-    /// The extended model's label: the base model's `label` and the plausible findings
+    /// The extended model's label: the base model's `label` and the findings in the model
     /// (`reduced + ECC@harmonic:2`).
     pub fn extended_label(&self, m: &Machine, label: &str) -> String {
         std::iter::once(label.to_string())
             .chain(
                 self.findings
                     .iter()
-                    .filter(|f| f.plausible)
+                    .filter(|f| f.in_model)
                     .map(|f| f.term.spelling(m)),
             )
             .collect::<Vec<_>>()

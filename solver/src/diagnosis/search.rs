@@ -10,6 +10,7 @@
 //! again.
 
 use super::confounded::{SameFinding, same_span, scaled_size};
+use super::profile::Scan;
 use super::projected::{Model, Projected};
 use super::select::{
     SPAN_TOLERANCE, Scored, Span, beyond, coordinates, f_p_value, f_statistic, monte_carlo_p,
@@ -42,6 +43,20 @@ pub(super) struct Problem<'a> {
     pub o: &'a DiagnoseOptions,
     /// Told of every candidate scored in a step (`selection`, done of the step's pool).
     pub progress: &'a dyn crate::io::progress::Progress,
+    /// A scanned candidate's parameter refined given a model (its span), with the refined
+    /// term's columns; `None` for a candidate without a scanned parameter.
+    pub refine: &'a dyn Fn(usize, &Span) -> Option<Refined>,
+}
+
+/// A scanned candidate's parameter refined with the other terms of the model in place.
+#[derive(Clone, Debug)]
+pub(super) struct Refined {
+    /// The term at the refined value.
+    pub term: Term,
+    /// The value and its interval.
+    pub scan: Scan,
+    /// Its columns, as the problem's groups give them.
+    pub columns: DMatrix<f64>,
 }
 
 /// A step of the selection, before the extended fit gives its values.
@@ -61,18 +76,38 @@ pub(super) struct Chosen {
     pub tried: usize,
     /// Its corrected p-value.
     pub p: f64,
+    /// For a scanned candidate, its parameter refined when it was chosen (the model then holds
+    /// the refined term's columns).
+    pub refined: Option<Refined>,
 }
 
-/// The model's basis: the base and the chosen terms (but `skip`).
+/// The columns of a chosen term: its refined term's, or its candidate's.
+fn columns_of(p: &Problem, c: &Chosen) -> DMatrix<f64> {
+    match &c.refined {
+        Some(r) => r.columns.clone(),
+        None => (p.group)(p.nb + c.index),
+    }
+}
+
+/// The model's basis: the base and the chosen terms (but `skip`; a refined term's columns).
 pub(super) fn basis_of(p: &Problem, chosen: &[Chosen], skip: Option<usize>) -> Span {
-    let terms = (0..p.nb).chain(
-        chosen
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| Some(*k) != skip)
-            .map(|(_, c)| p.nb + c.index),
-    );
-    Span::of_groups(p.y.len(), terms, p.group)
+    let mut span = Span::of_groups(p.y.len(), 0..p.nb, p.group);
+    for (_, c) in chosen.iter().enumerate().filter(|(k, _)| Some(*k) != skip) {
+        let d = span.new_directions(&columns_of(p, c));
+        span.extend(&d);
+    }
+    span
+}
+
+/// `c` with its scanned parameter refined given `model` (without it), and the directions it
+/// adds to that model.
+fn refined(p: &Problem, mut c: Chosen, model: &Model) -> (Chosen, DMatrix<f64>) {
+    c.refined = (p.refine)(c.index, model.span());
+    let d = match &c.refined {
+        Some(r) => model.span().new_directions(&r.columns),
+        None => model.directions(c.index),
+    };
+    (c, d)
 }
 
 /// The forward selection and its exchange pass: the findings in order, and why it stopped.
@@ -87,6 +122,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         live: candidates_live,
         o,
         progress,
+        refine: _,
     } = *p;
     let n = y.len();
     // One selection step on `model` over the candidates `pool`: the significant candidate
@@ -282,6 +318,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             correction: how,
             tried,
             p,
+            refined: None,
         })
     };
     // The candidates a step may take: the excited ones that are not chosen (but `skip`), nor
@@ -347,7 +384,9 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
                     break;
                 }
                 Ok(c) => {
-                    let d = state.model().directions(c.index);
+                    // A scanned parameter refined at once, the model grown by the refined term:
+                    // the next step sees the refined residual.
+                    let (c, d) = refined(p, c, &state.model());
                     state.grow(&d, y);
                     chosen.push(c);
                 }
@@ -359,7 +398,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             // The model without finding `j`: its span, and what the finding adds to it.
             let without = || {
                 let span = basis_of(p, &chosen, Some(j));
-                let d = span.new_directions(&group(nb + chosen[j].index));
+                let d = span.new_directions(&columns_of(p, &chosen[j]));
                 (span, d)
             };
             let context = context(&chosen, Some(j));
@@ -376,14 +415,15 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             };
             // The state changes only when the finding does.
             match result {
-                Ok(c) if c.index == chosen[j].index => {
+                Ok(mut c) if c.index == chosen[j].index => {
+                    c.refined = chosen[j].refined.take();
                     chosen[j] = c;
                     j += 1;
                 }
                 Ok(c) => {
                     let (span, d) = without();
                     state.shrink(span, &d, y);
-                    let d = state.model().directions(c.index);
+                    let (c, d) = refined(p, c, &state.model());
                     state.grow(&d, y);
                     chosen[j] = c;
                     changed = true;

@@ -19,6 +19,12 @@
 //!    finding (at rate α) that happens to nudge the held-out records the right way is not
 //!    recommended.
 //!
+//! 6. when the held-out records judged the findings one by one ([`super::confirm`]), at least
+//!    one is confirmed on its own (the extended model then holds only those).
+//!
+//! The held-out records are those given, or with none and several fitted records, every fitted
+//! record predicted by the fit on the others ([`super::confirm::Judges`]).
+//!
 //! Otherwise the reasons say which condition failed, with the records and sizes involved.
 
 use super::Finding;
@@ -33,6 +39,39 @@ pub struct Recommendation {
     pub recommended: bool,
     /// Why (not), for people, one sentence each.
     pub reasons: Vec<String>,
+}
+
+/// How many standard deviations of a spurious gain a held-out gain must exceed (condition 5;
+/// and a finding's own gain, [`super::confirm`]).
+pub const CONFIRM_SD: f64 = 2.0;
+
+/// The gain of a change of prediction on held-out readings and its standard deviation were the
+/// change spurious (condition 5): per record the residuals `before` and `after` the change (mm,
+/// one `[x, y, z]` per sample) and the samples left out (outliers). With `Δp = before − after`,
+/// the gain is `Σ (before² − after²)` and its standard deviation, `before` then the noise,
+/// `2σ·√(Σ Δp²·(1 + φ)/(1 − φ))` (mm²); and `Σ Δp²` (mm²), the gain were `after` right.
+pub fn gain_against_noise<'a>(
+    noise: &NoiseModel,
+    records: impl IntoIterator<Item = (&'a [[f64; 3]], &'a [[f64; 3]], Vec<usize>)>,
+) -> (f64, f64, f64) {
+    let (mut gain, mut var, mut spread) = (0.0, 0.0, 0.0);
+    for (before, after, drop) in records {
+        for (i, (b, a)) in before.iter().zip(after).enumerate() {
+            if drop.contains(&i) {
+                continue;
+            }
+            for d in 0..3 {
+                let dp = b[d] - a[d];
+                gain += b[d] * b[d] - a[d] * a[d];
+                spread += dp * dp;
+                // A smooth Δp meets correlated noise at its low-frequency power, (1 + φ)/(1 − φ)
+                // times the white noise's.
+                let (s, p) = (noise.sigma_mm[d], noise.phi[d]);
+                var += 4.0 * s * s * (1.0 + p) / (1.0 - p) * dp * dp;
+            }
+        }
+    }
+    (gain, var.sqrt(), spread)
 }
 
 fn um(v: f64) -> String {
@@ -76,9 +115,31 @@ pub fn recommend(
     }
     if held.is_empty() {
         reasons.push(
-            "no held-out record: the gain of the extension cannot be checked (give held-out records)"
+            "no held-out record: the gain of the extension cannot be checked (give held-out records, or fit several records: each is then predicted by the others)"
                 .into(),
         );
+    }
+    let judged: Vec<&Finding> = findings
+        .iter()
+        .filter(|f| f.plausible && f.confirmation.is_some())
+        .collect();
+    if !judged.is_empty() && !judged.iter().any(|f| f.confirmed()) {
+        let gains: Vec<String> = judged
+            .iter()
+            .filter_map(|f| {
+                f.confirmation.as_ref().map(|c| {
+                    format!(
+                        "{} {:.2}",
+                        f.description.split(": ").next().unwrap_or(""),
+                        c.gain_sd
+                    )
+                })
+            })
+            .collect();
+        reasons.push(format!(
+            "no finding is confirmed on its own by the held-out records (held-out gain given the others, in standard deviations of a spurious one's: {}; {CONFIRM_SD} needed)",
+            gains.join(", ")
+        ));
     }
     let estimable: Vec<&HeldOut> = held.iter().filter(|h| h.estimable()).collect();
     for h in held.iter().filter(|h| !h.estimable()) {
@@ -138,27 +199,20 @@ pub fn recommend(
         }
     }
     if let Some(n) = noise {
-        let (mut gain, mut var) = (0.0, 0.0);
-        for h in &estimable {
-            let drop = super::outliers::samples(&h.outliers);
-            for (i, (b, a)) in h.residual_before.iter().zip(&h.residual_after).enumerate() {
-                if drop.contains(&i) {
-                    continue;
-                }
-                for d in 0..3 {
-                    let dp = b[d] - a[d];
-                    gain += b[d] * b[d] - a[d] * a[d];
-                    // A smooth Δp meets correlated noise at its low-frequency power, (1 + φ)/(1 − φ)
-                    // times the white noise's.
-                    let (s, p) = (n.sigma_mm[d], n.phi[d]);
-                    var += 4.0 * s * s * (1.0 + p) / (1.0 - p) * dp * dp;
-                }
-            }
-        }
-        if !estimable.is_empty() && gain <= 2.0 * var.sqrt() {
+        let (gain, sd, _) = gain_against_noise(
+            n,
+            estimable.iter().map(|h| {
+                (
+                    h.residual_before.as_slice(),
+                    h.residual_after.as_slice(),
+                    super::outliers::samples(&h.outliers),
+                )
+            }),
+        );
+        if !estimable.is_empty() && gain <= CONFIRM_SD * sd {
             reasons.push(format!(
-                "the held-out gain is within what the noise gives ({:.2} standard deviations of a spurious finding's, 2 needed)",
-                gain / var.sqrt().max(f64::MIN_POSITIVE)
+                "the held-out gain is within what the noise gives ({:.2} standard deviations of a spurious finding's, {CONFIRM_SD} needed)",
+                gain / sd.max(f64::MIN_POSITIVE)
             ));
         }
     }

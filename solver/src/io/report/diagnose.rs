@@ -10,6 +10,7 @@ use super::verdict::{
     AdequacyReport, BudgetReport, OutlierReport, UnexplainedReport, adequacy, outliers, unexplained,
 };
 use super::{NonFinite, finite, finite_opt};
+use crate::diagnosis::confirm::Judges;
 use crate::diagnosis::harmonic::harmonic;
 use crate::diagnosis::structure::Component;
 use crate::diagnosis::{Correction, DiagnoseOptions, Diagnosis};
@@ -127,11 +128,46 @@ pub struct FindingReport {
     /// otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scan: Option<ScanReport>,
-    /// What the finding is: `cause` (plausible, and the extended model is recommended: the
-    /// held-out records confirm it), `not confirmed` (plausible, but the extended model is not
-    /// recommended: it fits the fitted record, the held-out records do not confirm it, or there
-    /// are none to check) or `implausible`.
+    /// What the finding is: `cause` (plausible, confirmed on its own by the held-out records,
+    /// or with none by the fitted records left out in turn, and the extended model, which holds
+    /// the confirmed findings, is recommended), `not confirmed` (plausible, but its own held-out
+    /// gain is within the noise's, or the extended model is not recommended, or there are no
+    /// records to check it) or `implausible`.
     pub status: String,
+    /// What the held-out records say of it on its own; absent when no record judged it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub confirmation: Option<ConfirmationReport>,
+}
+
+/// What the held-out (or left-out) records say of one finding.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ConfirmationReport {
+    /// `held-out` (the held-out records) or `left-out` (every fitted record predicted by the
+    /// fit on the others).
+    pub judged_by: String,
+    /// Its held-out gain given the other findings of the extended model, in standard
+    /// deviations of a spurious gain.
+    pub gain_sd: f64,
+    /// Whether that exceeds 2: confirmed on its own.
+    pub confirmed: bool,
+    /// The selection's finding this term replaces, the held-out records having chosen it among
+    /// that finding's alternatives (`NAME@BASIS`); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replaces: Option<String>,
+    /// The terms tried in the finding's place (the selection's finding first) and their
+    /// held-out gains given the confirmed findings, in standard deviations; empty when none
+    /// was tried.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub tried: Vec<TriedReport>,
+}
+
+/// A term tried in a finding's place on the held-out records.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TriedReport {
+    /// `NAME@BASIS`.
+    pub term: String,
+    /// Its held-out gain, in standard deviations of a spurious gain.
+    pub gain_sd: f64,
 }
 
 /// A scanned parameter and its interval.
@@ -227,6 +263,10 @@ pub struct GainReport {
     pub fit: GainRow,
     /// On every held-out record.
     pub validation: Vec<GainRow>,
+    /// With nothing held out and several records fitted: on every fitted record, predicted by
+    /// the fits (base and extended model) on the others; absent otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub left_out: Vec<GainRow>,
 }
 
 /// The diagnosis report.
@@ -398,6 +438,32 @@ fn gain_row(
     })
 }
 
+/// The gain rows of held-out (or left-out) records, each named by its file.
+fn held_rows(
+    field: &str,
+    rows: &[crate::diagnosis::heldout::HeldOut],
+    file_of: &dyn Fn(&str) -> String,
+) -> Result<Vec<GainRow>, NonFinite> {
+    rows.iter()
+        .enumerate()
+        .map(|(i, h)| {
+            let mut groups = h.undetermined_before.clone();
+            for g in &h.undetermined_after {
+                if !groups.contains(g) {
+                    groups.push(g.clone());
+                }
+            }
+            gain_row(
+                &format!("{field}[{i}]"),
+                &file_of(&h.name),
+                h.before_rms,
+                h.after_rms,
+                groups,
+            )
+        })
+        .collect()
+}
+
 impl DiagnosisReport {
     /// The report of `d` on machine `m`.
     ///
@@ -475,12 +541,37 @@ impl DiagnosisReport {
                         unit: unit.into(),
                     }
                 }),
-                status: match (f.plausible, d.recommendation.recommended) {
-                    (false, _) => "implausible",
-                    (true, true) => "cause",
-                    (true, false) => "not confirmed",
+                status: if !f.plausible {
+                    "implausible"
+                } else if d.is_cause(f) {
+                    "cause"
+                } else {
+                    "not confirmed"
                 }
                 .into(),
+                confirmation: match &f.confirmation {
+                    Some(c) => Some(ConfirmationReport {
+                        judged_by: match c.judges {
+                            Judges::HeldOut => "held-out",
+                            Judges::LeftOut => "left-out",
+                        }
+                        .into(),
+                        gain_sd: finite(|| field("confirmation.gain_sd"), c.gain_sd)?,
+                        confirmed: c.confirmed,
+                        replaces: c.replaces.map(|t| t.spelling(m)),
+                        tried: c
+                            .tried
+                            .iter()
+                            .map(|&(t, z)| {
+                                Ok(TriedReport {
+                                    term: t.spelling(m),
+                                    gain_sd: finite(|| field("confirmation.tried.gain_sd"), z)?,
+                                })
+                            })
+                            .collect::<Result<_, NonFinite>>()?,
+                    }),
+                    None => None,
+                },
             });
         }
         let (name, file) = match &source.model_out {
@@ -551,7 +642,7 @@ impl DiagnosisReport {
                 added: d
                     .findings
                     .iter()
-                    .filter(|f| f.plausible)
+                    .filter(|f| f.in_model)
                     .map(|f| f.term.spelling(m))
                     .collect(),
                 name,
@@ -559,26 +650,8 @@ impl DiagnosisReport {
             },
             gain: GainReport {
                 fit: gain_row("gain.fit", &data, d.fit_rms.0, d.fit_rms.1, Vec::new())?,
-                validation: d
-                    .validation
-                    .iter()
-                    .enumerate()
-                    .map(|(i, h)| {
-                        let mut groups = h.undetermined_before.clone();
-                        for g in &h.undetermined_after {
-                            if !groups.contains(g) {
-                                groups.push(g.clone());
-                            }
-                        }
-                        gain_row(
-                            &format!("gain.validation[{i}]"),
-                            &file_of(&h.name),
-                            h.before_rms,
-                            h.after_rms,
-                            groups,
-                        )
-                    })
-                    .collect::<Result<_, _>>()?,
+                validation: held_rows("gain.validation", &d.validation, &file_of)?,
+                left_out: held_rows("gain.left_out", &d.left_out, &file_of)?,
             },
             outliers: outliers(d, &file_of)?,
             budget: BudgetReport {
@@ -590,7 +663,13 @@ impl DiagnosisReport {
                 urad_per_s: o.budget.urad_per_s,
             },
             recommended: d.recommendation.recommended,
-            recommendation: d.recommendation_named(&source.held_out).reasons,
+            recommendation: d
+                .recommendation_named(if d.validation.is_empty() {
+                    &source.data
+                } else {
+                    &source.held_out
+                })
+                .reasons,
             noise_model: d.noise.to_string(),
             adequacy: match &d.adequacy {
                 Ok(a) => Some(adequacy(a, &file_of)?),

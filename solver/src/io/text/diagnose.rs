@@ -3,7 +3,9 @@
 //! commands that use the extended model.
 
 use super::{header, indent, shell, table, value, wrap, zeroed_text};
-use crate::io::report::diagnose::{DiagnosisReport, FindingReport, GainRow, RecordReport};
+use crate::io::report::diagnose::{
+    ConfirmationReport, DiagnosisReport, FindingReport, GainRow, RecordReport,
+};
 use model_spec::units::{fixed, p_value, symbol};
 
 /// `ECC harmonic:2` from `ECC@harmonic:2` (a constant term is its name).
@@ -71,10 +73,8 @@ pub fn findings(r: &DiagnosisReport) -> String {
                 value(f.size),
                 value(f.limit)
             ));
-        } else if f.status != "cause" {
-            out.push_str(
-                "     fits the fitted record, but not confirmed: the extended model is not recommended (below); not a cause\n",
-            );
+        } else {
+            out.push_str(&confirmation(f));
         }
         if let (Some(h), Some(k)) = (&f.harmonic, f.basis.strip_prefix("harmonic:")) {
             let pm = |s: Option<f64>, digits: usize| {
@@ -107,6 +107,60 @@ pub fn findings(r: &DiagnosisReport) -> String {
     out
 }
 
+/// What the held-out (or left-out) records say of a plausible finding, and its status when it
+/// is not a cause.
+fn confirmation(f: &FindingReport) -> String {
+    let mut out = String::new();
+    let Some(c) = &f.confirmation else {
+        if f.status != "cause" {
+            out.push_str("     fits the fitted record, but not confirmed: no record was held out to check it; not a cause\n");
+        }
+        return out;
+    };
+    let by = if c.judged_by == "left-out" {
+        "the fitted records (each left out in turn, predicted by the others)"
+    } else {
+        "the held-out records"
+    };
+    let tried = |c: &ConfirmationReport| -> String {
+        c.tried
+            .iter()
+            .map(|t| format!("{} {}", words(&t.term), fixed(t.gain_sd, 1)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if let Some(original) = &c.replaces {
+        out.push_str(&format!(
+            "     chosen by {by} among the alternatives of {}: held-out gain {} standard deviations of a spurious one's (tried: {})\n",
+            words(original),
+            fixed(c.gain_sd, 1),
+            tried(c)
+        ));
+    } else if c.confirmed {
+        out.push_str(&format!(
+            "     confirmed on its own by {by}: held-out gain given the other findings {} standard deviations of a spurious one's\n",
+            fixed(c.gain_sd, 1)
+        ));
+    } else {
+        out.push_str(&format!(
+            "     fits the fitted record, but not confirmed on its own by {by}: held-out gain given the other findings {} standard deviations of a spurious one's (2 needed); not a cause{}\n",
+            fixed(c.gain_sd, 1),
+            if c.tried.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; in its place, given the confirmed findings: {} (none chosen)",
+                    tried(c)
+                )
+            }
+        ));
+    }
+    if c.confirmed && f.status != "cause" {
+        out.push_str("     not a cause: the extended model is not recommended (below)\n");
+    }
+    out
+}
+
 /// The residual RMS before and after, fitted and held out, as a table.
 pub fn gain(r: &DiagnosisReport) -> String {
     let row = |name: String, g: &GainRow| {
@@ -127,6 +181,12 @@ pub fn gain(r: &DiagnosisReport) -> String {
     let mut rows = vec![row(format!("{} (fitted)", r.data), &r.gain.fit)];
     for g in &r.gain.validation {
         rows.push(row(format!("{} (held out)", g.data), g));
+    }
+    for g in &r.gain.left_out {
+        rows.push(row(
+            format!("{} (left out, fitted on the others)", g.data),
+            g,
+        ));
     }
     indent(
         &table(&header(&["data", "before µm", "after µm", "change"]), &rows),
@@ -286,7 +346,7 @@ pub fn next_steps(r: &DiagnosisReport) -> String {
     let data: Vec<String> = r.data_arguments.iter().map(|w| shell(w)).collect();
     let data = data.join(" ");
     let mut out = String::new();
-    let plausible: Vec<&FindingReport> = r.findings.iter().filter(|f| f.plausible).collect();
+    let causes: Vec<&FindingReport> = r.findings.iter().filter(|f| f.status == "cause").collect();
     if r.findings.is_empty() {
         out.push_str(&format!(
             "Nothing to add: no candidate of the dictionary is significant at α = {} after the correction for the candidates tried. {}\n",
@@ -313,7 +373,7 @@ pub fn next_steps(r: &DiagnosisReport) -> String {
             }
         ));
     } else if r.recommended {
-        let terms: Vec<String> = plausible
+        let terms: Vec<String> = causes
             .iter()
             .map(|f| {
                 if f.basis == "const" {

@@ -48,6 +48,7 @@ pub mod profile;
 mod projected;
 mod search;
 pub mod select;
+pub mod separable;
 pub mod structure;
 pub mod tones;
 pub mod unexplained;
@@ -71,6 +72,7 @@ pub use options::DiagnoseOptions;
 use outcome::recommend;
 pub use outcome::{Confounded, Correction, Diagnosis, Dropped, Finding, RecordDiagnosis, Stop};
 use select::Span;
+pub use separable::PositionOrTime;
 use std::borrow::Cow;
 
 /// Why a diagnosis could not be made.
@@ -337,7 +339,7 @@ pub fn diagnose(
     stage(4);
     let mut fit_model = |model: &Model| extend::fit(m, model, &cleaned, o, &gls);
     let extend::Extension {
-        findings,
+        mut findings,
         dropped,
         fit: extended_fit,
         kept,
@@ -401,6 +403,25 @@ pub fn diagnose(
         validation: &validation,
         weights: &weights,
     })?;
+    // A position error of an axis and a drift in time that these records cannot tell apart.
+    let found: Vec<(Term, usize, Vec<Term>)> = findings
+        .iter()
+        .filter_map(|f| {
+            let k = refined.iter().position(|r| r.0 == f.term)?;
+            Some((f.term, chosen[k].index, f.alternatives.clone()))
+        })
+        .collect();
+    let position_or_time = separable::find(&separable::Inputs {
+        m,
+        cols: &cols,
+        candidates: &candidates,
+        live: &live,
+        findings: &found,
+        model: &groups,
+        records: &cleaned,
+        alpha: o.alpha,
+    });
+    separable::name_alternatives(&mut findings, &position_or_time);
     let rows = n.max(1) as f64;
     let fit_rms = (
         (base_fit.fit.rss / rows).sqrt(),
@@ -455,5 +476,6 @@ pub fn diagnose(
         noise,
         adequacy,
         unexplained,
+        position_or_time,
     })
 }

@@ -185,7 +185,8 @@ pub fn check_model(m: &Machine, model: &Model) -> Result<(), PlanError> {
 }
 
 impl Plan {
-    /// The test spec called `name` among the machine's tests under this plan's clearance rule.
+    /// The test spec called `name` among the machine's tests under this plan's clearance rule
+    /// (`T-rev` and `T-back` included).
     ///
     /// # Errors
     /// [`GeneratorError::NoRotaryAxis`] or [`GeneratorError::UnknownTest`] (listing the
@@ -197,13 +198,11 @@ impl Plan {
                 machine: m.name.clone(),
             });
         }
-        generator::find_test(&all, name)
-            .cloned()
-            .ok_or_else(|| GeneratorError::UnknownTest {
-                machine: m.name.clone(),
-                name: name.trim().to_string(),
-                tests: all.iter().map(|t| t.name.clone()).collect(),
-            })
+        generator::lookup_test(&all, name).ok_or_else(|| GeneratorError::UnknownTest {
+            machine: m.name.clone(),
+            name: name.trim().to_string(),
+            tests: all.iter().map(|t| t.name.clone()).collect(),
+        })
     }
 
     /// Checks the plan's shape: at least one test, the first ball position [`BASE_BALL`],

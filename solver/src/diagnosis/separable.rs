@@ -41,7 +41,7 @@
 use super::columns::Columns;
 use super::select::{Span, f_p_value, f_statistic};
 use crate::fitting::campaign::Campaign;
-use model_spec::basis::{Basis, Carrier};
+pub use crate::fitting::plan::separate::{is_time, position_axis};
 use model_spec::terms::Term;
 use model_spec::{AxisKind, Machine};
 use nalgebra::{DMatrix, DVector};
@@ -120,23 +120,6 @@ pub(super) struct Inputs<'a> {
     pub records: &'a Campaign,
     /// The significance level of the F-tests.
     pub alpha: f64,
-}
-
-/// The axis of a term that depends on the position of its own axis (a harmonic, a polynomial,
-/// a period or a step of an error of that axis).
-pub fn position_axis(m: &Machine, t: &Term) -> Option<usize> {
-    match (t.effect.carrier(m), t.basis) {
-        (
-            Carrier::Axis(a),
-            Basis::Harmonic(_) | Basis::Poly(_) | Basis::Period(_) | Basis::Step(_),
-        ) => Some(a),
-        _ => None,
-    }
-}
-
-/// `true` for a term of time (`time:K`, `rate`, `exp:TAU`, `warmup:TAU`).
-pub fn is_time(t: &Term) -> bool {
-    t.basis.of_time()
 }
 
 /// The labels of the records of `c` on which axis `a` moves monotonically in time.
@@ -266,20 +249,9 @@ pub(super) fn find(inp: &Inputs) -> Vec<PositionOrTime> {
                 best = Some((score, o, x));
             }
         }
-        let Some(((collinear, cosine), o, x)) = best else {
+        let Some(((collinear, _), o, x)) = best else {
             continue;
         };
-        if std::env::var_os("RTEST_SEPARABLE_DEBUG").is_some() {
-            eprintln!(
-                "separable: {} ~ {} ({collinear} {cosine:.4}): {:.4} {:.4} p {:.2e} {:.2e}",
-                term.spelling(m),
-                inp.candidates[o].spelling(m),
-                x.time_in_position,
-                x.position_in_time,
-                x.position_beyond_time_p,
-                x.time_beyond_position_p
-            );
-        }
         if !collinear {
             continue;
         }

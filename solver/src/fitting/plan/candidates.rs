@@ -152,9 +152,9 @@ pub fn candidate_balls(
 }
 
 /// The tests a candidate may be: every test of the machine's generator under the plan's
-/// clearance rule (taken forward), then for every planned test, in plan order, the versions of
-/// it in the other orders (`T-rev`, `T-back` of a planned `T`; `T` and `T-back` of a planned
-/// `T-rev`), each once.
+/// clearance rule (taken forward), then for every planned test, in plan order, its reversed
+/// and there-and-back versions (`T-rev`, `T-back` of a planned `T`, `T-rev` or `T-back`: a
+/// repeat of a planned test is a candidate too), each once.
 pub fn candidate_tests(m: &Machine, plan: &Plan) -> Vec<TestSpec> {
     let forward = generator::tests_with(m, &plan.generator.clearance);
     let mut out = forward.clone();

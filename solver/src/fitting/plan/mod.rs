@@ -16,13 +16,16 @@
 //!   planned ball position and at positions moved from them by a fixed step along the ball's
 //!   offset symbols, each generated and checked; those the generator refuses are skipped, with
 //!   the reason;
-//! - [`choose`]: the criterion and the ranking of the candidates, best first.
+//! - [`choose`]: the criterion and the ranking of the candidates, best first;
+//! - [`separate`]: a position term of an axis and a time term the plan does not separate, and
+//!   the reversed or there-and-back test that separates them.
 //!
 //! `docs/plan.md` describes the method, the criterion and `rtest plan`.
 
 pub mod candidates;
 pub mod choose;
 pub mod predict;
+pub mod separate;
 
 use crate::fitting::campaign::design::{Design, design_matrix};
 use crate::fitting::least_squares::Tolerances;

@@ -28,6 +28,10 @@
 //!    its own zero and drifts always are).
 //! 5. The lack-of-fit test of what remains against the noise ([`adequacy`]), what remains
 //!    described ([`unexplained`]), and the verdict ([`verdict`]).
+//! 6. Position against time ([`separable`]): a finding that is an error of an axis's position
+//!    or a term of time, and a candidate of the other kind that the fitted records cannot tell
+//!    from it (the axis moving monotonically in time), reported with the test that separates
+//!    them.
 
 pub mod adequacy;
 mod columns;

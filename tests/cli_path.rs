@@ -19,15 +19,22 @@ fn the_list_names_every_test_with_one_line_each() {
     let dir = temp_dir_tagged("cli-path", "list");
     let out = ok(&dir, &["path", "--machine", "head-table-bc", "--list"]);
     let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines.len(), 4, "{out}");
+    assert_eq!(lines.len(), 10, "{out}");
     assert!(
         lines[0].starts_with("Tests of machine head-table-bc"),
         "{out}"
     );
-    assert!(lines[1].trim_start().starts_with("turn-B"), "{out}");
-    assert!(lines[2].trim_start().starts_with("turn-C"), "{out}");
+    // Every test, then its reversed and there-and-back versions.
+    assert!(lines[1].trim_start().starts_with("turn-B  "), "{out}");
+    assert!(lines[2].trim_start().starts_with("turn-B-rev  "), "{out}");
+    assert!(lines[3].trim_start().starts_with("turn-B-back  "), "{out}");
+    assert!(lines[4].trim_start().starts_with("turn-C  "), "{out}");
     assert!(
-        lines[3].contains("pair-B-C  C turns 0° .. 360° in 1.5° steps, B = -45·(1 − cos C)°"),
+        lines[7].contains("pair-B-C       C turns 0° .. 360° in 1.5° steps, B = -45·(1 − cos C)°"),
+        "{out}"
+    );
+    assert!(
+        lines[9].contains("pair-B-C-back  there and back (the poses forward, then reversed, the turning point once): C turns 0° .. 360° in 1.5° steps, B = -45·(1 − cos C)° (481 samples)"),
         "{out}"
     );
     // A machine without rotary axes says so.
@@ -67,10 +74,22 @@ fn the_list_names_every_test_with_one_line_each() {
     let json = read_json(&dir.join("list.json"));
     let tests = json["tests"].as_array().unwrap();
     let names: Vec<&str> = tests.iter().map(|t| t["name"].as_str().unwrap()).collect();
-    assert_eq!(names, ["K1", "K2", "K4", "turn-A", "turn-C", "pair-A-C"]);
-    assert_eq!(tests[5]["follower"]["amplitude_deg"], -45.0);
-    assert_eq!(tests[5]["samples"], 241);
-    assert_eq!(tests[3]["from_deg"], -90.0);
+    let forward: Vec<&str> = names.iter().copied().step_by(3).collect();
+    assert_eq!(forward, ["K1", "K2", "K4", "turn-A", "turn-C", "pair-A-C"]);
+    assert_eq!(&names[15..], ["pair-A-C", "pair-A-C-rev", "pair-A-C-back"]);
+    assert_eq!(tests[15]["follower"]["amplitude_deg"], -45.0);
+    assert_eq!(tests[15]["samples"], 241);
+    assert_eq!(tests[16]["samples"], 241);
+    assert_eq!(tests[17]["samples"], 481);
+    assert_eq!(
+        [
+            &tests[15]["order"],
+            &tests[16]["order"],
+            &tests[17]["order"]
+        ],
+        ["forward", "reversed", "there and back"]
+    );
+    assert_eq!(tests[9]["from_deg"], -90.0);
     assert!(tests.iter().all(|t| t["within_limits"] == true));
 }
 

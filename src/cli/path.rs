@@ -10,7 +10,7 @@ use output::{Outputs, Target};
 use solver::io::csv::{ReadOptions, format_record};
 use solver::record::Record;
 use solver::simulation::generator::{
-    self, Clearance, GeneratorError, GeneratorOptions, SampleProblem, TestKind, TestSpec,
+    self, Clearance, GeneratorError, GeneratorOptions, Order, SampleProblem, TestKind, TestSpec,
 };
 use solver::simulation::paths::parse_path;
 
@@ -19,7 +19,10 @@ The R-test tests of a machine, in the spirit of ISO 10791-6 (docs/paths.md): `tu
 rotary axis R (R turns over its range, a full turn where the range allows it, the other rotary \
 axes at 0°), `pair-R-S` for every two rotary axes (the primary turns, the secondary follows \
 base + a·(1 − cos φ), like the seed's K4), and on machines whose rotary axes are A and C the \
-seed's K1, K2, K4.
+seed's K1, K2, K4. Every test T also comes reversed, T-rev (the same poses from the last to the \
+first, times from 0 again), and there and back, T-back (the poses forward then reversed in one \
+record, the turning point once): an error of an axis that turns monotonically in time in T and a \
+drift in time explain the same readings on T alone, not on T with T-rev or on T-back.
 
 --list: the machine's tests, one line each (with --param: whether each stays within the strokes \
 at that ball position). --test NAME -o FILE: the test's path as a CSV in the measurement format \
@@ -176,8 +179,8 @@ pub fn poses(
         name: name.trim().to_string(),
         tests: all.iter().map(|t| t.name.clone()).collect(),
     };
-    let spec = match generator::find_test(&all, name) {
-        Some(s) => s.clone(),
+    let spec = match generator::lookup_test(&all, name) {
+        Some(s) => s,
         None if all.is_empty() => {
             return Err(generator_error(
                 &GeneratorError::NoRotaryAxis {
@@ -388,7 +391,7 @@ fn off_default_note(m: &Machine, record: &Record) -> String {
 /// `--list`: the tests of `m` under `opts`, each with whether it is generated within the limits
 /// at `params`; as text on standard output, or as JSON to `json`.
 fn list(json: Option<&Target>, m: &Machine, params: &[f64], opts: &GeneratorOptions) -> CliResult {
-    let tests = generator::tests_with(m, &opts.clearance);
+    let tests = generator::tests_with_orders(m, &opts.clearance);
     let status: Vec<Option<String>> = tests
         .iter()
         .map(|t| {
@@ -416,7 +419,12 @@ fn list(json: Option<&Target>, m: &Machine, params: &[f64], opts: &GeneratorOpti
                     "from_deg": sw.from_deg,
                     "to_deg": sw.to_deg,
                     "step_deg": sw.span_deg() / n as f64,
-                    "samples": n + 1,
+                    "samples": t.order.samples(n),
+                    "order": match t.order {
+                        Order::Forward => "forward",
+                        Order::Reversed => "reversed",
+                        Order::ThereAndBack => "there and back",
+                    },
                     "follower": sw.follower.map(|f| serde_json::json!({
                         "axis": m.axes[f.axis].name,
                         "base_deg": f.base_deg,

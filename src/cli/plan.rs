@@ -48,6 +48,12 @@ determined; then the smallest largest predicted uncertainty relative to its targ
 (--target-um, --target-urad, --target-ms); then the smallest sum of (std/target)^2. --top sets \
 how many candidates the ranking shows.
 
+Position against time: where the plan's model holds an error that depends on an axis's position \
+and a term of time (time:K, rate, exp:TAU, warmup:TAU) whose estimates correlate by 0.9 or more \
+(the axis moves monotonically in time on the planned tests), the plan says so and names the \
+reversed (T-rev) or there-and-back (T-back) version of a planned test T that separates them best. \
+The candidates include those versions of the planned tests.
+
 --json writes the report: {machine, fingerprint, model, terms, noise, zeroed, shared_setup, \
 balls, records, parameters: [{name, error, basis, owner, unit, determined, std}], rank, \
 columns, condition, confounded, near_confounded, targets, largest, suggestion: {criterion, \
@@ -391,6 +397,9 @@ pub fn run(args: &PlanArgs) -> CliResult {
         suggest_with_progress(&m, &model, &plan, &predicted, &set, &targets, &tol, &bar);
     drop(bar);
     let suggestion = suggestion.map_err(fail)?;
+    let separation =
+        plan::separate::separation(&m, &model, &plan, &predicted.prediction, &set, &noise, &tol)
+            .map_err(fail)?;
     let source = PlanSource {
         label: &label,
         base_model: args.model.as_deref(),
@@ -401,6 +410,7 @@ pub fn run(args: &PlanArgs) -> CliResult {
         candidates: &set,
         suggestion: &suggestion,
         targets: &targets,
+        separation: separation.as_ref(),
     };
     let report =
         PlanReport::new(&m, source).map_err(|e| CliError::computation(format!("plan: {e}")))?;

@@ -28,6 +28,10 @@
 //!    its own zero and drifts always are).
 //! 5. The lack-of-fit test of what remains against the noise ([`adequacy`]), what remains
 //!    described ([`unexplained`]), and the verdict ([`verdict`]).
+//! 6. Position against time ([`separable`]): a finding that is an error of an axis's position
+//!    or a term of time, and a candidate of the other kind that the fitted records cannot tell
+//!    from it (the axis moving monotonically in time), reported with the test that separates
+//!    them.
 
 pub mod adequacy;
 mod columns;
@@ -50,6 +54,7 @@ pub mod profile;
 mod projected;
 mod search;
 pub mod select;
+pub mod separable;
 pub mod structure;
 pub mod tones;
 pub mod unexplained;
@@ -73,6 +78,7 @@ pub use options::DiagnoseOptions;
 use outcome::recommend;
 pub use outcome::{Confounded, Correction, Diagnosis, Dropped, Finding, RecordDiagnosis, Stop};
 use select::Span;
+pub use separable::PositionOrTime;
 use std::borrow::Cow;
 
 /// Why a diagnosis could not be made.
@@ -461,6 +467,25 @@ pub fn diagnose(
         validation: &validation,
         weights: &weights,
     })?;
+    // A position error of an axis and a drift in time that these records cannot tell apart.
+    let found: Vec<(Term, usize, Vec<Term>)> = findings
+        .iter()
+        .filter_map(|f| {
+            let k = refined.iter().position(|r| r.0 == f.term)?;
+            Some((f.term, chosen[k].index, f.alternatives.clone()))
+        })
+        .collect();
+    let position_or_time = separable::find(&separable::Inputs {
+        m,
+        cols: &cols,
+        candidates: &candidates,
+        live: &live,
+        findings: &found,
+        model: &groups,
+        records: &cleaned,
+        alpha: o.alpha,
+    });
+    separable::name_alternatives(&mut findings, &position_or_time);
     let rows = n.max(1) as f64;
     let fit_rms = (
         (base_fit.fit.rss / rows).sqrt(),
@@ -521,6 +546,7 @@ pub fn diagnose(
         noise,
         adequacy,
         unexplained,
+        position_or_time,
     })
 }
 

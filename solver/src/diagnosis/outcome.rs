@@ -174,6 +174,10 @@ pub struct Diagnosis {
     pub adequacy: Result<adequacy::Adequacy, String>,
     /// What remains in each direction the adequacy test finds inconsistent with the noise.
     pub unexplained: Vec<unexplained::Unexplained>,
+    /// Position errors of axes and terms of time that the fitted records cannot tell apart (an
+    /// axis that moves monotonically in time), with the tests that separate them
+    /// ([`super::separable`]).
+    pub position_or_time: Vec<super::separable::PositionOrTime>,
 }
 
 /// The verdict on the extension, the held-out records named `names` (one per record, in

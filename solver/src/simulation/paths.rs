@@ -89,7 +89,7 @@ pub enum PathError {
 pub fn builtin_path(m: &Machine, name: &str) -> Option<Result<Record, PathError>> {
     let upper = name.trim().to_ascii_uppercase();
     let tests = generator::tests(m);
-    let Some(spec) = generator::find_test(&tests, name) else {
+    let Some(spec) = generator::lookup_test(&tests, name) else {
         return BUILTIN_PATHS
             .contains(&upper.as_str())
             .then(|| Err(not_ac(m, &upper, &tests)));
@@ -97,7 +97,7 @@ pub fn builtin_path(m: &Machine, name: &str) -> Option<Result<Record, PathError>
     Some(
         generator::generate_test(
             m,
-            spec,
+            &spec,
             &m.default_parameters(),
             &GeneratorOptions::default(),
         )

@@ -16,13 +16,16 @@
 //!   planned ball position and at positions moved from them by a fixed step along the ball's
 //!   offset symbols, each generated and checked; those the generator refuses are skipped, with
 //!   the reason;
-//! - [`choose`]: the criterion and the ranking of the candidates, best first.
+//! - [`choose`]: the criterion and the ranking of the candidates, best first;
+//! - [`separate`]: a position term of an axis and a time term the plan does not separate, and
+//!   the reversed or there-and-back test that separates them.
 //!
 //! `docs/plan.md` describes the method, the criterion and `rtest plan`.
 
 pub mod candidates;
 pub mod choose;
 pub mod predict;
+pub mod separate;
 
 use crate::fitting::campaign::design::{Design, design_matrix};
 use crate::fitting::least_squares::Tolerances;
@@ -185,7 +188,8 @@ pub fn check_model(m: &Machine, model: &Model) -> Result<(), PlanError> {
 }
 
 impl Plan {
-    /// The test spec called `name` among the machine's tests under this plan's clearance rule.
+    /// The test spec called `name` among the machine's tests under this plan's clearance rule
+    /// (`T-rev` and `T-back` included).
     ///
     /// # Errors
     /// [`GeneratorError::NoRotaryAxis`] or [`GeneratorError::UnknownTest`] (listing the
@@ -197,13 +201,11 @@ impl Plan {
                 machine: m.name.clone(),
             });
         }
-        generator::find_test(&all, name)
-            .cloned()
-            .ok_or_else(|| GeneratorError::UnknownTest {
-                machine: m.name.clone(),
-                name: name.trim().to_string(),
-                tests: all.iter().map(|t| t.name.clone()).collect(),
-            })
+        generator::lookup_test(&all, name).ok_or_else(|| GeneratorError::UnknownTest {
+            machine: m.name.clone(),
+            name: name.trim().to_string(),
+            tests: all.iter().map(|t| t.name.clone()).collect(),
+        })
     }
 
     /// Checks the plan's shape: at least one test, the first ball position [`BASE_BALL`],

@@ -221,6 +221,41 @@ pub struct ConfoundedReport {
     pub with: Vec<String>,
 }
 
+/// A position error of an axis and a term of time that the fitted records cannot tell apart
+/// ([`solver::diagnosis::separable`](crate::diagnosis::separable)).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PositionOrTimeReport {
+    /// The error of the axis that depends on its position (`EBB@harmonic:1`).
+    pub position: String,
+    /// The term of time (`BOC@rate`).
+    pub time: String,
+    /// Which of the two the selection chose.
+    pub chosen: String,
+    /// What the data say: `cannot be told apart`, `position preferred`, `time preferred`.
+    pub verdict: String,
+    /// The axis.
+    pub axis: String,
+    /// The fitted records (files) on which the axis moves monotonically in time.
+    pub monotonic: Vec<String>,
+    /// Cosine between what the time term explains and the position term's span, given the rest
+    /// of the model.
+    pub time_in_position: f64,
+    /// Cosine between what the position term explains and the time term's span.
+    pub position_in_time: f64,
+    /// The least cosine, both ways, at which the two are not told apart.
+    pub threshold: f64,
+    /// Raw F-test p-value of the position term added to the time term.
+    pub position_beyond_time_p: f64,
+    /// Raw F-test p-value of the time term added to the position term.
+    pub time_beyond_position_p: f64,
+    /// The tests that separate them (`turn-B-back`, `turn-B-rev`).
+    pub separating: Vec<String>,
+    /// The `rtest plan` command that checks the separation before measuring; absent for an
+    /// error of a linear axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plan_command: Option<String>,
+}
+
 /// The extended model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ExtendedModelReport {
@@ -319,6 +354,10 @@ pub struct DiagnosisReport {
     pub stop: StopReport,
     /// Candidates the extended model spans.
     pub confounded: Vec<ConfoundedReport>,
+    /// Position errors of axes and terms of time the fitted records cannot tell apart, with the
+    /// tests that separate them; absent when none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub position_or_time: Vec<PositionOrTimeReport>,
     /// The extended model.
     pub extended_model: ExtendedModelReport,
     /// The gain.
@@ -379,6 +418,79 @@ impl DiagnosisSource<'_> {
         .cloned()
         .unwrap_or_else(|| label.to_string())
     }
+}
+
+/// The entries of [`Diagnosis::position_or_time`], with the `rtest plan` command of each: the
+/// two terms planned on the axis's turn at the ball position of the first record on which the
+/// axis moves monotonically (`--param` for what differs from the description's defaults).
+fn position_or_time(
+    m: &Machine,
+    source: &DiagnosisSource,
+    d: &Diagnosis,
+) -> Result<Vec<PositionOrTimeReport>, NonFinite> {
+    use crate::diagnosis::separable::Verdict;
+    let defaults = m.default_parameters();
+    d.position_or_time
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let field = |what: &str| format!("position_or_time[{i}].{what}");
+            let plan_command = (!e.plan_arguments.is_empty()).then(|| {
+                let mut words = vec![
+                    "rtest".to_string(),
+                    "plan".into(),
+                    "--machine".into(),
+                    source.machine_source.to_string(),
+                ];
+                words.extend(e.plan_arguments.iter().cloned());
+                let params = e
+                    .monotonic
+                    .first()
+                    .and_then(|l| d.records.iter().find(|r| &r.label == l))
+                    .map(|r| r.params.clone())
+                    .unwrap_or_default();
+                let changed: Vec<String> = m
+                    .symbols
+                    .iter()
+                    .zip(&params)
+                    .zip(&defaults)
+                    .filter(|((_, x), y)| x.to_bits() != y.to_bits())
+                    .map(|((s, x), _)| format!("{}={}", s.name, model_spec::units::short(*x)))
+                    .collect();
+                if !changed.is_empty() {
+                    words.push("--param".into());
+                    words.push(changed.join(","));
+                }
+                words.join(" ")
+            });
+            Ok(PositionOrTimeReport {
+                position: e.position.spelling(m),
+                time: e.time.spelling(m),
+                chosen: e.chosen.spelling(m),
+                verdict: match e.verdict {
+                    Verdict::Undecided => "cannot be told apart",
+                    Verdict::Position => "position preferred",
+                    Verdict::Time => "time preferred",
+                }
+                .into(),
+                axis: e.axis.clone(),
+                monotonic: e.monotonic.iter().map(|l| source.file_of(d, l)).collect(),
+                time_in_position: finite(|| field("time_in_position"), e.time_in_position)?,
+                position_in_time: finite(|| field("position_in_time"), e.position_in_time)?,
+                threshold: crate::diagnosis::separable::COLLINEAR_COSINE,
+                position_beyond_time_p: finite(
+                    || field("position_beyond_time_p"),
+                    e.position_beyond_time_p,
+                )?,
+                time_beyond_position_p: finite(
+                    || field("time_beyond_position_p"),
+                    e.time_beyond_position_p,
+                )?,
+                separating: e.separating.clone(),
+                plan_command,
+            })
+        })
+        .collect()
 }
 
 fn spell(m: &Machine, ts: &[Term]) -> Vec<String> {
@@ -636,6 +748,7 @@ impl DiagnosisReport {
                     with: spell(m, &c.with),
                 })
                 .collect(),
+            position_or_time: position_or_time(m, source, d)?,
             extended_model: ExtendedModelReport {
                 label: d.extended_label(m, source.label),
                 terms: spell(m, &d.extended_terms().terms),

@@ -33,6 +33,7 @@
 use super::identify::{NearPairReport, poly_stroke};
 use super::{NonFinite, Ordered, finite, finite_opt};
 use crate::fitting::plan::choose::{Largest, Score, Suggestion, Targets};
+use crate::fitting::plan::separate::{NEARLY_CONFOUNDED, Separation};
 use crate::fitting::plan::{CandidateSet, Plan, PlannedCampaign, Prediction, ball_symbols};
 use crate::model::Model;
 use model_spec::Machine;
@@ -207,6 +208,42 @@ pub struct SuggestionReport {
     pub skipped: Vec<SkippedReport>,
 }
 
+/// A position column and a time column whose estimates the plan does not separate.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PositionTimeReport {
+    /// The position term's column (`EBB@harmonic:1:sin`).
+    pub position: String,
+    /// The time term's column (`BOC@time:1[turn-B]`).
+    pub time: String,
+    /// The correlation of their estimates (±1: confounded).
+    pub correlation: f64,
+}
+
+/// A reversed or there-and-back candidate and the largest correlation it leaves.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SeparatingReport {
+    /// The test (`turn-B-back`).
+    pub test: String,
+    /// Its ball position's name.
+    pub ball: String,
+    /// The item to add to `--paths`.
+    pub paths_item: String,
+    /// The largest absolute correlation of a position term and a time term with it.
+    pub largest_correlation: f64,
+}
+
+/// What the plan does not separate of position and time, and what separates it
+/// ([`crate::fitting::plan::separate`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SeparationReport {
+    /// The least absolute correlation counted as not separated.
+    pub threshold: f64,
+    /// The pairs at or above it, largest first.
+    pub pairs: Vec<PositionTimeReport>,
+    /// The reversed and there-and-back candidates, best first.
+    pub candidates: Vec<SeparatingReport>,
+}
+
 /// The plan report.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PlanReport {
@@ -255,6 +292,10 @@ pub struct PlanReport {
     pub largest: Option<LargestReport>,
     /// The suggestion.
     pub suggestion: SuggestionReport,
+    /// A position term and a time term the plan does not separate, and the reversed or
+    /// there-and-back test that separates them; absent when there is none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub separation: Option<SeparationReport>,
 }
 
 /// What a plan report is made of.
@@ -278,6 +319,8 @@ pub struct PlanSource<'a> {
     pub suggestion: &'a Suggestion,
     /// The targets.
     pub targets: &'a Targets,
+    /// What the plan does not separate of position and time, if anything.
+    pub separation: Option<&'a Separation>,
 }
 
 /// The criterion, for people.
@@ -406,7 +449,47 @@ impl PlanReport {
                 noise.sigma_mm[d] * UM_PER_MM,
             )?;
         }
+        let separation = source
+            .separation
+            .map(|sep| -> Result<SeparationReport, NonFinite> {
+                Ok(SeparationReport {
+                    threshold: NEARLY_CONFOUNDED,
+                    pairs: sep
+                        .pairs
+                        .iter()
+                        .map(|p| {
+                            Ok(PositionTimeReport {
+                                position: p.position.clone(),
+                                time: p.time.clone(),
+                                correlation: finite(
+                                    || "separation.pairs.correlation".into(),
+                                    p.correlation,
+                                )?,
+                            })
+                        })
+                        .collect::<Result<_, NonFinite>>()?,
+                    candidates: sep
+                        .candidates
+                        .iter()
+                        .map(|c| {
+                            let cand = &source.candidates.candidates[c.candidate];
+                            let ball = &source.candidates.balls[cand.ball].name;
+                            Ok(SeparatingReport {
+                                test: cand.test.clone(),
+                                ball: ball.clone(),
+                                paths_item: crate::fitting::plan::record_label(&cand.test, ball),
+                                largest_correlation: finite(
+                                    || "separation.candidates.largest_correlation".into(),
+                                    c.largest,
+                                )?,
+                            })
+                        })
+                        .collect::<Result<_, NonFinite>>()?,
+                })
+            })
+            .transpose()?;
         Ok(PlanReport {
+            separation,
             machine: m.name.clone(),
             fingerprint: m.fingerprint(),
             model: source.label.to_string(),

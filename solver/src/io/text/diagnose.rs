@@ -400,6 +400,72 @@ pub fn next_steps(r: &DiagnosisReport) -> String {
     out
 }
 
+/// The position errors of axes and the terms of time that the fitted records cannot tell apart
+/// (or where the data prefer the term the selection did not choose), with the test that
+/// separates them; empty when there is none.
+pub fn position_or_time(r: &DiagnosisReport) -> String {
+    let mut out = String::new();
+    for e in &r.position_or_time {
+        let other = if e.chosen == e.position {
+            &e.time
+        } else {
+            &e.position
+        };
+        let why = format!(
+            "{} moves monotonically in time on {}, so that there its position is a function of time: what each explains lies within the other's span to cosines {} and {} (given the rest of the model; nearly collinear from {} on)",
+            e.axis,
+            e.monotonic.join(", "),
+            fixed(e.time_in_position, 4),
+            fixed(e.position_in_time, 4),
+            fixed(e.threshold, 2),
+        );
+        let tests = format!(
+            "{} adds to {}: p = {}; {} adds to {}: p = {}",
+            words(&e.position),
+            words(&e.time),
+            p_value(e.position_beyond_time_p),
+            words(&e.time),
+            words(&e.position),
+            p_value(e.time_beyond_position_p),
+        );
+        let head = match e.verdict.as_str() {
+            "cannot be told apart" => format!(
+                "Cannot be told apart on these records: {} (an error of axis {} that depends on its position) and {} (a term of time). {why}, and neither adds significantly to the other ({tests}). The selection chose {}, {} is its alternative. A position error of an axis holds on every record, a drift is a record's own: {} is the physical reading, not confirmed by these records.",
+                words(&e.position),
+                e.axis,
+                words(&e.time),
+                words(&e.chosen),
+                words(other),
+                words(&e.position),
+            ),
+            _ => format!(
+                "The data prefer {} to {} ({}): {why}, and only the one preferred adds significantly ({tests}). The selection chose {}, which the extended model keeps; {} is its alternative: refit with it in its place, or confirm with the test below.",
+                words(other),
+                words(&e.chosen),
+                e.verdict,
+                words(&e.chosen),
+                words(other),
+            ),
+        };
+        out.push_str(&format!("\n{head}\n"));
+        if e.separating.is_empty() {
+            out.push_str(
+                "  To separate them, measure the same path reversed, or there and back in one record.\n",
+            );
+        } else {
+            out.push_str(&format!(
+                "  To separate them, measure {} (there and back in one record) or {} (the same poses reversed) with the campaign.\n",
+                e.separating[0],
+                e.separating.get(1).map_or("", String::as_str)
+            ));
+        }
+        if let Some(c) = &e.plan_command {
+            out.push_str(&format!("  Plan it first: {c}\n"));
+        }
+    }
+    out
+}
+
 /// Why the selection stopped, one line.
 pub fn stop(r: &DiagnosisReport) -> String {
     let best = r.stop.best_remaining.as_ref().map_or(String::new(), |t| {
@@ -524,6 +590,7 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
             .collect();
         out.push_str(&wrap(&items, "; ", "  ", 100));
     }
+    out.push_str(&position_or_time(r));
     out.push_str(&format!(
         "\nGain: residual RMS, base model {} → extended model {}:\n",
         r.base_model, r.extended_model.label

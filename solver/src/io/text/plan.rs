@@ -18,6 +18,53 @@ pub fn plan(r: &PlanReport, top: usize) -> String {
     out.push_str(&summary(r));
     out.push('\n');
     out.push_str(&suggestion(r, top));
+    out.push_str(&separation(r));
+    out
+}
+
+/// A position term and a time term the plan does not separate, and the reversed or
+/// there-and-back test that does; empty when there is none.
+fn separation(r: &PlanReport) -> String {
+    let Some(sep) = &r.separation else {
+        return String::new();
+    };
+    let pairs: Vec<String> = sep
+        .pairs
+        .iter()
+        .map(|p| {
+            format!(
+                "{} and {} (correlation {})",
+                p.position,
+                p.time,
+                fixed(p.correlation, 3)
+            )
+        })
+        .collect();
+    let mut out = format!(
+        "\nPosition against time: the plan does not separate {} (the estimates of an error that depends on an axis's position and of a term of time correlate by {} or more: the axis moves monotonically in time).\n",
+        pairs.join(", "),
+        fixed(sep.threshold, 2)
+    );
+    match sep.candidates.first() {
+        Some(best) => {
+            out.push_str(&format!(
+                "Separation: add {} to --paths: the largest such correlation is then {}",
+                best.paths_item,
+                fixed(best.largest_correlation, 3)
+            ));
+            let others: Vec<String> = sep.candidates[1..]
+                .iter()
+                .map(|c| format!("{} {}", c.paths_item, fixed(c.largest_correlation, 3)))
+                .collect();
+            if !others.is_empty() {
+                out.push_str(&format!(" (the others: {})", others.join(", ")));
+            }
+            out.push_str(".\n");
+        }
+        None => out.push_str(
+            "Separation: no reversed or there-and-back version of a planned test could be generated.\n",
+        ),
+    }
     out
 }
 

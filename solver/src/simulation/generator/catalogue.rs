@@ -73,6 +73,55 @@ impl Sweep {
     }
 }
 
+/// In which order a test takes its poses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Order {
+    /// As the sweep goes: the primary from `from_deg` to `to_deg`.
+    Forward,
+    /// The same poses in the reverse order (`T-rev`), times from 0 again: the primary from
+    /// `to_deg` to `from_deg`.
+    Reversed,
+    /// There and back in one record (`T-back`): the forward poses, then the same poses
+    /// reversed, the turning point (the last forward pose) taken once.
+    ThereAndBack,
+}
+
+impl Order {
+    /// The suffix of the test's name: none, `-rev`, `-back`.
+    pub fn suffix(self) -> &'static str {
+        match self {
+            Order::Forward => "",
+            Order::Reversed => "-rev",
+            Order::ThereAndBack => "-back",
+        }
+    }
+
+    /// The number of samples of a sweep of `steps` steps taken in this order: `steps + 1`,
+    /// or `2·steps + 1` there and back.
+    pub fn samples(self, steps: usize) -> usize {
+        match self {
+            Order::Forward | Order::Reversed => steps.saturating_add(1),
+            Order::ThereAndBack => steps.saturating_mul(2).saturating_add(1),
+        }
+    }
+
+    /// `poses` (the forward order) arranged in this order.
+    pub fn arrange<T: Clone>(self, mut poses: Vec<T>) -> Vec<T> {
+        match self {
+            Order::Forward => poses,
+            Order::Reversed => {
+                poses.reverse();
+                poses
+            }
+            Order::ThereAndBack => {
+                let back: Vec<T> = poses.iter().rev().skip(1).cloned().collect();
+                poses.extend(back);
+                poses
+            }
+        }
+    }
+}
+
 /// A test of a machine.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TestSpec {
@@ -86,6 +135,49 @@ pub struct TestSpec {
     pub moves: Vec<AxisId>,
     /// The motion.
     pub sweep: Sweep,
+    /// The order of its poses: forward for the catalogue's tests, reversed (`T-rev`) or there
+    /// and back (`T-back`) for their variants ([`TestSpec::in_order`]).
+    pub order: Order,
+}
+
+impl TestSpec {
+    /// This test (taken forward) with its poses in `order`: named `T-rev` or `T-back` (`T` its
+    /// name), described as such, the same motion, the same checks.
+    pub fn in_order(&self, order: Order) -> TestSpec {
+        let n = super::sweep::steps(self.sweep.span_deg(), self.sweep.default_step_deg);
+        let forward = Order::Forward.samples(n);
+        let body = self
+            .description
+            .strip_suffix(&format!(" ({forward} samples)"))
+            .unwrap_or(&self.description);
+        let count = order.samples(n);
+        let description = match order {
+            Order::Forward => format!("{body} ({count} samples)"),
+            Order::Reversed => {
+                format!(
+                    "reversed (the same poses from the last to the first): {body} ({count} samples)"
+                )
+            }
+            Order::ThereAndBack => format!(
+                "there and back (the poses forward, then reversed, the turning point once): {body} ({count} samples)"
+            ),
+        };
+        TestSpec {
+            name: format!("{}{}", self.name, order.suffix()),
+            description,
+            order,
+            ..self.clone()
+        }
+    }
+}
+
+/// Every test of `tests` (taken forward) followed by its reversed and there-and-back versions:
+/// `T`, `T-rev`, `T-back`.
+pub fn with_orders(tests: &[TestSpec]) -> Vec<TestSpec> {
+    tests
+        .iter()
+        .flat_map(|t| [Order::Forward, Order::Reversed, Order::ThereAndBack].map(|o| t.in_order(o)))
+        .collect()
 }
 
 /// The value of rotary axis `a` where it stands still: 0°, or the end of its range nearest 0°.
@@ -205,6 +297,7 @@ pub fn catalogue(m: &Machine, clearance: &Clearance) -> Vec<TestSpec> {
             kind: TestKind::Turn,
             moves: vec![a],
             sweep,
+            order: Order::Forward,
         });
     }
     for (i, &a) in rotary.iter().enumerate() {
@@ -256,6 +349,7 @@ fn pair(
         kind: TestKind::Pair,
         moves: vec![primary, secondary],
         sweep,
+        order: Order::Forward,
     }
 }
 
@@ -302,6 +396,7 @@ fn seed_tests(m: &Machine, rotary: &[AxisId]) -> Vec<TestSpec> {
             kind: TestKind::Seed,
             moves,
             sweep,
+            order: Order::Forward,
         })
         .collect()
 }

@@ -11,6 +11,11 @@
 //!   the strokes and ranges, within the clearance rule ([`clearance`]), with the nest on the
 //!   ball. A sample that is not is an error naming it: nothing is clipped.
 //!
+//! Every test `T` has two versions of the same poses in another order: `T-rev`, reversed (times
+//! from 0 again), and `T-back`, there and back in one record (the turning point once): an error
+//! of an axis that moves monotonically in time in `T` and a drift in time cannot be told apart
+//! on `T` alone; on `T` with `T-rev`, or on `T-back`, they can ([`Order`], [`lookup_test`]).
+//!
 //! Files: [`catalogue`] (the tests and their sweeps), [`clearance`] (the rule),
 //! [`mod@sweep`] (samples and checks).
 
@@ -19,7 +24,8 @@ pub mod clearance;
 pub mod sweep;
 
 pub use catalogue::{
-    DEFAULT_PAIR_STEP_DEG, DEFAULT_STEP_DEG, Follower, SEED_TESTS, Sweep, TestKind, TestSpec,
+    DEFAULT_PAIR_STEP_DEG, DEFAULT_STEP_DEG, Follower, Order, SEED_TESTS, Sweep, TestKind,
+    TestSpec, with_orders,
 };
 pub use clearance::{Clearance, ball_height_mm};
 
@@ -262,10 +268,33 @@ pub fn tests_with(m: &Machine, clearance: &Clearance) -> Vec<TestSpec> {
     catalogue::catalogue(m, clearance)
 }
 
+/// The tests of machine `m` under the clearance rule `clearance` with their reversed and
+/// there-and-back versions: `T`, `T-rev`, `T-back` for every test `T` of [`tests_with`].
+pub fn tests_with_orders(m: &Machine, clearance: &Clearance) -> Vec<TestSpec> {
+    with_orders(&tests_with(m, clearance))
+}
+
 /// The test called `name` (without regard to case) among `tests`.
 pub fn find_test<'t>(tests: &'t [TestSpec], name: &str) -> Option<&'t TestSpec> {
     let name = name.trim();
     tests.iter().find(|t| t.name.eq_ignore_ascii_case(name))
+}
+
+/// The test called `name` (without regard to case) among `tests` or, for `T-rev` and `T-back`
+/// with `T` among `tests`, its reversed or there-and-back version ([`TestSpec::in_order`]).
+pub fn lookup_test(tests: &[TestSpec], name: &str) -> Option<TestSpec> {
+    if let Some(t) = find_test(tests, name) {
+        return Some(t.clone());
+    }
+    let name = name.trim();
+    let lower = name.to_ascii_lowercase();
+    [Order::Reversed, Order::ThereAndBack]
+        .into_iter()
+        .find_map(|order| {
+            let stem = lower.strip_suffix(order.suffix())?;
+            let base = find_test(tests, &name[..stem.len()])?;
+            (base.order == Order::Forward).then(|| base.in_order(order))
+        })
 }
 
 /// Checks the options: a finite step above 0, a finite period above 0, a largest tilt from 0
@@ -362,14 +391,14 @@ pub fn generate(
             machine: m.name.clone(),
         });
     }
-    let Some(spec) = find_test(&all, name) else {
+    let Some(spec) = lookup_test(&all, name) else {
         return Err(GeneratorError::UnknownTest {
             machine: m.name.clone(),
             name: name.trim().to_string(),
             tests: all.iter().map(|t| t.name.clone()).collect(),
         });
     };
-    generate_test(m, spec, params, opts)
+    generate_test(m, &spec, params, opts)
 }
 
 /// The record of test `spec` (from [`tests_with`] for `m`) at the kinematic parameters

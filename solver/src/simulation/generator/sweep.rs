@@ -172,7 +172,7 @@ pub(crate) fn generate(
         });
     }
     let n = steps(span, step_deg);
-    if n > super::MAX_SAMPLES - 1 {
+    if spec.order.samples(n) > super::MAX_SAMPLES {
         return Err(GeneratorError::TooManySamples {
             test: spec.name.clone(),
             span_deg: span,
@@ -181,7 +181,9 @@ pub(crate) fn generate(
         });
     }
     let gauge = TiltGauge::new(m);
-    let poses = pair_degrees(m, &gauge, spec, n, clearance);
+    let poses = spec
+        .order
+        .arrange(pair_degrees(m, &gauge, spec, n, clearance));
     let vm = VirtualMachine::new(m);
     let place = |i: usize, deg: &[f64]| SamplePlace {
         test: spec.name.clone(),

@@ -393,7 +393,16 @@ pub fn run_with(seed: u64, o: &DiagnoseOptions) -> Study {
         records: Vec::new(),
     };
     progress(&format!("noise seed {seed}: diagnosis"));
-    let d: Diagnosis = diagnose(&m, &reduced, &c, &none, o, &Unwatched).unwrap();
+    // The diagnosis's stages as they begin, with the time (its speed: BENCHMARKS.md §8).
+    let stages = |what: &str, done: u64, _total: u64| {
+        if what == "diagnosis" {
+            let stage = solver::diagnosis::STAGES
+                .get(done as usize)
+                .unwrap_or(&"done");
+            progress(&format!("noise seed {seed}: diagnosis: {stage}"));
+        }
+    };
+    let d: Diagnosis = diagnose(&m, &reduced, &c, &none, o, &stages).unwrap();
     let extended = d.extended_terms();
     let findings: Vec<String> = spelled(&m, &extended)[reduced.terms.len()..].to_vec();
 

@@ -17,6 +17,7 @@
 //! on the exact virtual machine before and after (the study is `solver/tests/full_loop/study.rs`,
 //! the test `solver/tests/full_loop.rs` asserts its gate).
 
+// The test `full_loop` uses the rest of the study.
 #[allow(dead_code)]
 #[path = "../tests/full_loop/study.rs"]
 mod study;

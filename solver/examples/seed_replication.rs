@@ -168,7 +168,7 @@ fn main() {
         ("A component errors (6)", Box::new(move |e| axis_is(e, "A"))),
         ("C component errors (6)", Box::new(move |e| axis_is(e, "C"))),
         (
-            "reading drift dx0, dz0 (time:1)",
+            "reading drift dx0, dz0 (rate)",
             Box::new(|e| matches!(e, Effect::SensorOffset(_))),
         ),
         ("everything (no noise)", Box::new(|_| true)),

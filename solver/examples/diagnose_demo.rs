@@ -12,6 +12,7 @@
 //! and two figures: the K1 residual along C before and after, and its spectrum against C.
 
 use model_spec::Machine;
+use model_spec::basis::Basis;
 use solver::diagnosis::{DiagnoseOptions, Diagnosis, diagnose, one_record};
 use solver::fitting::validate::{ValidateOptions, validate};
 use solver::io::progress::Unwatched;
@@ -63,18 +64,17 @@ fn main() {
     structure(&d.structure_before);
     println!("\nFindings:");
     for (k, f) in d.findings.iter().enumerate() {
-        let (scale, unit) = if f.term.effect.is_angular(&m) {
-            (1e6, "µrad")
-        } else {
-            (1e3, "µm")
-        };
+        // The term's own unit (µm, µrad; µm/s for a rate, ms for a lag), a rate to 4 places.
+        let scale = f.term.display_factor(&m);
+        let unit = f.term.unit(&m).replace("urad", "µrad").replace("um", "µm");
+        let dp = if f.term.basis == Basis::Rate { 4 } else { 2 };
         let v: Vec<String> = f
             .values
             .iter()
             .zip(&f.stds)
             .map(|(v, s)| match (v, s) {
-                (Some(v), Some(s)) => format!("{:.2} ± {:.2}", v * scale, s * scale),
-                (Some(v), None) => format!("{:.2}", v * scale),
+                (Some(v), Some(s)) => format!("{:.dp$} ± {:.dp$}", v * scale, s * scale),
+                (Some(v), None) => format!("{:.dp$}", v * scale),
                 _ => "not determined".into(),
             })
             .collect();

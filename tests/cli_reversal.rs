@@ -66,7 +66,7 @@ fn the_diagnosis_says_b_s_error_and_a_drift_cannot_be_told_apart_and_the_plan_se
     let out = ok(
         &dir,
         &words(
-            "diagnose --machine table-table-bc --model location --campaign c.toml --json d.json",
+            "diagnose --machine table-table-bc --model location --campaign c.toml --json d.json --report d.html",
         ),
     );
     assert!(
@@ -93,6 +93,17 @@ fn the_diagnosis_says_b_s_error_and_a_drift_cannot_be_told_apart_and_the_plan_se
         format!("rtest plan --machine table-table-bc --terms EBB@harmonic:1,{time} --paths turn-B")
     );
     assert!(out.contains(&format!("Plan it first: {command}")), "{out}");
+    // The HTML report says the same.
+    let html = std::fs::read_to_string(dir.join("d.html")).unwrap();
+    assert!(html.contains("Position against time:"), "{html}");
+    assert!(
+        html.contains("EBB@harmonic:1 (an error of B&#39;s position)"),
+        "{html}"
+    );
+    assert!(
+        html.contains(&format!("Plan it first: {command}")),
+        "{html}"
+    );
     // The finding names the other term as its alternative.
     let finding = d["findings"]
         .as_array()

@@ -163,6 +163,7 @@ pub fn write(
         );
         b.list(&lines);
     }
+    position_or_time(b, d);
     b.subheading("Gain");
     let mut rows = vec![gain_row("fitted", &d.gain.fit)];
     rows.extend(d.gain.validation.iter().map(|g| gain_row("held out", g)));
@@ -285,6 +286,38 @@ pub fn write(
 
 /// The records, when there is more to say than their files: several fitted records, or held-out
 /// records with parameters refitted on them (a new set-up's errors, their own zero and drifts).
+/// A position error of an axis and a term of time that the records cannot tell apart (or that
+/// the data tell apart against the selection's choice): both named, the records on which the
+/// axis moves one way in time, and the test that separates them.
+fn position_or_time(b: &mut Body, d: &DiagnosisReport) {
+    if d.position_or_time.is_empty() {
+        return;
+    }
+    let lines: Vec<String> = d
+        .position_or_time
+        .iter()
+        .map(|e| {
+            let mut line = format!(
+                "{} (an error of {}'s position) and {} (in time): {}; the selection chose {}; {} moves one way in time on {}. To separate them, measure {}.",
+                e.position,
+                e.axis,
+                e.time,
+                e.verdict,
+                e.chosen,
+                e.axis,
+                e.monotonic.join(", "),
+                e.separating.join(" or ")
+            );
+            if let Some(c) = &e.plan_command {
+                line.push_str(&format!(" Plan it first: {c}"));
+            }
+            line
+        })
+        .collect();
+    b.paragraph("Position against time:");
+    b.list(&lines);
+}
+
 fn records(b: &mut Body, d: &DiagnosisReport) {
     let fitted = d.records.iter().filter(|r| r.role == "fitted").count();
     let refitted = d.records.iter().any(|r| !r.refitted.is_empty());

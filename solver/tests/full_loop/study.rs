@@ -30,7 +30,6 @@ use solver::fitting::campaign::{
 };
 use solver::fitting::least_squares::Constraint;
 use solver::fitting::{IdentifyOptions, NoiseChoice, RefineOptions};
-use solver::io::progress::Unwatched;
 use solver::model::Model;
 use solver::simulation::exact::VirtualMachine;
 use solver::simulation::rng::Rng;
@@ -383,8 +382,17 @@ pub fn run(seed: u64) -> Study {
     run_with(seed, &DiagnoseOptions::default())
 }
 
-/// The whole loop at noise seed `seed`, the diagnosis with options `o`.
-pub fn run_with(seed: u64, o: &DiagnoseOptions) -> Study {
+/// The campaign at noise seed `seed` diagnosed with options `o` (base model `reduced`, nothing
+/// held out), the diagnosis's stages printed as they begin.
+struct Diagnosed {
+    m: Machine,
+    truth: Truth,
+    c: Campaign,
+    reduced: Model,
+    d: Diagnosis,
+}
+
+fn diagnosed(seed: u64, o: &DiagnoseOptions) -> Diagnosed {
     let m = seed_ac();
     let truth = budget(&m);
     let c = campaign(&m, &truth, seed);
@@ -402,7 +410,25 @@ pub fn run_with(seed: u64, o: &DiagnoseOptions) -> Study {
             progress(&format!("noise seed {seed}: diagnosis: {stage}"));
         }
     };
-    let d: Diagnosis = diagnose(&m, &reduced, &c, &none, o, &stages).unwrap();
+    let d = diagnose(&m, &reduced, &c, &none, o, &stages).unwrap();
+    Diagnosed {
+        m,
+        truth,
+        c,
+        reduced,
+        d,
+    }
+}
+
+/// The whole loop at noise seed `seed`, the diagnosis with options `o`.
+pub fn run_with(seed: u64, o: &DiagnoseOptions) -> Study {
+    let Diagnosed {
+        m,
+        truth,
+        c,
+        reduced,
+        d,
+    } = diagnosed(seed, o);
     let extended = d.extended_terms();
     let findings: Vec<String> = spelled(&m, &extended)[reduced.terms.len()..].to_vec();
 
@@ -483,23 +509,7 @@ pub fn run_with(seed: u64, o: &DiagnoseOptions) -> Study {
 pub fn additions(seed: u64) -> Vec<(String, Vec<String>, Figure)> {
     use model_spec::ErrorKind;
     use solver::model::Effect;
-    let m = seed_ac();
-    let truth = budget(&m);
-    let c = campaign(&m, &truth, seed);
-    let reduced = Model::of(&m, "reduced").unwrap();
-    let none = Campaign {
-        records: Vec::new(),
-    };
-    progress(&format!("noise seed {seed}: diagnosis"));
-    let d = diagnose(
-        &m,
-        &reduced,
-        &c,
-        &none,
-        &DiagnoseOptions::default(),
-        &Unwatched,
-    )
-    .unwrap();
+    let Diagnosed { m, truth, c, d, .. } = diagnosed(seed, &DiagnoseOptions::default());
     let extended = d.extended_terms();
     let axis_of = |e: usize| match m.catalogue[e].kind {
         ErrorKind::Component { axis, .. } => Some(m.axes[axis].name.clone()),

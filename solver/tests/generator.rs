@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::builtin;
+use common::{builtin, fixture};
 use model_spec::{Machine, parse_machine};
 use solver::io::csv::{ReadOptions, format_record};
 use solver::record::Record;
@@ -15,13 +15,6 @@ use solver::simulation::generator::{
     generate_test, tests, tests_with,
 };
 use solver::simulation::paths::{builtin_path, fill_linear_ik, parse_path, record_from_commands};
-
-/// A fixture machine of the repository, by its path from the workspace root.
-fn fixture(path: &str) -> Machine {
-    let file = format!("{}/../{path}", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(&file).expect("fixture");
-    parse_machine(&file, &text).expect("valid fixture")
-}
 
 /// Every built-in machine and every fixture machine with rotary axes.
 fn machines() -> Vec<Machine> {

@@ -2,18 +2,15 @@
 //! same poses in the reverse order, or forward then reversed in one record with the turning
 //! point once, times from 0; the same checks, the failing sample counted in their own order.
 
-use model_spec::{Machine, parse_machine};
+mod common;
+
+use common::fixture;
+use model_spec::Machine;
 use solver::record::Record;
 use solver::simulation::generator::{
     GeneratorError, GeneratorOptions, MAX_SAMPLES, Order, generate, generate_test, lookup_test,
     tests, tests_with_orders,
 };
-
-fn fixture(path: &str) -> Machine {
-    let file = format!("{}/../{path}", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(&file).expect("fixture");
-    parse_machine(&file, &text).expect("valid fixture")
-}
 
 /// Every built-in machine and the fixture machines with rotary axes.
 fn machines() -> Vec<Machine> {

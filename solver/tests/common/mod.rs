@@ -60,6 +60,13 @@ pub fn builtin(name: &str) -> Machine {
     model_spec::builtin(name).expect("built-in").expect("valid")
 }
 
+/// A fixture machine of the repository, by its path from the workspace root.
+pub fn fixture(path: &str) -> Machine {
+    let file = format!("{}/../{path}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&file).expect("fixture");
+    model_spec::parse_machine(&file, &text).expect("valid fixture")
+}
+
 /// The catalogue id of `name` on `m`.
 pub fn id(m: &Machine, name: &str) -> usize {
     m.error_by_name(name)

@@ -59,7 +59,9 @@ balls, records, parameters: [{name, error, basis, owner, unit, determined, std}]
 columns, condition, confounded, near_confounded, targets, largest, suggestion: {criterion, \
 interest, step_mm, positions, evaluated, ranking: [{place, test, ball, paths_item, samples, \
 ball_arg, newly_determined, rank, columns, determined, largest, sum_squares}], skipped: [{test, ball, \
-reason}]}}; `null` only where the plan does not determine a value.
+reason}]}, separation (when a position term and a time term are not separated): {threshold, \
+pairs: [{position, time, correlation}], candidates: [{test, ball, paths_item, \
+largest_correlation}]}}; `null` only where the plan does not determine a value.
 
 Progress: on a terminal, a bar on standard error follows the candidates evaluated once the work \
 has run half a second (RTEST_PROGRESS_DELAY_MS sets the delay, in ms) and is cleared when it \

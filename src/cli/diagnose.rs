@@ -51,9 +51,8 @@ interval. A finding beyond --budget is 'implausible': not a cause, not in the ex
 --validate file (exact prediction, with only what the fits determine: a file whose prediction \
 needs an undetermined combination is flagged and not counted); residual RMS before and after, \
 µm. Each finding is then confirmed on its own: its held-out gain given the other findings must \
-exceed twice a spurious gain's standard deviation; a finding not confirmed has up to three of \
-its alternatives tried in its place, and one the held-out files confirm clearly better replaces \
-it. The extended model holds the confirmed findings. With no --validate and several --data \
+exceed twice a spurious gain's standard deviation; a finding with alternatives has up to five \
+of them tried in its place, and one the held-out files confirm clearly better replaces it. The extended model holds the confirmed findings. With no --validate and several --data \
 files, each file is predicted by the fit on the others instead.
 7. Verdict: the residual of the extended model on every file is tested against the noise \
 (parametric bootstrap; 'down to the noise' only when it passes); where it fails, what remains is \

@@ -241,5 +241,22 @@ fn a_bad_machine_file_is_named_with_its_line_and_nothing_is_written() {
         2,
         &["--model", "`nope`"],
     );
-    assert_eq!(entries(&tmp), ["bad.toml"]);
+    // A text-direction control in the description (rustc refuses it in the crate's comments).
+    let reordered = TRUNNION.replacen(
+        "description = \"Five-axis",
+        "description = \"x\\u202eFive-axis",
+        1,
+    );
+    std::fs::write(tmp.join("reordered.toml"), reordered).unwrap();
+    fails(
+        &tmp,
+        &["generate", "--machine", "reordered.toml", "--crate", "out"],
+        1,
+        &[
+            "--machine",
+            "reordered.toml:8:15",
+            "description holds U+202E at character 2",
+        ],
+    );
+    assert_eq!(entries(&tmp), ["bad.toml", "reordered.toml"]);
 }

@@ -83,8 +83,7 @@ pub enum RawDirection {
 #[serde(deny_unknown_fields)]
 pub struct RawMachine {
     pub name: Option<Spanned<String>>,
-    #[serde(default)]
-    pub description: String,
+    pub description: Option<Spanned<String>>,
     #[serde(default)]
     pub symbols: BTreeMap<Spanned<String>, Spanned<Num>>,
     #[serde(default)]
@@ -125,7 +124,6 @@ pub struct RawErrors {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawModel {
-    #[serde(default)]
-    pub description: String,
+    pub description: Option<Spanned<String>>,
     pub errors: Option<Spanned<Vec<Spanned<String>>>>,
 }

@@ -113,6 +113,80 @@ pub fn decode_text(file_name: &str, mut bytes: Vec<u8>) -> Result<String, TextEr
         }
     })
 }
+/// Why a free text of a description (a machine's, a sub-model's or an instrument's
+/// `description`) is refused, or `None` when it is accepted. Refused: the text-direction
+/// controls U+202A–U+202E and U+2066–U+2069, which make text display in another order than it
+/// is stored (rustc refuses them in generated code's comments and literals, and a terminal or
+/// a report would show a misleading text), and control characters other than a tab or a line
+/// break. The reason names the code point and its position, counted in characters from 1.
+///
+/// ```
+/// use model_spec::text::free_text_refusal;
+/// assert_eq!(free_text_refusal("Five-axis mill\n(trunnion)"), None);
+/// assert_eq!(
+///     free_text_refusal("x\u{202e}y").unwrap(),
+///     "holds U+202E at character 2, a text-direction control (it shows the text in another order than it is stored): remove it"
+/// );
+/// ```
+pub fn free_text_refusal(text: &str) -> Option<String> {
+    let (at, c) = text.chars().enumerate().find(|&(_, c)| refused(c))?;
+    let what = if is_text_direction_control(c) {
+        "a text-direction control (it shows the text in another order than it is stored)"
+    } else {
+        "a control character"
+    };
+    Some(format!(
+        "holds U+{:04X} at character {}, {what}: remove it",
+        u32::from(c),
+        at + 1
+    ))
+}
+
+/// A description's text as a validator takes it: trimmed, empty when there is none, or the
+/// span of the TOML value and why it is refused ([`free_text_refusal`]).
+pub fn description_text(
+    raw: Option<&toml::Spanned<String>>,
+) -> Result<String, (std::ops::Range<usize>, String)> {
+    let Some(raw) = raw else {
+        return Ok(String::new());
+    };
+    match free_text_refusal(raw.get_ref()) {
+        None => Ok(raw.get_ref().trim().to_string()),
+        Some(why) => Err((raw.span(), format!("description {why}"))),
+    }
+}
+
+/// `text` with every character a description may not hold ([`free_text_refusal`]) written
+/// as `<U+XXXX>`, for a description rtest writes from text it did not choose (a file name).
+///
+/// ```
+/// use model_spec::text::{free_text_refusal, visible_text};
+/// assert_eq!(visible_text("a\u{7}b\u{202e}\tc"), "a<U+0007>b<U+202E>\tc");
+/// assert_eq!(free_text_refusal(&visible_text("a\u{7}b\u{202e}")), None);
+/// ```
+pub fn visible_text(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if refused(c) {
+                format!("<U+{:04X}>", u32::from(c))
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
+/// A character no description may hold: a text-direction control, or a control character
+/// other than a tab or a line break.
+fn refused(c: char) -> bool {
+    is_text_direction_control(c) || (c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
+}
+
+/// The bidirectional embedding, override and isolate controls (U+202A–U+202E, U+2066–U+2069).
+fn is_text_direction_control(c: char) -> bool {
+    matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')
+}
+
 /// `pieces` joined by single spaces into lines of at most `width` characters, greedily; lines
 /// after the first start with `indent` (counted in the width). A piece longer than a line stays
 /// whole on a line of its own. No piece gives one empty line.

@@ -103,7 +103,8 @@ fn wrapped(items: &[String]) -> String {
 }
 
 /// The machine description `text` of `m` with a sub-model of `terms` appended, described by
-/// `description` (trimmed, as descriptions are read). Returns the model's name and the new
+/// `description` (trimmed, as descriptions are read; a character a description may not hold
+/// is written `<U+XXXX>`, [`crate::text::visible_text`]). Returns the model's name and the new
 /// text.
 ///
 /// The model is called `extended`, or `extended2`, `extended3`, … if the name is taken. Each
@@ -142,7 +143,7 @@ pub fn append_model(
         parsed.push(term);
     }
     let name = free_name(m);
-    let description = description.trim();
+    let description = crate::text::visible_text(description.trim());
     let items: Vec<String> = parsed.iter().map(|t| toml_string(&t.spelling(m))).collect();
     let mut out = text.to_string();
     if !out.is_empty() && !out.ends_with('\n') {
@@ -150,7 +151,7 @@ pub fn append_model(
     }
     out.push_str(&format!(
         "\n# Model {name}, appended by rtest.\n[models.{name}]\ndescription = {}\nerrors = [\n{}]\n",
-        toml_string(description),
+        toml_string(&description),
         wrapped(&items)
     ));
 
@@ -164,7 +165,7 @@ pub fn append_model(
     let mut without = back;
     let model = without.models.remove(&name);
     let expected = SubModel {
-        description: description.to_string(),
+        description: description.clone(),
         errors: errors_of(&parsed),
         terms: parsed,
     };

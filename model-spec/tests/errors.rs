@@ -1225,3 +1225,45 @@ fn an_inclined_linear_axis_leading_the_squareness_order_is_reported_at_the_axis(
         assert!(m.error_by_name(name).is_some(), "{name}");
     }
 }
+
+// ---------------------------------------------------------------- free text
+
+/// A description holding a text-direction control (written as a TOML escape or as the
+/// character itself) is refused where it stands: rustc refuses such a character in the
+/// comments of the generated code, and a terminal would show the text reordered.
+#[test]
+fn a_description_with_a_text_direction_control_is_refused() {
+    let why = "a text-direction control (it shows the text in another order than it is stored): remove it";
+    check(
+        &edit(
+            r#"description = "test machine""#,
+            r#"description = "x\u202e""#,
+        ),
+        &format!("m.toml:2:15: description holds U+202E at character 2, {why}"),
+    );
+    check(
+        &edit(
+            r#"description = "location errors of C""#,
+            "description = \"C\u{2067}\"",
+        ),
+        &format!("m.toml:53:15: description holds U+2067 at character 2, {why}"),
+    );
+    check(
+        &edit(
+            r#"description = "test machine""#,
+            r#"description = "bell\u0007""#,
+        ),
+        "m.toml:2:15: description holds U+0007 at character 5, a control character: remove it",
+    );
+    // Line breaks and tabs are text.
+    let m = parse_machine(
+        "m.toml",
+        &edit(
+            r#"description = "test machine""#,
+            r#"description = """test\tmachine
+on two lines""""#,
+        ),
+    )
+    .unwrap();
+    assert_eq!(m.description, "test\tmachine\non two lines");
+}

@@ -70,6 +70,13 @@ fn every_bad_field_names_its_line_and_column() {
             "i.toml:1:8: instrument name `a b` must be letters, digits, `-` or `_`",
         ),
         (
+            GOOD.replace(
+                "name = \"t\"\n",
+                "name = \"t\"\ndescription = \"\\u202d\"\n",
+            ),
+            "i.toml:2:15: description holds U+202D at character 1, a text-direction control (it shows the text in another order than it is stored): remove it",
+        ),
+        (
             GOOD.replace("ball_radius_mm = 12.7\n", ""),
             "i.toml:1:8: instrument `t` has no `ball_radius_mm`",
         ),

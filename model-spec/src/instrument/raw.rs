@@ -10,8 +10,7 @@ use toml::Spanned;
 #[serde(deny_unknown_fields)]
 pub(super) struct RawInstrument {
     pub name: Option<Spanned<String>>,
-    #[serde(default)]
-    pub description: String,
+    pub description: Option<Spanned<String>>,
     pub ball_radius_mm: Option<Spanned<Num>>,
     pub frame: Option<Spanned<String>>,
     pub sensor: Option<Spanned<Vec<Spanned<RawSensor>>>>,

@@ -142,7 +142,7 @@ impl V<'_> {
         }
         let instrument = Instrument {
             name: name.get_ref().clone(),
-            description: raw.description.trim().to_string(),
+            description: self.description(raw.description.as_ref())?,
             ball_radius_mm: ball,
             frame,
             sensors,
@@ -158,6 +158,11 @@ impl V<'_> {
             );
         }
         Ok(instrument)
+    }
+
+    /// The `description`, trimmed; empty when there is none ([`crate::text::description_text`]).
+    fn description(&self, raw: Option<&Spanned<String>>) -> Res<String> {
+        crate::text::description_text(raw).or_else(|(span, why)| self.err(span, why))
     }
 
     fn instrument_name(&self, name: &Spanned<String>) -> Res<()> {

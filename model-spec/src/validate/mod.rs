@@ -112,7 +112,7 @@ impl Validator<'_> {
         self.symbols_not_measurement_effects(&raw_symbols)?;
         let mut machine = Machine {
             name,
-            description: raw.description.trim().to_string(),
+            description: self.description(raw.description.as_ref())?,
             symbols,
             axes,
             work,

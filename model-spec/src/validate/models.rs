@@ -32,7 +32,7 @@ impl Validator<'_> {
             machine.models.insert(
                 n.clone(),
                 SubModel {
-                    description: model.get_ref().description.trim().to_string(),
+                    description: self.description(model.get_ref().description.as_ref())?,
                     errors,
                     terms,
                 },

@@ -65,6 +65,12 @@ impl Validator<'_> {
         )
     }
 
+    /// A `description` (of the machine or a sub-model), trimmed; empty when there is none
+    /// ([`crate::text::description_text`]).
+    pub(super) fn description(&self, raw: Option<&Spanned<String>>) -> Res<String> {
+        crate::text::description_text(raw).or_else(|(span, why)| self.err(span, why))
+    }
+
     /// The machine's name, trimmed: letters, digits, `-` or `_`, not too long.
     pub(super) fn machine_name(&self, raw_name: &Spanned<String>) -> Res<String> {
         self.name_length("machine name", raw_name)?;

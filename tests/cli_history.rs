@@ -867,3 +867,71 @@ fn bad_history_inputs_are_refused_and_the_database_left_as_it_is() {
         "check 1: fine\n"
     );
 }
+
+/// A history in a directory one may not write, the file read-only too (a shared drive, an
+/// archive): `rtest history` reads it and leaves nothing beside it; recording into it is
+/// refused. Run as an unprivileged user (through `setpriv` when the tests run as root, whom
+/// permissions do not stop).
+#[test]
+fn a_history_in_a_directory_one_may_not_write_is_read() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = temp_dir("read-only");
+    for k in 1..=2u32 {
+        let name = format!("k4-{k}.csv");
+        k4(&dir, &name, 10.0, u64::from(k));
+        record(&dir, &name, "M123", &week(k));
+    }
+    let ro = dir.join("ro");
+    std::fs::create_dir(&ro).unwrap();
+    std::fs::copy(dir.join("h.sqlite"), ro.join("h.sqlite")).unwrap();
+    let before = std::fs::read(ro.join("h.sqlite")).unwrap();
+    let mode = |p: &Path, m: u32| std::fs::set_permissions(p, std::fs::Permissions::from_mode(m));
+    mode(&ro.join("h.sqlite"), 0o444).unwrap();
+    mode(&ro, 0o555).unwrap();
+    let root = std::process::Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| o.stdout.trim_ascii() == b"0");
+    let as_user = |args: &[&str]| {
+        let bin = env!("CARGO_BIN_EXE_rtest");
+        let mut c = if root {
+            let mut c = std::process::Command::new("setpriv");
+            c.args([
+                "--reuid=65534",
+                "--regid=65534",
+                "--clear-groups",
+                "--",
+                bin,
+            ]);
+            c
+        } else {
+            std::process::Command::new(bin)
+        };
+        c.args(args).current_dir(&*dir).output().expect("rtest runs")
+    };
+    let listed = as_user(&["history", "--db", "ro/h.sqlite"]);
+    let out = String::from_utf8_lossy(&listed.stdout).into_owned();
+    let err = String::from_utf8_lossy(&listed.stderr).into_owned();
+    assert!(listed.status.success(), "{out}{err}");
+    assert!(out.contains("1 machine, 2 checks"), "{out}");
+    let recorded = as_user(&[
+        "identify",
+        "--machine",
+        "seed-ac",
+        "--model",
+        "reduced",
+        "--data",
+        "k4-1.csv",
+        "--record",
+        "--db",
+        "ro/h.sqlite",
+        "--machine-id",
+        "M123",
+    ]);
+    let err = String::from_utf8_lossy(&recorded.stderr).into_owned();
+    assert_eq!(recorded.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot be written"), "{err}");
+    assert_eq!(entries(&ro), ["h.sqlite"]);
+    assert_eq!(std::fs::read(ro.join("h.sqlite")).unwrap(), before);
+    mode(&ro, 0o755).unwrap();
+}

@@ -132,6 +132,10 @@ fn a_version_1_file_is_migrated() {
             .unwrap();
         assert_eq!(mode, "delete");
     }
+    // Opened for reading, an older file is migrated first (reading needs the new column).
+    let store = Store::open_for_reading(&path).unwrap();
+    assert_eq!(store.checks(None).unwrap().len(), 1);
+    drop(store);
     let mut store = Store::open(&path).unwrap();
     let checks = store.checks(None).unwrap();
     assert_eq!(checks.len(), 1);
@@ -168,13 +172,30 @@ fn database(path: &Path, n: i64) -> Vec<u8> {
     std::fs::read(path).unwrap()
 }
 
-/// Opens `path` both ways; both refuse it with a message naming the file and `needle`, and
-/// the file's bytes are unchanged.
+/// Reading a database writes nothing: its bytes stay and no file is left beside it. (Reading
+/// one in a directory one may not write: `tests/cli_history.rs`.)
+#[test]
+fn reading_a_database_writes_nothing() {
+    let d = dir("reading");
+    let path = d.join("h.sqlite");
+    let bytes = database(&path, 3);
+    let store = Store::open_for_reading(&path).unwrap();
+    assert_eq!(store.count().unwrap(), 3);
+    assert_eq!(store.checks(Some("M123")).unwrap().len(), 3);
+    drop(store);
+    assert_eq!(std::fs::read(&path).unwrap(), bytes);
+    assert_eq!(names_in(&d), ["h.sqlite"]);
+}
+
+/// Opens `path` every way (to record, to create, to read); each refuses it with a message
+/// naming the file and `needle`, and the file's bytes are unchanged.
 fn refused(path: &Path, needle: &str) -> String {
     let before = std::fs::read(path).unwrap();
     let e = Store::open(path).unwrap_err().to_string();
     let e2 = Store::open_or_create(path).unwrap_err().to_string();
     assert_eq!(e, e2);
+    let e3 = Store::open_for_reading(path).unwrap_err().to_string();
+    assert_eq!(e, e3);
     assert!(e.contains(&path.display().to_string()), "{e}");
     assert!(e.contains(needle), "`{needle}` not in: {e}");
     assert_eq!(

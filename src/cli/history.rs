@@ -321,7 +321,7 @@ pub fn run(args: &HistoryArgs) -> CliResult {
     .filter_map(|(f, t)| t.as_ref().map(|t| (f, t)))
     .collect();
     check_outputs(&inputs, &outputs, &[])?;
-    let store = Store::open(&db).map_err(|e| history_error("--db", e))?;
+    let store = Store::open_for_reading(&db).map_err(|e| history_error("--db", e))?;
     let all = store.checks(None).map_err(|e| history_error("--db", e))?;
     let name = db.display().to_string();
     if all.is_empty() {

@@ -9,6 +9,7 @@
 
 mod open;
 mod read;
+mod reading;
 
 pub use open::BUSY_TIMEOUT;
 pub use read::{MachineSummary, RecordedCheck};
@@ -70,6 +71,21 @@ impl Store {
     pub fn open(path: &Path) -> Result<Store, HistoryError> {
         Ok(Store {
             conn: open::open_existing(path)?,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Opens the existing database at `path` for reading: as [`Store::open`] where that works,
+    /// else (a directory or file system one may not write) through a read-only connection, so
+    /// that such a history can be read. Recording through a read-only store fails
+    /// ([`HistoryError::Failed`], the database cannot be written).
+    ///
+    /// # Errors
+    /// Those of [`Store::open`]; [`HistoryError::Failed`] for an older schema that cannot be
+    /// migrated (it needs write access).
+    pub fn open_for_reading(path: &Path) -> Result<Store, HistoryError> {
+        Ok(Store {
+            conn: open::open_for_reading(path)?,
             path: path.to_path_buf(),
         })
     }

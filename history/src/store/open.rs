@@ -57,6 +57,38 @@ pub(crate) fn open_existing(path: &Path) -> Res<Connection> {
     Ok(conn)
 }
 
+/// Opens the existing database at `path` for reading: as [`open_existing`] opens it where
+/// that works (so an older schema is migrated and SQLite's files beside it are removed when
+/// it closes), else, at the current schema version, through a read-only connection that
+/// writes nothing and reads in a directory one may not write ([`super::reading::connect`]).
+///
+/// # Errors
+/// Those of [`open_existing`]; where it fails, an older schema (its migration needs write
+/// access) is [`HistoryError::Failed`] saying so, and so is a read-only connection that
+/// fails too.
+pub(crate) fn open_for_reading(path: &Path) -> Res<Connection> {
+    let written = match open_existing(path) {
+        Err(HistoryError::Failed { file, message }) => (file, message),
+        other => return other,
+    };
+    let sql = |e| HistoryError::sqlite(path, e);
+    let conn = super::reading::connect(path).map_err(sql)?;
+    conn.busy_timeout(BUSY_TIMEOUT).map_err(sql)?;
+    let version: i32 = conn
+        .pragma_query_value(None, "user_version", |r| r.get(0))
+        .map_err(sql)?;
+    if version < VERSION {
+        let (file, message) = written;
+        return Err(HistoryError::Failed {
+            file,
+            message: format!(
+                "the database has schema version {version}, older than this rtest's {VERSION}; reading it needs a migration, which needs write access: {message}"
+            ),
+        });
+    }
+    Ok(conn)
+}
+
 /// Opens the database at `path`, making a new one first when there is no file there.
 ///
 /// # Errors
@@ -135,7 +167,7 @@ fn header_note(path: &Path) -> String {
 }
 
 /// The path of SQLite's file `suffix` (`-wal`, `-shm`) beside the database at `path`.
-fn beside(path: &Path, suffix: &str) -> PathBuf {
+pub(super) fn beside(path: &Path, suffix: &str) -> PathBuf {
     let mut side = path.as_os_str().to_owned();
     side.push(suffix);
     PathBuf::from(side)
@@ -169,11 +201,7 @@ fn read_only_checks(path: &Path) -> Res<()> {
         },
         other => other,
     };
-    let conn = Connection::open_with_flags(
-        path,
-        OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
-    )
-    .map_err(damaged)?;
+    let conn = super::reading::connect(path).map_err(damaged)?;
     conn.busy_timeout(BUSY_TIMEOUT).map_err(damaged)?;
     let id: i32 = conn
         .pragma_query_value(None, "application_id", |r| r.get(0))

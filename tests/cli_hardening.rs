@@ -682,3 +682,71 @@ fn a_closed_standard_output_is_an_error_not_a_panic() {
         );
     }
 }
+
+// ---------------------------------------------------------------- limits
+
+/// Counts and lengths that drive work are refused beyond their limits before any work, with
+/// the limit named and a short message: records of a campaign (200), a label (256
+/// characters), tests of a plan (50), a ball position's name (128 characters).
+#[test]
+fn counts_and_lengths_beyond_their_limits_are_refused_before_any_work() {
+    let dir = temp_dir("limits");
+    simulate(&dir, "K4", "k4.csv");
+    let identify = "identify --machine seed-ac --model reduced";
+    // 2 000 records of one campaign file (54 kB): refused at the list, no record read.
+    let mut text = String::from("machine = \"seed-ac\"\n");
+    text += &"[[record]]\nfile = \"k4.csv\"\n".repeat(2000);
+    std::fs::write(dir.join("many.toml"), &text).unwrap();
+    fails(
+        &dir,
+        &words(&format!("{identify} --campaign many.toml")),
+        1,
+        &["many.toml:2:1", "2000 records, more than 200"],
+    );
+    // 201 files of --data (none of them exists: the count is checked first).
+    let files: Vec<String> = (0..201).map(|k| format!("k{k}.csv")).collect();
+    for flag in ["--data", "--validate"] {
+        let verb = if flag == "--data" {
+            identify.to_string()
+        } else {
+            "diagnose --machine seed-ac --model reduced --data k4.csv".to_string()
+        };
+        fails(
+            &dir,
+            &words(&format!("{verb} {flag} {}", files.join(","))),
+            2,
+            &[flag, "201 records, more than 200"],
+        );
+    }
+    // A label of 65 536 characters: one short line.
+    let label = "a".repeat(65_536);
+    std::fs::write(
+        dir.join("long.toml"),
+        format!("machine = \"seed-ac\"\n[[record]]\nfile = \"k4.csv\"\nlabel = \"{label}\"\n"),
+    )
+    .unwrap();
+    let e = fails(
+        &dir,
+        &words(&format!("{identify} --campaign long.toml")),
+        1,
+        &["long.toml:4:9", "65536 characters, more than 256"],
+    );
+    assert!(e.len() < 300, "{e}");
+    // A plan of 51 tests; a ball position's name of 70 000 characters.
+    let plan = "plan --machine seed-ac --model reduced";
+    fails(
+        &dir,
+        &words(&format!("{plan} --paths {}", vec!["K4"; 51].join(","))),
+        2,
+        &["--paths", "51 tests, more than 50"],
+    );
+    let name = "b".repeat(70_000);
+    let e = fails(
+        &dir,
+        &words(&format!("{plan} --paths K4,K4:{name} --ball {name}:Zw=260")),
+        2,
+        &["--ball", "at most 128 characters"],
+    );
+    assert!(e.len() < 300, "{e}");
+    assert_eq!(common::entries(&dir), ["k4.csv", "long.toml", "many.toml"]);
+}

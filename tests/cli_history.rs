@@ -907,7 +907,10 @@ fn a_history_in_a_directory_one_may_not_write_is_read() {
         } else {
             std::process::Command::new(bin)
         };
-        c.args(args).current_dir(&*dir).output().expect("rtest runs")
+        c.args(args)
+            .current_dir(&*dir)
+            .output()
+            .expect("rtest runs")
     };
     let listed = as_user(&["history", "--db", "ro/h.sqlite"]);
     let out = String::from_utf8_lossy(&listed.stdout).into_owned();

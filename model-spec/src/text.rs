@@ -187,6 +187,23 @@ fn is_text_direction_control(c: char) -> bool {
     matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}')
 }
 
+/// `text` as a message quotes it: whole when it has at most 40 characters, else its first 16
+/// and `…` (a 70 000-character name given by mistake makes no 70 kB message).
+///
+/// ```
+/// use model_spec::text::quoted_start;
+/// assert_eq!(quoted_start("high"), "high");
+/// assert_eq!(quoted_start(&"a".repeat(70_000)), format!("{}…", "a".repeat(16)));
+/// ```
+pub fn quoted_start(text: &str) -> String {
+    if text.chars().count() <= 40 {
+        text.to_string()
+    } else {
+        let start: String = text.chars().take(16).collect();
+        format!("{start}…")
+    }
+}
+
 /// `pieces` joined by single spaces into lines of at most `width` characters, greedily; lines
 /// after the first start with `indent` (counted in the width). A piece longer than a line stays
 /// whole on a line of its own. No piece gives one empty line.

@@ -39,6 +39,7 @@ pub fn from_files(
     read: &ReadOptions,
     instrument: Through,
 ) -> CliResult<Loaded> {
+    record_count(flag, files)?;
     let labels = labels_from_files(files);
     let mut records = Vec::with_capacity(files.len());
     for (f, label) in files.iter().zip(&labels) {
@@ -62,6 +63,15 @@ pub fn from_files(
         files: files.iter().map(|f| f.display().to_string()).collect(),
         source: None,
     })
+}
+
+/// Refuses more files in `flag`'s list than a campaign may have records, before any is read.
+///
+/// # Errors
+/// A usage error naming `flag` and the limit.
+pub fn record_count(flag: &str, files: &[PathBuf]) -> CliResult<()> {
+    solver::fitting::campaign::check_record_count(files.len())
+        .map_err(|e| CliError::usage(format!("{flag}: {e}")))
 }
 
 /// The campaign of the campaign file `path` (given by `flag`), every record's CSV read at its

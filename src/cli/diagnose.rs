@@ -429,6 +429,7 @@ fn read_records(
     args: &DiagnoseArgs,
     shown: bool,
 ) -> CliResult<Vec<Record>> {
+    campaign::record_count(flag, files)?;
     let read = args.records.read_options();
     files
         .iter()

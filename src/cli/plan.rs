@@ -4,6 +4,7 @@
 use super::args::{self, items, positive};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, pose_args, print_text, write, wrote};
 use model_spec::Machine;
+use model_spec::text::quoted_start;
 use model_spec::units::{UM_PER_MM, compact};
 use output::{Outputs, Target};
 use solver::fitting::EstimateError;
@@ -191,7 +192,9 @@ fn ball(m: &Machine, text: &str, base: &[f64]) -> CliResult<BallPosition> {
     let name = name.trim();
     if name == BASE_BALL || !plan::valid_ball_name(name) {
         return Err(CliError::usage(format!(
-            "--ball: `{name}` is not a ball position name: a letter, then letters, digits, `_`, `-`, `.` or `+`, and not `{BASE_BALL}` (the position of --param)"
+            "--ball: `{}` is not a ball position name: a letter, then letters, digits, `_`, `-`, `.` or `+`, at most {} characters, and not `{BASE_BALL}` (the position of --param)",
+            quoted_start(name),
+            plan::MAX_BALL_NAME_CHARS
         )));
     }
     let flag = format!("--ball {name}");
@@ -261,13 +264,24 @@ fn plan_of(m: &Machine, args: &PlanArgs) -> CliResult<Plan> {
     }
     let mut tests = Vec::new();
     let example = "expected a comma list of TEST or TEST:BALL, e.g. K4,K1,K4:high";
-    for item in items("--paths", &args.paths, example)? {
+    let listed = items("--paths", &args.paths, example)?;
+    if listed.len() > plan::MAX_TESTS {
+        return Err(CliError::usage(format!(
+            "--paths: {} tests, more than {}, the most a plan may have",
+            listed.len(),
+            plan::MAX_TESTS
+        )));
+    }
+    for item in listed {
         let (test, name) = item.split_once(':').unwrap_or((item, BASE_BALL));
         let (test, name) = (test.trim(), name.trim());
         let Some(b) = balls.iter().position(|b| b.name == name) else {
             let named: Vec<&str> = balls[1..].iter().map(|b| b.name.as_str()).collect();
             return Err(CliError::usage(format!(
-                "--paths: `{item}`: no ball position `{name}` (define it with --ball {name}:SYMBOL=VALUE,...; defined: {})",
+                "--paths: `{}`: no ball position `{}` (define it with --ball {}:SYMBOL=VALUE,...; defined: {})",
+                quoted_start(item),
+                quoted_start(name),
+                quoted_start(name),
                 if named.is_empty() {
                     "none".to_string()
                 } else {

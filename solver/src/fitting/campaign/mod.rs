@@ -117,19 +117,47 @@ pub struct Campaign {
 #[error("{0}")]
 pub struct CampaignError(pub String);
 
+/// The most records a campaign may hold. A real calibration campaign has some tens (tests ×
+/// ball positions × repeats); the limit keeps a mistyped or hostile list from allocating the
+/// design matrices of thousands of records.
+pub const MAX_RECORDS: usize = 200;
+
+/// The longest record or set-up label, in characters.
+pub const MAX_LABEL_CHARS: usize = 256;
+
+/// Refuses a campaign of more than [`MAX_RECORDS`] records (`n` of them), before any is read.
+///
+/// # Errors
+/// [`CampaignError`] naming the count and the limit.
+pub fn check_record_count(n: usize) -> Result<(), CampaignError> {
+    if n > MAX_RECORDS {
+        return Err(CampaignError(format!(
+            "{n} records, more than {MAX_RECORDS}, the most a campaign may have"
+        )));
+    }
+    Ok(())
+}
+
 /// `true` when `c` may appear in a record or set-up label: ASCII letters, digits and `- _ . + :`.
 pub fn label_char(c: char) -> bool {
     c.is_ascii_alphanumeric() || "-_.+:".contains(c)
 }
 
-/// Checks a record or set-up label (`what` names it in the message): not empty, only
-/// [`label_char`]s.
+/// Checks a record or set-up label (`what` names it in the message): not empty, at most
+/// [`MAX_LABEL_CHARS`] characters, only [`label_char`]s.
 ///
 /// # Errors
 /// [`CampaignError`] naming `what`, the label and the first character not allowed.
 pub fn check_label(what: &str, label: &str) -> Result<(), CampaignError> {
     if label.is_empty() {
         return Err(CampaignError(format!("{what}: the label is empty")));
+    }
+    let n = label.chars().count();
+    if n > MAX_LABEL_CHARS {
+        return Err(CampaignError(format!(
+            "{what} `{}` has {n} characters, more than {MAX_LABEL_CHARS}, the longest a label may have",
+            model_spec::text::quoted_start(label)
+        )));
     }
     if let Some(c) = label.chars().find(|&c| !label_char(c)) {
         return Err(CampaignError(format!(
@@ -147,6 +175,7 @@ impl Campaign {
     /// # Errors
     /// [`CampaignError`] naming the record.
     pub fn new(records: Vec<CampaignRecord>) -> Result<Campaign, CampaignError> {
+        check_record_count(records.len())?;
         let c = Campaign { records };
         c.check_labels()?;
         Ok(c)

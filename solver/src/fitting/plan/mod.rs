@@ -138,11 +138,23 @@ pub struct Predicted {
     pub prediction: Prediction,
 }
 
-/// `true` for a ball position's name: a letter, then letters, digits, `_`, `-`, `.` or `+`
-/// (the names of moved candidate positions, `base.Zw+100`, are valid names).
+/// The most tests a plan may hold. A campaign of some tens of records is a long day on the
+/// machine; each planned test adds its rows to every candidate's prediction, so the limit
+/// bounds the plan's time and memory.
+pub const MAX_TESTS: usize = 50;
+
+/// The longest name of a ball position, in characters: a record's label is `TEST:BALL`, and
+/// with a test's name of at most 64 characters it stays within a label's 256
+/// ([`crate::fitting::campaign::MAX_LABEL_CHARS`]).
+pub const MAX_BALL_NAME_CHARS: usize = 128;
+
+/// `true` for a ball position's name: a letter, then letters, digits, `_`, `-`, `.` or `+`,
+/// at most [`MAX_BALL_NAME_CHARS`] characters (the names of moved candidate positions,
+/// `base.Zw+100`, are valid names).
 pub fn valid_ball_name(name: &str) -> bool {
     let mut c = name.chars();
-    c.next().is_some_and(|f| f.is_ascii_alphabetic())
+    name.chars().count() <= MAX_BALL_NAME_CHARS
+        && c.next().is_some_and(|f| f.is_ascii_alphabetic())
         && c.all(|x| x.is_ascii_alphanumeric() || "_-.+".contains(x))
 }
 
@@ -219,6 +231,12 @@ impl Plan {
         if self.tests.is_empty() {
             return bad("a plan needs at least one test".into());
         }
+        if self.tests.len() > MAX_TESTS {
+            return bad(format!(
+                "{} tests, more than {MAX_TESTS}, the most a plan may have",
+                self.tests.len()
+            ));
+        }
         match self.balls.first() {
             Some(b) if b.name == BASE_BALL => {}
             _ => return bad(format!("the first ball position must be `{BASE_BALL}`")),
@@ -226,8 +244,8 @@ impl Plan {
         for (i, b) in self.balls.iter().enumerate() {
             if i > 0 && (b.name == BASE_BALL || !valid_ball_name(&b.name)) {
                 return bad(format!(
-                    "ball position name `{}`: a letter, then letters, digits, `_`, `-`, `.` or `+`, and not `{BASE_BALL}` (the position of the plan's own parameters)",
-                    b.name
+                    "ball position name `{}`: a letter, then letters, digits, `_`, `-`, `.` or `+`, at most {MAX_BALL_NAME_CHARS} characters, and not `{BASE_BALL}` (the position of the plan's own parameters)",
+                    model_spec::text::quoted_start(&b.name)
                 ));
             }
             if self.balls[..i].iter().any(|o| o.name == b.name) {

@@ -4,7 +4,7 @@
 use super::{
     CampaignEntry, CampaignFile, CampaignFileError, RECORD_KEYS, TOP_KEYS, stem_label, unique_label,
 };
-use crate::fitting::campaign::check_label;
+use crate::fitting::campaign::{check_label, check_record_count};
 use model_spec::Machine;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -124,6 +124,7 @@ impl Parser<'_> {
                 "`record` must be an array of tables, written [[record]]",
             ));
         };
+        check_record_count(items.len()).map_err(|e| self.err(entries.span(), e.0))?;
         let mut records: Vec<CampaignEntry> = Vec::with_capacity(items.len());
         let mut label_spans: Vec<Option<Range<usize>>> = Vec::new();
         let mut setup_given: Vec<bool> = Vec::new();

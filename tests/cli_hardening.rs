@@ -750,3 +750,32 @@ fn counts_and_lengths_beyond_their_limits_are_refused_before_any_work() {
     assert!(e.len() < 300, "{e}");
     assert_eq!(common::entries(&dir), ["k4.csv", "long.toml", "many.toml"]);
 }
+
+/// `rtest report` reads its JSON reports no further than 64 MiB: an endless FIFO is refused
+/// with the limit named, in bounded memory, and nothing is written.
+#[test]
+fn a_report_json_is_read_no_further_than_its_limit() {
+    let dir = temp_dir("report-json");
+    let fifo = dir.join("endless.json");
+    mkfifo(&fifo);
+    let writer = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || {
+            let mut f = std::fs::OpenOptions::new().write(true).open(fifo).unwrap();
+            let block = vec![b' '; 1 << 20];
+            // Until the reader closes its end (a broken pipe), or 1 GiB.
+            (0..1024)
+                .take_while(|_| f.write_all(&block).is_ok())
+                .count()
+        })
+    };
+    fails(
+        &dir,
+        &["report", "endless.json", "-o", "r.html"],
+        1,
+        &["endless.json", "larger than 67108864 bytes (64 MiB)"],
+    );
+    let written = writer.join().unwrap();
+    assert!(written < 1024, "{written} MiB were read");
+    assert_eq!(common::entries(&dir), ["endless.json"]);
+}

@@ -45,14 +45,11 @@ impl Document {
 /// Why a report cannot be read or does not fit with the others.
 #[derive(Debug, thiserror::Error)]
 pub enum InputError {
-    /// The file cannot be read.
-    #[error("{file}: cannot read: {source}")]
-    Read {
-        /// The file.
-        file: String,
-        /// The system's reason.
-        source: std::io::Error,
-    },
+    /// The file cannot be read as text: an I/O error, more than
+    /// [`solver::io::report::read::MAX_REPORT_BYTES`], or not UTF-8 (the message names the
+    /// file).
+    #[error("{0}")]
+    Read(#[from] model_spec::text::TextError),
     /// The file is not JSON, or is a JSON that no verb of rtest writes.
     #[error(
         "{file}: not a report of rtest ({why}); give what identify --json, validate --json, diagnose --json or compensate --json writes"
@@ -98,13 +95,11 @@ pub enum InputError {
 /// Reads the report in `path` and recognises its kind from its fields.
 ///
 /// # Errors
-/// [`InputError`]: unreadable, not JSON, not a report of rtest, a field missing or malformed.
+/// [`InputError`]: unreadable, larger than 64 MiB, not UTF-8, not JSON, not a report of rtest,
+/// a field missing or malformed.
 pub fn read_document(path: &Path) -> Result<Document, InputError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| InputError::Read {
-        file: file.clone(),
-        source,
-    })?;
+    let text = model_spec::text::read_text(path, solver::io::report::read::MAX_REPORT_BYTES)?;
     classify(&file, &text)
 }
 

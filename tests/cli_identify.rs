@@ -874,6 +874,7 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
         "k4-path.svg",
         "k4-spectrum.svg",
         "k4.csv",
+        "report-compensation.html",
         "report.html",
         "rtest-history.sqlite",
         "seed-ac-extended.toml",
@@ -922,6 +923,15 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
             .unwrap();
         assert!(less >= 90.0, "{line}");
     }
+    // The report of the check says where the compensation is; that report shows it.
+    let html = std::fs::read_to_string(demo.join("report.html")).unwrap();
+    assert!(
+        html.contains("rtest-demo/report-compensation.html is the report of that compensation"),
+        "report.html"
+    );
+    let html = std::fs::read_to_string(demo.join("report-compensation.html")).unwrap();
+    assert!(html.contains("identify-recommended.json (model reduced + ECC@harmonic:2)"));
+    assert!(!html.contains("No compensation in this report"));
     let summary = read_json(&demo.join("compensate-k1.json"));
     assert_eq!(summary["poses"], 361);
     assert!(summary["position_remainder_um"].as_f64().unwrap() < 1e-3);

@@ -293,6 +293,8 @@ pub struct Inputs {
     pub path_figures: Vec<Figure>,
     /// Why there are no path figures, when there are none (one line).
     pub no_path_figures: Option<String>,
+    /// Why there is no compensation, when the verb knows where it is (one line).
+    pub no_compensation: Option<String>,
     /// Measured against the identified model's prediction along the path of each record (the
     /// fitted one and the validations'), drawn by the verb that read the records.
     pub prediction_figures: Vec<Figure>,

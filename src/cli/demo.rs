@@ -15,6 +15,9 @@ const HISTORY: &str = "rtest-history.sqlite";
 
 /// The HTML report of the check, inside [`OUT_DIR`].
 const REPORT: &str = "report.html";
+/// The HTML report of the compensation: the recommended model's identification on K4, the
+/// diagnosis that recommends it, K1 compensated with it.
+const REPORT_COMPENSATION: &str = "report-compensation.html";
 
 /// The machine id of the demo's virtual machine in that history.
 const MACHINE_ID: &str = "demo";
@@ -53,8 +56,11 @@ diagnose.json (rtest diagnose --json), seed-ac-extended.toml (the machine with t
 model, rtest diagnose --model-out) and the figures of rtest diagnose --plot: k4-path.svg, \
 k1-path.svg, k2-path.svg (measured against predicted error, base and extended model) and \
 k4-spectrum.svg, k1-spectrum.svg, k2-spectrum.svg (residual components before and after), and \
-report.html (the HTML report of the check: identification, validations, diagnosis with its \
-figures; docs/report.md). It \
+identify-recommended.json (the model the diagnosis recommends, identified on K4), \
+k1-compensated.csv and compensate-k1.json (K1 compensated with it, rtest compensate -o and \
+--json), report.html (the HTML report of the check: identification, validations, diagnosis \
+with its figures; docs/report.md) and report-compensation.html (the report of the \
+compensation: the recommended model's identification, the diagnosis, K1 compensated). It \
 records the identification on K4 in the history database rtest-demo/rtest-history.sqlite \
 (machine id demo; each run adds a check: rtest history --db rtest-demo/rtest-history.sqlite). The \
 same steps one by one: rtest simulate / identify / validate / diagnose / history.",
@@ -81,10 +87,20 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         files.add_in_dir("demo", dir, &name, svg);
         listed.push((name, what));
     }
-    files.add_in_dir("demo", dir, REPORT, html_report(&result)?);
+    files.add_in_dir("demo", dir, REPORT, html_report(&result, Check::Reduced)?);
     listed.push((
         REPORT.to_string(),
         "the HTML report of the check: identification on K4, validations on K1 and K2, diagnosis with its figures (rtest report, docs/report.md)".to_string(),
+    ));
+    files.add_in_dir(
+        "demo",
+        dir,
+        REPORT_COMPENSATION,
+        html_report(&result, Check::Compensation)?,
+    );
+    listed.push((
+        REPORT_COMPENSATION.to_string(),
+        "the HTML report of the compensation: the recommended model identified on K4, the diagnosis, K1 compensated".to_string(),
     ));
     write(files)?;
     let recorded = record(&mut recorder, &result.files)?;
@@ -120,9 +136,18 @@ fn record(recorder: &mut super::history::Recorder, files: &[demo::DemoFile]) -> 
     ))
 }
 
-/// The HTML report of the demo's check: its identification on K4, its validations, its
-/// diagnosis with the path figures, the measurement files hashed as written.
-fn html_report(result: &demo::Demo) -> CliResult<String> {
+/// The two checks the demo's HTML reports show.
+#[derive(Clone, Copy, PartialEq)]
+enum Check {
+    /// The reduced model identified on K4, validated on K1 and K2, diagnosed.
+    Reduced,
+    /// The model the diagnosis recommends identified on K4, the diagnosis, K1 compensated.
+    Compensation,
+}
+
+/// The HTML report of one of the demo's checks, with the diagnosis's path figures and the
+/// measurement files hashed as written.
+fn html_report(result: &demo::Demo, check: Check) -> CliResult<String> {
     let m = super::load_machine("seed-ac")?;
     let mut i = super::report::inputs_for(&m, &[]);
     let fail = |e: ::report::InputError| CliError::computation(format!("demo: {e}"));
@@ -139,13 +164,21 @@ fn html_report(result: &demo::Demo) -> CliResult<String> {
                 modified: None,
             });
         }
-        let wanted = f.name == "identify.json"
-            || f.name == "diagnose.json"
-            || (f.name.starts_with("validate-") && f.name.ends_with(".json"));
+        let json = |prefix: &str| f.name.starts_with(prefix) && f.name.ends_with(".json");
+        let wanted = f.name == "diagnose.json"
+            || match check {
+                Check::Reduced => f.name == "identify.json" || json("validate-"),
+                Check::Compensation => f.name == "identify-recommended.json" || json("compensate-"),
+            };
         if wanted {
             let doc = ::report::inputs::classify(&path, &f.contents).map_err(fail)?;
             i.add(&path, doc).map_err(fail)?;
         }
+    }
+    if check == Check::Reduced {
+        i.no_compensation = Some(format!(
+            "The demo compensated K1 with the model the diagnosis recommends, identified again on K4 (identify-recommended.json), not with this report's: {OUT_DIR}/{REPORT_COMPENSATION} is the report of that compensation."
+        ));
     }
     i.path_figures = ::report::figures::path_figures(&result.figures)
         .map_err(|e| CliError::computation(format!("demo: {e}")))?;

@@ -10,9 +10,9 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
     let (id, title) = super::SECTIONS[5];
     b.section(id, title);
     let Some((file, c)) = &inputs.compensation else {
-        b.absent(
+        b.absent(inputs.no_compensation.as_deref().unwrap_or(
             "No compensation in this report (rtest compensate --json, or compensate --report).",
-        );
+        ));
         b.end_section();
         return;
     };

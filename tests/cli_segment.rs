@@ -82,12 +82,33 @@ fn errors_name_the_flag_and_the_place() {
     let dir = temp_dir_tagged("segment", "errors");
     files(&dir);
     let base = "segment --machine seed-ac --plan plan.csv -o rec.csv --log";
-    std::fs::write(dir.join("bad.csv"), "t_s,dx_um\n0,1\n0.01,x\n").unwrap();
+    std::fs::write(dir.join("bad.csv"), "t_s,s1_um\n0,1\n0.01,x\n").unwrap();
     fails(
         &dir,
         &words(&format!("{base} bad.csv")),
         1,
-        &["--log: bad.csv:3: column 2 `dx_um`: `x` is not a finite number"],
+        &["--log: bad.csv:3: column 2 `s1_um`: `x` is not a finite number"],
+    );
+    // The error vector and a sensor column: the record would hold both, which `identify`
+    // refuses, so it is refused here, at the column, before the log is cut.
+    let log = std::fs::read_to_string(dir.join("log.csv")).unwrap();
+    let mixed: String = log
+        .lines()
+        .map(|l| match l {
+            _ if l.starts_with('#') || l.is_empty() => format!("{l}\n"),
+            _ if l.contains("dz_um") => format!("{l},s1_um\n"),
+            _ => format!("{l},0.5\n"),
+        })
+        .collect();
+    std::fs::write(dir.join("mixed.csv"), mixed).unwrap();
+    fails(
+        &dir,
+        &words(&format!("{base} mixed.csv")),
+        1,
+        &[
+            "--log: mixed.csv:",
+            "`s1_um`: a reading column beside the error vector's `dx_um`",
+        ],
     );
     let log = std::fs::read_to_string(dir.join("log.csv")).unwrap();
     let short: String = log.lines().take(20_000).collect::<Vec<_>>().join("\n");

@@ -404,6 +404,14 @@ fn a_malformed_log_is_refused_at_its_line_and_column() {
         ("dx_um,dy_um\n", "log.csv:1: no time column"),
         ("t_s,x,y\n", "log.csv:1: no reading column"),
         (
+            "t_s,dx_um,dy_um,dz_um,s1_um\n",
+            "log.csv:1: column 5 `s1_um`: a reading column beside the error vector's `dx_um`",
+        ),
+        (
+            "t_s,dy_um,dx_um\n",
+            "log.csv:1: the error vector lacks dz_um",
+        ),
+        (
             "t_s,t_abs_s,dx_um\n",
             "log.csv:1: column 2 `t_abs_s`: a second time column",
         ),
@@ -412,27 +420,27 @@ fn a_malformed_log_is_refused_at_its_line_and_column() {
             "log.csv:1: column 3 `DX_UM`: column `DX_UM` appears twice",
         ),
         (
-            "t_s,dx_um\n0,1\n",
+            "t_s,s1_um\n0,1\n",
             "log.csv: 1 row(s): a log needs at least two",
         ),
         (
-            "t_s,dx_um\n0,1\n0.01,1,2\n",
+            "t_s,s1_um\n0,1\n0.01,1,2\n",
             "log.csv:3: 3 fields, the header has 2",
         ),
         (
-            "t_s,dx_um\n0,1\n0.01,nan\n",
-            "log.csv:3: column 2 `dx_um`: `nan` is not a finite number",
+            "t_s,s1_um\n0,1\n0.01,nan\n",
+            "log.csv:3: column 2 `s1_um`: `nan` is not a finite number",
         ),
         (
-            "t_s,dx_um\n0,1\nx,1\n",
+            "t_s,s1_um\n0,1\nx,1\n",
             "log.csv:3: column 1 `t_s`: `x` is not a finite number",
         ),
         (
-            "# c\nt_s,dx_um\n0,1\n0.02,1\n0.01,1\n",
+            "# c\nt_s,s1_um\n0,1\n0.02,1\n0.01,1\n",
             "log.csv:5: column 1 `t_s`: the time 0.01 s does not increase (line 4: 0.02 s)",
         ),
         (
-            "t_abs_s,dx_um\n1717171717.5,1\n-3,1\n",
+            "t_abs_s,s1_um\n1717171717.5,1\n-3,1\n",
             "log.csv:3: column 1 `t_abs_s`: `-3` is not a Unix time",
         ),
     ];

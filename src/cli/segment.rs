@@ -20,7 +20,8 @@ Cuts a time-stamped R-test log into one sample per pose of a measurement program
 --plan is the plan written beside the program (sample, the axes in mm and degrees, arrive_s, \
 start_s, end_s, depart_s on the program clock). --log is the R-test's stream: a CSV with a time \
 column, t_s (s on any clock) or t_abs_s (Unix time, s), and reading columns named …_um (µm: \
-dx_um,dy_um,dz_um, or sensor columns s1_um,s2_um,…, carried through under their names); other \
+dx_um,dy_um,dz_um, or sensor columns s1_um,s2_um,…, carried through under their names; not \
+both); other \
 columns are not read. The log is read twice, so it must be a file.
 
 The log usually starts before the program. Static plans: the still periods of the readings are \

@@ -7,8 +7,9 @@
 //!   Unix time is split into its whole seconds and its fraction, so no precision is lost to the
 //!   size of the number.
 //! - **Readings**: every column whose name ends in `_um` (any case): µm, decimals with an
-//!   optional exponent, finite. `dx_um,dy_um,dz_um`, sensor columns `s1_um,s2_um,…`, any
-//!   mixture, kept under their names. At least one.
+//!   optional exponent, finite, kept under their names. Either the error vector
+//!   `dx_um,dy_um,dz_um` (all three, nothing else) or sensor columns `s1_um,s2_um,…`: a
+//!   record holds one or the other, as `identify` reads it.
 //! - **Other columns** (a sample counter, a status word) are not read; their names are
 //!   reported.
 //!
@@ -319,6 +320,41 @@ fn parse_header(cx: &Ctx, line: usize, text: &str) -> Result<LogHeader, CsvError
             None,
             "no reading column: a log's readings are the columns named `…_um` (µm: dx_um,dy_um,dz_um or s1_um,s2_um,…)",
         ));
+    }
+    // A record holds the error vector or sensor readings, never a part or a mixture of them
+    // (`identify` reads one or the other).
+    const ERROR_VECTOR: [&str; 3] = ["dx_um", "dy_um", "dz_um"];
+    let is_vector = |&i: &usize| {
+        ERROR_VECTOR
+            .iter()
+            .any(|c| names[i].eq_ignore_ascii_case(c))
+    };
+    let vector: Vec<usize> = readings.iter().copied().filter(is_vector).collect();
+    if !vector.is_empty() {
+        if let Some(&k) = readings.iter().find(|k| !is_vector(k)) {
+            return Err(cx.err(
+                line,
+                Some((k, &names[k])),
+                format!(
+                    "a reading column beside the error vector's `{}`: a record holds dx_um,dy_um,dz_um or sensor columns (s1_um,s2_um,…), not both (remove one set from the log)",
+                    names[vector[0]]
+                ),
+            ));
+        }
+        if vector.len() < 3 {
+            let missing: Vec<&str> = ERROR_VECTOR
+                .into_iter()
+                .filter(|c| !vector.iter().any(|&i| names[i].eq_ignore_ascii_case(c)))
+                .collect();
+            return Err(cx.err(
+                line,
+                None,
+                format!(
+                    "the error vector lacks {}: a record holds all of dx_um,dy_um,dz_um",
+                    missing.join(", ")
+                ),
+            ));
+        }
     }
     Ok(LogHeader {
         names,

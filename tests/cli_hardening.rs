@@ -255,6 +255,53 @@ fn an_output_that_names_an_input_is_refused_before_any_work() {
     assert_eq!(snapshot(&dir), before);
 }
 
+/// An output directory (`--tables`, `--plot`) that holds an input under a name the verb would
+/// write there, itself or through a link, is refused before any work, naming both.
+#[test]
+fn an_output_directory_holding_an_input_is_refused_before_any_work() {
+    let dir = temp_dir("input-dir");
+    simulate(&dir, "K4", "k4.csv");
+    simulate(&dir, "K1", "k1.csv");
+    ok(
+        &dir,
+        &words(
+            "identify --machine seed-ac --model reduced --terms ECC@harmonic:2,EXX@poly:2 --data k4.csv --json e.json",
+        ),
+    );
+    std::fs::create_dir(dir.join("t")).unwrap();
+    std::fs::copy(dir.join("k4.csv"), dir.join("t/axis_X.csv")).unwrap();
+    std::fs::create_dir(dir.join("p")).unwrap();
+    std::fs::copy(dir.join("k4.csv"), dir.join("p/k4.csv")).unwrap();
+    std::fs::copy(dir.join("k1.csv"), dir.join("p/k4-path.svg")).unwrap();
+    std::fs::create_dir(dir.join("q")).unwrap();
+    std::fs::hard_link(dir.join("k1.csv"), dir.join("q/k1-spectrum.svg")).unwrap();
+    let before = snapshot(&dir);
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &words(
+                "compensate --machine seed-ac --params e.json --path t/axis_X.csv -o kc.csv --tables t",
+            ),
+            "--tables: `t/axis_X.csv` is also the input of --path",
+        ),
+        (
+            &words(
+                "diagnose --machine seed-ac --model reduced --data p/k4.csv --validate p/k4-path.svg --plot p",
+            ),
+            "--plot: `p/k4-path.svg` is also the input of --validate",
+        ),
+        (
+            &words(
+                "diagnose --machine seed-ac --model reduced --data k4.csv --validate k1.csv --plot q",
+            ),
+            "--plot: `q/k1-spectrum.svg` is also the input of --validate",
+        ),
+    ];
+    for (args, message) in cases {
+        fails(&dir, args, 2, &[message]);
+    }
+    assert_eq!(snapshot(&dir), before);
+}
+
 // ---------------------------------------------------------------- B. failures
 
 #[test]

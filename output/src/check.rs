@@ -244,6 +244,58 @@ pub fn refuse_overwriting_inputs(
     Ok(())
 }
 
+/// Refuses, before any work, an output directory that holds an input under a name the command
+/// may write there: every entry of `dir` whose name `writes` accepts (the names the command
+/// writes, e.g. `*.svg` for plots) is compared with the inputs as
+/// [`refuse_overwriting_inputs`] compares them, so that a hard or symbolic link into the
+/// directory is caught too. A directory that does not exist yet holds nothing.
+///
+/// ```
+/// use output::refuse_inputs_in_dir;
+/// let dir = std::env::temp_dir().join(format!("rtest-doc-dir-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir).unwrap();
+/// let input = dir.join("k4-path.svg");
+/// std::fs::write(&input, "x\n").unwrap();
+/// let svg = |name: &str| name.ends_with(".svg");
+/// let e = refuse_inputs_in_dir(&[("--validate", &input)], "--plot", &dir, &svg).unwrap_err();
+/// assert!(e.to_string().ends_with("is also the input of --validate: refusing to overwrite an input"));
+/// assert!(refuse_inputs_in_dir(&[("--validate", &input)], "--plot", &dir, &|n: &str| n.ends_with(".png")).is_ok());
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn refuse_inputs_in_dir(
+    inputs: &[(&str, &Path)],
+    label: &str,
+    dir: &Path,
+    writes: &dyn Fn(&str) -> bool,
+) -> Result<(), WriteError> {
+    // A directory that cannot be listed is reported by `check_dir` or the write itself.
+    let Ok(entries) = fs::read_dir(dir) else {
+        return Ok(());
+    };
+    let inputs: Vec<(&str, Identity)> = inputs
+        .iter()
+        .map(|(label, path)| (*label, identity_of_path(path)))
+        .collect();
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(name) = name.to_str().filter(|n| writes(n)) else {
+            continue;
+        };
+        let path = dir.join(name);
+        let Some(identity) = resolve(&path).ok().and_then(|r| r.identity()) else {
+            continue;
+        };
+        if let Some((input, _)) = inputs.iter().find(|(_, id)| *id == identity) {
+            return Err(WriteError::IsInput {
+                label: label.to_string(),
+                path,
+                input: input.to_string(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Who standard output is, when it is a regular file (a command's output redirected to a file
 /// that is also named as another output).
 fn stdout_identity() -> Option<Identity> {

@@ -114,7 +114,7 @@ mod temp;
 #[doc(hidden)]
 pub mod testing;
 
-pub use check::{check_dir, check_targets, refuse_overwriting_inputs};
+pub use check::{check_dir, check_targets, refuse_inputs_in_dir, refuse_overwriting_inputs};
 pub use error::{Cause, WriteError};
 pub use outputs::{Outputs, Written};
 pub use target::Target;

@@ -3,7 +3,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use crate::check::{Planned, check_distinct, plan_in_dir, plan_target};
+use crate::check::{Planned, check_distinct, plan_in_dir, plan_target, refuse_overwriting_inputs};
 use crate::commit;
 use crate::error::{Shown, WriteError};
 use crate::target::Target;
@@ -14,6 +14,8 @@ use crate::target::Target;
 #[derive(Debug, Default)]
 pub struct Outputs {
     items: Vec<Item>,
+    /// The command's inputs, which no output may overwrite ([`Outputs::protect`]).
+    inputs: Vec<(String, PathBuf)>,
 }
 
 #[derive(Debug)]
@@ -84,6 +86,14 @@ impl Outputs {
         });
     }
 
+    /// The command's inputs (`label` the flag, `path` as given): [`write_all`](Outputs::write_all)
+    /// refuses an output that is one of them as [`refuse_overwriting_inputs`] does, for the
+    /// files of an output directory too, whose names were not known before the work.
+    pub fn protect(&mut self, inputs: &[(&str, &Path)]) {
+        self.inputs
+            .extend(inputs.iter().map(|(l, p)| (l.to_string(), p.to_path_buf())));
+    }
+
     /// How many outputs were added.
     pub fn len(&self) -> usize {
         self.items.len()
@@ -131,6 +141,16 @@ impl Outputs {
             })
             .collect::<Result<Vec<_>, _>>()?;
         check_distinct(&planned)?;
+        let inputs: Vec<(&str, &Path)> = self
+            .inputs
+            .iter()
+            .map(|(l, p)| (l.as_str(), p.as_path()))
+            .collect();
+        let targets: Vec<(&str, &Target)> = planned
+            .iter()
+            .map(|p| (p.label.as_str(), &p.target))
+            .collect();
+        refuse_overwriting_inputs(&inputs, &targets)?;
         Ok(planned)
     }
 }

@@ -91,3 +91,43 @@ fn the_first_clashing_output_and_its_input_are_named() {
         )
     );
 }
+
+/// A file of an output directory (named only once the work is done) that is an input, under
+/// its own name or through a link, is refused when the outputs are written, and nothing is
+/// written; an output directory holding such a file is found before the work too.
+#[test]
+fn an_input_inside_an_output_directory_is_never_overwritten() {
+    let dir = TestDir::new("inputs-in-dir");
+    let x = dir.file("x.csv", "data");
+    fs::create_dir(dir.join("plots")).unwrap();
+    fs::hard_link(&x, dir.join("plots/a.svg")).unwrap();
+    symlink("../x.csv", dir.join("plots/b.svg")).unwrap();
+    let before = snapshot(&dir.path);
+    for name in ["a.svg", "b.svg"] {
+        let mut outputs = output::Outputs::new();
+        outputs.protect(&[("--data", x.as_path())]);
+        outputs.add_in_dir("--plot", dir.join("plots"), "other.svg", "<svg/>");
+        outputs.add_in_dir("--plot", dir.join("plots"), name, "<svg/>");
+        let err = outputs.write_all().unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "--plot: `{}` is also the input of --data: refusing to overwrite an input",
+                dir.join("plots").join(name).display()
+            )
+        );
+        assert!(err.is_usage());
+        assert_only_changed(&before, &snapshot(&dir.path), &[]);
+    }
+    let svg = |n: &str| n.ends_with(".svg");
+    let err = output::refuse_inputs_in_dir(&[("--data", &x)], "--plot", &dir.join("plots"), &svg)
+        .unwrap_err();
+    assert!(
+        err.to_string().contains("is also the input of --data"),
+        "{err}"
+    );
+    let csv = |n: &str| n.ends_with(".csv");
+    assert!(
+        output::refuse_inputs_in_dir(&[("--data", &x)], "--plot", &dir.join("plots"), &csv).is_ok()
+    );
+}

@@ -144,6 +144,10 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         .map(|d| ("--tables", d.as_path()))
         .collect();
     check_outputs(&inputs, &outputs, &dirs)?;
+    if let Some(dir) = &args.tables {
+        let table = |n: &str| n.starts_with("axis_") && n.ends_with(".csv");
+        super::check_dir_inputs(&inputs, "--tables", dir, &table)?;
+    }
     let params = super::pose_args::params(&m, args.param.as_deref())?;
     let id = read_identification(&args.params, &m)
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
@@ -159,6 +163,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
     let symbols_note = symbols_note(&m, &params, errors.record_params(), args.param.is_some());
     let mut files = Outputs::new();
+    files.protect(&inputs);
     let params_file = args.params.display().to_string();
     let mut source = CompensationSource::of(&m, &id.model_name, &params_file, &errors, &left_out);
     let mut summary = None;

@@ -244,6 +244,9 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     given.extend(args.instrument.input());
     given.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     check_outputs(&given, &outputs, &dirs)?;
+    if let Some(dir) = &args.plot {
+        super::check_dir_inputs(&given, "--plot", dir, &|n: &str| n.ends_with(".svg"))?;
+    }
 
     let read = args.records.read_options();
     let params = super::pose_args::params(&m, args.param.as_deref())?;
@@ -307,6 +310,9 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     if args.campaign.is_some() || args.validate_campaign.is_some() {
         check_outputs(&inputs, &outputs, &dirs)?;
+        if let Some(dir) = &args.plot {
+            super::check_dir_inputs(&inputs, "--plot", dir, &|n: &str| n.ends_with(".svg"))?;
+        }
     }
     let flag = if args.campaign.is_some() {
         "--campaign"
@@ -339,6 +345,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     // Everything is computed before anything is written.
     let data = fitted.files.join(",");
     let mut out = Outputs::new();
+    out.protect(&inputs);
     let mut model_out = None;
     if let Some(target) = &args.model_out {
         let (name, contents) = d

@@ -191,6 +191,17 @@ pub fn check_outputs(
     Ok(())
 }
 
+/// Checks, before any work, that the output directory `dir` of `flag` holds no input under a
+/// name the verb may write there (`writes`: e.g. `*.svg` for `--plot`), links included.
+pub fn check_dir_inputs(
+    inputs: &[(&str, &Path)],
+    flag: &str,
+    dir: &Path,
+    writes: &dyn Fn(&str) -> bool,
+) -> CliResult {
+    output::refuse_inputs_in_dir(inputs, flag, dir, writes).map_err(write_error)
+}
+
 /// Writes every output (all or none).
 pub fn write(outputs: Outputs) -> CliResult<Vec<Written>> {
     outputs.write_all().map_err(write_error)

@@ -826,3 +826,48 @@ fn a_report_json_is_read_no_further_than_its_limit() {
     assert!(written < 1024, "{written} MiB were read");
     assert_eq!(common::entries(&dir), ["endless.json"]);
 }
+
+/// A value out of its range is a usage error (exit code 2) naming its flag, with the number
+/// printed short, whatever the verb: never a failed computation (3) or a file error (1).
+#[test]
+fn out_of_range_values_are_usage_errors_naming_their_flag() {
+    let dir = temp_dir("ranges");
+    simulate(&dir, "K4", "k4.csv");
+    ok(
+        &dir,
+        &words("identify --machine seed-ac --model reduced --data k4.csv --json id.json"),
+    );
+    std::fs::write(dir.join("p.nc"), "G90\nG1 X0 Y0 Z0 A0 C0\nG1 A-10 C20\n").unwrap();
+    let before = snapshot(&dir);
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "compensate --machine seed-ac --params id.json --nc iso --path p.nc -o q.nc --decimals 10",
+            &["--decimals: 10 decimals asked for, at most 9"],
+        ),
+        (
+            "plan --machine seed-ac --model reduced --paths K4 --target-um 1e-320",
+            &["--target-um", "`1e-320` is not a number from 1e-6 to 1e6"],
+        ),
+        (
+            "plan --machine seed-ac --model reduced --paths K4 --period-s 1e308",
+            &["--period-s: period = 1e308", "at most 3600"],
+        ),
+        (
+            "path --machine seed-ac --test K4 --nc iso -o q.nc --continuous --sample-rate-hz 1e-12",
+            &["sampling rate 1e-12 Hz: from 0.1 to 100000 Hz"],
+        ),
+        (
+            "path --machine seed-ac --test K4 --nc iso -o q.nc --settle-s 1e308",
+            &["settle time 1e308 s: from 0 to 3600 s"],
+        ),
+        (
+            "path --machine seed-ac --test K4 --nc iso -o q.nc --decimals 12",
+            &["--decimals: 12 decimals asked for, at most 9"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let e = fails(&dir, &words(args), 2, needles);
+        assert!(e.len() < 300, "{e}");
+    }
+    assert_eq!(snapshot(&dir), before);
+}

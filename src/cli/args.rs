@@ -4,7 +4,7 @@
 
 use super::{CliError, CliResult};
 use model_spec::instrument::{Instrument, InstrumentLoadError, ReadingsFrame, load_instrument};
-use model_spec::units::UM_PER_MM;
+use model_spec::units::{UM_PER_MM, significant};
 use model_spec::{ErrorId, Machine};
 use solver::fitting::noise::{NoiseChoice, NoiseModel};
 use solver::fitting::{Constraint, ValueLimits};
@@ -169,6 +169,20 @@ impl ValueBounds {
     /// The bounds of identified values.
     pub fn values(&self) -> ValueLimits {
         ValueLimits::from_display(self.max_error_um, self.max_error_urad)
+    }
+}
+
+/// A parser of a number from `lo` to `hi` (both included), for flags whose value drives a
+/// computation that has no meaning beyond them: the message gives the range.
+pub fn between(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync {
+    move |s: &str| match s.trim().parse::<f64>() {
+        Ok(x) if (lo..=hi).contains(&x) => Ok(x),
+        _ => Err(format!(
+            "`{}` is not a number from {} to {}",
+            model_spec::text::quoted_start(s),
+            significant(lo),
+            significant(hi)
+        )),
     }
 }
 

@@ -76,7 +76,7 @@ pub struct CompensateArgs {
     /// --path is an NC program of this dialect.
     #[arg(long, value_name = "iso|heidenhain", value_parser = ["iso", "heidenhain"])]
     nc: Option<String>,
-    /// The fewest decimals of a corrected NC word (default: the program's own).
+    /// The fewest decimals of a corrected NC word (default: the program's own; at most 9).
     #[arg(long, value_name = "N")]
     decimals: Option<usize>,
     /// Kinematic symbols (mm), `NAME=VALUE,...`, overriding the machine's defaults.
@@ -124,6 +124,12 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     }
     if args.nc.is_none() && args.decimals.is_some() {
         return Err(CliError::usage("--decimals applies to NC programs (--nc)"));
+    }
+    if let Some(d) = args.decimals.filter(|&d| d > solver::io::nc::MAX_DECIMALS) {
+        return Err(CliError::usage(format!(
+            "--decimals: {d} decimals asked for, at most {}",
+            solver::io::nc::MAX_DECIMALS
+        )));
     }
     let (m, machine_text) = super::load_machine_and_text(&args.machine)?;
     let mut inputs = vec![("--params", args.params.as_path())];

@@ -39,7 +39,7 @@ pub struct NcArgs {
     /// Continuous program: the R-test's sampling rate, Hz.
     #[arg(long, value_name = "HZ", requires = "continuous")]
     pub sample_rate_hz: Option<f64>,
-    /// Decimals of the axis words (default 4: 0.0001 mm, 0.0001°).
+    /// Decimals of the axis words (default 4: 0.0001 mm, 0.0001°; at most 9).
     #[arg(long, value_name = "N", requires = "nc")]
     pub decimals: Option<usize>,
 }
@@ -105,6 +105,12 @@ impl NcArgs {
         o.test_name = test.to_string();
         o.params = params.to_vec();
         if let Some(d) = self.decimals {
+            if d > solver::io::nc::MAX_DECIMALS {
+                return Err(CliError::usage(format!(
+                    "--decimals: {d} decimals asked for, at most {}",
+                    solver::io::nc::MAX_DECIMALS
+                )));
+            }
             o.decimals = d;
         }
         Ok(o)

@@ -110,14 +110,14 @@ pub struct PlanArgs {
     /// Lag-1 autocorrelation of the reading noise (AR(1); 0: white), 0 ≤ F < 0.99.
     #[arg(long, value_name = "F", default_value = "0", value_parser = phi)]
     noise_phi: f64,
-    /// Target uncertainty of translational parameters, µm.
-    #[arg(long, value_name = "UM", default_value = "1", value_parser = positive)]
+    /// Target uncertainty of translational parameters, µm (1e-6 to 1e6).
+    #[arg(long, value_name = "UM", default_value = "1", value_parser = args::between(1e-6, 1e6))]
     target_um: f64,
-    /// Target uncertainty of angular parameters, µrad.
-    #[arg(long, value_name = "URAD", default_value = "5", value_parser = positive)]
+    /// Target uncertainty of angular parameters, µrad (1e-6 to 1e6).
+    #[arg(long, value_name = "URAD", default_value = "5", value_parser = args::between(1e-6, 1e6))]
     target_urad: f64,
-    /// Target uncertainty of servo lags (velocity terms), ms.
-    #[arg(long, value_name = "MS", default_value = "0.1", value_parser = positive)]
+    /// Target uncertainty of servo lags (velocity terms), ms (1e-6 to 1e6).
+    #[arg(long, value_name = "MS", default_value = "0.1", value_parser = args::between(1e-6, 1e6))]
     target_ms: f64,
     /// The step by which the candidate ball positions are moved from the planned ones, mm.
     #[arg(long, value_name = "MM", default_value = "100", value_parser = positive)]

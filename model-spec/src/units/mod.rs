@@ -107,11 +107,45 @@ pub fn compact(x: f64) -> String {
     let digits = shortest.bytes().filter(u8::is_ascii_digit).count();
     if digits <= 12 || !x.is_finite() {
         shortest
-    } else if x.abs() < 1e12 {
+    } else if (1e-3..1e12).contains(&x.abs()) {
         short(x)
     } else {
-        format!("{x:.6e}")
+        significant(x)
     }
+}
+
+/// A number for a message: at most six significant digits, trailing zeros removed, in
+/// scientific notation below 1e-4 and from 1e6 on (`0.168855`, `1e-12`, `1e308`,
+/// `1.23457e7`, `-2400`, `0`).
+///
+/// ```
+/// use model_spec::units::significant;
+/// assert_eq!(significant(1e308), "1e308");
+/// assert_eq!(significant(1e-12), "1e-12");
+/// assert_eq!(significant(0.16885531), "0.168855");
+/// assert_eq!(significant(-2400.0), "-2400");
+/// assert_eq!(significant(12_345_678.0), "1.23457e7");
+/// assert_eq!(significant(0.0), "0");
+/// ```
+pub fn significant(x: f64) -> String {
+    if !x.is_finite() || x == 0.0 {
+        return if x == 0.0 { "0".into() } else { format!("{x}") };
+    }
+    let exponent = x.abs().log10().floor();
+    if !(-4.0..6.0).contains(&exponent) {
+        let s = format!("{x:.5e}");
+        let (mantissa, exp) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        return format!("{mantissa}e{exp}");
+    }
+    let decimals = (5.0 - exponent).max(0.0) as usize;
+    let s = format!("{x:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
+    if s == "-0" { "0".into() } else { s }
 }
 
 #[cfg(test)]

@@ -105,7 +105,7 @@ pub enum GeneratorError {
         machine: String,
     },
     /// No test of that name.
-    #[error("machine {machine} has no test `{name}` (its tests: {})", tests.join(", "))]
+    #[error("machine {machine} has no test `{}` (its tests: {})", model_spec::text::quoted_start(name), tests.join(", "))]
     UnknownTest {
         /// The machine.
         machine: String,
@@ -297,7 +297,10 @@ pub fn lookup_test(tests: &[TestSpec], name: &str) -> Option<TestSpec> {
         })
 }
 
-/// Checks the options: a finite step above 0, a finite period above 0, a largest tilt from 0
+/// The longest time between two samples of a generated test, s (an hour).
+pub const MAX_PERIOD_S: f64 = 3600.0;
+
+/// Checks the options: a finite step above 0, a period above 0 and at most [`MAX_PERIOD_S`], a largest tilt from 0
 /// to 180°, a finite least ball height of at least 0.
 ///
 /// # Errors
@@ -313,11 +316,11 @@ pub fn check_options(opts: &GeneratorOptions) -> Result<(), GeneratorError> {
             "the step must be a finite number of degrees above 0",
         );
     }
-    if !(opts.period_s.is_finite() && opts.period_s > 0.0) {
+    if !(opts.period_s.is_finite() && opts.period_s > 0.0 && opts.period_s <= MAX_PERIOD_S) {
         return bad(
             "period",
             opts.period_s,
-            "the time between samples must be a finite number of seconds above 0",
+            "the time between samples must be a number of seconds above 0 and at most 3600",
         );
     }
     let tilt = opts.clearance.max_tilt_deg;

@@ -13,9 +13,15 @@ use crate::record::Record;
 use crate::simulation::exact::VirtualMachine;
 use model_spec::Machine;
 use model_spec::units::short;
+use model_spec::units::significant;
 
 /// The longest dwell written, s: the range of Heidenhain's cycle 9.
 const MAX_DWELL_S: f64 = 3600.0;
+/// The slowest sampling of the R-test a continuous program is planned for, Hz.
+pub const MIN_SAMPLE_RATE_HZ: f64 = 0.1;
+/// The fastest sampling of the R-test a continuous program is planned for, Hz (100 kHz, beyond
+/// any displacement sensor's output rate).
+pub const MAX_SAMPLE_RATE_HZ: f64 = 1e5;
 
 /// The measurement program of `poses` (commands in mm and rad, one sample per pose, in order;
 /// their times are not used) on machine `m`, and its sample-timing plan (see the module
@@ -117,13 +123,13 @@ fn check_options(m: &Machine, o: &MeasureOptions) -> Result<(), MeasureError> {
     if !positive(o.approach_feed_mm_min) || o.approach_feed_mm_min > MAX_F {
         return bad(format!(
             "approach feed {} mm/min: above 0 and at most {MAX_F}",
-            o.approach_feed_mm_min
+            significant(o.approach_feed_mm_min)
         ));
     }
     if !positive(o.max_gap_mm) {
         return bad(format!(
             "largest gap {} mm: finite and above 0",
-            o.max_gap_mm
+            significant(o.max_gap_mm)
         ));
     }
     let dwell = |what: &str, s: f64, min: f64| {
@@ -131,7 +137,8 @@ fn check_options(m: &Machine, o: &MeasureOptions) -> Result<(), MeasureError> {
             Ok(())
         } else {
             Err(MeasureError::Options(format!(
-                "{what} {s} s: from {min} to {MAX_DWELL_S} s"
+                "{what} {} s: from {min} to {MAX_DWELL_S} s",
+                significant(s)
             )))
         }
     };
@@ -143,10 +150,10 @@ fn check_options(m: &Machine, o: &MeasureOptions) -> Result<(), MeasureError> {
         }
         MeasureMode::Continuous(t) => {
             dwell("lead-in and lead-out", t.lead_s, 0.001)?;
-            if !positive(t.sample_rate_hz) {
+            if !(MIN_SAMPLE_RATE_HZ..=MAX_SAMPLE_RATE_HZ).contains(&t.sample_rate_hz) {
                 return bad(format!(
-                    "sampling rate {} Hz: finite and above 0",
-                    t.sample_rate_hz
+                    "sampling rate {} Hz: from {MIN_SAMPLE_RATE_HZ} to {MAX_SAMPLE_RATE_HZ} Hz",
+                    significant(t.sample_rate_hz)
                 ));
             }
         }

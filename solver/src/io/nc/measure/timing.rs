@@ -10,7 +10,7 @@ use crate::io::nc::measure::text::{Feed, word_style};
 use crate::io::nc::measure::{MeasureError, MeasureMode, MeasureOptions, StaticMotion};
 use crate::io::nc::number::write_number;
 use crate::record::Record;
-use model_spec::units::short;
+use model_spec::units::significant;
 
 /// The largest `F` number written (five digits before the point, as ISO and Heidenhain
 /// controls read feeds).
@@ -83,8 +83,8 @@ pub(crate) fn plan_moves(
         {
             return Err(err(format!(
                 "the block lasts {} s, less than one sampling period of the R-test at {} Hz: lower the feeds, or sample faster",
-                short(duration_s),
-                short(t.sample_rate_hz)
+                significant(duration_s),
+                significant(t.sample_rate_hz)
             )));
         }
         moves.push(Move {

@@ -938,3 +938,39 @@ fn a_history_in_a_directory_one_may_not_write_is_read() {
     assert_eq!(std::fs::read(ro.join("h.sqlite")).unwrap(), before);
     mode(&ro, 0o755).unwrap();
 }
+
+/// The commands the output suggests are shell-quoted: pasted back into a shell, a machine id
+/// with quotes and a semicolon is one argument, never a second command.
+#[test]
+fn suggested_commands_are_shell_quoted() {
+    let dir = temp_dir("quoted");
+    k4(&dir, "k4.csv", 10.0, 1);
+    let id = "M'; touch pwned; --";
+    let out = record(&dir, "k4.csv", id, &week(1));
+    let suggested = out
+        .split("(rtest history ")
+        .nth(1)
+        .and_then(|s| s.split(")\n").next())
+        .unwrap_or_else(|| panic!("no suggested command in: {out}"));
+    assert!(
+        suggested.contains(r"--machine-id 'M'\''; touch pwned; --'"),
+        "{suggested}"
+    );
+    let listed = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "{} history {suggested}",
+            env!("CARGO_BIN_EXE_rtest")
+        ))
+        .current_dir(&*dir)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&listed.stdout).into_owned();
+    assert!(listed.status.success(), "{text}");
+    assert!(text.contains(&format!("Machine {id} ")), "{text}");
+    assert!(
+        text.contains(r"(rtest history --machine-id 'M'\''; touch pwned; --' --error NAME)"),
+        "{text}"
+    );
+    assert!(!dir.join("pwned").exists());
+}

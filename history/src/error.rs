@@ -7,7 +7,10 @@ use std::path::Path;
 #[derive(Debug, thiserror::Error)]
 pub enum HistoryError {
     /// No database at that path (reading a history that was never recorded).
-    #[error("{file}: no history database there (rtest identify --record --db {file} creates it)")]
+    #[error(
+        "{file}: no history database there (rtest identify --record --db {} creates it)",
+        solver::io::text::shell(file)
+    )]
     NotFound {
         /// The path.
         file: String,

@@ -9,6 +9,7 @@ use history::tolerance::{self, MAX_TOLERANCE_BYTES, Tolerances};
 use history::trend::{self, Options, TrendError};
 use history::{Check, HistoryError, InputFile, Provenance, Staged, Store, Timestamp};
 use output::{Outputs, Target};
+use solver::io::text::shell;
 use std::path::{Path, PathBuf};
 
 /// The `--record` flags of `rtest identify`.
@@ -206,9 +207,10 @@ impl Recorder {
     pub fn recorded(&self, id: i64) -> String {
         let m = &self.provenance.machine_id;
         format!(
-            "Recorded as check {id} of machine {m} in {} (rtest history --db {} --machine-id {m})\n",
+            "Recorded as check {id} of machine {m} in {} (rtest history --db {} --machine-id {})\n",
             self.db.display(),
-            self.db.display()
+            shell(&self.db.display().to_string()),
+            shell(m)
         )
     }
 }

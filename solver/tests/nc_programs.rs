@@ -400,6 +400,15 @@ fn iso_refusals_name_line_and_word() {
         ("G1 X1 M3.5", 7, "M3.5", "cannot read the number"),
         ("N3 G1 X1 N4", 10, "N4", "second `N`"),
         ("X1 [2]", 4, "[", "not part of an ISO word"),
+        ("G1 X1 F-100", 7, "F-100", "a negative feed is meaningless"),
+        ("G4 P-5", 4, "P-5", "a negative dwell time is meaningless"),
+        ("T-1 M6", 1, "T-1", "a negative tool number is meaningless"),
+        (
+            "S-1000 M3",
+            1,
+            "S-1000",
+            "a negative spindle speed is meaningless",
+        ),
     ];
     for &(block, column, word, why) in cases {
         let text = format!("{START}N2 M3\n{block}\n");
@@ -583,6 +592,50 @@ fn programs_without_moves_and_clashing_letters_are_refused() {
         e.to_string()
             .starts_with("p.nc:2:1: line longer than 65536 bytes"),
         "{e}"
+    );
+}
+
+/// Nothing after the end of a program is read: a block after `%` (the tape's end), `M30`, `M2`
+/// or `END PGM` is refused, since the control would not run it; blank lines and a closing `%`
+/// after the end pass. A line that ends with a carriage return alone is refused where it is.
+#[test]
+fn blocks_after_the_end_of_a_program_and_lone_carriage_returns_are_refused() {
+    let after = "a block after the end of the program";
+    refused(
+        iso(&format!("%\n{START}G1 X1\n%\nG1 X2\n")),
+        5,
+        1,
+        "",
+        after,
+    );
+    refused(
+        iso(&format!("{START}M30\nG1 X2\n")),
+        3,
+        1,
+        "",
+        "(`M30` at line 2)",
+    );
+    refused(
+        iso(&format!("{START}G1 X1 M2\n\nG1 X2\n")),
+        4,
+        1,
+        "",
+        "(`M2` at line 2)",
+    );
+    let hh_text =
+        "0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 A+0 C+0 R0 FMAX\n2 END PGM T MM\n3 L X+5 R0 FMAX\n";
+    refused(hh(hh_text), 4, 1, "", "(`END PGM` at line 3)");
+    // What may follow the end.
+    let p = iso(&format!("%\n{START}G1 X1\nM30\n%\n\n")).unwrap();
+    assert_eq!(p.poses().len(), 2);
+    let p = hh("0 BEGIN PGM T MM\n1 L X+0 Y+0 Z+0 A+0 C+0 R0 FMAX\n2 END PGM T MM\n\n").unwrap();
+    assert_eq!(p.poses().len(), 1);
+    refused(
+        iso(&format!("{START}G1 X1\rG1 X2\r")),
+        2,
+        6,
+        "",
+        "a carriage return inside a line",
     );
 }
 

@@ -96,11 +96,13 @@ fn m_refusal(code: u32) -> Option<&'static str> {
 /// The block reader of Heidenhain conversational programs (no modal state beyond the axes).
 pub(crate) struct HeidenhainReader<'a> {
     axes: &'a [AxisWord],
+    /// `END PGM` was read.
+    ended: bool,
 }
 
 impl<'a> HeidenhainReader<'a> {
     pub(crate) fn new(axes: &'a [AxisWord]) -> Self {
-        HeidenhainReader { axes }
+        HeidenhainReader { axes, ended: false }
     }
 
     /// The words of an `L` block: `tokens` (text and byte start in the line) after the `L`.
@@ -239,8 +241,15 @@ impl BlockReader for HeidenhainReader<'_> {
         }
         let next: Vec<&str> = tokens[k + 1..].iter().map(|(t, _)| *t).collect();
         match keyword_refusal(kw, &next) {
-            None => Ok(None),
+            None => {
+                self.ended |= kw == "END";
+                Ok(None)
+            }
             Some(why) => Err(place.err(at, content.trim_end().len(), why)),
         }
+    }
+
+    fn ended(&self) -> Option<&'static str> {
+        self.ended.then_some("`END PGM`")
     }
 }

@@ -75,6 +75,10 @@ fn g_refusal(major: u32, minor: Option<u32>) -> String {
 pub(crate) struct IsoReader<'a> {
     axes: &'a [AxisWord],
     absolute: bool,
+    /// A line with a word was read (a `%` before it starts the program, one after ends it).
+    started: bool,
+    /// What ended the program: a `%` after the first block, or `M2` / `M30`.
+    ended: Option<&'static str>,
 }
 
 /// A word: its letter (upper case) and the byte range of the word and of its number in the line.
@@ -94,6 +98,8 @@ struct Seen {
     any_g: bool,
     g90: bool,
     p: Option<(usize, usize)>,
+    /// The block ends the program (`M2`, `M30`).
+    end: Option<&'static str>,
 }
 
 impl<'a> IsoReader<'a> {
@@ -101,6 +107,8 @@ impl<'a> IsoReader<'a> {
         IsoReader {
             axes,
             absolute: false,
+            started: false,
+            ended: None,
         }
     }
 
@@ -148,10 +156,26 @@ impl<'a> IsoReader<'a> {
         }
         match l {
             'N' | 'O' if integer() => {}
+            'F' | 'S' | 'T' | 'P' if read_number(w.letter, num).is_some_and(|(v, _)| v < 0.0) => {
+                return Err(err(format!(
+                    "a negative {} is meaningless",
+                    match l {
+                        'F' => "feed",
+                        'S' => "spindle speed",
+                        'T' => "tool number",
+                        _ => "dwell time",
+                    }
+                )));
+            }
             'F' | 'S' | 'T' if read_number(w.letter, num).is_some() => {}
             'P' if read_number(w.letter, num).is_some() => seen.p = Some((w.start, w.end)),
             'M' if integer() => {
                 let code: u32 = num.parse().map_err(|_| unreadable())?;
+                match code {
+                    2 => seen.end = Some("`M2`"),
+                    30 => seen.end = Some("`M30`"),
+                    _ => {}
+                }
                 if matches!(code, 98 | 99 | 198) {
                     return Err(err(
                         "subprogram calls and returns are refused: the moves of a subprogram are not in this program, and M99 repeats it".into(),
@@ -220,6 +244,10 @@ impl<'a> IsoReader<'a> {
 }
 
 impl BlockReader for IsoReader<'_> {
+    fn ended(&self) -> Option<&'static str> {
+        self.ended
+    }
+
     fn block(&mut self, place: &Place, offset: usize) -> Result<Option<BlockAxes>, NcError> {
         let line = place.text;
         let b = line.as_bytes();
@@ -249,7 +277,12 @@ impl BlockReader for IsoReader<'_> {
                     }
                 },
                 b';' => break,
-                b'%' if tokens == 0 => i += 1,
+                b'%' if tokens == 0 => {
+                    if self.started && line.trim() == "%" {
+                        self.ended = Some("`%`");
+                    }
+                    i += 1
+                }
                 b'/' if tokens == 0 => {
                     block_delete = Some(i);
                     i += 1;
@@ -311,6 +344,10 @@ impl BlockReader for IsoReader<'_> {
             ));
         }
         self.absolute |= seen.g90;
+        self.started |= words > 0;
+        if seen.end.is_some() {
+            self.ended = seen.end;
+        }
         let Some(first) = fields.first() else {
             return Ok(None);
         };

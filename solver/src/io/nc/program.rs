@@ -42,6 +42,10 @@ pub(crate) trait BlockReader {
     /// The axis words of line `place.text` (at byte `offset` of the program), `None` for a
     /// line that does not move; the reader keeps its own modal state.
     fn block(&mut self, place: &Place, offset: usize) -> Result<Option<BlockAxes>, NcError>;
+
+    /// The end of the program, once a block has ended it (`%` or `M30` in ISO, `END PGM` in
+    /// Heidenhain): what ended it, for messages. The control runs nothing after it.
+    fn ended(&self) -> Option<&'static str>;
 }
 
 /// Letters that words other than axis words use, per dialect, with what they are.
@@ -117,15 +121,37 @@ pub(crate) fn parse(
     let mut modal: Vec<Option<f64>> = vec![None; axes.len()];
     let mut poses = Vec::new();
     let mut blocks = Vec::new();
+    let mut end: Option<(usize, &str)> = None;
     for (number, offset, raw) in lines(text) {
+        let refused = |column: usize, message: String| NcError::Block {
+            file: file.to_string(),
+            line: number,
+            column,
+            word: None,
+            message,
+        };
         if raw.len() > MAX_LINE_BYTES {
-            return Err(NcError::Block {
-                file: file.to_string(),
-                line: number,
-                column: 1,
-                word: None,
-                message: format!("line longer than {MAX_LINE_BYTES} bytes: not an NC block"),
-            });
+            return Err(refused(
+                1,
+                format!("line longer than {MAX_LINE_BYTES} bytes: not an NC block"),
+            ));
+        }
+        if let Some(at) = raw.find('\r') {
+            return Err(refused(
+                raw[..at].chars().count() + 1,
+                "a carriage return inside a line: lines end with a line feed (LF or CR LF); a file whose lines end with CR alone is read as one line".into(),
+            ));
+        }
+        if let Some((line, what)) = end {
+            if !matches!(raw.trim(), "" | "%") {
+                return Err(refused(
+                    1,
+                    format!(
+                        "a block after the end of the program ({what} at line {line}): the control does not run it; remove it"
+                    ),
+                ));
+            }
+            continue;
         }
         let (line, bom) = strip_bom(number, raw);
         let place = Place {
@@ -133,7 +159,11 @@ pub(crate) fn parse(
             line: number,
             text: line,
         };
-        let Some(block) = reader.block(&place, offset + bom)? else {
+        let read = reader.block(&place, offset + bom)?;
+        if let Some(what) = reader.ended() {
+            end = Some((number, what));
+        }
+        let Some(block) = read else {
             continue;
         };
         for f in &block.fields {

@@ -135,7 +135,7 @@ fn errors_name_the_flag_and_the_place() {
         &dir,
         &words(&format!("{base} log.csv --margin-s 5")),
         2,
-        &["a margin of 5 s at each end leaves nothing"],
+        &["--margin-s: a margin of 5 s at each end leaves nothing"],
     );
     fails(
         &dir,

@@ -37,6 +37,7 @@ pub use align::Anchor;
 use align::{align_continuous, align_static};
 pub use log::LogClock;
 use log::LogReader;
+use model_spec::units::significant;
 use std::io::Read;
 use std::path::Path;
 use still::{Bins, still_periods};
@@ -288,20 +289,24 @@ impl Shape {
         } else {
             0.2
         };
-        for (name, v) in [
-            ("offset", opts.offset_s),
-            ("margin", opts.margin_s),
-            ("stillness limit", opts.still_mm),
-            ("tolerance", opts.tolerance_s),
+        // Named by their flags (the stillness limit is given in µm).
+        for (flag, v, scale) in [
+            ("--offset-s", opts.offset_s, 1.0),
+            ("--margin-s", opts.margin_s, 1.0),
+            ("--still-um", opts.still_mm, 1e3),
+            ("--tolerance-s", opts.tolerance_s, 1.0),
         ] {
             if let Some(v) = v
                 && (!v.is_finite()
-                    || (name != "offset" && v < 0.0)
-                    || (name == "tolerance" && v == 0.0))
+                    || (flag != "--offset-s" && v < 0.0)
+                    || (flag == "--tolerance-s" && v == 0.0))
             {
-                return bad(format!(
-                    "{name} {v}: finite, and above 0 (a margin or limit may be 0)"
-                ));
+                let why = match flag {
+                    "--offset-s" => "a finite number",
+                    "--tolerance-s" => "a finite number above 0",
+                    _ => "a finite number, at least 0",
+                };
+                return bad(format!("{flag}: {}: {why}", significant(v * scale)));
             }
         }
         let (feature, tolerance_s) = match plan.kind {
@@ -314,7 +319,9 @@ impl Shape {
                     && 2.0 * m >= shortest
                 {
                     return bad(format!(
-                        "a margin of {m} s at each end leaves nothing of the shortest window ({shortest} s)"
+                        "--margin-s: a margin of {} s at each end leaves nothing of the shortest window ({} s)",
+                        significant(m),
+                        significant(shortest)
                     ));
                 }
                 let spacing = rows

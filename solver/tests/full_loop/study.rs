@@ -431,6 +431,22 @@ pub fn run_with(seed: u64, o: &DiagnoseOptions) -> Study {
     } = diagnosed(seed, o);
     let extended = d.extended_terms();
     let findings: Vec<String> = spelled(&m, &extended)[reduced.terms.len()..].to_vec();
+    for g in &d.groups {
+        progress(&format!(
+            "group {} ({} terms, {} directions of {} columns): share {:.3}, F {:.2}, p {:.2e} of {} tried, left-out gain {:?} sd, confirmed {}, undetermined {}",
+            g.group.name,
+            g.group.terms.len(),
+            g.directions,
+            g.columns,
+            g.fraction,
+            g.f,
+            g.p,
+            g.tried,
+            g.gain_sd,
+            g.confirmed,
+            g.undetermined.join(" ")
+        ));
+    }
 
     let mut figures = Vec::new();
     progress(&format!(
@@ -665,4 +681,115 @@ pub fn text(s: &Study) -> String {
         }
     ));
     out
+}
+
+/// The grouped candidates at noise seed `seed` ([`solver::diagnosis::groups`]): the campaign
+/// diagnosed with them on, each group the selection takes described (its members, directions,
+/// F, corrected p, the left-out gain in standard deviations and whether it is confirmed), the
+/// figure of the extended model the diagnosis then gives (its findings and confirmed groups,
+/// under `minimum-norm` when the campaign does not determine it), and the figure of the diagnosis's extended model with **every** selected group's members added,
+/// confirmed or not, identified under `minimum-norm`: what the groups would give were they
+/// taken on the fitted records' significance alone.
+pub fn groups(seed: u64) -> (Vec<String>, Figure, Figure) {
+    let Diagnosed { m, truth, c, d, .. } =
+        diagnosed(seed, &DiagnoseOptions::default().groups(true));
+    let recommended = d.extended_terms();
+    let mut ident = identify(&m, &recommended, &c, Constraint::None);
+    if !undetermined(&ident).is_empty() {
+        ident = identify(&m, &recommended, &c, Constraint::MinimumNorm);
+    }
+    let with_confirmed = figure(
+        &m,
+        &truth,
+        &ident,
+        "extended, confirmed groups",
+        d.extended_label(&m, "reduced"),
+        vec![],
+    );
+    let mut model = recommended.clone();
+    let mut described = Vec::new();
+    for g in &d.groups {
+        described.push(format!(
+            "{} ({}): {} directions of {} columns, F {:.1}, p {:.1e} ({} groups tried), left-out gain {} sd, {}",
+            g.group.name,
+            g.group
+                .terms
+                .iter()
+                .map(|t| t.spelling(&m))
+                .collect::<Vec<_>>()
+                .join(" "),
+            g.directions,
+            g.columns,
+            g.f,
+            g.p,
+            g.tried,
+            g.gain_sd.map_or("—".into(), |z| format!("{z:.1}")),
+            if g.confirmed { "confirmed" } else { "not confirmed" }
+        ));
+        for t in &g.group.terms {
+            if !model.terms.contains(t) {
+                model.terms.push(*t);
+            }
+        }
+    }
+    progress(&format!(
+        "noise seed {seed}: extended model with every selected group"
+    ));
+    let ident = identify(&m, &model, &c, Constraint::MinimumNorm);
+    let f = figure(
+        &m,
+        &truth,
+        &ident,
+        "extended + groups",
+        format!("{} terms", model.terms.len()),
+        vec![],
+    );
+    (described, with_confirmed, f)
+}
+
+/// Why the records left out in turn do not confirm the groups: at noise seed `seed`, with the
+/// grouped candidates on, every record of the campaign predicted by the fit on the four others,
+/// with the diagnosis's extended model and with it plus each selected group alone (µm RMS of
+/// the prediction's residual, over the three directions; the rank and condition number of the
+/// fit on the four). One line per record left out.
+pub fn left_out(seed: u64) -> Vec<String> {
+    let Diagnosed { m, c, d, .. } = diagnosed(seed, &DiagnoseOptions::default().groups(true));
+    let extended = d.extended_terms();
+    let mut models = vec![("extended".to_string(), extended.clone())];
+    for g in &d.groups {
+        let mut model = extended.clone();
+        model.terms.extend(g.group.terms.iter().copied());
+        models.push((format!("+ {}", g.group.name), model));
+    }
+    (0..c.records.len())
+        .map(|j| {
+            let fitted = Campaign {
+                records: c
+                    .records
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| *k != j)
+                    .map(|(_, r)| r.clone())
+                    .collect(),
+            };
+            let judged = Campaign {
+                records: vec![c.records[j].clone()],
+            };
+            let mut line = format!("{} left out:", c.records[j].label);
+            for (name, model) in &models {
+                let ident = identify(&m, model, &fitted, Constraint::None);
+                let p = solver::diagnosis::heldout::predict(&m, &ident, &judged).unwrap();
+                let r = &p[0].validation.residual;
+                let ss: f64 = r.iter().flatten().map(|x| x * x).sum();
+                line.push_str(&format!(
+                    " {name} {:.3} µm (rank {} of {}, condition {:.0});",
+                    (ss / (3 * r.len()) as f64).sqrt() * 1e3,
+                    ident.fit.rank,
+                    ident.fit.names.len(),
+                    ident.fit.condition.unwrap_or(f64::NAN)
+                ));
+            }
+            line
+        })
+        .collect()
 }

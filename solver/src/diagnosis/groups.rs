@@ -20,8 +20,10 @@
 //! until no group is significant at α. A group is then kept only when the judging records
 //! (held out, or every fitted record left out in turn) confirm it as a whole: the extended
 //! model with it predicts them better than without it by more than the noise explains
-//! ([`super::verdict::CONFIRM_SD`] standard deviations), judged given every other group kept
-//! and dropped backwards as findings are ([`super::confirm`]). A group is fitted with every
+//! ([`super::verdict::CONFIRM_SD`] standard deviations, as findings are judged,
+//! [`super::confirm`]): forwards in the order of selection, each given the groups kept before
+//! it, then backwards, each given every other group kept, until every group left is
+//! confirmed. A group is fitted with every
 //! member; the campaign need not determine them all (the report lists which combinations it
 //! does not, and `rtest identify --constraint min-norm` gives the values that carry the
 //! determined ones only).

@@ -623,8 +623,9 @@ struct Grouped<'a> {
 }
 
 /// The grouped candidates ([`groups`]) given the extended model of `g.terms`: selected on the
-/// fitted records, confirmed as wholes by the judging records of `folds` (backwards, each given
-/// the others kept), and the extended model's fit with the confirmed ones (`None` when none is).
+/// fitted records, confirmed as wholes by the judging records of `folds` (forwards, each given
+/// the groups kept before it, then backwards, each given the others kept), and the extended
+/// model's fit with the confirmed ones (`None` when none is).
 fn grouped(
     g: &Grouped,
     folds: &mut confirm::Folds,
@@ -693,7 +694,19 @@ fn grouped(
             undetermined: Vec::new(),
         })
         .collect();
-    // Confirmed as wholes, backwards: each given the others still in.
+    // Confirmed as wholes: forwards in the order of selection, each given the groups kept
+    // before it; then backwards, each given every other group kept, until all are confirmed.
+    for f in found.iter_mut() {
+        f.confirmed = false;
+    }
+    for k in 0..found.len() {
+        let without: Vec<Term> = g.terms.iter().copied().chain(group_terms(&found)).collect();
+        let mut with = without.clone();
+        with.extend(found[k].group.terms.iter().copied());
+        let z = folds.gain_sd(&without, &with, g.whitening)?;
+        found[k].gain_sd = Some(z);
+        found[k].confirmed = z > verdict::CONFIRM_SD;
+    }
     loop {
         let with: Vec<Term> = g.terms.iter().copied().chain(group_terms(&found)).collect();
         let mut out = Vec::new();

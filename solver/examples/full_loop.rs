@@ -8,6 +8,8 @@
 //! # The grouped candidates (error groups tested as one candidate each, confirmed on the
 //! # records left out in turn), and the extended model with every selected group added.
 //! cargo run --release -p solver --example full_loop -- --error-groups 1 2 3 4 5
+//! # The same on a sixth record, K2 with the ball at the higher position.
+//! cargo run --release -p solver --example full_loop -- --error-groups --k2-high 1
 //! # Each record predicted by the fit on the four others, with each selected group.
 //! cargo run --release -p solver --example full_loop -- --left-out 1
 //! # The diagnosis allowed more than its default 8 findings.
@@ -33,6 +35,8 @@ fn main() {
     args.retain(|a| a != "--groups");
     let error_groups = args.iter().any(|a| a == "--error-groups");
     args.retain(|a| a != "--error-groups");
+    let k2_high = args.iter().any(|a| a == "--k2-high");
+    args.retain(|a| a != "--k2-high");
     let left_out = args.iter().any(|a| a == "--left-out");
     args.retain(|a| a != "--left-out");
     let mut options = solver::diagnosis::DiagnoseOptions::default();
@@ -64,7 +68,7 @@ fn main() {
             continue;
         }
         if error_groups {
-            let (groups, confirmed, f) = study::groups(seed);
+            let (groups, confirmed, f) = study::groups(seed, k2_high);
             for g in groups {
                 println!("noise seed {seed}: group {g}");
             }

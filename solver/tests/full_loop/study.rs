@@ -134,31 +134,45 @@ fn raised(m: &Machine, params: &[f64], mm: f64) -> Vec<f64> {
 
 /// The campaign at noise seed `seed` (see the module documentation).
 pub fn campaign(m: &Machine, truth: &Truth, seed: u64) -> Campaign {
-    let records = [
+    campaign_of(m, truth, seed, false)
+}
+
+/// The campaign at noise seed `seed`, with `k2_high` a sixth record: K2 with the ball at the
+/// higher position (generator seed `1000 + seed`), so that A sweeps with C still on two records.
+pub fn campaign_of(m: &Machine, truth: &Truth, seed: u64, k2_high: bool) -> Campaign {
+    let mut paths = vec![
         ("K4", 0.0),
         ("K1", 0.0),
         ("K2", 0.0),
         ("K4", HIGH_RAISE_MM),
         ("K1", HIGH_RAISE_MM),
-    ]
-    .into_iter()
-    .enumerate()
-    .map(|(k, (path, raise))| {
-        let params = raised(m, &m.default_parameters(), raise);
-        let mut t = truth.clone();
-        t.seed = 5 * (seed - 1) + k as u64 + 1;
-        t.params = raised(m, &truth.params, raise);
-        let at = solver::io::campaign::machine_at(m, &params);
-        let planned = builtin_path(&at, path).unwrap().unwrap();
-        let record = simulate(&at, &t, &planned).unwrap();
-        let (label, setup) = if raise > 0.0 {
-            (format!("{}-high", path.to_lowercase()), "high")
-        } else {
-            (path.to_lowercase(), "low")
-        };
-        CampaignRecord::new(label, record, params, setup, false)
-    })
-    .collect();
+    ];
+    if k2_high {
+        paths.push(("K2", HIGH_RAISE_MM));
+    }
+    let records = paths
+        .into_iter()
+        .enumerate()
+        .map(|(k, (path, raise))| {
+            let params = raised(m, &m.default_parameters(), raise);
+            let mut t = truth.clone();
+            t.seed = if k < 5 {
+                5 * (seed - 1) + k as u64 + 1
+            } else {
+                1000 + seed
+            };
+            t.params = raised(m, &truth.params, raise);
+            let at = solver::io::campaign::machine_at(m, &params);
+            let planned = builtin_path(&at, path).unwrap().unwrap();
+            let record = simulate(&at, &t, &planned).unwrap();
+            let (label, setup) = if raise > 0.0 {
+                (format!("{}-high", path.to_lowercase()), "high")
+            } else {
+                (path.to_lowercase(), "low")
+            };
+            CampaignRecord::new(label, record, params, setup, false)
+        })
+        .collect();
     Campaign::new(records).unwrap()
 }
 
@@ -393,9 +407,14 @@ struct Diagnosed {
 }
 
 fn diagnosed(seed: u64, o: &DiagnoseOptions) -> Diagnosed {
+    diagnosed_of(seed, o, false)
+}
+
+/// [`diagnosed`] on [`campaign_of`] (`k2_high`: with K2 at the higher ball position too).
+fn diagnosed_of(seed: u64, o: &DiagnoseOptions, k2_high: bool) -> Diagnosed {
     let m = seed_ac();
     let truth = budget(&m);
-    let c = campaign(&m, &truth, seed);
+    let c = campaign_of(&m, &truth, seed, k2_high);
     let reduced = Model::of(&m, "reduced").unwrap();
     let none = Campaign {
         records: Vec::new(),
@@ -689,10 +708,11 @@ pub fn text(s: &Study) -> String {
 /// figure of the extended model the diagnosis then gives (its findings and confirmed groups,
 /// under `minimum-norm` when the campaign does not determine it), and the figure of the diagnosis's extended model with **every** selected group's members added,
 /// confirmed or not, identified under `minimum-norm`: what the groups would give were they
-/// taken on the fitted records' significance alone.
-pub fn groups(seed: u64) -> (Vec<String>, Figure, Figure) {
+/// taken on the fitted records' significance alone. `k2_high`: on [`campaign_of`] with K2 at
+/// the higher ball position as a sixth record.
+pub fn groups(seed: u64, k2_high: bool) -> (Vec<String>, Figure, Figure) {
     let Diagnosed { m, truth, c, d, .. } =
-        diagnosed(seed, &DiagnoseOptions::default().groups(true));
+        diagnosed_of(seed, &DiagnoseOptions::default().groups(true), k2_high);
     let recommended = d.extended_terms();
     let mut ident = identify(&m, &recommended, &c, Constraint::None);
     if !undetermined(&ident).is_empty() {

@@ -28,7 +28,16 @@
 //! does not, and `rtest identify --constraint min-norm` gives the values that carry the
 //! determined ones only).
 
+use super::columns::Columns;
+use super::confirm::Folds;
+use super::extend::fit;
 use super::select::{Span, f_p_value, f_statistic};
+use super::verdict::CONFIRM_SD;
+use super::weights::Weights;
+use super::{DiagnoseError, DiagnoseOptions};
+use crate::fitting::campaign::{Campaign, CampaignIdentification};
+use crate::fitting::noise::{NoiseChoice, NoiseModel};
+use crate::model::Model;
 use model_spec::basis::Basis;
 use model_spec::terms::{Effect, Term};
 use model_spec::{AxisKind, ErrorKind, Machine, Motion};
@@ -209,6 +218,171 @@ pub(super) fn select(
         out.push(s);
     }
     out
+}
+
+/// The members of the confirmed groups, in order.
+pub(super) fn group_terms(found: &[GroupFinding]) -> Vec<Term> {
+    found
+        .iter()
+        .filter(|g| g.confirmed)
+        .flat_map(|g| g.group.terms.iter().copied())
+        .collect()
+}
+
+/// What the stage of grouped candidates works on.
+pub(super) struct Grouped<'a> {
+    /// The machine.
+    pub m: &'a Machine,
+    /// The diagnosis's options.
+    pub o: &'a DiagnoseOptions,
+    /// The base model.
+    pub base: &'a Model,
+    /// The candidates (every group member is one).
+    pub candidates: &'a [Term],
+    /// The candidates that vary on the fitted records.
+    pub live: &'a [usize],
+    /// The whitened columns and readings.
+    pub cols: &'a Columns,
+    /// The columns of a group of `cols` (base term `t < nb`, candidate `nb + c`).
+    pub group: &'a dyn Fn(usize) -> DMatrix<f64>,
+    /// The base model's residual sum of squares (whitened).
+    pub rss_base: f64,
+    /// The findings in the extended model.
+    pub terms: &'a [Term],
+    /// The fitted records, outliers left out.
+    pub cleaned: &'a Campaign,
+    /// The noise model of the fits.
+    pub gls: &'a NoiseChoice,
+    /// The noise model of the tests.
+    pub whitening: &'a NoiseModel,
+    /// The covariances of records read through an instrument.
+    pub weights: &'a Weights,
+}
+
+/// The grouped candidates ([module documentation](self)) given the extended model of `g.terms`: selected on the
+/// fitted records, confirmed as wholes by the judging records of `folds` (forwards, each given
+/// the groups kept before it, then backwards, each given the others kept), and the extended
+/// model's fit with the confirmed ones (`None` when none is).
+pub(super) fn grouped(
+    g: &Grouped,
+    folds: &mut Folds,
+) -> Result<(Vec<GroupFinding>, Option<CampaignIdentification>), DiagnoseError> {
+    let Grouped {
+        m,
+        o,
+        base,
+        candidates,
+        live,
+        cols,
+        group,
+        ..
+    } = *g;
+    let n = cols.y.len();
+    // Members that are candidates varying on the records.
+    let mut all = error_groups(m, &[base.terms.as_slice(), g.terms].concat());
+    for gr in &mut all {
+        gr.terms.retain(|t| {
+            candidates
+                .iter()
+                .position(|c| c == t)
+                .is_some_and(|c| live.contains(&c))
+        });
+    }
+    all.retain(|gr| !gr.terms.is_empty());
+    let index = |t: &Term| candidates.iter().position(|c| c == t).expect("a candidate");
+    let columns = |k: usize| -> DMatrix<f64> {
+        let blocks: Vec<DMatrix<f64>> = all[k]
+            .terms
+            .iter()
+            .map(|t| group(cols.nb + index(t)))
+            .collect();
+        let width = blocks.iter().map(|b| b.ncols()).sum();
+        let mut out = DMatrix::zeros(n, width);
+        let mut at = 0;
+        for b in &blocks {
+            out.columns_mut(at, b.ncols()).copy_from(b);
+            at += b.ncols();
+        }
+        out
+    };
+    let mut span = Span::of_groups(n, 0..cols.nb, group);
+    for &t in g.terms {
+        let c = cols.term_columns(m, t, g.cleaned, g.weights, g.whitening)?;
+        let d = span.new_directions(&c);
+        span.extend(&d);
+    }
+    let selected = select(span, &cols.y, all.len(), &columns, g.rss_base, o.alpha);
+    let mut found: Vec<GroupFinding> = selected
+        .iter()
+        .map(|s| GroupFinding {
+            group: all[s.index].clone(),
+            directions: s.directions,
+            columns: all[s.index]
+                .terms
+                .iter()
+                .map(|t| group(cols.nb + index(t)).ncols())
+                .sum(),
+            fraction: s.fraction,
+            f: s.f,
+            p: s.p,
+            tried: s.tried,
+            gain_sd: None,
+            confirmed: true,
+            undetermined: Vec::new(),
+        })
+        .collect();
+    // Confirmed as wholes: forwards in the order of selection, each given the groups kept
+    // before it; then backwards, each given every other group kept, until all are confirmed.
+    for f in found.iter_mut() {
+        f.confirmed = false;
+    }
+    for k in 0..found.len() {
+        let without: Vec<Term> = g.terms.iter().copied().chain(group_terms(&found)).collect();
+        let mut with = without.clone();
+        with.extend(found[k].group.terms.iter().copied());
+        let z = folds.gain_sd(&without, &with, g.whitening)?;
+        found[k].gain_sd = Some(z);
+        found[k].confirmed = z > CONFIRM_SD;
+    }
+    loop {
+        let with: Vec<Term> = g.terms.iter().copied().chain(group_terms(&found)).collect();
+        let mut out = Vec::new();
+        let judged: Vec<usize> = (0..found.len()).filter(|&k| found[k].confirmed).collect();
+        for k in judged {
+            let without: Vec<Term> = with
+                .iter()
+                .copied()
+                .filter(|t| !found[k].group.terms.contains(t))
+                .collect();
+            let z = folds.gain_sd(&without, &with, g.whitening)?;
+            found[k].gain_sd = Some(z);
+            if z <= CONFIRM_SD {
+                out.push(k);
+            }
+        }
+        if out.is_empty() {
+            break;
+        }
+        for k in out {
+            found[k].confirmed = false;
+        }
+    }
+    let added = group_terms(&found);
+    if added.is_empty() {
+        return Ok((found, None));
+    }
+    let mut model = base.clone();
+    model.terms.extend_from_slice(g.terms);
+    model.terms.extend(added);
+    let fit = fit(m, &model, g.cleaned, o, g.gls)?;
+    for f in found.iter_mut().filter(|f| f.confirmed) {
+        f.undetermined = (0..fit.layout.columns.len())
+            .filter(|&j| f.group.terms.contains(&fit.layout.columns[j].term))
+            .filter(|&j| fit.fit.values[j].is_none())
+            .map(|j| fit.fit.names[j].clone())
+            .collect();
+    }
+    Ok((found, Some(fit)))
 }
 
 #[cfg(test)]

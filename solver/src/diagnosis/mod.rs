@@ -407,8 +407,8 @@ pub fn diagnose(
             extended_fit = e;
         }
         if o.groups {
-            let (found, fit) = grouped(
-                &Grouped {
+            let (found, fit) = groups::grouped(
+                &groups::Grouped {
                     m,
                     o,
                     base,
@@ -436,7 +436,7 @@ pub fn diagnose(
             (f.size, f.limit) = plausible::size_and_limit(m, &f.term, &known, &o.budget);
         }
         let mut terms = extended_terms_of(&findings);
-        terms.extend(group_terms(&group_findings));
+        terms.extend(groups::group_terms(&group_findings));
         left_out = folds.left_out_rows(&terms)?;
     }
     // The candidates of the findings in the extended model (a finding chosen among the
@@ -451,13 +451,13 @@ pub fn diagnose(
         .collect();
     let mut kept = kept;
     kept.extend(
-        group_terms(&group_findings)
+        groups::group_terms(&group_findings)
             .iter()
             .filter_map(|t| candidates.iter().position(|c| c == t)),
     );
     let mut extended = base.clone();
     extended.terms.extend(extended_terms_of(&findings));
-    extended.terms.extend(group_terms(&group_findings));
+    extended.terms.extend(groups::group_terms(&group_findings));
 
     // The extended model's findings as candidates (their coarse grid values: the spans the
     // selection saw).
@@ -593,157 +593,4 @@ fn extended_terms_of(findings: &[Finding]) -> Vec<Term> {
         .filter(|f| f.in_model)
         .map(|f| f.term)
         .collect()
-}
-
-/// The members of the confirmed groups, in order.
-fn group_terms(found: &[groups::GroupFinding]) -> Vec<Term> {
-    found
-        .iter()
-        .filter(|g| g.confirmed)
-        .flat_map(|g| g.group.terms.iter().copied())
-        .collect()
-}
-
-/// What the stage of grouped candidates works on.
-struct Grouped<'a> {
-    m: &'a Machine,
-    o: &'a DiagnoseOptions,
-    base: &'a Model,
-    candidates: &'a [Term],
-    live: &'a [usize],
-    cols: &'a columns::Columns,
-    group: &'a dyn Fn(usize) -> nalgebra::DMatrix<f64>,
-    rss_base: f64,
-    /// The findings in the extended model.
-    terms: &'a [Term],
-    cleaned: &'a Campaign,
-    gls: &'a NoiseChoice,
-    whitening: &'a crate::fitting::noise::NoiseModel,
-    weights: &'a weights::Weights,
-}
-
-/// The grouped candidates ([`groups`]) given the extended model of `g.terms`: selected on the
-/// fitted records, confirmed as wholes by the judging records of `folds` (forwards, each given
-/// the groups kept before it, then backwards, each given the others kept), and the extended
-/// model's fit with the confirmed ones (`None` when none is).
-fn grouped(
-    g: &Grouped,
-    folds: &mut confirm::Folds,
-) -> Result<(Vec<groups::GroupFinding>, Option<CampaignIdentification>), DiagnoseError> {
-    let Grouped {
-        m,
-        o,
-        base,
-        candidates,
-        live,
-        cols,
-        group,
-        ..
-    } = *g;
-    let n = cols.y.len();
-    // Members that are candidates varying on the records.
-    let mut all = groups::error_groups(m, &[base.terms.as_slice(), g.terms].concat());
-    for gr in &mut all {
-        gr.terms.retain(|t| {
-            candidates
-                .iter()
-                .position(|c| c == t)
-                .is_some_and(|c| live.contains(&c))
-        });
-    }
-    all.retain(|gr| !gr.terms.is_empty());
-    let index = |t: &Term| candidates.iter().position(|c| c == t).expect("a candidate");
-    let columns = |k: usize| -> nalgebra::DMatrix<f64> {
-        let blocks: Vec<nalgebra::DMatrix<f64>> = all[k]
-            .terms
-            .iter()
-            .map(|t| group(cols.nb + index(t)))
-            .collect();
-        let width = blocks.iter().map(|b| b.ncols()).sum();
-        let mut out = nalgebra::DMatrix::zeros(n, width);
-        let mut at = 0;
-        for b in &blocks {
-            out.columns_mut(at, b.ncols()).copy_from(b);
-            at += b.ncols();
-        }
-        out
-    };
-    let mut span = Span::of_groups(n, 0..cols.nb, group);
-    for &t in g.terms {
-        let c = cols.term_columns(m, t, g.cleaned, g.weights, g.whitening)?;
-        let d = span.new_directions(&c);
-        span.extend(&d);
-    }
-    let selected = groups::select(span, &cols.y, all.len(), &columns, g.rss_base, o.alpha);
-    let mut found: Vec<groups::GroupFinding> = selected
-        .iter()
-        .map(|s| groups::GroupFinding {
-            group: all[s.index].clone(),
-            directions: s.directions,
-            columns: all[s.index]
-                .terms
-                .iter()
-                .map(|t| group(cols.nb + index(t)).ncols())
-                .sum(),
-            fraction: s.fraction,
-            f: s.f,
-            p: s.p,
-            tried: s.tried,
-            gain_sd: None,
-            confirmed: true,
-            undetermined: Vec::new(),
-        })
-        .collect();
-    // Confirmed as wholes: forwards in the order of selection, each given the groups kept
-    // before it; then backwards, each given every other group kept, until all are confirmed.
-    for f in found.iter_mut() {
-        f.confirmed = false;
-    }
-    for k in 0..found.len() {
-        let without: Vec<Term> = g.terms.iter().copied().chain(group_terms(&found)).collect();
-        let mut with = without.clone();
-        with.extend(found[k].group.terms.iter().copied());
-        let z = folds.gain_sd(&without, &with, g.whitening)?;
-        found[k].gain_sd = Some(z);
-        found[k].confirmed = z > verdict::CONFIRM_SD;
-    }
-    loop {
-        let with: Vec<Term> = g.terms.iter().copied().chain(group_terms(&found)).collect();
-        let mut out = Vec::new();
-        let judged: Vec<usize> = (0..found.len()).filter(|&k| found[k].confirmed).collect();
-        for k in judged {
-            let without: Vec<Term> = with
-                .iter()
-                .copied()
-                .filter(|t| !found[k].group.terms.contains(t))
-                .collect();
-            let z = folds.gain_sd(&without, &with, g.whitening)?;
-            found[k].gain_sd = Some(z);
-            if z <= verdict::CONFIRM_SD {
-                out.push(k);
-            }
-        }
-        if out.is_empty() {
-            break;
-        }
-        for k in out {
-            found[k].confirmed = false;
-        }
-    }
-    let added = group_terms(&found);
-    if added.is_empty() {
-        return Ok((found, None));
-    }
-    let mut model = base.clone();
-    model.terms.extend_from_slice(g.terms);
-    model.terms.extend(added);
-    let fit = extend::fit(m, &model, g.cleaned, o, g.gls)?;
-    for f in found.iter_mut().filter(|f| f.confirmed) {
-        f.undetermined = (0..fit.layout.columns.len())
-            .filter(|&j| f.group.terms.contains(&fit.layout.columns[j].term))
-            .filter(|&j| fit.fit.values[j].is_none())
-            .map(|j| fit.fit.names[j].clone())
-            .collect();
-    }
-    Ok((found, Some(fit)))
 }

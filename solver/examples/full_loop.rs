@@ -5,6 +5,13 @@
 //! cargo run --release -p solver --example full_loop -- 1 2 3 4 5
 //! # What the extended model lacks: the truth's missing machine terms added group by group.
 //! cargo run --release -p solver --example full_loop -- --groups 1
+//! # The grouped candidates (error groups tested as one candidate each, confirmed on the
+//! # records left out in turn), and the extended model with every selected group added.
+//! cargo run --release -p solver --example full_loop -- --error-groups 1 2 3 4 5
+//! # The same on a sixth record, K2 with the ball at the higher position.
+//! cargo run --release -p solver --example full_loop -- --error-groups --k2-high 1
+//! # Each record predicted by the fit on the four others, with each selected group.
+//! cargo run --release -p solver --example full_loop -- --left-out 1
 //! # The diagnosis allowed more than its default 8 findings.
 //! cargo run --release -p solver --example full_loop -- --max-findings 30 1 2 3
 //! ```
@@ -26,6 +33,12 @@ fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
     let groups = args.iter().any(|a| a == "--groups");
     args.retain(|a| a != "--groups");
+    let error_groups = args.iter().any(|a| a == "--error-groups");
+    args.retain(|a| a != "--error-groups");
+    let k2_high = args.iter().any(|a| a == "--k2-high");
+    args.retain(|a| a != "--k2-high");
+    let left_out = args.iter().any(|a| a == "--left-out");
+    args.retain(|a| a != "--left-out");
     let mut options = solver::diagnosis::DiagnoseOptions::default();
     if let Some(k) = args.iter().position(|a| a == "--max-findings") {
         let n = args.get(k + 1).and_then(|n| n.parse::<usize>().ok());
@@ -48,6 +61,35 @@ fn main() {
         .collect();
     let seeds = if seeds.is_empty() { vec![1] } else { seeds };
     for seed in seeds {
+        if left_out {
+            for line in study::left_out(seed) {
+                println!("noise seed {seed}: {line}");
+            }
+            continue;
+        }
+        if error_groups {
+            let (groups, confirmed, f) = study::groups(seed, k2_high);
+            for g in groups {
+                println!("noise seed {seed}: group {g}");
+            }
+            println!(
+                "noise seed {seed}: the extended model ({}): {:.3} → {:.3} µm, {:.1} % less with the set-up refitted ({:.1} % without)",
+                confirmed.model,
+                confirmed.before_um,
+                confirmed.after_refitted_um,
+                100.0 * confirmed.fall_refitted(),
+                100.0 * confirmed.fall()
+            );
+            println!(
+                "noise seed {seed}: extended + every selected group ({}): {:.3} → {:.3} µm, {:.1} % less with the set-up refitted ({:.1} % without)",
+                f.model,
+                f.before_um,
+                f.after_refitted_um,
+                100.0 * f.fall_refitted(),
+                100.0 * f.fall()
+            );
+            continue;
+        }
         if groups {
             for (group, terms, f) in study::additions(seed) {
                 println!(

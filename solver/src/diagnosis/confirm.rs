@@ -293,7 +293,7 @@ impl<'a> Folds<'a> {
     }
 
     /// [`Folds::gain`] in standard deviations (0 when the change is nothing or a fit fails).
-    fn gain_sd(
+    pub(super) fn gain_sd(
         &mut self,
         without: &[Term],
         with: &[Term],

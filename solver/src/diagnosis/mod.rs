@@ -40,6 +40,7 @@ mod confounded;
 pub mod dictionary;
 mod extend;
 pub mod figures;
+pub mod groups;
 pub mod harmonic;
 pub mod heldout;
 pub mod hidden;
@@ -389,6 +390,7 @@ pub fn diagnose(
         .collect();
     let all: Vec<Term> = selected.iter().map(|s| s.0).collect();
     let mut left_out = Vec::new();
+    let mut group_findings: Vec<groups::GroupFinding> = Vec::new();
     if let Some(mut folds) = confirm::Folds::new(m, o, &gls, base, &cleaned, held_out, &base_fit)? {
         folds.seed(&all, &extended_fit)?;
         let terms = confirm::confirm(&mut folds, &mut findings, &whitening)?;
@@ -404,12 +406,38 @@ pub fn diagnose(
             dropped.extend(more);
             extended_fit = e;
         }
+        if o.groups {
+            let (found, fit) = groups::grouped(
+                &groups::Grouped {
+                    m,
+                    o,
+                    base,
+                    candidates: &candidates,
+                    live: &live,
+                    cols: &cols,
+                    group: &group,
+                    rss_base,
+                    terms: &extended_terms_of(&findings),
+                    cleaned: &cleaned,
+                    gls: &gls,
+                    whitening: &whitening,
+                    weights: &weights,
+                },
+                &mut folds,
+            )?;
+            if let Some(fit) = fit {
+                extended_fit = fit;
+            }
+            group_findings = found;
+        }
         for f in findings.iter_mut().filter(|f| f.in_model) {
             (f.values, f.stds) = extend::term_values(&extended_fit, &f.term);
             let known: Vec<f64> = f.values.iter().map(|v| v.unwrap_or(0.0)).collect();
             (f.size, f.limit) = plausible::size_and_limit(m, &f.term, &known, &o.budget);
         }
-        left_out = folds.left_out_rows(&extended_terms_of(&findings))?;
+        let mut terms = extended_terms_of(&findings);
+        terms.extend(groups::group_terms(&group_findings));
+        left_out = folds.left_out_rows(&terms)?;
     }
     // The candidates of the findings in the extended model (a finding chosen among the
     // alternatives by the held-out records is that candidate).
@@ -421,8 +449,15 @@ pub fn diagnose(
             None => selected.iter().find(|s| s.0 == f.term).map(|s| s.1),
         })
         .collect();
+    let mut kept = kept;
+    kept.extend(
+        groups::group_terms(&group_findings)
+            .iter()
+            .filter_map(|t| candidates.iter().position(|c| c == t)),
+    );
     let mut extended = base.clone();
     extended.terms.extend(extended_terms_of(&findings));
+    extended.terms.extend(groups::group_terms(&group_findings));
 
     // The extended model's findings as candidates (their coarse grid values: the spans the
     // selection saw).
@@ -534,6 +569,7 @@ pub fn diagnose(
         base_fit,
         dictionary_size: candidates.len(),
         findings,
+        groups: group_findings,
         dropped,
         confounded,
         unexcited,

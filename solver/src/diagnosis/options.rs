@@ -34,6 +34,10 @@ pub struct DiagnoseOptions {
     pub noise: NoiseChoice,
     /// Bootstrap draws of the lack-of-fit test (default 400); 0: no test.
     pub adequacy_draws: usize,
+    /// Grouped candidates after the findings ([`super::groups`]): the error groups of a
+    /// calibration standard, each tested as one candidate and confirmed as a whole (default
+    /// off).
+    pub groups: bool,
 }
 
 impl Default for DiagnoseOptions {
@@ -49,6 +53,7 @@ impl Default for DiagnoseOptions {
             budget: Budget::default(),
             noise: NoiseChoice::Estimate,
             adequacy_draws: super::adequacy::DRAWS,
+            groups: false,
         }
     }
 }
@@ -80,6 +85,12 @@ impl DiagnoseOptions {
     /// With `draws` Monte-Carlo draws.
     pub fn draws(mut self, draws: usize) -> DiagnoseOptions {
         self.draws = draws;
+        self
+    }
+
+    /// With the grouped candidates on or off.
+    pub fn groups(mut self, on: bool) -> DiagnoseOptions {
+        self.groups = on;
         self
     }
 

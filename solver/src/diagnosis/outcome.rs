@@ -138,6 +138,9 @@ pub struct Diagnosis {
     pub dictionary_size: usize,
     /// The findings, in the order they were added.
     pub findings: Vec<Finding>,
+    /// The grouped candidates added after the findings ([`super::groups`]; only with
+    /// [`super::DiagnoseOptions::groups`]): confirmed ones are in the extended model.
+    pub groups: Vec<super::groups::GroupFinding>,
     /// Findings left out because the extended fit with them did not converge.
     pub dropped: Vec<Dropped>,
     /// Candidates spanned by the final model.
@@ -239,6 +242,16 @@ impl Diagnosis {
                 out.terms.push(f.term);
             }
         }
+        for t in self
+            .groups
+            .iter()
+            .filter(|g| g.confirmed)
+            .flat_map(|g| &g.group.terms)
+        {
+            if !out.terms.contains(t) {
+                out.terms.push(*t);
+            }
+        }
         out
     }
 
@@ -251,6 +264,12 @@ impl Diagnosis {
                     .iter()
                     .filter(|f| f.in_model)
                     .map(|f| f.term.spelling(m)),
+            )
+            .chain(
+                self.groups
+                    .iter()
+                    .filter(|g| g.confirmed)
+                    .map(|g| format!("[{}]", g.group.name)),
             )
             .collect::<Vec<_>>()
             .join(" + ")

@@ -134,31 +134,45 @@ fn raised(m: &Machine, params: &[f64], mm: f64) -> Vec<f64> {
 
 /// The campaign at noise seed `seed` (see the module documentation).
 pub fn campaign(m: &Machine, truth: &Truth, seed: u64) -> Campaign {
-    let records = [
+    campaign_of(m, truth, seed, false)
+}
+
+/// The campaign at noise seed `seed`, with `k2_high` a sixth record: K2 with the ball at the
+/// higher position (generator seed `1000 + seed`), so that A sweeps with C still on two records.
+pub fn campaign_of(m: &Machine, truth: &Truth, seed: u64, k2_high: bool) -> Campaign {
+    let mut paths = vec![
         ("K4", 0.0),
         ("K1", 0.0),
         ("K2", 0.0),
         ("K4", HIGH_RAISE_MM),
         ("K1", HIGH_RAISE_MM),
-    ]
-    .into_iter()
-    .enumerate()
-    .map(|(k, (path, raise))| {
-        let params = raised(m, &m.default_parameters(), raise);
-        let mut t = truth.clone();
-        t.seed = 5 * (seed - 1) + k as u64 + 1;
-        t.params = raised(m, &truth.params, raise);
-        let at = solver::io::campaign::machine_at(m, &params);
-        let planned = builtin_path(&at, path).unwrap().unwrap();
-        let record = simulate(&at, &t, &planned).unwrap();
-        let (label, setup) = if raise > 0.0 {
-            (format!("{}-high", path.to_lowercase()), "high")
-        } else {
-            (path.to_lowercase(), "low")
-        };
-        CampaignRecord::new(label, record, params, setup, false)
-    })
-    .collect();
+    ];
+    if k2_high {
+        paths.push(("K2", HIGH_RAISE_MM));
+    }
+    let records = paths
+        .into_iter()
+        .enumerate()
+        .map(|(k, (path, raise))| {
+            let params = raised(m, &m.default_parameters(), raise);
+            let mut t = truth.clone();
+            t.seed = if k < 5 {
+                5 * (seed - 1) + k as u64 + 1
+            } else {
+                1000 + seed
+            };
+            t.params = raised(m, &truth.params, raise);
+            let at = solver::io::campaign::machine_at(m, &params);
+            let planned = builtin_path(&at, path).unwrap().unwrap();
+            let record = simulate(&at, &t, &planned).unwrap();
+            let (label, setup) = if raise > 0.0 {
+                (format!("{}-high", path.to_lowercase()), "high")
+            } else {
+                (path.to_lowercase(), "low")
+            };
+            CampaignRecord::new(label, record, params, setup, false)
+        })
+        .collect();
     Campaign::new(records).unwrap()
 }
 
@@ -393,9 +407,14 @@ struct Diagnosed {
 }
 
 fn diagnosed(seed: u64, o: &DiagnoseOptions) -> Diagnosed {
+    diagnosed_of(seed, o, false)
+}
+
+/// [`diagnosed`] on [`campaign_of`] (`k2_high`: with K2 at the higher ball position too).
+fn diagnosed_of(seed: u64, o: &DiagnoseOptions, k2_high: bool) -> Diagnosed {
     let m = seed_ac();
     let truth = budget(&m);
-    let c = campaign(&m, &truth, seed);
+    let c = campaign_of(&m, &truth, seed, k2_high);
     let reduced = Model::of(&m, "reduced").unwrap();
     let none = Campaign {
         records: Vec::new(),
@@ -431,6 +450,22 @@ pub fn run_with(seed: u64, o: &DiagnoseOptions) -> Study {
     } = diagnosed(seed, o);
     let extended = d.extended_terms();
     let findings: Vec<String> = spelled(&m, &extended)[reduced.terms.len()..].to_vec();
+    for g in &d.groups {
+        progress(&format!(
+            "group {} ({} terms, {} directions of {} columns): share {:.3}, F {:.2}, p {:.2e} of {} tried, left-out gain {:?} sd, confirmed {}, undetermined {}",
+            g.group.name,
+            g.group.terms.len(),
+            g.directions,
+            g.columns,
+            g.fraction,
+            g.f,
+            g.p,
+            g.tried,
+            g.gain_sd,
+            g.confirmed,
+            g.undetermined.join(" ")
+        ));
+    }
 
     let mut figures = Vec::new();
     progress(&format!(
@@ -665,4 +700,116 @@ pub fn text(s: &Study) -> String {
         }
     ));
     out
+}
+
+/// The grouped candidates at noise seed `seed` ([`solver::diagnosis::groups`]): the campaign
+/// diagnosed with them on, each group the selection takes described (its members, directions,
+/// F, corrected p, the left-out gain in standard deviations and whether it is confirmed), the
+/// figure of the extended model the diagnosis then gives (its findings and confirmed groups,
+/// under `minimum-norm` when the campaign does not determine it), and the figure of the diagnosis's extended model with **every** selected group's members added,
+/// confirmed or not, identified under `minimum-norm`: what the groups would give were they
+/// taken on the fitted records' significance alone. `k2_high`: on [`campaign_of`] with K2 at
+/// the higher ball position as a sixth record.
+pub fn groups(seed: u64, k2_high: bool) -> (Vec<String>, Figure, Figure) {
+    let Diagnosed { m, truth, c, d, .. } =
+        diagnosed_of(seed, &DiagnoseOptions::default().groups(true), k2_high);
+    let recommended = d.extended_terms();
+    let mut ident = identify(&m, &recommended, &c, Constraint::None);
+    if !undetermined(&ident).is_empty() {
+        ident = identify(&m, &recommended, &c, Constraint::MinimumNorm);
+    }
+    let with_confirmed = figure(
+        &m,
+        &truth,
+        &ident,
+        "extended, confirmed groups",
+        d.extended_label(&m, "reduced"),
+        vec![],
+    );
+    let mut model = recommended.clone();
+    let mut described = Vec::new();
+    for g in &d.groups {
+        described.push(format!(
+            "{} ({}): {} directions of {} columns, F {:.1}, p {:.1e} ({} groups tried), left-out gain {} sd, {}",
+            g.group.name,
+            g.group
+                .terms
+                .iter()
+                .map(|t| t.spelling(&m))
+                .collect::<Vec<_>>()
+                .join(" "),
+            g.directions,
+            g.columns,
+            g.f,
+            g.p,
+            g.tried,
+            g.gain_sd.map_or("—".into(), |z| format!("{z:.1}")),
+            if g.confirmed { "confirmed" } else { "not confirmed" }
+        ));
+        for t in &g.group.terms {
+            if !model.terms.contains(t) {
+                model.terms.push(*t);
+            }
+        }
+    }
+    progress(&format!(
+        "noise seed {seed}: extended model with every selected group"
+    ));
+    let ident = identify(&m, &model, &c, Constraint::MinimumNorm);
+    let f = figure(
+        &m,
+        &truth,
+        &ident,
+        "extended + groups",
+        format!("{} terms", model.terms.len()),
+        vec![],
+    );
+    (described, with_confirmed, f)
+}
+
+/// Why the records left out in turn do not confirm the groups: at noise seed `seed`, with the
+/// grouped candidates on, every record of the campaign predicted by the fit on the four others,
+/// with the diagnosis's extended model and with it plus each selected group alone (µm RMS of
+/// the prediction's residual, over the three directions; the rank and condition number of the
+/// fit on the four). One line per record left out.
+pub fn left_out(seed: u64) -> Vec<String> {
+    let Diagnosed { m, c, d, .. } = diagnosed(seed, &DiagnoseOptions::default().groups(true));
+    let extended = d.extended_terms();
+    let mut models = vec![("extended".to_string(), extended.clone())];
+    for g in &d.groups {
+        let mut model = extended.clone();
+        model.terms.extend(g.group.terms.iter().copied());
+        models.push((format!("+ {}", g.group.name), model));
+    }
+    (0..c.records.len())
+        .map(|j| {
+            let fitted = Campaign {
+                records: c
+                    .records
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| *k != j)
+                    .map(|(_, r)| r.clone())
+                    .collect(),
+            };
+            let judged = Campaign {
+                records: vec![c.records[j].clone()],
+            };
+            let mut line = format!("{} left out:", c.records[j].label);
+            for (name, model) in &models {
+                let ident = identify(&m, model, &fitted, Constraint::None);
+                let p = solver::diagnosis::heldout::predict(&m, &ident, &judged).unwrap();
+                let r = &p[0].validation.residual;
+                let ss: f64 = r.iter().flatten().map(|x| x * x).sum();
+                line.push_str(&format!(
+                    " {name} {:.3} µm (rank {} of {}, condition {:.0});",
+                    (ss / (3 * r.len()) as f64).sqrt() * 1e3,
+                    ident.fit.rank,
+                    ident.fit.names.len(),
+                    ident.fit.condition.unwrap_or(f64::NAN)
+                ));
+            }
+            line
+        })
+        .collect()
 }

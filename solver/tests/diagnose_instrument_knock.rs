@@ -313,7 +313,6 @@ fn a_ball_knocked_along_x_is_a_jump_not_a_cause() {
 /// knock from its look-alikes needs the jump itself as a candidate whose held-out prediction is
 /// compared with theirs (docs/diagnosis.md §8).
 #[test]
-#[ignore = "fails at noise seed 5: look-alikes of a knock along z that improve the held-out prediction are named causes (docs/diagnosis.md §8)"]
 fn a_ball_knocked_along_z_is_a_jump_not_a_cause() {
     for seed in SEEDS {
         knock("ZOW", seed);

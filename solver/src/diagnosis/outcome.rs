@@ -205,13 +205,19 @@ impl Finding {
     pub fn confirmed(&self) -> bool {
         self.confirmation.as_ref().is_some_and(|c| c.confirmed)
     }
+
+    /// A jump in time of a fitted record (`jump:T`): the ball or the sensor moved during it.
+    pub fn is_jump(&self) -> bool {
+        self.term.basis.jump_at().is_some()
+    }
 }
 
 impl Diagnosis {
-    /// Whether finding `f` is named a cause: in the extended model, confirmed on its own, and
-    /// the extended model recommended.
+    /// Whether finding `f` is named a cause: in the extended model, confirmed on its own, the
+    /// extended model recommended, and no jump in time of a fitted record (a jump is an event
+    /// of the record, never a cause of the machine).
     pub fn is_cause(&self, f: &Finding) -> bool {
-        f.in_model && f.confirmed() && self.recommendation.recommended
+        f.in_model && f.confirmed() && self.recommendation.recommended && !f.is_jump()
     }
 
     /// The rows of the records that judged the extension: the held-out records, or with none

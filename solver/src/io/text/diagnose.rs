@@ -111,8 +111,12 @@ pub fn findings(r: &DiagnosisReport) -> String {
 /// is not a cause.
 fn confirmation(f: &FindingReport) -> String {
     let mut out = String::new();
+    if f.status == "jump" {
+        out.push_str("     a jump in time of the fitted record: the ball or the sensor moved during the record; it predicts nothing on another record and is no cause of the machine: measure the record again
+");
+    }
     let Some(c) = &f.confirmation else {
-        if f.status != "cause" {
+        if f.status != "cause" && f.status != "jump" {
             out.push_str("     fits the fitted record, but not confirmed: no record was held out to check it; not a cause\n");
         }
         return out;
@@ -155,7 +159,7 @@ fn confirmation(f: &FindingReport) -> String {
             }
         ));
     }
-    if c.confirmed && f.status != "cause" {
+    if c.confirmed && f.status != "cause" && f.status != "jump" {
         out.push_str("     not a cause: the extended model is not recommended (below)\n");
     }
     out

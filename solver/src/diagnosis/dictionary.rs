@@ -40,11 +40,13 @@
 //! - `velocity` of the positioning error of every axis that moves (records with real times);
 //! - the R-test's instrument terms `SXX … SZY`, constant.
 //!
-//! And a jump in time of a fitted record ([`jumps`], with the scanned families): `jump:T` of
-//! the ball's set-up errors `XOW YOW ZOW` and of the zero offsets `dx0 dy0 dz0` (the ball
-//! knocked, a sensor bumped), T at [`JUMPS`] instants evenly between the 5 % and 95 %
-//! quantiles of the records' sample times (each on its own clock). A jump is a term of each
-//! fitted record (its own value per record) and of no other record: it predicts nothing.
+//! And a jump in time of the fitted record ([`jumps`], with the scanned families, where one
+//! record is fitted): `jump:T` of the ball's set-up errors `XOW YOW ZOW` and of the zero
+//! offsets `dx0 dy0 dz0` (the ball knocked, a sensor bumped), T at [`JUMPS`] instants evenly
+//! between the 5 % and 95 % quantiles of its sample times. A jump is a term of that record
+//! and of no other: it predicts nothing elsewhere. (On a campaign of several records a
+//! `jump:T` would be a jump at T of every record's own clock, a look-alike of a position error
+//! on records that repeat a path: it is not offered there.)
 
 use model_spec::basis::Basis;
 use model_spec::terms::{Effect, Term};
@@ -158,8 +160,8 @@ pub const TAUS: usize = 8;
 /// Instants scanned for `jump:T`.
 pub const JUMPS: usize = 24;
 
-/// The jumps in time that `model_terms` lacks, on fitted records whose samples are at the times
-/// `times` (s, each on its record's own clock; every record's together): `jump:T` of every
+/// The jumps in time that `model_terms` lacks, on a fitted record whose samples are at the
+/// times `times` (s, on its own clock): `jump:T` of every
 /// set-up error and zero offset, T at [`JUMPS`] instants evenly between the 5 % and 95 %
 /// quantiles of `times` (see the module documentation). None without the scanned families or
 /// with fewer than 20 samples.

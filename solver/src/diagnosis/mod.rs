@@ -252,8 +252,16 @@ pub fn diagnose(
         &joined(fitted),
         &o.dictionary,
     ));
-    let times = own_times(fitted);
-    candidates.extend(dictionary::jumps(m, &base_terms.terms, &times, &o.dictionary));
+    // A jump in time where one record is fitted (`dictionary::jumps`).
+    if let [one] = fitted.records.as_slice() {
+        let times: Vec<f64> = one.record.samples.iter().map(|s| s.t).collect();
+        candidates.extend(dictionary::jumps(
+            m,
+            &base_terms.terms,
+            &times,
+            &o.dictionary,
+        ));
+    }
 
     // Outliers of every fitted record, from the base fit's residual: everything after works
     // without their samples.

@@ -251,11 +251,17 @@ impl Diagnosis {
     /// The extended model's label: the base model's `label` and the findings in the model
     /// (`reduced + ECC@harmonic:2`).
     pub fn extended_label(&self, m: &Machine, label: &str) -> String {
+        self.label_of(m, label, true)
+    }
+
+    /// `label` and the findings in the extended model (but jumps when `jumps` is `false`),
+    /// joined by ` + `.
+    fn label_of(&self, m: &Machine, label: &str, jumps: bool) -> String {
         std::iter::once(label.to_string())
             .chain(
                 self.findings
                     .iter()
-                    .filter(|f| f.in_model)
+                    .filter(|f| f.in_model && (jumps || !f.is_jump()))
                     .map(|f| f.term.spelling(m)),
             )
             .collect::<Vec<_>>()
@@ -264,7 +270,9 @@ impl Diagnosis {
 
     /// The machine description `text` of `m` with the extended model appended as a sub-model
     /// ([`model_spec::write::append_model`]), described by its label and `context` (`rtest
-    /// diagnose on k4.csv`): the model's name and the new text.
+    /// diagnose on k4.csv`): the model's name and the new text. A jump in time of a fitted
+    /// record (`jump:T`) is left out of it: an event of that record, no term of the machine to
+    /// fit on another record.
     ///
     /// # Errors
     /// [`model_spec::write::AppendError`] when the text does not read back as the same machine
@@ -280,9 +288,10 @@ impl Diagnosis {
             .extended_terms()
             .terms
             .iter()
+            .filter(|t| t.basis.jump_at().is_none())
             .map(|t| t.spelling(m))
             .collect();
-        let description = format!("{} ({context})", self.extended_label(m, label));
+        let description = format!("{} ({context})", self.label_of(m, label, false));
         model_spec::write::append_model(m, text, &terms, &description)
     }
 }

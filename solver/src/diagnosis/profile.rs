@@ -85,9 +85,12 @@ fn grid(basis: Basis, x: &[f64], times: &[f64], tau_range: (f64, f64)) -> Vec<f6
         Basis::Jump(_) => {
             // Within one spacing of the dictionary's grid, between the same quantiles.
             let v = basis.jump_at().unwrap_or(0.0);
-            let Some((q0, q1)) = (times.len() >= 20)
-                .then(|| (times[times.len() / 20], times[times.len() - 1 - times.len() / 20]))
-            else {
+            let Some((q0, q1)) = (times.len() >= 20).then(|| {
+                (
+                    times[times.len() / 20],
+                    times[times.len() - 1 - times.len() / 20],
+                )
+            }) else {
                 return Vec::new();
             };
             between(times, v, (q1 - q0) / super::dictionary::JUMPS as f64)

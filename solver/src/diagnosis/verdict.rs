@@ -152,7 +152,7 @@ pub fn recommend(
         .collect();
     if !jumps.is_empty() {
         reasons.push(format!(
-            "a fitted record jumped in time ({}): the ball or the sensor moved during the record; measure it again",
+            "a fitted record holds a jump in time ({}): the ball or the sensor moved during the record, or something the dictionary lacks changed at once; measure it again",
             jumps.join(", ")
         ));
     }

@@ -15,7 +15,12 @@
 //! - `warmup:TAU`: 1 − exp(−(t − start)/TAU) of the time since the stated start, TAU in s: its
 //!   coefficient is the warm-up's asymptotic amplitude;
 //! - `velocity`: −v, the own axis's velocity (mm/ms, rad/ms) with the sign of a lag, for the
-//!   axis's positioning error; its coefficient is the servo lag τ in ms.
+//!   axis's positioning error; its coefficient is the servo lag τ in ms;
+//! - `jump:T`: 0 before the time T of the record's own clock (its `t_s`, s; the sample's number
+//!   on a record whose samples are only numbered), 1 from T on, for effects of no axis: a
+//!   set-up error or a zero offset that moved during one record (the ball knocked, a sensor
+//!   bumped). It is a term of that record only: a campaign gives every record its own value,
+//!   and a record that was not fitted takes none (the jump is an event of the fitted record).
 //!
 //! A term (effect × basis) is one column of the H matrix, two for `harmonic:K` and `period:P`
 //! (cos, then sin). Every basis is evaluated in one place, [`Basis::values`], at a
@@ -29,8 +34,8 @@
 //! times the rate); a warm-up before its start is not defined, and a record with a sample there
 //! is refused for a `warmup:TAU` term ([`Basis::starts_at_zero`]).
 //!
-//! The scanned parameters of `period`, `step`, `exp` and `warmup` are kept as whole numbers of
-//! thousandths (µm, thousandths of mm or degree, ms), so that a basis is `Copy + Eq + Hash +
+//! The scanned parameters of `period`, `step`, `exp`, `warmup` and `jump` are kept as whole
+//! numbers of thousandths (µm, thousandths of mm or degree, ms), so that a basis is `Copy + Eq + Hash +
 //! Ord`; they are written with at most three decimals and printed as the shortest decimal
 //! (`period:2.5`).
 
@@ -74,6 +79,9 @@ pub enum Basis {
     /// 1 − exp(−(t − start)/TAU), t − start the time since the stated start; TAU in ms,
     /// TAU > 0. Its coefficient is the asymptotic amplitude of the warm-up (mm or rad).
     Warmup(u32),
+    /// 0 before the time T on the record's own clock, 1 from T on; T in ms (thousandths of s).
+    /// Its coefficient is the size of the jump (mm or rad).
+    Jump(i64),
 }
 
 /// What a basis needs to know about the effect it multiplies.
@@ -155,7 +163,8 @@ fn decimal(v: i64) -> String {
 impl Basis {
     /// Parses `const`, `harmonic:K`, `poly:K`, `reversal`, `time:K` (K ≥ 1), `period:P`
     /// (P > 0 mm), `step:V` (mm or degrees), `exp:TAU` (TAU > 0 s), `velocity`, `rate` and
-    /// `warmup:TAU` (TAU > 0 s). P, V and TAU are decimals with at most three decimals.
+    /// `warmup:TAU` (TAU > 0 s) and `jump:T` (s). P, V, TAU and T are decimals with at most
+    /// three decimals.
     pub fn parse(s: &str) -> Result<Basis, BasisError> {
         let s = s.trim();
         let order = |k: &str, name: &str| -> Result<u32, BasisError> {
@@ -211,6 +220,11 @@ impl Basis {
             Some(("warmup", t)) => Ok(Basis::Warmup(positive(
                 t,
                 "the time constant TAU of `warmup:TAU` (s)",
+                MAX_TAU_S,
+            )?)),
+            Some(("jump", t)) => Ok(Basis::Jump(value(
+                t,
+                "the time T of `jump:T` (s)",
                 MAX_TAU_S,
             )?)),
             _ => Err(BasisError(format!(
@@ -280,6 +294,14 @@ impl Basis {
         }
     }
 
+    /// The time T of `jump:T` on the record's own clock, s.
+    pub fn jump_at(self) -> Option<f64> {
+        match self {
+            Basis::Jump(t) => Some(t as f64 / MILLI),
+            _ => None,
+        }
+    }
+
     /// The position V of `step:V`: mm, or degrees for a rotary axis.
     pub fn step_at(self) -> Option<f64> {
         match self {
@@ -290,7 +312,7 @@ impl Basis {
 
     /// Checks that the basis fits an effect carried by `carrier` of machine `m`: harmonics need
     /// a rotary axis, polynomials and periods a linear axis, reversal, steps and velocity an
-    /// axis, `exp:TAU` an effect of no axis; `const`, `time:K`, `rate` and `warmup:TAU` fit
+    /// axis, `exp:TAU` and `jump:T` an effect of no axis; `const`, `time:K`, `rate` and `warmup:TAU` fit
     /// every effect. (That `velocity` needs the positioning error, and that instrument terms
     /// and kinematic offsets are constants, is checked by [`crate::terms::Term::new`].)
     pub fn check(self, m: &Machine, carrier: Carrier) -> Result<(), BasisError> {
@@ -303,7 +325,7 @@ impl Basis {
             (Basis::Harmonic(_), Some(AxisKind::Rotary)) => Ok(()),
             (Basis::Poly(_) | Basis::Period(_), Some(AxisKind::Linear)) => Ok(()),
             (Basis::Reversal | Basis::Step(_) | Basis::Velocity, Some(_)) => Ok(()),
-            (Basis::Exp(_), None) => Ok(()),
+            (Basis::Exp(_) | Basis::Jump(_), None) => Ok(()),
             (Basis::Harmonic(_), _) => Err(BasisError(format!(
                 "`{self}` needs an error of a rotary axis"
             ))),
@@ -313,7 +335,7 @@ impl Basis {
             (Basis::Reversal | Basis::Step(_) | Basis::Velocity, None) => {
                 Err(BasisError(format!("`{self}` needs an error of an axis")))
             }
-            (Basis::Exp(_), Some(_)) => Err(BasisError(format!(
+            (Basis::Exp(_) | Basis::Jump(_), Some(_)) => Err(BasisError(format!(
                 "`{self}` needs an effect of no axis (dx0 dy0 dz0, a location, squareness or set-up error)"
             ))),
         }
@@ -357,12 +379,20 @@ impl Basis {
             Basis::Velocity => [-cx.velocity[axis], 0.0],
             Basis::Rate => [cx.since_start_s, 0.0],
             Basis::Warmup(t) => [-(-cx.since_start_s * MILLI / f64::from(t)).exp_m1(), 0.0],
+            Basis::Jump(t) => [
+                if cx.since_start_s * MILLI >= t as f64 {
+                    1.0
+                } else {
+                    0.0
+                },
+                0.0,
+            ],
         }
     }
 }
 
 /// The vocabulary as error messages list it.
-const VOCABULARY: &str = "const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate or warmup:TAU";
+const VOCABULARY: &str = "const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate, warmup:TAU or jump:T";
 
 impl fmt::Display for Basis {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -378,6 +408,7 @@ impl fmt::Display for Basis {
             Basis::Velocity => write!(f, "velocity"),
             Basis::Rate => write!(f, "rate"),
             Basis::Warmup(t) => write!(f, "warmup:{}", decimal(i64::from(*t))),
+            Basis::Jump(t) => write!(f, "jump:{}", decimal(*t)),
         }
     }
 }
@@ -435,6 +466,8 @@ mod tests {
             ("warmup:40", Basis::Warmup(40_000)),
             ("warmup:0.125", Basis::Warmup(125)),
             ("warmup:1000000", Basis::Warmup(1_000_000_000)),
+            ("jump:149.5", Basis::Jump(149_500)),
+            ("jump:-2", Basis::Jump(-2_000)),
         ] {
             assert_eq!(Basis::parse(s).unwrap(), b, "{s}");
             assert_eq!(b.to_string(), s);
@@ -515,6 +548,15 @@ mod tests {
         }
         assert!(Basis::Warmup(1).starts_at_zero() && !Basis::Rate.starts_at_zero());
         assert!(!Basis::Exp(1).starts_at_zero() && Basis::Exp(1).of_time());
+        // A jump: 0 before T on the record's own clock, 1 from T on; a term of one record, not
+        // of a clock.
+        assert_eq!(v(Basis::Jump(149_500), 149.0), 0.0);
+        assert_eq!(v(Basis::Jump(149_500), 149.5), 1.0);
+        assert_eq!(v(Basis::Jump(149_500), 150.0), 1.0);
+        assert_eq!(Basis::Jump(149_500).jump_at(), Some(149.5));
+        assert!(!Basis::Jump(1).of_time() && !Basis::Jump(1).needs_times());
+        assert!(Basis::Jump(1).check(&m, Carrier::None).is_ok());
+        assert!(Basis::Jump(1).check(&m, Carrier::Axis(0)).is_err());
     }
 
     #[test]

@@ -507,6 +507,10 @@ pub fn describe_basis(basis: Basis) -> String {
             "warming up from the start, time constant {} s (coefficient: the amplitude it tends to)",
             basis.to_string().trim_start_matches("warmup:")
         ),
+        Basis::Jump(_) => format!(
+            "a jump at {} s of the record's own clock (the ball or the sensor moved during the record)",
+            basis.to_string().trim_start_matches("jump:")
+        ),
     }
 }
 

@@ -997,7 +997,7 @@ fn submodel_term_errors_are_located() {
             r#"errors = ["XOC", "ECC@cubic:2"]"#,
         ),
         &format!(
-            "m.toml:{line}:18: model `reduced`: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate or warmup:TAU)"
+            "m.toml:{line}:18: model `reduced`: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate, warmup:TAU or jump:T)"
         ),
     );
     check(

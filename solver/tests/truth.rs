@@ -299,7 +299,7 @@ fn every_invalid_entry_names_file_line_and_column() {
         ),
         (
             "[errors]\nECC = { \"cubic:2\" = 1 }\n",
-            "t.toml:2:9: ECC: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate or warmup:TAU)",
+            "t.toml:2:9: ECC: unknown basis `cubic:2` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate, warmup:TAU or jump:T)",
         ),
         (
             "[errors]\nECC = { \"harmonic:0\" = [1, 2] }\n",

@@ -358,7 +358,7 @@ fn bad_identify_json_names_the_file_and_the_field() {
         ),
         (
             ok.replace("\"const\"", "\"cubic\""),
-            "id.json: field `parameters[0].basis`: unknown basis `cubic` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate or warmup:TAU)",
+            "id.json: field `parameters[0].basis`: unknown basis `cubic` (expected const, harmonic:K, poly:K, reversal, time:K, period:P, step:V, exp:TAU, velocity, rate, warmup:TAU or jump:T)",
         ),
         (
             ok.replace("\"model\": \"m\",", ""),

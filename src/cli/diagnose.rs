@@ -39,13 +39,15 @@ reversal of positioning errors (backlash), const location, squareness and ball s
 the R-test's zero offsets dx0 dy0 dz0 (const, a drift as rate in µm/s, or time:1 on a record \
 without t_s, and time:2..T); and scanned: period:P (ballscrew, scale) and step:V of positioning \
 errors, warmup:TAU (warm-up from t_s = 0) of the zero offsets and location errors, rate of \
-location errors, velocity (servo lag, records with t_s) of positioning errors, and the \
-instrument terms SXX..SZY (sensor gain and cross-talk).
+location errors, velocity (servo lag, records with t_s) of positioning errors, the \
+instrument terms SXX..SZY (sensor gain and cross-talk), and jump:T of the ball's set-up errors \
+XOW YOW ZOW and the zero offsets (the ball knocked or a sensor bumped at T s of a fitted \
+record: a term of that record only, which predicts nothing on another).
 5. Selection: one candidate at a time, the one that explains most of what is left; kept if its \
 F-test is significant at --alpha after a correction for the number of candidates tried, every \
 scanned value counted (Bonferroni, else a Monte-Carlo null of the selection itself). Candidates \
 the model already spans are listed as confounded (with what); candidates the data cannot tell \
-from a finding are named with it. A scanned parameter (P, V, TAU) is refined with a 95 % \
+from a finding are named with it. A scanned parameter (P, V, TAU, T) is refined with a 95 % \
 interval. A finding beyond --budget is 'implausible': not a cause, not in the extended model.
 6. Gain: the extended model (model + plausible findings) is fitted on --data and predicts every \
 --validate file (exact prediction, with only what the fits determine: a file whose prediction \
@@ -57,8 +59,11 @@ files, each file is predicted by the fit on the others instead.
 7. Verdict: the residual of the extended model on every file is tested against the noise \
 (parametric bootstrap; 'down to the noise' only when it passes); where it fails, what remains is \
 described (what it follows, its shape, its RMS). The extended model is recommended only when no \
-held-out file gets worse, the held-out residual falls and a finding is confirmed; a finding is \
-a 'cause' only when confirmed and recommended, otherwise 'not confirmed', and the text says why.
+held-out file gets worse, the held-out residual falls, a finding is confirmed and no fitted \
+record jumped; a finding is a 'cause' only when confirmed and recommended, otherwise 'not \
+confirmed', and the text says why. A jump is never a cause: its status is 'jump', it is \
+described in what remains (a step in time at its sample), and the record is to be measured \
+again.
 
 Values of findings are in µm (translational errors, offsets) and µrad (angular errors); a \
 harmonic is printed as its cos and sin coefficients, its amplitude √(cos² + sin²) and phase φ \

@@ -254,6 +254,9 @@ fn left_out_reason(m: &Machine, term: &Term) -> Option<String> {
         (Effect::Error(e), _) if matches!(m.catalogue[e].kind, ErrorKind::Setup { .. }) => {
             "a set-up error of the workpiece (where the ball was placed), not an error of the machine"
         }
+        (_, b) if b.jump_at().is_some() => {
+            "a jump during one record (the ball or the sensor moved), not an error of the machine"
+        }
         (_, b) if b.of_time() => {
             "it changes with time over the record (a drift, a rate, a warm-up, a settling), not with the pose: no geometric compensation holds it"
         }

@@ -19,16 +19,20 @@ use std::collections::HashMap;
 /// - `period:P` of one error: 1/P within one spacing of the error's period grid in 1/P (the
 ///   other's refinement interval), or P within 2 % (a period 0.3 % off the chosen one only
 ///   mops up what the coarse grid left);
-/// - `exp:TAU` or `warmup:TAU` of one effect: TAU within a factor 3.
+/// - `exp:TAU` or `warmup:TAU` of one effect: TAU within a factor 3;
+/// - `jump:T` of one effect: T within one spacing of its grid ([`super::dictionary::jumps`]),
+///   as steps.
 ///
 /// A spacing is the grid's extent over its number of intervals, with 1 % slack (and, for
-/// steps, two thousandths) for the values' rounding to thousandths.
+/// steps and jumps, two thousandths) for the values' rounding to thousandths.
 #[derive(Clone, Debug, Default)]
 pub(super) struct SameFinding {
     /// Per effect, the spacing of its `step:V` grid (mm or degrees).
     step: HashMap<Effect, f64>,
     /// Per effect, the spacing of its `period:P` grid in 1/P (1/mm).
     period: HashMap<Effect, f64>,
+    /// Per effect, the spacing of its `jump:T` grid (s).
+    jump: HashMap<Effect, f64>,
 }
 
 impl SameFinding {
@@ -36,9 +40,12 @@ impl SameFinding {
     pub fn of(candidates: &[Term]) -> SameFinding {
         let mut steps: HashMap<Effect, Vec<f64>> = HashMap::new();
         let mut periods: HashMap<Effect, Vec<f64>> = HashMap::new();
+        let mut jumps: HashMap<Effect, Vec<f64>> = HashMap::new();
         for t in candidates {
             if let Some(v) = t.basis.step_at() {
                 steps.entry(t.effect).or_default().push(v);
+            } else if let Some(v) = t.basis.jump_at() {
+                jumps.entry(t.effect).or_default().push(v);
             } else if let Some(p) = t.basis.period_mm() {
                 periods.entry(t.effect).or_default().push(1.0 / p);
             }
@@ -56,6 +63,7 @@ impl SameFinding {
         SameFinding {
             step: spacings(steps),
             period: spacings(periods),
+            jump: spacings(jumps),
         }
     }
 
@@ -81,6 +89,10 @@ impl SameFinding {
                         .get(&a.effect)
                         .is_some_and(|&s| (1000.0 / p - 1000.0 / q).abs() <= 1.01 * s)
             }
+            (Basis::Jump(u), Basis::Jump(v)) => self
+                .jump
+                .get(&a.effect)
+                .is_some_and(|&s| ((u - v) as f64 / 1000.0).abs() <= 1.01 * s + 2e-3),
             (Basis::Exp(p), Basis::Exp(q)) | (Basis::Warmup(p), Basis::Warmup(q)) => {
                 f64::from(p.max(q)) / f64::from(p.min(q).max(1)) < 3.0
             }

@@ -39,6 +39,14 @@
 //!   (from its first sample: a warm-up before its start is not defined);
 //! - `velocity` of the positioning error of every axis that moves (records with real times);
 //! - the R-test's instrument terms `SXX … SZY`, constant.
+//!
+//! And a jump in time of the fitted record ([`jumps`], with the scanned families, where one
+//! record is fitted): `jump:T` of the ball's set-up errors `XOW YOW ZOW` and of the zero
+//! offsets `dx0 dy0 dz0` (the ball knocked, a sensor bumped), T at [`JUMPS`] instants evenly
+//! between the 5 % and 95 % quantiles of its sample times. A jump is a term of that record
+//! and of no other: it predicts nothing elsewhere. (On a campaign of several records a
+//! `jump:T` would be a jump at T of every record's own clock, a look-alike of a position error
+//! on records that repeat a path: it is not offered there.)
 
 use model_spec::basis::Basis;
 use model_spec::terms::{Effect, Term};
@@ -148,6 +156,42 @@ pub const STEPS: usize = 24;
 
 /// Time constants scanned for `warmup:TAU`.
 pub const TAUS: usize = 8;
+
+/// Instants scanned for `jump:T`.
+pub const JUMPS: usize = 24;
+
+/// The jumps in time that `model_terms` lacks, on a fitted record whose samples are at the
+/// times `times` (s, on its own clock): `jump:T` of every
+/// set-up error and zero offset, T at [`JUMPS`] instants evenly between the 5 % and 95 %
+/// quantiles of `times` (see the module documentation). None without the scanned families or
+/// with fewer than 20 samples.
+pub fn jumps(m: &Machine, model_terms: &[Term], times: &[f64], o: &DictionaryOptions) -> Vec<Term> {
+    if !o.scans || times.len() < 20 {
+        return Vec::new();
+    }
+    let t = sorted(times.to_vec());
+    let (q0, q1) = (t[t.len() / 20], t[t.len() - 1 - t.len() / 20]);
+    if q1 - q0 <= 0.0 {
+        return Vec::new();
+    }
+    let effects: Vec<Effect> = (0..m.catalogue.len())
+        .filter(|&e| matches!(m.catalogue[e].kind, ErrorKind::Setup { .. }))
+        .map(Effect::Error)
+        .chain(Dir::ALL.into_iter().map(Effect::SensorOffset))
+        .collect();
+    let mut out = Vec::with_capacity(effects.len() * JUMPS);
+    for effect in effects {
+        for k in 0..JUMPS {
+            let at = q0 + (q1 - q0) * (k as f64 + 0.5) / JUMPS as f64;
+            out.push(Term {
+                effect,
+                basis: Basis::Jump((at * 1000.0).round() as i64),
+            });
+        }
+    }
+    out.retain(|t| !model_terms.contains(t) && t.check(m).is_ok());
+    out
+}
 
 /// Sorted copy.
 fn sorted(mut v: Vec<f64>) -> Vec<f64> {

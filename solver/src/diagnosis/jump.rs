@@ -1,11 +1,13 @@
-//! A jump in time on a fitted record: the ball's set-up or the R-test's zero moved at one
-//! sample and stayed there (the ball knocked, a sensor bumped).
+//! A jump in time on a fitted record described: the ball's set-up or the R-test's zero moved at
+//! one sample and stayed there (the ball knocked, a sensor bumped).
 //!
-//! Such a jump is no term of the dictionary (a term holds over the whole record), and the base
-//! fit absorbs much of it into the set-up and location errors, so that what the base model
-//! leaves is neither a step nor large: on K4 a 3 µm knock of the ball along x leaves 0.93 µm
-//! RMS in x, which follows C and time smoothly, under twice the noise. It is looked for as a
-//! whole: for a sample k between the 5 % and 95 % quantiles of a fitted record, the columns of
+//! The selection has each of the six jumps as a candidate (`ZOW@jump:149.5`,
+//! [`super::dictionary::jumps`]), which names the term that moved and competes with the
+//! look-alikes of the machine; here the jump is described, where the lack-of-fit test fails and
+//! wherever the extended model holds a jump. The base fit absorbs much of a jump into the set-up
+//! and location errors, so that what the base model leaves is neither a step nor large: on K4 a
+//! 3 µm knock of the ball along x leaves 0.93 µm RMS in x, which follows C and time smoothly,
+//! under twice the noise. It is looked for as a whole: for a sample k between the 5 % and 95 % quantiles of a fitted record, the columns of
 //! the ball's set-up errors (`XOW YOW ZOW`) and of the zero offsets (`dx0 dy0 dz0`) on that
 //! record from sample k on (zero before), whitened as the selection's columns, with the base
 //! model projected out, are fitted to the base model's residual; k runs over a grid of at most

@@ -229,8 +229,13 @@ pub(super) fn test(
             let mut described = unexplained::describe_failures(m, a, &records, o.alpha);
             // The findings may have absorbed on the fitted records what the held-out records
             // then mispredict: the base model's residual there is described where it is, as a
-            // jump in time of the set-up or the zero where it is one ([`jump`]).
-            let jumps = if a.consistent_with_noise {
+            // jump in time of the set-up or the zero where it is one ([`jump`]); and so it is
+            // when the extended model holds a jump, which leaves the noise.
+            let jumped = as_candidates
+                .terms
+                .iter()
+                .any(|t| t.basis.jump_at().is_some());
+            let jumps = if a.consistent_with_noise && !jumped {
                 Vec::new()
             } else {
                 jump::find(m, cleaned, cols, weights, whitening, o.alpha, &|r| {

@@ -191,6 +191,18 @@ fn joined(c: &Campaign) -> Cow<'_, Record> {
     Cow::Owned(out)
 }
 
+/// The sample times of every record of `c`, each on its own clock (s), sorted: the instants a
+/// jump is scanned over.
+fn own_times(c: &Campaign) -> Vec<f64> {
+    let mut t: Vec<f64> = c
+        .records
+        .iter()
+        .flat_map(|r| r.record.samples.iter().map(|s| s.t))
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t
+}
+
 /// The residuals of every record of `fit`, one after the other (mm, one `[x, y, z]` per sample).
 fn flat_residual(fit: &CampaignIdentification) -> Vec<[f64; 3]> {
     (0..fit.records.len())
@@ -241,6 +253,16 @@ pub fn diagnose(
         &joined(fitted),
         &o.dictionary,
     ));
+    // A jump in time where one record is fitted (`dictionary::jumps`).
+    if let [one] = fitted.records.as_slice() {
+        let times: Vec<f64> = one.record.samples.iter().map(|s| s.t).collect();
+        candidates.extend(dictionary::jumps(
+            m,
+            &base_terms.terms,
+            &times,
+            &o.dictionary,
+        ));
+    }
 
     // Outliers of every fitted record, from the base fit's residual: everything after works
     // without their samples.
@@ -318,11 +340,15 @@ pub fn diagnose(
     // A scanned candidate's parameter refined on a fine grid given a model, in the selection
     // (after each step) and after it (with every other finding in place).
     let grid_record = joined(&cleaned);
+    let grid = profile::Grid {
+        record: &grid_record,
+        times: &own_times(&cleaned),
+    };
     let term_columns = |t: Term| cols.term_columns(m, t, &cleaned, &weights, &whitening);
     let refine_step = |c: usize, q: &Span| -> Option<search::Refined> {
         let mut columns = term_columns;
         let (term, scan) =
-            profile::refine(m, candidates[c], &grid_record, &mut columns, q, &cols.y).ok()??;
+            profile::refine(m, candidates[c], &grid, &mut columns, q, &cols.y).ok()??;
         let columns = term_columns(term).ok()?;
         Some(search::Refined {
             term,
@@ -351,7 +377,7 @@ pub fn diagnose(
         let coarse = candidates[chosen[k].index];
         let mut columns = |t: Term| cols.term_columns(m, t, &cleaned, &weights, &whitening);
         refined.push(
-            match profile::refine(m, coarse, &grid_record, &mut columns, &q, &cols.y)? {
+            match profile::refine(m, coarse, &grid, &mut columns, &q, &cols.y)? {
                 Some((t, scan)) => (t, Some(scan)),
                 None => chosen[k]
                     .refined

@@ -208,13 +208,19 @@ impl Finding {
     pub fn confirmed(&self) -> bool {
         self.confirmation.as_ref().is_some_and(|c| c.confirmed)
     }
+
+    /// A jump in time of a fitted record (`jump:T`): the ball or the sensor moved during it.
+    pub fn is_jump(&self) -> bool {
+        self.term.basis.jump_at().is_some()
+    }
 }
 
 impl Diagnosis {
-    /// Whether finding `f` is named a cause: in the extended model, confirmed on its own, and
-    /// the extended model recommended.
+    /// Whether finding `f` is named a cause: in the extended model, confirmed on its own, the
+    /// extended model recommended, and no jump in time of a fitted record (a jump is an event
+    /// of the record, never a cause of the machine).
     pub fn is_cause(&self, f: &Finding) -> bool {
-        f.in_model && f.confirmed() && self.recommendation.recommended
+        f.in_model && f.confirmed() && self.recommendation.recommended && !f.is_jump()
     }
 
     /// The rows of the records that judged the extension: the held-out records, or with none
@@ -258,11 +264,17 @@ impl Diagnosis {
     /// The extended model's label: the base model's `label` and the findings in the model
     /// (`reduced + ECC@harmonic:2`).
     pub fn extended_label(&self, m: &Machine, label: &str) -> String {
+        self.label_of(m, label, true)
+    }
+
+    /// `label` and the findings in the extended model (but jumps when `jumps` is `false`),
+    /// joined by ` + `.
+    fn label_of(&self, m: &Machine, label: &str, jumps: bool) -> String {
         std::iter::once(label.to_string())
             .chain(
                 self.findings
                     .iter()
-                    .filter(|f| f.in_model)
+                    .filter(|f| f.in_model && (jumps || !f.is_jump()))
                     .map(|f| f.term.spelling(m)),
             )
             .chain(
@@ -277,7 +289,9 @@ impl Diagnosis {
 
     /// The machine description `text` of `m` with the extended model appended as a sub-model
     /// ([`model_spec::write::append_model`]), described by its label and `context` (`rtest
-    /// diagnose on k4.csv`): the model's name and the new text.
+    /// diagnose on k4.csv`): the model's name and the new text. A jump in time of a fitted
+    /// record (`jump:T`) is left out of it: an event of that record, no term of the machine to
+    /// fit on another record.
     ///
     /// # Errors
     /// [`model_spec::write::AppendError`] when the text does not read back as the same machine
@@ -293,9 +307,10 @@ impl Diagnosis {
             .extended_terms()
             .terms
             .iter()
+            .filter(|t| t.basis.jump_at().is_none())
             .map(|t| t.spelling(m))
             .collect();
-        let description = format!("{} ({context})", self.extended_label(m, label));
+        let description = format!("{} ({context})", self.label_of(m, label, false));
         model_spec::write::append_model(m, text, &terms, &description)
     }
 }

@@ -1,10 +1,11 @@
 //! The scanned parameter of a finding (P of `period:P`, V of `step:V`, TAU of `warmup:TAU` and
-//! `exp:TAU`), refined and given an interval from the profile of the fit.
+//! `exp:TAU`, T of `jump:T`), refined and given an interval from the profile of the fit.
 //!
 //! The selection picks the best value of the coarse grid ([`super::dictionary::scanned`]). Here
 //! the parameter is scanned again on a fine grid around it (41 values: ±1 coarse step in 1/P,
-//! every distinct position between the neighbouring grid steps for V, ±half a coarse ratio
-//! in ln TAU within the coarse grid's range), with every other term of the model in place, in
+//! every distinct position between the neighbouring grid steps for V, every instant between
+//! two samples between the neighbouring grid instants for T, ±half a coarse ratio in ln TAU
+//! within the coarse grid's range), with every other term of the model in place, in
 //! the whitened rows of every fitted record (a term's columns as the campaign gives them): the
 //! value that explains most (largest ΔRSS) is the finding's, and its 95 % interval is the set of
 //! values whose ΔRSS lies within `3.84·s²` of the best (`s²` the whitened residual variance of
@@ -19,10 +20,21 @@ use nalgebra::{DMatrix, DVector};
 
 use super::select::Span;
 
+/// Where the fine grids come from: the fitted records one after the other (the positions and
+/// times of periods, steps and time constants) and every fitted record's sample times on its
+/// own clock, sorted (the instants of a jump).
+#[derive(Clone, Copy, Debug)]
+pub struct Grid<'a> {
+    /// The fitted records one after the other.
+    pub record: &'a Record,
+    /// The sample times of every fitted record on its own clock, s, sorted.
+    pub times: &'a [f64],
+}
+
 /// A refined scanned parameter.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Scan {
-    /// The value (mm for P; mm or degrees for V; s for TAU).
+    /// The value (mm for P; mm or degrees for V; s for TAU and T).
     pub value: f64,
     /// The lower end of its 95 % interval.
     pub low: f64,
@@ -36,6 +48,7 @@ pub fn parameter(basis: Basis) -> Option<f64> {
         .period_mm()
         .or_else(|| basis.step_at())
         .or_else(|| basis.tau_s())
+        .or_else(|| basis.jump_at())
 }
 
 /// The basis with parameter `v` (same family as `basis`), rounded to the vocabulary's
@@ -47,14 +60,41 @@ fn with_parameter(basis: Basis, v: f64) -> Basis {
         Basis::Exp(_) => Basis::Exp(milli.max(1.0) as u32),
         Basis::Warmup(_) => Basis::Warmup(milli.max(1.0) as u32),
         Basis::Step(_) => Basis::Step(milli as i64),
+        Basis::Jump(_) => Basis::Jump(milli as i64),
         other => other,
     }
 }
 
-/// The fine grid around the coarse value of `basis` on axis values `x` (sorted; for steps).
-fn grid(basis: Basis, x: &[f64], tau_range: (f64, f64)) -> Vec<f64> {
+/// Every instant between two consecutive distinct values of `x` (sorted) within `half` of `v`.
+fn between(x: &[f64], v: f64, half: f64) -> Vec<f64> {
+    let mut out: Vec<f64> = x
+        .windows(2)
+        .filter(|w| w[1] > w[0])
+        .map(|w| 0.5 * (w[0] + w[1]))
+        .filter(|m| (m - v).abs() <= half)
+        .collect();
+    out.dedup();
+    out
+}
+
+/// The fine grid around the coarse value of `basis` on axis values `x` (sorted; for steps) or
+/// the records' sample times `times` (sorted; for jumps).
+fn grid(basis: Basis, x: &[f64], times: &[f64], tau_range: (f64, f64)) -> Vec<f64> {
     let n = 41;
     match basis {
+        Basis::Jump(_) => {
+            // Within one spacing of the dictionary's grid, between the same quantiles.
+            let v = basis.jump_at().unwrap_or(0.0);
+            let Some((q0, q1)) = (times.len() >= 20).then(|| {
+                (
+                    times[times.len() / 20],
+                    times[times.len() - 1 - times.len() / 20],
+                )
+            }) else {
+                return Vec::new();
+            };
+            between(times, v, (q1 - q0) / super::dictionary::JUMPS as f64)
+        }
         Basis::Period(_) => {
             let p = basis.period_mm().unwrap_or(1.0);
             let range = x.last().copied().unwrap_or(0.0) - x.first().copied().unwrap_or(0.0);
@@ -71,15 +111,7 @@ fn grid(basis: Basis, x: &[f64], tau_range: (f64, f64)) -> Vec<f64> {
                 x.first().copied().unwrap_or(v),
                 x.last().copied().unwrap_or(v),
             );
-            let half = (hi - lo) / n_steps;
-            let mut out: Vec<f64> = x
-                .windows(2)
-                .filter(|w| w[1] > w[0])
-                .map(|w| 0.5 * (w[0] + w[1]))
-                .filter(|m| (m - v).abs() <= half)
-                .collect();
-            out.dedup();
-            out
+            between(x, v, (hi - lo) / n_steps)
         }
         Basis::Exp(_) | Basis::Warmup(_) => {
             let t = basis.tau_s().unwrap_or(1.0);
@@ -102,16 +134,15 @@ fn explains(h: &DMatrix<f64>, q: &Span, y: &DVector<f64>) -> Option<f64> {
 
 /// The refined term and its interval: `term`'s scanned parameter on the fine grid around its
 /// value, with the model `q` (orthonormal, whitened, every other term) in place; `columns`
-/// gives the whitened columns of a term in the rows of `y` (the whitened readings); `record`
-/// is the fitted records one after the other (the positions and times the grid is built
-/// from). `None` for a term without a scanned parameter.
+/// gives the whitened columns of a term in the rows of `y` (the whitened readings); `at` is
+/// where the fine grid is built from. `None` for a term without a scanned parameter.
 ///
 /// # Errors
 /// The error of `columns`.
 pub fn refine<E>(
     m: &Machine,
     term: Term,
-    record: &Record,
+    at: &Grid,
     columns: &mut dyn FnMut(Term) -> Result<DMatrix<f64>, E>,
     q: &Span,
     y: &DVector<f64>,
@@ -119,6 +150,7 @@ pub fn refine<E>(
     if parameter(term.basis).is_none() {
         return Ok(None);
     }
+    let record = at.record;
     let axis = match term.effect.carrier(m) {
         model_spec::basis::Carrier::Axis(a) => Some(a),
         model_spec::basis::Carrier::None => None,
@@ -147,7 +179,10 @@ pub fn refine<E>(
         }
         _ => (coarse, coarse),
     };
-    for v in grid(term.basis, &x, tau_range).into_iter().chain([coarse]) {
+    for v in grid(term.basis, &x, at.times, tau_range)
+        .into_iter()
+        .chain([coarse])
+    {
         let t = Term {
             effect: term.effect,
             basis: with_parameter(term.basis, v),

@@ -179,9 +179,13 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         // A drift or warm-up that the zero offsets of the R-test explain as well as an axis
         // line is named as the instrument's: the first suspect of a slow change over a record,
         // and a random-walk drift of the instrument is never named a geometric cause.
+        // A jump in time of one record comes last: a term of the machine or a drift that the
+        // fitted records cannot tell from it is named, with the jump among its alternatives,
+        // and the judging records decide between them (the jump predicts nothing on them).
         let rank = |t: &Term| -> u8 {
             use model_spec::ErrorKind::{Location, Setup, Squareness};
             match (t.effect, t.basis) {
+                (_, b) if b.jump_at().is_some() => 3,
                 (model_spec::terms::Effect::SensorOffset(_), b) if b.of_time() => 0,
                 (model_spec::terms::Effect::Error(e), _)
                     if matches!(
@@ -293,6 +297,22 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             .filter(|s| adds_nothing(best, s) && adds_nothing(s, best))
             .max_by(|a, b| a.delta_rss.total_cmp(&b.delta_rss))
             .map_or(best, |s| &scored[prefer(s)]);
+        // A jump in time of one record is named only where no other candidate explains what it
+        // explains as far as the data can tell (each adds nothing significant to the other, at
+        // no more directions): on K4, where C turns with time, a step of C is a jump of the
+        // ball's set-up at the instant C passes it. The other is named, the jump among its
+        // alternatives, and the judging records decide (the jump predicts nothing on them).
+        let is_jump = |s: &Scored| candidates[s.index].basis.jump_at().is_some();
+        let named = if is_jump(named) {
+            scored
+                .iter()
+                .filter(|s| !is_jump(s) && s.directions.ncols() <= named.directions.ncols())
+                .filter(|s| adds_nothing(named, s) && adds_nothing(s, named))
+                .max_by(|a, b| a.delta_rss.total_cmp(&b.delta_rss))
+                .map_or(named, |s| &scored[prefer(s)])
+        } else {
+            named
+        };
         // Candidates of the named one's span (the extended model spans them).
         let spanned: Vec<usize> = scored
             .iter()

@@ -20,7 +20,11 @@
 //!    recommended.
 //!
 //! 6. when the held-out records judged the findings one by one ([`super::confirm`]), at least
-//!    one is confirmed on its own (the extended model then holds only those).
+//!    one is confirmed on its own (the extended model then holds only those);
+//! 7. no plausible finding is a jump in time of a fitted record (`ZOW@jump:149.5`): the ball
+//!    or the sensor moved during the record. The fit with the jump gives the machine's errors
+//!    as well as that record can, and a machine term confirmed beside it may be real, but a
+//!    record that jumped is measured again before anything of it is named a cause.
 //!
 //! The held-out records are those given, or with none and several fitted records, every fitted
 //! record predicted by the fit on the others ([`super::confirm::Judges`]).
@@ -139,6 +143,17 @@ pub fn recommend(
         reasons.push(format!(
             "no finding is confirmed on its own by the held-out records (held-out gain given the others, in standard deviations of a spurious one's: {}; {CONFIRM_SD} needed)",
             gains.join(", ")
+        ));
+    }
+    let jumps: Vec<&str> = findings
+        .iter()
+        .filter(|f| f.plausible && f.term.basis.jump_at().is_some())
+        .map(|f| f.description.split(": ").next().unwrap_or(""))
+        .collect();
+    if !jumps.is_empty() {
+        reasons.push(format!(
+            "a fitted record holds a jump in time ({}): the ball or the sensor moved during the record, or something the dictionary lacks changed at once; measure it again",
+            jumps.join(", ")
         ));
     }
     let estimable: Vec<&HeldOut> = held.iter().filter(|h| h.estimable()).collect();

@@ -120,6 +120,7 @@ fn kind(m: &Machine, t: &Term, clock: bool) -> Kind {
     match t.effect {
         Effect::SensorOffset(_) => Kind::Record,
         _ if on_clock(t.basis) && !clock => Kind::Record,
+        _ if t.basis.jump_at().is_some() => Kind::Record,
         Effect::Error(e) if matches!(m.catalogue[e].kind, ErrorKind::Setup { .. }) => Kind::Setup,
         Effect::KinematicOffset(s) if is_setup_symbol(m, s) => Kind::Setup,
         _ => Kind::Shared,

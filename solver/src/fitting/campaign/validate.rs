@@ -13,7 +13,9 @@
 //!   which no identification knows;
 //! - **record** (its R-test zero `dx0 dy0 dz0` when zeroed, the drift of its zero, and, on own
 //!   clocks, its terms of a time basis): the identified values when the record was fitted (the
-//!   same record label), else **refitted** alike: they are the state of one recording.
+//!   same record label), else **refitted** alike: they are the state of one recording. A jump
+//!   (`ZOW@jump:149.5`, [`model_spec::basis::Basis::Jump`]) is the exception: an event of the
+//!   fitted record it was found on, it is left out of a record that was not fitted.
 //!
 //! A parameter without a value (not determined by the identification) is set to 0 and named
 //! ([`crate::fitting::validate::Unidentified`], as for a single record). The refit is least
@@ -218,11 +220,16 @@ pub fn record_plan(
         }
         _ => None,
     };
-    let model = if r.zeroed {
+    let mut model = if r.zeroed {
         with_offsets(&values.model)
     } else {
         values.model.clone()
     };
+    // A jump is an event of the fitted record it was found on: a record that was not fitted is
+    // predicted without it, not refitted.
+    if fitted.is_none() {
+        model.terms.retain(|t| t.basis.jump_at().is_none());
+    }
     check_model(m, &model)?;
     let mut sources = Vec::with_capacity(model.width());
     let mut names = Vec::with_capacity(model.width());

@@ -111,8 +111,12 @@ pub fn findings(r: &DiagnosisReport) -> String {
 /// is not a cause.
 fn confirmation(f: &FindingReport) -> String {
     let mut out = String::new();
+    if f.status == "jump" {
+        out.push_str("     a jump in time of the fitted record: the ball or the sensor moved during the record; it predicts nothing on another record and is no cause of the machine: measure the record again
+");
+    }
     let Some(c) = &f.confirmation else {
-        if f.status != "cause" {
+        if f.status != "cause" && f.status != "jump" {
             out.push_str("     fits the fitted record, but not confirmed: no record was held out to check it; not a cause\n");
         }
         return out;
@@ -155,7 +159,7 @@ fn confirmation(f: &FindingReport) -> String {
             }
         ));
     }
-    if c.confirmed && f.status != "cause" {
+    if c.confirmed && f.status != "cause" && f.status != "jump" {
         out.push_str("     not a cause: the extended model is not recommended (below)\n");
     }
     out
@@ -210,6 +214,11 @@ pub fn recommendation(r: &DiagnosisReport) -> String {
     }
     if r.recommended {
         out.push_str(&format!("Recommended: {}.\n", r.recommendation.join("; ")));
+    } else if r.findings.iter().all(|f| f.status == "jump") {
+        out.push_str(&format!(
+            "Not recommended: {}. The machine's errors fitted with the jump in place are the best this record gives (the gain above); no cause is named from a record that jumped.\n",
+            r.recommendation.join("; ")
+        ));
     } else {
         out.push_str(&format!(
             "Not recommended: {}. A finding may stand for one of the candidates the data cannot tell it from, or the fitted path does not separate the cause; try those alternatives (identify --terms) on the held-out data.\n",
@@ -253,6 +262,10 @@ pub fn adequacy(r: &DiagnosisReport) -> String {
             p_value(a.p_value),
             r.alpha
         ));
+        if !r.unexplained.is_empty() {
+            out.push_str("  The extended model holds a jump in time; the base model's residual where it jumped:\n");
+            out.push_str(&unexplained(r));
+        }
         return out;
     }
     let over: Vec<String> = a
@@ -277,6 +290,13 @@ pub fn adequacy(r: &DiagnosisReport) -> String {
             r.alpha
         ));
     }
+    out.push_str(&unexplained(r));
+    out
+}
+
+/// What remains, described: one line per record and direction.
+fn unexplained(r: &DiagnosisReport) -> String {
+    let mut out = String::new();
     for u in &r.unexplained {
         let what = match (u.follows.as_deref(), u.shape.as_str()) {
             (None, _) | (_, "irregular") => "follows nothing simple (no shape of an axis position, velocity, direction of motion or time beats the noise)".to_string(),
@@ -546,7 +566,7 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
     out.push_str(&structure(r));
     let [k, p, t] = r.dictionary_extent;
     out.push_str(&format!(
-        "\nCandidates: {} terms the model lacks (harmonic:1..{k} of rotary-axis errors, poly:1..{p} of linear-axis errors, reversal of positioning errors, const location, squareness and set-up errors, dx0 dy0 dz0 const and time:1..{t}; scanned: period:P and step:V of positioning errors, exp:TAU of the zero offsets and location errors, time:1 of location errors, velocity of positioning errors, the instrument terms SXX..SZY); {} do not vary on {} (unexcited).\n",
+        "\nCandidates: {} terms the model lacks (harmonic:1..{k} of rotary-axis errors, poly:1..{p} of linear-axis errors, reversal of positioning errors, const location, squareness and set-up errors, dx0 dy0 dz0 const and time:1..{t}; scanned: period:P and step:V of positioning errors, exp:TAU of the zero offsets and location errors, time:1 of location errors, velocity of positioning errors, the instrument terms SXX..SZY, jump:T of the set-up errors and zero offsets where one record is fitted); {} do not vary on {} (unexcited).\n",
         r.dictionary_size,
         r.unexcited.len(),
         r.data

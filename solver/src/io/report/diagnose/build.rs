@@ -267,6 +267,7 @@ impl DiagnosisReport {
                     let (parameter, unit) = match f.term.basis {
                         Basis::Period(_) => ("P", "mm"),
                         Basis::Exp(_) | Basis::Warmup(_) => ("TAU", "s"),
+                        Basis::Jump(_) => ("T", "s"),
                         _ => match f.term.effect.carrier(m) {
                             Carrier::Axis(a) if m.axes[a].kind == model_spec::AxisKind::Rotary => {
                                 ("V", "deg")
@@ -284,6 +285,8 @@ impl DiagnosisReport {
                 }),
                 status: if !f.plausible {
                     "implausible"
+                } else if f.is_jump() {
+                    "jump"
                 } else if d.is_cause(f) {
                     "cause"
                 } else {

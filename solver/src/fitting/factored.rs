@@ -9,7 +9,7 @@
 use crate::fitting::identifiability::{Identifiability, near_confounded, null_space_groups};
 use crate::fitting::least_squares::{Constraint, EstimateError, Fit, Tolerances, WhitenedFit};
 use crate::fitting::noise::{NoiseError, NoiseModel, SampleWhitening};
-use nalgebra::{DMatrix, DVector, SVD};
+use nalgebra::{DMatrix, DVector, Dyn, QR, SVD};
 
 /// The factorisation of one H (m × n, mm per unit of each parameter) under one constraint and
 /// set of tolerances: everything of a fit but what the readings change (the solution, the
@@ -30,7 +30,10 @@ pub struct Factored {
     norms: Vec<f64>,
     /// Singular values of the scaled H of the free columns, descending.
     sv: Vec<f64>,
-    /// Left singular vectors (the scaled H padded with zero rows to at least n rows).
+    /// The QR decomposition of the scaled H when it has more rows than free columns.
+    qr: Option<QR<f64, Dyn, Dyn>>,
+    /// Left singular vectors: of `R` when there is a QR decomposition, else of the scaled H
+    /// padded with zero rows to at least n rows.
     u: DMatrix<f64>,
     /// Right singular vectors, as columns.
     v: DMatrix<f64>,
@@ -148,6 +151,15 @@ impl Factored {
                 a[(i, k)] = h[(i, j)] / norms[j];
             }
         }
+        // More rows than columns (a record has thousands of readings for tens of parameters):
+        // `A = Q·R` first, and the SVD of the small `R` (`A = (Q·U_R)·Σ·Vᵀ`): the rotations of
+        // the SVD then act on n rows instead of m.
+        let (a, qr) = if nf > 0 && m > nf {
+            let qr = QR::new(a);
+            (qr.r(), Some(qr))
+        } else {
+            (a, None)
+        };
         let (sv, u, v) = if nf == 0 {
             (Vec::new(), DMatrix::zeros(rows, 0), DMatrix::zeros(0, 0))
         } else {
@@ -207,6 +219,7 @@ impl Factored {
             free,
             norms,
             sv,
+            qr,
             u,
             v,
             rank,
@@ -252,8 +265,18 @@ impl Factored {
         let (free, norms, sv, rank) = (&self.free, &self.norms, &self.sv, self.rank);
         let nf = free.len();
         // Minimum-norm solution in the identifiable subspace (scaled coordinates).
-        let mut ypad = DVector::<f64>::zeros(m.max(nf));
-        ypad.rows_mut(0, m).copy_from(y);
+        let ypad = match &self.qr {
+            Some(qr) => {
+                let mut qy = y.clone();
+                qr.q_tr_mul(&mut qy);
+                qy.rows(0, nf).into_owned()
+            }
+            None => {
+                let mut ypad = DVector::<f64>::zeros(m.max(nf));
+                ypad.rows_mut(0, m).copy_from(y);
+                ypad
+            }
+        };
         let mut z = DVector::<f64>::zeros(nf);
         for (i, s) in sv.iter().enumerate().take(rank) {
             let c = self.u.column(i).dot(&ypad) / s;

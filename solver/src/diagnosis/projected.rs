@@ -75,9 +75,9 @@ impl Projected {
         }
     }
 
-    /// The number of columns held: what [`Model::directions_into`] may write.
-    pub fn width(&self) -> usize {
-        self.columns.ncols()
+    /// The width of the widest candidate held: what [`Model::directions_into`] writes at most.
+    pub fn widest(&self) -> usize {
+        self.at.iter().map(|a| a.1).max().unwrap_or(0)
     }
 
     /// The model held.
@@ -389,6 +389,30 @@ mod tests {
         let near = g[0].column(0) + matrix(40, 1, 10).column(0) * 1e-9;
         g.push(DMatrix::from_columns(&[near]));
         g
+    }
+
+    /// The directions of groups projected together are those of each group projected on its
+    /// own (same number, same span), within a span of candidates 3 and 4 and of none.
+    #[test]
+    fn directions_of_groups_agree_with_each_group_on_its_own() {
+        let g = groups();
+        for model in [&[3usize, 4][..], &[]] {
+            let span = Span::of_groups(40, model.iter().copied(), &|t| g[t].clone());
+            let together = new_directions_of(&span, &g);
+            assert_eq!(together.len(), g.len());
+            for (c, (here, gc)) in together.iter().zip(&g).enumerate() {
+                let alone = span.new_directions(gc);
+                assert_eq!(
+                    here.ncols(),
+                    alone.ncols(),
+                    "candidate {c}, model {model:?}"
+                );
+                if here.ncols() > 0 {
+                    let same = here.tr_mul(&alone).norm_squared();
+                    assert!((same - here.ncols() as f64).abs() < 1e-9, "{c}: {same}");
+                }
+            }
+        }
     }
 
     /// The directions of every held candidate agree with `Span::new_directions` from scratch

@@ -590,3 +590,54 @@ impl<'a> RowsFactored<'a> {
         ))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simulation::rng::Rng;
+
+    /// A tall H (QR first) gives the solution, singular values and rank of the SVD of H itself;
+    /// a column that is a combination of two others leaves them undetermined.
+    #[test]
+    fn a_tall_system_fits_as_its_own_svd_solves_it() {
+        let mut rng = Rng::new(5);
+        let (m, n) = (300, 6);
+        let mut h = DMatrix::from_fn(m, n, |_, _| rng.normal());
+        let combined = h.column(0) * 2.0 - h.column(1) * 3.0;
+        h.set_column(5, &combined);
+        h.column_mut(2).scale_mut(1e3);
+        let y = DVector::from_fn(m, |_, _| rng.normal());
+        let names: Vec<String> = (0..n).map(|j| format!("p{j}")).collect();
+        let f = Factored::new(
+            &h,
+            &names,
+            &Constraint::MinimumNorm,
+            &Tolerances::default(),
+            m,
+        )
+        .unwrap();
+        assert_eq!(f.rank(), 5);
+        assert!(!f.determined()[0] && !f.determined()[1] && !f.determined()[5]);
+        assert!(f.determined()[2] && f.determined()[3] && f.determined()[4]);
+        let fit = f.fit(&h, &y, 0.0).unwrap();
+        // The minimum-norm solution in scaled coordinates, from the SVD of the scaled H.
+        let norms: Vec<f64> = h.column_iter().map(|c| c.norm()).collect();
+        let a = DMatrix::from_fn(m, n, |i, j| h[(i, j)] / norms[j]);
+        let svd = a.clone().svd(true, true);
+        let z = svd.solve(&y, 1e-8 * svd.singular_values.max()).unwrap();
+        for j in 0..n {
+            let want = z[j] / norms[j];
+            assert!(
+                (fit.solution[j] - want).abs() <= 1e-10 * want.abs().max(1e-3),
+                "{j}"
+            );
+        }
+        let mut sv = svd.singular_values.as_slice().to_vec();
+        sv.sort_by(|a, b| b.total_cmp(a));
+        for (got, want) in fit.singular_values.iter().zip(&sv).take(5) {
+            assert!((got - want).abs() <= 1e-12 * want, "{got} vs {want}");
+        }
+        let residual = &y - &h * DVector::from_column_slice(&fit.solution);
+        assert!((fit.rss - residual.norm_squared()).abs() <= 1e-12 * fit.rss);
+    }
+}

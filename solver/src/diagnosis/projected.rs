@@ -199,50 +199,6 @@ impl Model<'_> {
     }
 }
 
-/// The directions each of `groups` (columns of `span`'s rows) adds to `span`, as
-/// `span.new_directions(group)` gives them, to rounding: the groups are scaled and projected
-/// together, [`BATCH_COLUMNS`] columns at a time ([`project_out`]: blocked products instead of
-/// one pass over the span per column), then each orthonormalised on its own.
-pub fn new_directions_of(span: &Span, groups: &[DMatrix<f64>]) -> Vec<DMatrix<f64>> {
-    let n = span.rows();
-    let mut out = Vec::with_capacity(groups.len());
-    let mut first = 0;
-    while first < groups.len() {
-        let mut last = first;
-        let mut width = 0;
-        while last < groups.len()
-            && (last == first || width + groups[last].ncols() <= BATCH_COLUMNS)
-        {
-            width += groups[last].ncols();
-            last += 1;
-        }
-        let mut batch = DMatrix::zeros(n, width);
-        let mut at = 0;
-        for g in &groups[first..last] {
-            batch.columns_mut(at, g.ncols()).copy_from(&unit_columns(g));
-            at += g.ncols();
-        }
-        project_out(&span.q, &mut batch);
-        let mut at = 0;
-        for g in &groups[first..last] {
-            let w = g.ncols();
-            let mut d = batch.columns(at, w).into_owned();
-            let kept = orthonormalise(d.as_mut_slice(), n);
-            out.push(if kept < w {
-                d.resize_horizontally(kept, 0.0)
-            } else {
-                d
-            });
-            at += w;
-        }
-        first = last;
-    }
-    out
-}
-
-/// The columns [`new_directions_of`] projects together: 512 columns of 4 000 rows are 16 MB.
-const BATCH_COLUMNS: usize = 512;
-
 /// The columns of `g` scaled to unit norm; a column of zero or non-finite norm is zero (it adds
 /// no direction, as in [`Span::new_directions`]).
 pub fn unit_columns(g: &DMatrix<f64>) -> DMatrix<f64> {
@@ -389,30 +345,6 @@ mod tests {
         let near = g[0].column(0) + matrix(40, 1, 10).column(0) * 1e-9;
         g.push(DMatrix::from_columns(&[near]));
         g
-    }
-
-    /// The directions of groups projected together are those of each group projected on its
-    /// own (same number, same span), within a span of candidates 3 and 4 and of none.
-    #[test]
-    fn directions_of_groups_agree_with_each_group_on_its_own() {
-        let g = groups();
-        for model in [&[3usize, 4][..], &[]] {
-            let span = Span::of_groups(40, model.iter().copied(), &|t| g[t].clone());
-            let together = new_directions_of(&span, &g);
-            assert_eq!(together.len(), g.len());
-            for (c, (here, gc)) in together.iter().zip(&g).enumerate() {
-                let alone = span.new_directions(gc);
-                assert_eq!(
-                    here.ncols(),
-                    alone.ncols(),
-                    "candidate {c}, model {model:?}"
-                );
-                if here.ncols() > 0 {
-                    let same = here.tr_mul(&alone).norm_squared();
-                    assert!((same - here.ncols() as f64).abs() < 1e-9, "{c}: {same}");
-                }
-            }
-        }
     }
 
     /// The directions of every held candidate agree with `Span::new_directions` from scratch

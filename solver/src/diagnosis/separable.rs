@@ -39,7 +39,7 @@
 //! confirmed by the separating test.
 
 use super::columns::Columns;
-use super::projected::new_directions_of;
+use super::projected::Projected;
 use super::select::{Span, f_p_value, f_statistic};
 use crate::fitting::campaign::Campaign;
 pub use crate::fitting::plan::separate::{is_time, position_axis};
@@ -217,6 +217,15 @@ pub(super) fn find(inp: &Inputs) -> Vec<PositionOrTime> {
         .filter(|(_, r)| !r.is_empty())
         .collect();
     let monotonic = |a: usize| moving.iter().find(|(x, _)| *x == a).map(|(_, r)| r);
+    // The candidates of either kind outside the extended model, with the extended model
+    // projected out once: the rest of the model of a finding is the extended model without
+    // it, whose span the finding's own directions complete ([`Projected::without`]).
+    let of_a_kind = |o: &usize| {
+        let other = inp.candidates[*o];
+        (is_time(&other) || position_axis(m, &other).is_some_and(|a| monotonic(a).is_some()))
+            && !inp.model.contains(&(nb + o))
+    };
+    let mut held: Option<Projected> = None;
     let mut out = Vec::new();
     for (term, c, alternatives) in inp.findings {
         let (term, c) = (*term, *c);
@@ -233,8 +242,7 @@ pub(super) fn find(inp: &Inputs) -> Vec<PositionOrTime> {
         if own.ncols() == 0 {
             continue;
         }
-        // The candidates of the other kind, their directions outside the rest projected
-        // together.
+        // The candidates of the other kind, and their directions outside the rest.
         let others: Vec<usize> = inp
             .live
             .iter()
@@ -249,8 +257,15 @@ pub(super) fn find(inp: &Inputs) -> Vec<PositionOrTime> {
                 fits && !inp.model.contains(&(nb + o))
             })
             .collect();
-        let columns: Vec<DMatrix<f64>> = others.iter().map(|&o| group(nb + o)).collect();
-        let directions = new_directions_of(&span, &columns);
+        let held = held.get_or_insert_with(|| {
+            let kinds: Vec<usize> = inp.live.iter().copied().filter(of_a_kind).collect();
+            let full = Span::of_groups(n, inp.model.iter().copied(), &group);
+            Projected::new(full, &cols.y, inp.candidates.len(), &kinds, &|o| {
+                group(nb + o)
+            })
+        });
+        let without = held.without(span.clone(), own.clone(), &cols.y);
+        let directions: Vec<DMatrix<f64>> = others.iter().map(|&o| without.directions(o)).collect();
         // The partner: the collinear candidate with the largest smaller cosine (the F-tests
         // are made for it alone).
         let mut best: Option<((bool, f64), usize, usize)> = None;

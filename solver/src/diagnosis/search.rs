@@ -297,14 +297,13 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             .collect();
         // Candidates the data cannot tell from the named one: those of its span, and those to
         // which the named one adds nothing significant (they explain what it explains); most
-        // explaining first (those that explain the same to rounding, of one span, in the
-        // dictionary's order).
+        // explaining first.
         let mut alike: Vec<&Scored> = scored
             .iter()
             .filter(|s| s.index != named.index)
             .filter(|s| spanned.contains(&s.index) || adds_nothing(named, s))
             .collect();
-        alike.sort_by(|a, b| rounded_cmp(b.delta_rss, a.delta_rss));
+        alike.sort_by(|a, b| b.delta_rss.total_cmp(&a.delta_rss));
 
         let alternatives: Vec<usize> = alike.iter().map(|s| s.index).collect();
         Ok(Chosen {

@@ -9,7 +9,7 @@
 use crate::fitting::identifiability::{Identifiability, near_confounded, null_space_groups};
 use crate::fitting::least_squares::{Constraint, EstimateError, Fit, Tolerances, WhitenedFit};
 use crate::fitting::noise::{NoiseError, NoiseModel, SampleWhitening};
-use nalgebra::{DMatrix, DVector, Dyn, QR, SVD};
+use nalgebra::{DMatrix, DVector, SVD};
 
 /// The factorisation of one H (m × n, mm per unit of each parameter) under one constraint and
 /// set of tolerances: everything of a fit but what the readings change (the solution, the
@@ -30,10 +30,7 @@ pub struct Factored {
     norms: Vec<f64>,
     /// Singular values of the scaled H of the free columns, descending.
     sv: Vec<f64>,
-    /// The QR decomposition of the scaled H when it has more rows than free columns.
-    qr: Option<QR<f64, Dyn, Dyn>>,
-    /// Left singular vectors: of `R` when there is a QR decomposition, else of the scaled H
-    /// padded with zero rows to at least n rows.
+    /// Left singular vectors (the scaled H padded with zero rows to at least n rows).
     u: DMatrix<f64>,
     /// Right singular vectors, as columns.
     v: DMatrix<f64>,
@@ -151,15 +148,6 @@ impl Factored {
                 a[(i, k)] = h[(i, j)] / norms[j];
             }
         }
-        // More rows than columns (a record has thousands of readings for tens of parameters):
-        // `A = Q·R` first, and the SVD of the small `R` (`A = (Q·U_R)·Σ·Vᵀ`): the rotations of
-        // the SVD then act on n rows instead of m.
-        let (a, qr) = if nf > 0 && m > nf {
-            let qr = QR::new(a);
-            (qr.r(), Some(qr))
-        } else {
-            (a, None)
-        };
         let (sv, u, v) = if nf == 0 {
             (Vec::new(), DMatrix::zeros(rows, 0), DMatrix::zeros(0, 0))
         } else {
@@ -219,7 +207,6 @@ impl Factored {
             free,
             norms,
             sv,
-            qr,
             u,
             v,
             rank,
@@ -265,18 +252,8 @@ impl Factored {
         let (free, norms, sv, rank) = (&self.free, &self.norms, &self.sv, self.rank);
         let nf = free.len();
         // Minimum-norm solution in the identifiable subspace (scaled coordinates).
-        let ypad = match &self.qr {
-            Some(qr) => {
-                let mut qy = y.clone();
-                qr.q_tr_mul(&mut qy);
-                qy.rows(0, nf).into_owned()
-            }
-            None => {
-                let mut ypad = DVector::<f64>::zeros(m.max(nf));
-                ypad.rows_mut(0, m).copy_from(y);
-                ypad
-            }
-        };
+        let mut ypad = DVector::<f64>::zeros(m.max(nf));
+        ypad.rows_mut(0, m).copy_from(y);
         let mut z = DVector::<f64>::zeros(nf);
         for (i, s) in sv.iter().enumerate().take(rank) {
             let c = self.u.column(i).dot(&ypad) / s;
@@ -596,10 +573,11 @@ mod tests {
     use super::*;
     use crate::simulation::rng::Rng;
 
-    /// A tall H (QR first) gives the solution, singular values and rank of the SVD of H itself;
-    /// a column that is a combination of two others leaves them undetermined.
+    /// A fit made from a factorisation is the minimum-norm least-squares solution with the
+    /// singular values and rank of the scaled H; a column that is a combination of two others
+    /// leaves them undetermined.
     #[test]
-    fn a_tall_system_fits_as_its_own_svd_solves_it() {
+    fn a_factorisation_fits_as_the_svd_solves() {
         let mut rng = Rng::new(5);
         let (m, n) = (300, 6);
         let mut h = DMatrix::from_fn(m, n, |_, _| rng.normal());
@@ -629,7 +607,8 @@ mod tests {
             let want = z[j] / norms[j];
             assert!(
                 (fit.solution[j] - want).abs() <= 1e-10 * want.abs().max(1e-3),
-                "{j}"
+                "{j}: {} vs {want}",
+                fit.solution[j]
             );
         }
         let mut sv = svd.singular_values.as_slice().to_vec();

@@ -410,8 +410,8 @@ impl WhitenedFactored {
 /// generalized under a noise model.
 #[derive(Clone, Debug)]
 enum Inner {
-    Ordinary(Factored),
-    Whitened(WhitenedFactored),
+    Ordinary(Box<Factored>),
+    Whitened(Box<WhitenedFactored>),
 }
 
 impl Inner {
@@ -424,17 +424,23 @@ impl Inner {
         layout: &[usize],
     ) -> Result<Inner, EstimateError> {
         Ok(match noise {
-            None => Inner::Ordinary(Factored::new(h, names, constraint, tol, h.nrows())?),
-            Some(n) => {
-                Inner::Whitened(WhitenedFactored::new(h, names, constraint, tol, n, layout)?)
-            }
+            None => Inner::Ordinary(Box::new(Factored::new(
+                h,
+                names,
+                constraint,
+                tol,
+                h.nrows(),
+            )?)),
+            Some(n) => Inner::Whitened(Box::new(WhitenedFactored::new(
+                h, names, constraint, tol, n, layout,
+            )?)),
         })
     }
 
     /// The factorisation whose rank and identifiability the fit reports.
     fn reported(&self) -> &Factored {
         match self {
-            Inner::Ordinary(f) => f,
+            Inner::Ordinary(f) => f.as_ref(),
             Inner::Whitened(w) => &w.ordinary,
         }
     }
@@ -452,9 +458,13 @@ impl Inner {
                 let w = w.fit(h, y, n, layout)?;
                 Ok((w.fit, w.whitened_sigma))
             }
-            (Inner::Ordinary(f), _)
-            | (Inner::Whitened(WhitenedFactored { ordinary: f, .. }), _) => {
+            (Inner::Ordinary(f), _) => {
                 let f = f.fit(h, y, 0.0)?;
+                let s = f.sigma;
+                Ok((f, s))
+            }
+            (Inner::Whitened(w), None) => {
+                let f = w.ordinary.fit(h, y, 0.0)?;
                 let s = f.sigma;
                 Ok((f, s))
             }

@@ -4,7 +4,7 @@
 //! a noise model ([`WhitenedFactored`]). A Gauss–Newton refinement fits the same H to a new
 //! residual at every step: it factorises once. A fit made from a factorisation is the fit
 //! [`super::least_squares()`] makes, bit for bit (the same operations in the same order); the
-//! method is in [`super::least_squares`]'s documentation.
+//! method is in [`mod@super::least_squares`]'s documentation.
 
 use crate::fitting::identifiability::{Identifiability, near_confounded, null_space_groups};
 use crate::fitting::least_squares::{Constraint, EstimateError, Fit, Tolerances, WhitenedFit};

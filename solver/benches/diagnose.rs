@@ -5,7 +5,7 @@
 //! the noise estimated from the records). It includes the outlier search, the noise estimate,
 //! the base and extended fits (generalized least squares, refined against the exact machine),
 //! the refinement of scanned parameters, the exact predictions of the held-out records and the
-//! lack-of-fit bootstrap (400 draws per record).
+//! lack-of-fit bootstrap (200 draws per record).
 //!
 //! - `diagnose/demo`: truth `seed-ac-demo` (one hidden effect, ECC harmonic:2; one finding);
 //! - `diagnose/budget`: truth `seed-ac-budget` (the full error budget; several findings, the

@@ -108,15 +108,15 @@ impl SameFinding {
 /// most that times `√rss` in square root: candidates whose ΔRSS differ by more are not
 /// compared further.
 pub(super) fn same_span(a: &Scored, b: &Scored, rss: f64) -> bool {
-    let q = a.directions.ncols();
-    if q != b.directions.ncols() {
+    let q = a.width;
+    if q != b.width {
         return false;
     }
     let angle = (q as f64 * SAME_SPAN).sqrt();
     if (a.delta_rss.sqrt() - b.delta_rss.sqrt()).abs() > 2.0 * angle * rss.sqrt() {
         return false;
     }
-    gram(&a.directions, &b.directions).norm_squared() > q as f64 * (1.0 - SAME_SPAN)
+    gram(&a.directions(), &b.directions()).norm_squared() > q as f64 * (1.0 - SAME_SPAN)
 }
 
 /// Two spans of q directions are the same when `‖aᵀb‖²` exceeds `q·(1 − SAME_SPAN)`.

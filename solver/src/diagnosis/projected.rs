@@ -75,9 +75,9 @@ impl Projected {
         }
     }
 
-    /// The number of columns held: what [`Model::directions_into`] may write.
-    pub fn width(&self) -> usize {
-        self.columns.ncols()
+    /// The width of the widest candidate held: what [`Model::directions_into`] writes at most.
+    pub fn widest(&self) -> usize {
+        self.at.iter().map(|a| a.1).max().unwrap_or(0)
     }
 
     /// The model held.

@@ -137,23 +137,19 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         let rss = r.norm_squared();
         let total = pool.len() as u64;
         progress.update("selection", 0, total);
-        let mut placed = Vec::with_capacity(pool.len());
-        let mut at = 0;
+        // Every candidate's directions made in `buffer` (one at a time: it stays in cache) and
+        // the residual's coordinates on them; the directions of the few candidates a step looks
+        // at are made again when asked for ([`Scored::directions`]).
+        let make = |c: usize| model.directions(c);
+        let mut scored: Vec<Scored> = Vec::with_capacity(pool.len());
         for (k, &c) in pool.iter().enumerate() {
             progress.update("selection", k as u64 + 1, total);
-            let width = model.directions_into(c, buffer, at);
+            let width = model.directions_into(c, buffer, 0);
             if width > 0 {
-                // While the candidate's directions are in cache.
-                let on = coordinates(&buffer.columns(at, width), r);
-                placed.push((c, at, width, on));
-                at += width;
+                let on = coordinates(&buffer.columns(0, width), r);
+                scored.push(Scored::made_by(c, width, on, &make));
             }
         }
-        let buffer = &*buffer;
-        let scored: Vec<Scored> = placed
-            .into_iter()
-            .map(|(c, at, width, on)| Scored::with_coordinates(c, buffer.columns(at, width), on))
-            .collect();
         let Some(best) = scored
             .iter()
             .max_by(|a, b| a.delta_rss.total_cmp(&b.delta_rss))
@@ -219,7 +215,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
                 .map_or(0, |(k, _)| k)
         };
         let best = &scored[prefer(best)];
-        let qg = best.directions.ncols();
+        let qg = best.width;
         let Some(f) = f_statistic(best.delta_rss, rss, qg, n, q.rank()) else {
             return Err(Stop {
                 best: Some(candidates[best.index]),
@@ -252,7 +248,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         // directions outside their span, how many, and the RSS left with both.
         let beyond = |a: &Scored, b: &Scored| -> (f64, usize, f64, usize) {
             let (gain, extra) = beyond(a, b, r);
-            let dim = b.directions.ncols() + extra;
+            let dim = b.width + extra;
             (gain, extra, rss - b.delta_rss - gain, dim)
         };
         // The raw F-test at α of an addition of `extra` directions explaining `gain`, `dim` in
@@ -271,10 +267,10 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
             // added). When that bound is significant whatever the number of directions added
             // (the F-test's p-value falls as the gain grows), the directions are not made:
             // most candidates are far from one another.
-            let qa = a.directions.ncols();
+            let qa = a.width;
             let delta = 2.0 * (qa as f64).sqrt() * SPAN_TOLERANCE * rss.sqrt();
             let low = (a.delta_rss.sqrt() - delta).max(0.0).powi(2) - b.delta_rss;
-            let qb = b.directions.ncols();
+            let qb = b.width;
             let rest = rss - b.delta_rss - low;
             if a.delta_rss.sqrt() - b.delta_rss.sqrt() > delta
                 && rest > 0.0
@@ -293,7 +289,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         // step's significance (the test above) is unchanged.
         let named = scored
             .iter()
-            .filter(|s| s.index != best.index && s.directions.ncols() < qg)
+            .filter(|s| s.index != best.index && s.width < qg)
             .filter(|s| adds_nothing(best, s) && adds_nothing(s, best))
             .max_by(|a, b| a.delta_rss.total_cmp(&b.delta_rss))
             .map_or(best, |s| &scored[prefer(s)]);
@@ -374,7 +370,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         candidates_live,
         &|c| group(nb + c),
     );
-    let mut buffer = DMatrix::zeros(n, state.width());
+    let mut buffer = DMatrix::zeros(n, state.widest());
     let mut chosen: Vec<Chosen> = Vec::new();
     let mut stop;
     let mut round = 0;

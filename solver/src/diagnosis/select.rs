@@ -23,6 +23,7 @@ use super::projected::dot;
 use crate::fitting::distributions::f_upper_tail;
 use crate::simulation::rng::Rng;
 use nalgebra::{DMatrix, DMatrixView, DVector};
+use std::cell::OnceCell;
 
 /// A column whose part outside the span of the others is below this (relative to its norm) adds
 /// nothing: the model spans it.
@@ -125,39 +126,66 @@ impl Span {
 }
 
 /// One candidate at one step: its new directions and what they explain.
-#[derive(Clone, Debug)]
 pub struct Scored<'a> {
     /// Index in the candidate list.
     pub index: usize,
-    /// `Q_g`: its orthonormal directions outside the model (n × q).
-    pub directions: DMatrixView<'a, f64>,
+    /// q, the number of its directions outside the model.
+    pub width: usize,
+    /// `Q_g`: its orthonormal directions outside the model (n × q), given or made when first
+    /// asked for ([`Scored::directions`]).
+    directions: Directions<'a>,
     /// `Q_gᵀ r`: the residual's coordinates on them (mm; q).
     pub coordinates: DVector<f64>,
     /// ΔRSS = ‖Q_gᵀ r‖², mm².
     pub delta_rss: f64,
 }
 
+/// A candidate's directions: given, or made from its index when first asked for (a step scores
+/// every candidate, and looks at the directions of a few).
+enum Directions<'a> {
+    Given(DMatrix<f64>),
+    Made(&'a dyn Fn(usize) -> DMatrix<f64>, OnceCell<DMatrix<f64>>),
+}
+
 impl<'a> Scored<'a> {
     /// Candidate `index` with directions `directions` (orthonormal, outside the model) against
     /// the model's residual `r`.
-    pub fn new(index: usize, directions: DMatrixView<'a, f64>, r: &DVector<f64>) -> Scored<'a> {
+    pub fn new(index: usize, directions: DMatrixView<'_, f64>, r: &DVector<f64>) -> Scored<'a> {
         let coordinates = coordinates(&directions, r);
-        Scored::with_coordinates(index, directions, coordinates)
+        Scored {
+            index,
+            width: directions.ncols(),
+            delta_rss: coordinates.norm_squared(),
+            directions: Directions::Given(directions.clone_owned()),
+            coordinates,
+        }
     }
 
-    /// As [`Scored::new`], with the residual's coordinates on the directions already computed
-    /// ([`coordinates`]).
-    pub fn with_coordinates(
+    /// Candidate `index` with `width` directions on which the residual has `coordinates`
+    /// ([`coordinates`]), the directions made by `make(index)` when first asked for (the same
+    /// directions, to the bit, as those the coordinates were computed on).
+    pub fn made_by(
         index: usize,
-        directions: DMatrixView<'a, f64>,
+        width: usize,
         coordinates: DVector<f64>,
+        make: &'a dyn Fn(usize) -> DMatrix<f64>,
     ) -> Scored<'a> {
         Scored {
             index,
+            width,
             delta_rss: coordinates.norm_squared(),
-            directions,
+            directions: Directions::Made(make, OnceCell::new()),
             coordinates,
         }
+    }
+
+    /// `Q_g`, its directions (n × q).
+    pub fn directions(&self) -> DMatrixView<'_, f64> {
+        let d = match &self.directions {
+            Directions::Given(d) => d,
+            Directions::Made(make, cell) => cell.get_or_init(|| make(self.index)),
+        };
+        d.columns(0, d.ncols())
     }
 }
 
@@ -181,9 +209,10 @@ pub fn coordinates(directions: &DMatrixView<'_, f64>, r: &DVector<f64>) -> DVect
 /// (well conditioned), `Mᵀr = aᵀr − Gᵀ·bᵀr`, and the ΔRSS is `(Mᵀr)ᵀ (MᵀM)⁻¹ (Mᵀr)`.
 /// Otherwise the directions are made explicitly.
 pub fn beyond(a: &Scored, b: &Scored, r: &DVector<f64>) -> (f64, usize) {
-    let g = gram(&b.directions, &a.directions);
+    let (da, db) = (a.directions(), b.directions());
+    let g = gram(&db, &da);
     if g.norm_squared() <= 0.5 {
-        let qa = a.directions.ncols();
+        let qa = a.width;
         let t = &a.coordinates - g.tr_mul(&b.coordinates);
         let gram = DMatrix::identity(qa, qa) - g.tr_mul(&g);
         if let Some(c) = gram.cholesky() {
@@ -191,9 +220,9 @@ pub fn beyond(a: &Scored, b: &Scored, r: &DVector<f64>) -> (f64, usize) {
         }
     }
     let extra = Span {
-        q: b.directions.clone_owned(),
+        q: db.clone_owned(),
     }
-    .new_directions(&a.directions.clone_owned());
+    .new_directions(&da.clone_owned());
     (extra.tr_mul(r).norm_squared(), extra.ncols())
 }
 
@@ -254,7 +283,7 @@ fn monte_carlo_p_stopping(
 ) -> f64 {
     let n = model.rows();
     let rank = model.rank();
-    let widths: Vec<usize> = scored.iter().map(|s| s.directions.ncols()).collect();
+    let widths: Vec<usize> = scored.iter().map(|s| s.width).collect();
     let total: usize = widths.iter().sum();
     if total == 0 || draws == 0 {
         return 1.0;
@@ -262,9 +291,8 @@ fn monte_carlo_p_stopping(
     let mut all = DMatrix::zeros(n, total);
     let mut at = 0;
     for s in scored {
-        all.columns_mut(at, s.directions.ncols())
-            .copy_from(&s.directions);
-        at += s.directions.ncols();
+        all.columns_mut(at, s.width).copy_from(&s.directions());
+        at += s.width;
     }
     let mut rng = Rng::new(seed);
     let mut exceed = 0usize;

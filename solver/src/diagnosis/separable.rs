@@ -39,6 +39,7 @@
 //! confirmed by the separating test.
 
 use super::columns::Columns;
+use super::projected::Projected;
 use super::select::{Span, f_p_value, f_statistic};
 use crate::fitting::campaign::Campaign;
 pub use crate::fitting::plan::separate::{is_time, position_axis};
@@ -151,6 +152,21 @@ fn part(q: &DMatrix<f64>, r: &DVector<f64>) -> DVector<f64> {
     q * (q.transpose() * r)
 }
 
+/// The cosines of [`measure`] (time in position, position in time), as it computes them;
+/// `None` where it gives none.
+fn cosines(t: &DMatrix<f64>, p: &DMatrix<f64>, r: &DVector<f64>) -> Option<(f64, f64)> {
+    let u = part(t, r);
+    let v = part(p, r);
+    let (nu, nv) = (u.norm(), v.norm());
+    if nu == 0.0 || nv == 0.0 {
+        return None;
+    }
+    Some((
+        (p.transpose() * &u).norm() / nu,
+        (t.transpose() * &v).norm() / nv,
+    ))
+}
+
 /// The measure of the time directions `t` and the position directions `p` (orthonormal, the
 /// rest of the model projected out) on `r`, the rest's residual, the rest of rank `rank`.
 fn measure(t: &DMatrix<f64>, p: &DMatrix<f64>, r: &DVector<f64>, rank: usize) -> Option<Measure> {
@@ -201,6 +217,15 @@ pub(super) fn find(inp: &Inputs) -> Vec<PositionOrTime> {
         .filter(|(_, r)| !r.is_empty())
         .collect();
     let monotonic = |a: usize| moving.iter().find(|(x, _)| *x == a).map(|(_, r)| r);
+    // The candidates of either kind outside the extended model, with the extended model
+    // projected out once: the rest of the model of a finding is the extended model without
+    // it, whose span the finding's own directions complete ([`Projected::without`]).
+    let of_a_kind = |o: &usize| {
+        let other = inp.candidates[*o];
+        (is_time(&other) || position_axis(m, &other).is_some_and(|a| monotonic(a).is_some()))
+            && !inp.model.contains(&(nb + o))
+    };
+    let mut held: Option<Projected> = None;
     let mut out = Vec::new();
     for (term, c, alternatives) in inp.findings {
         let (term, c) = (*term, *c);
@@ -217,44 +242,69 @@ pub(super) fn find(inp: &Inputs) -> Vec<PositionOrTime> {
         if own.ncols() == 0 {
             continue;
         }
-        let mut best: Option<((bool, f64), usize, Measure)> = None;
-        for &o in inp.live {
+        // The candidates of the other kind, and their directions outside the rest.
+        let others: Vec<usize> = inp
+            .live
+            .iter()
+            .copied()
+            .filter(|&o| {
+                let other = inp.candidates[o];
+                let fits = if finding_is_time {
+                    position_axis(m, &other).is_some_and(|a| monotonic(a).is_some())
+                } else {
+                    is_time(&other)
+                };
+                fits && !inp.model.contains(&(nb + o))
+            })
+            .collect();
+        let held = held.get_or_insert_with(|| {
+            let kinds: Vec<usize> = inp.live.iter().copied().filter(of_a_kind).collect();
+            let full = Span::of_groups(n, inp.model.iter().copied(), &group);
+            Projected::new(full, &cols.y, inp.candidates.len(), &kinds, &|o| {
+                group(nb + o)
+            })
+        });
+        let without = held.without(span.clone(), own.clone(), &cols.y);
+        let directions: Vec<DMatrix<f64>> = others.iter().map(|&o| without.directions(o)).collect();
+        // The partner: the collinear candidate with the largest smaller cosine (the F-tests
+        // are made for it alone).
+        let mut best: Option<((bool, f64), usize, usize)> = None;
+        for (k, (&o, dirs)) in others.iter().zip(&directions).enumerate() {
             let other = inp.candidates[o];
-            let fits = if finding_is_time {
-                position_axis(m, &other).is_some_and(|a| monotonic(a).is_some())
-            } else {
-                is_time(&other)
-            };
-            if !fits || inp.model.contains(&(nb + o)) {
-                continue;
-            }
-            let dirs = span.new_directions(&group(nb + o));
             if dirs.ncols() == 0 {
                 continue;
             }
             let (t, p) = if finding_is_time {
-                (&own, &dirs)
+                (&own, dirs)
             } else {
-                (&dirs, &own)
+                (dirs, &own)
             };
-            let Some(x) = measure(t, p, &r, span.rank()) else {
+            let Some((time_in_position, position_in_time)) = cosines(t, p, &r) else {
                 continue;
             };
-            let cosine = x.time_in_position.min(x.position_in_time);
+            let cosine = time_in_position.min(position_in_time);
             // The selection's alternatives explain what the finding explains as far as the
             // data tell: collinear enough whatever the cosine.
             let collinear = cosine >= COLLINEAR_COSINE || alternatives.contains(&other);
             let score = (collinear, cosine);
             if best.as_ref().is_none_or(|b| score > b.0) {
-                best = Some((score, o, x));
+                best = Some((score, o, k));
             }
         }
-        let Some(((collinear, _), o, x)) = best else {
+        let Some(((collinear, _), o, k)) = best else {
             continue;
         };
         if !collinear {
             continue;
         }
+        let (t, p) = if finding_is_time {
+            (&own, &directions[k])
+        } else {
+            (&directions[k], &own)
+        };
+        let Some(x) = measure(t, p, &r, span.rank()) else {
+            continue;
+        };
         let verdict = match (
             x.position_beyond_time_p < inp.alpha,
             x.time_beyond_position_p < inp.alpha,

@@ -15,11 +15,10 @@
 //! ([`NoiseError::DeclaredTwice`]). The values, uncertainties and correlations are the whitened
 //! fit's; the residual, σ̂, rank and identifiability those of the readings and the path.
 
+use super::factored::{RowsFactored, check_readings_of};
 use super::hmatrix::{Backend, GainSource, h_matrix, parameter_names};
 use super::identifiability::{Swallowed, swallowed_by_offsets};
-use super::least_squares::{
-    Constraint, EstimateError, Fit, Tolerances, least_squares, least_squares_whitened,
-};
+use super::least_squares::{Constraint, EstimateError, Fit, Tolerances};
 use super::noise::{NoiseChoice, NoiseError, NoiseModel, NoiseSource, SampleWhitening};
 use crate::model::{Basis, Effect, Model, Term};
 use crate::record::Record;
@@ -284,59 +283,8 @@ pub fn fit_rows(
     layout: &[usize],
     weights: Option<&SampleWhitening>,
 ) -> Result<(Fit, Option<f64>), EstimateError> {
-    let Some(weights) = weights else {
-        return match noise {
-            None => Ok((least_squares(h, y, names, constraint, tolerances)?, None)),
-            Some(n) => {
-                let w = least_squares_whitened(h, y, names, constraint, tolerances, n, layout)?;
-                Ok((w.fit, w.whitened_sigma))
-            }
-        };
-    };
-    let (mut wh, mut wy) = (h.clone(), y.clone());
-    weights.whiten_matrix(&mut wh)?;
-    weights.whiten_vector(&mut wy)?;
-    let ordinary = least_squares(h, y, names, constraint, tolerances)?;
-    let (weighted, whitened_sigma) = match noise {
-        None => {
-            let f = least_squares(&wh, &wy, names, constraint, tolerances)?;
-            let s = f.sigma.map(|s| s / weights.scale_mm);
-            (f, s)
-        }
-        Some(n) => {
-            let w = least_squares_whitened(&wh, &wy, names, constraint, tolerances, n, layout)?;
-            (w.fit, w.whitened_sigma)
-        }
-    };
-    if weighted.rank != ordinary.rank
-        || weighted.identifiability.determined != ordinary.identifiability.determined
-    {
-        return Err(NoiseError::RankChanged {
-            ordinary: ordinary.rank,
-            whitened: weighted.rank,
-        }
-        .into());
-    }
-    let residual = y - h * DVector::from_column_slice(&weighted.solution);
-    let rss = residual.norm_squared();
-    let sigma = (ordinary.dof > 0).then(|| (rss / ordinary.dof as f64).sqrt());
-    let mut identifiability = ordinary.identifiability;
-    identifiability.near_confounded = weighted.identifiability.near_confounded;
-    Ok((
-        Fit {
-            values: weighted.values,
-            solution: weighted.solution,
-            std: weighted.std,
-            covariance: weighted.covariance,
-            correlation: weighted.correlation,
-            identifiability,
-            residual,
-            rss,
-            sigma,
-            ..ordinary
-        },
-        whitened_sigma,
-    ))
+    check_readings_of(h, y, names)?;
+    RowsFactored::new(h, names, constraint, tolerances, noise, layout, weights)?.fit(h, y)
 }
 
 /// [`choose_noise`] for a fit of a record whitened by `weights` (when it has covariances): the

@@ -19,13 +19,13 @@
 //! 5. Covariance `C = σ̂²·S⁻¹·V_r·Σ_r⁻²·V_rᵀ·S⁻¹`, std `√C_jj`, correlation
 //!    `C_jk / √(C_jj·C_kk)`; condition number `κ = σ_max / σ_r` of the scaled H.
 
+use crate::fitting::factored::{Factored, WhitenedFactored, check_readings_of};
 use crate::fitting::hmatrix::HMatrixError;
 use crate::fitting::identifiability::{
-    CORRELATION_LIMIT, DETERMINED_TOLERANCE, Identifiability, LINK_TOLERANCE, near_confounded,
-    null_space_groups,
+    CORRELATION_LIMIT, DETERMINED_TOLERANCE, Identifiability, LINK_TOLERANCE,
 };
 use crate::fitting::noise::{NoiseError, NoiseModel};
-use nalgebra::{DMatrix, DVector, SVD};
+use nalgebra::{DMatrix, DVector};
 
 /// Default `ρ`: singular values of the scaled H below `ρ·σ_max` count as zero (condition
 /// numbers above 1e8 are treated as rank deficiency; see `docs/identification.md`).
@@ -171,19 +171,6 @@ impl Fit {
     }
 }
 
-fn check_finite(what: &str, v: &[f64], cols: usize) -> Result<(), EstimateError> {
-    match v.iter().position(|x| !x.is_finite()) {
-        None => Ok(()),
-        Some(i) if cols > 0 => Err(EstimateError::NotFinite(format!(
-            "{what}[{}, {}] ({})",
-            i % (v.len() / cols),
-            i / (v.len() / cols),
-            v[i]
-        ))),
-        Some(i) => Err(EstimateError::NotFinite(format!("{what}[{i}] ({})", v[i]))),
-    }
-}
-
 /// Fits `y ≈ H·p` (H: m × n, mm per unit; y: m, mm) with parameter `names` (one per column),
 /// under `constraint`, with `tol`. See the module documentation for the method.
 ///
@@ -236,46 +223,8 @@ pub fn least_squares_whitened(
     noise: &NoiseModel,
     layout: &[usize],
 ) -> Result<WhitenedFit, EstimateError> {
-    let ordinary = least_squares(h, y, names, constraint, tol)?;
-    if noise.is_uniform_white() {
-        let s = noise.sigma_mm[0];
-        return Ok(WhitenedFit {
-            whitened_sigma: ordinary.sigma.filter(|_| s > 0.0).map(|x| x / s),
-            fit: ordinary,
-        });
-    }
-    let (mut wh, mut wy) = (h.clone(), y.clone());
-    noise.whiten(layout, &mut wh, &mut wy)?;
-    let w = least_squares(&wh, &wy, names, constraint, tol)?;
-    if w.rank != ordinary.rank
-        || w.identifiability.determined != ordinary.identifiability.determined
-    {
-        return Err(NoiseError::RankChanged {
-            ordinary: ordinary.rank,
-            whitened: w.rank,
-        }
-        .into());
-    }
-    let residual = y - h * DVector::from_column_slice(&w.solution);
-    let rss = residual.norm_squared();
-    let sigma = (ordinary.dof > 0).then(|| (rss / ordinary.dof as f64).sqrt());
-    let mut identifiability = ordinary.identifiability;
-    identifiability.near_confounded = w.identifiability.near_confounded;
-    Ok(WhitenedFit {
-        whitened_sigma: w.sigma,
-        fit: Fit {
-            values: w.values,
-            solution: w.solution,
-            std: w.std,
-            covariance: w.covariance,
-            correlation: w.correlation,
-            identifiability,
-            residual,
-            rss,
-            sigma,
-            ..ordinary
-        },
-    })
+    check_readings_of(h, y, names)?;
+    WhitenedFactored::new(h, names, constraint, tol, noise, layout)?.fit(h, y, noise, layout)
 }
 
 /// [`least_squares`] on a reduced system: `r` (p × p or (p+1) × p) and `z` with `rᵀr = HᵀH`
@@ -306,162 +255,6 @@ fn solve(
     rows_total: usize,
     rss_outside: f64,
 ) -> Result<Fit, EstimateError> {
-    let (m, n) = h.shape();
-    if m == 0 || n == 0 {
-        return Err(EstimateError::Shape(format!(
-            "nothing to fit: H is {m}×{n} (samples × 3 by parameters)"
-        )));
-    }
-    if y.len() != m || names.len() != n {
-        return Err(EstimateError::Shape(format!(
-            "H is {m}×{n} but there are {} measured values and {} names",
-            y.len(),
-            names.len()
-        )));
-    }
-    check_finite("H", h.as_slice(), n)?;
-    check_finite("y", y.as_slice(), 0)?;
-    let mut fixed = vec![false; n];
-    if let Constraint::Zero(zero) = constraint {
-        for z in zero {
-            // The exact name, or the canonical spelling of its effect (`X0C` for `XOC`).
-            let canonical = match z.trim().split_once('@') {
-                Some((e, b)) => format!("{}@{b}", model_spec::canonical_name(e)),
-                None => model_spec::canonical_name(z),
-            };
-            let j = names
-                .iter()
-                .position(|x| x == z.trim() || *x == canonical)
-                .ok_or_else(|| EstimateError::UnknownParameter(z.clone(), names.join(", ")))?;
-            fixed[j] = true;
-        }
-    }
-    let free: Vec<usize> = (0..n).filter(|&j| !fixed[j]).collect();
-    let nf = free.len();
-    // Column scaling.
-    let mut norms = vec![1.0; n];
-    for &j in &free {
-        let s = h.column(j).norm();
-        if !s.is_finite() {
-            return Err(EstimateError::NotFinite(format!(
-                "the norm of column `{}` of H",
-                names[j]
-            )));
-        }
-        if s > 0.0 {
-            norms[j] = s;
-        }
-    }
-    let rows = m.max(nf);
-    let mut a = DMatrix::<f64>::zeros(rows, nf);
-    for (k, &j) in free.iter().enumerate() {
-        for i in 0..m {
-            a[(i, k)] = h[(i, j)] / norms[j];
-        }
-    }
-    let (sv, u, v) = if nf == 0 {
-        (Vec::new(), DMatrix::zeros(rows, 0), DMatrix::zeros(0, 0))
-    } else {
-        let svd = SVD::try_new(a, true, true, f64::EPSILON, 1000 + 200 * nf)
-            .ok_or(EstimateError::Svd(m, nf))?;
-        let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
-            return Err(EstimateError::Svd(m, nf));
-        };
-        (svd.singular_values.as_slice().to_vec(), u, vt.transpose())
-    };
-    let smax = sv.first().copied().unwrap_or(0.0);
-    let tau = smax
-        * tol
-            .rank_relative
-            .max(rows_total.max(n) as f64 * f64::EPSILON);
-    let rank = sv.iter().take_while(|&&s| s > tau && s > 0.0).count();
-    // Minimum-norm solution in the identifiable subspace (scaled coordinates).
-    let mut ypad = DVector::<f64>::zeros(rows);
-    ypad.rows_mut(0, m).copy_from(y);
-    let mut z = DVector::<f64>::zeros(nf);
-    for (i, s) in sv.iter().enumerate().take(rank) {
-        let c = u.column(i).dot(&ypad) / s;
-        z.axpy(c, &v.column(i), 1.0);
-    }
-    let mut x = vec![0.0; n];
-    for (k, &j) in free.iter().enumerate() {
-        x[j] = z[k] / norms[j];
-    }
-    let residual = y - h * DVector::from_column_slice(&x);
-    let rss = residual.norm_squared() + rss_outside;
-    let dof = rows_total.saturating_sub(rank);
-    let sigma = (dof > 0).then(|| (rss / dof as f64).sqrt());
-    // Unit covariance V_r Σ_r⁻² V_rᵀ in scaled coordinates, then unscaled.
-    let mut unit = DMatrix::<f64>::zeros(n, n);
-    for (ka, &ja) in free.iter().enumerate() {
-        for (kb, &jb) in free.iter().enumerate() {
-            let c: f64 = (0..rank)
-                .map(|i| v[(ka, i)] * v[(kb, i)] / (sv[i] * sv[i]))
-                .sum();
-            unit[(ja, jb)] = c / (norms[ja] * norms[jb]);
-        }
-    }
-    // Null space (rows: all parameters; fixed rows zero).
-    let mut null = DMatrix::<f64>::zeros(n, nf - rank);
-    for (k, &j) in free.iter().enumerate() {
-        for c in rank..nf {
-            null[(j, c - rank)] = v[(k, c)];
-        }
-    }
-    let (null_weight, determined, confounded) = null_space_groups(&null, tol.determined, tol.link);
-    let has_value: Vec<bool> = (0..n)
-        .map(|j| fixed[j] || determined[j] || *constraint == Constraint::MinimumNorm)
-        .collect();
-    let values: Vec<Option<f64>> = (0..n).map(|j| has_value[j].then_some(x[j])).collect();
-    let std: Vec<Option<f64>> = (0..n)
-        .map(|j| match sigma {
-            Some(s) if has_value[j] && !fixed[j] => Some(s * unit[(j, j)].max(0.0).sqrt()),
-            _ => None,
-        })
-        .collect();
-    let mut covariance = DMatrix::<f64>::from_element(n, n, f64::NAN);
-    let mut correlation = DMatrix::<f64>::from_element(n, n, f64::NAN);
-    for a in 0..n {
-        for b in 0..n {
-            if fixed[a] || fixed[b] {
-                covariance[(a, b)] = 0.0;
-            } else if has_value[a] && has_value[b] {
-                if let Some(s) = sigma {
-                    covariance[(a, b)] = s * s * unit[(a, b)];
-                }
-                let d = (unit[(a, a)] * unit[(b, b)]).sqrt();
-                if d > 0.0 {
-                    correlation[(a, b)] = (unit[(a, b)] / d).clamp(-1.0, 1.0);
-                }
-            }
-        }
-    }
-    let eligible: Vec<bool> = (0..n).map(|j| determined[j] && !fixed[j]).collect();
-    let near = near_confounded(&correlation, &eligible, tol.correlation);
-    Ok(Fit {
-        names: names.to_vec(),
-        values,
-        solution: x,
-        std,
-        fixed,
-        column_norms: norms,
-        rank_tolerance: tau,
-        condition: (rank > 0).then(|| smax / sv[rank - 1]),
-        singular_values: sv,
-        rank,
-        covariance,
-        correlation,
-        residual,
-        rss,
-        dof,
-        sigma,
-        identifiability: Identifiability {
-            null_space: null,
-            null_weight,
-            determined,
-            confounded,
-            near_confounded: near,
-        },
-        constraint: constraint.clone(),
-    })
+    check_readings_of(h, y, names)?;
+    Factored::new(h, names, constraint, tol, rows_total)?.fit(h, y, rss_outside)
 }

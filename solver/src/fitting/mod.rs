@@ -19,6 +19,7 @@
 
 pub mod campaign;
 pub mod distributions;
+pub mod factored;
 pub mod hmatrix;
 pub mod identifiability;
 pub mod identify;

@@ -51,8 +51,9 @@
 //! instrument) has every correction weighted by them as well
 //! ([`crate::fitting::identify::fit_rows`]).
 
+use crate::fitting::factored::{RowsFactored, check_readings_of};
 use crate::fitting::hmatrix::{GainSource, HMatrixError, h_matrix};
-use crate::fitting::identify::{choose_noise_weighted, fit_rows, sample_whitening};
+use crate::fitting::identify::{choose_noise_weighted, sample_whitening};
 use crate::fitting::noise::SampleWhitening;
 use crate::fitting::noise::{NoiseChoice, NoiseModel};
 use crate::fitting::{
@@ -328,13 +329,24 @@ pub(crate) fn gauss_newton(
         weights,
     } = *problem;
     // The fit of a residual: ordinary, or generalized under the noise model, rows weighted by
-    // the samples' covariances when there are any.
-    let fit_of = |h: &nalgebra::DMatrix<f64>,
-                  r: &DVector<f64>,
-                  names: &[String],
-                  constraint: &crate::fitting::Constraint|
-     -> Result<(Fit, Option<f64>), EstimateError> {
-        fit_rows(h, r, names, constraint, tolerances, noise, layout, weights)
+    // the samples' covariances when there are any (`fit_rows`). H is the same at every step:
+    // it is factorised once, at the first fit.
+    let mut factored: Option<RowsFactored> = None;
+    let mut fit_of = |r: &DVector<f64>| -> Result<(Fit, Option<f64>), EstimateError> {
+        check_readings_of(h, r, &start.names)?;
+        let f = match &mut factored {
+            Some(f) => f,
+            none => none.insert(RowsFactored::new(
+                h,
+                &start.names,
+                &start.constraint,
+                tolerances,
+                noise,
+                layout,
+                weights,
+            )?),
+        };
+        f.fit(h, r)
     };
     let rows = y.len().max(1) as f64;
     let linear_rms = (start.rss / rows).sqrt();
@@ -374,7 +386,7 @@ pub(crate) fn gauss_newton(
     let mut residual = |x: &[f64]| -> Result<DVector<f64>, RefineError> { Ok(y - predict(x)?) };
     for _ in 0..opts.max_iterations {
         let r = residual(&x)?;
-        let (correction, _) = fit_of(h, &r, &start.names, &start.constraint)?;
+        let (correction, _) = fit_of(&r)?;
         for (v, d) in x.iter_mut().zip(&correction.solution) {
             *v += d;
         }
@@ -396,7 +408,7 @@ pub(crate) fn gauss_newton(
     // exact model. Its own correction is below the tolerance and is not added.
     let r = residual(&x)?;
     let refined_rms = (r.norm_squared() / rows).sqrt();
-    let (mut fit, whitened_sigma) = fit_of(h, &r, &start.names, &start.constraint)?;
+    let (mut fit, whitened_sigma) = fit_of(&r)?;
     fit.values = fit
         .values
         .iter()

@@ -302,7 +302,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         let named = if is_jump(named) {
             scored
                 .iter()
-                .filter(|s| !is_jump(s) && s.directions.ncols() <= named.directions.ncols())
+                .filter(|s| !is_jump(s) && s.width <= named.width)
                 .filter(|s| adds_nothing(named, s) && adds_nothing(s, named))
                 .max_by(|a, b| a.delta_rss.total_cmp(&b.delta_rss))
                 .map_or(named, |s| &scored[prefer(s)])

@@ -77,7 +77,7 @@ fn a_huge_value_is_written_compactly() {
     );
     assert_eq!(
         message([0.0, 0.0, 0.0, 0.0, -2.5e12]).unwrap(),
-        "Z = -2.500000e12 mm outside its stroke -500 .. 500 mm"
+        "Z = -2.5e12 mm outside its stroke -500 .. 500 mm"
     );
 }
 

@@ -100,8 +100,9 @@ pub fn p_value(p: f64) -> String {
 }
 
 /// A value as it would be written back: the shortest decimal that reads back to `x` when it
-/// has at most twelve digits (`1e308`, `-2400`, `1.5e-12`), else six decimals at most
-/// ([`short`]: `0.30000000000000004` is `0.3`), and scientific notation for huge values.
+/// has at most twelve digits (`1e308`, `-2400`, `1.5e-12`), else six decimals at most from
+/// 1e-3 to 1e12 ([`short`]: `0.30000000000000004` is `0.3`), and six significant digits
+/// outside ([`significant`]: `-2.5e12`, `1.23457e-7`).
 pub fn compact(x: f64) -> String {
     let shortest = format_scaled(x, 0);
     let digits = shortest.bytes().filter(u8::is_ascii_digit).count();

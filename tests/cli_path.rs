@@ -497,3 +497,30 @@ fn simulate_and_identify_take_the_ball_position_the_path_was_planned_at() {
     );
     assert!(!dir.join("x.csv").exists());
 }
+
+/// The gap check of a measurement program names the flag that relaxes it, and the flag does:
+/// 15° steps of K4 take the nest 1.9 mm off the ball, refused at the default 0.5 mm and
+/// written with `--max-gap-mm 5`; beyond 5 mm the flag itself is refused.
+#[test]
+fn the_gap_check_names_and_takes_its_flag() {
+    let dir = temp_dir_tagged("path", "gap");
+    let base = "path --machine seed-ac --test K4 --nc iso -o k4.nc --step-deg 15";
+    fails(
+        &dir,
+        &common::words(base),
+        3,
+        &[
+            "the nest leaves the ball by 1.89",
+            "rtest path --max-gap-mm",
+        ],
+    );
+    assert!(entries(&dir).is_empty());
+    ok(&dir, &common::words(&format!("{base} --max-gap-mm 5")));
+    assert!(dir.join("k4.nc").exists());
+    fails(
+        &dir,
+        &common::words(&format!("{base} --max-gap-mm 9")),
+        2,
+        &["--max-gap-mm", "`9` is not a number from 0.001 to 5"],
+    );
+}

@@ -39,6 +39,10 @@ pub struct NcArgs {
     /// Continuous program: the R-test's sampling rate, Hz.
     #[arg(long, value_name = "HZ", requires = "continuous")]
     pub sample_rate_hz: Option<f64>,
+    /// The farthest the nest may leave the ball between two poses on the nominal machine, mm
+    /// (default 0.5; at most 5): a move that leaves it farther is refused.
+    #[arg(long, value_name = "MM", requires = "nc", value_parser = super::args::between(1e-3, 5.0))]
+    pub max_gap_mm: Option<f64>,
     /// Decimals of the axis words (default 4: 0.0001 mm, 0.0001°; at most 9).
     #[arg(long, value_name = "N", requires = "nc")]
     pub decimals: Option<usize>,
@@ -104,6 +108,9 @@ impl NcArgs {
         let mut o = MeasureOptions::new(m, dialect, mode);
         o.test_name = test.to_string();
         o.params = params.to_vec();
+        if let Some(g) = self.max_gap_mm {
+            o.max_gap_mm = g;
+        }
         if let Some(d) = self.decimals {
             if d > solver::io::nc::MAX_DECIMALS {
                 return Err(CliError::usage(format!(

@@ -57,7 +57,7 @@ pub fn measurement_program(
             return Err(MeasureError::Move {
                 from: poses.place(i),
                 message: format!(
-                    "the nest leaves the ball by {} mm on the nominal machine, more than the {} mm allowed: add poses between, or allow more",
+                    "the nest leaves the ball by {} mm on the nominal machine, more than the {} mm allowed: add poses between (a smaller step), or allow more (rtest path --max-gap-mm)",
                     short(gap),
                     short(opts.max_gap_mm)
                 ),

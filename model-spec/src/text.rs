@@ -113,6 +113,7 @@ pub fn decode_text(file_name: &str, mut bytes: Vec<u8>) -> Result<String, TextEr
         }
     })
 }
+
 /// Why a free text of a description (a machine's, a sub-model's or an instrument's
 /// `description`) is refused, or `None` when it is accepted. Refused: the text-direction
 /// controls U+202A–U+202E and U+2066–U+2069, which make text display in another order than it

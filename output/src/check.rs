@@ -272,28 +272,18 @@ pub fn refuse_inputs_in_dir(
     let Ok(entries) = fs::read_dir(dir) else {
         return Ok(());
     };
-    let inputs: Vec<(&str, Identity)> = inputs
-        .iter()
-        .map(|(label, path)| (*label, identity_of_path(path)))
+    let written: Vec<Target> = entries
+        .flatten()
+        .filter_map(|e| {
+            e.file_name()
+                .to_str()
+                .filter(|n| writes(n))
+                .map(|n| dir.join(n))
+        })
+        .map(Target::Path)
         .collect();
-    for entry in entries.flatten() {
-        let name = entry.file_name();
-        let Some(name) = name.to_str().filter(|n| writes(n)) else {
-            continue;
-        };
-        let path = dir.join(name);
-        let Some(identity) = resolve(&path).ok().and_then(|r| r.identity()) else {
-            continue;
-        };
-        if let Some((input, _)) = inputs.iter().find(|(_, id)| *id == identity) {
-            return Err(WriteError::IsInput {
-                label: label.to_string(),
-                path,
-                input: input.to_string(),
-            });
-        }
-    }
-    Ok(())
+    let outputs: Vec<(&str, &Target)> = written.iter().map(|t| (label, t)).collect();
+    refuse_overwriting_inputs(inputs, &outputs)
 }
 
 /// Who standard output is, when it is a regular file (a command's output redirected to a file

@@ -186,6 +186,20 @@ pub fn between(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone
     }
 }
 
+/// `--decimals` of an NC program, when given: at most [`solver::io::nc::MAX_DECIMALS`].
+///
+/// # Errors
+/// A usage error naming `--decimals` and the limit.
+pub fn nc_decimals(d: Option<usize>) -> CliResult<Option<usize>> {
+    let max = solver::io::nc::MAX_DECIMALS;
+    match d {
+        Some(d) if d > max => Err(CliError::usage(format!(
+            "--decimals: {d} decimals asked for, at most {max}"
+        ))),
+        d => Ok(d),
+    }
+}
+
 /// A finite number above zero (µm, µrad).
 pub fn positive(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {

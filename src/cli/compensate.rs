@@ -125,12 +125,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     if args.nc.is_none() && args.decimals.is_some() {
         return Err(CliError::usage("--decimals applies to NC programs (--nc)"));
     }
-    if let Some(d) = args.decimals.filter(|&d| d > solver::io::nc::MAX_DECIMALS) {
-        return Err(CliError::usage(format!(
-            "--decimals: {d} decimals asked for, at most {}",
-            solver::io::nc::MAX_DECIMALS
-        )));
-    }
+    super::args::nc_decimals(args.decimals)?;
     let (m, machine_text) = super::load_machine_and_text(&args.machine)?;
     let mut inputs = vec![("--params", args.params.as_path())];
     inputs.extend(args.path.as_deref().map(|p| ("--path", p)));

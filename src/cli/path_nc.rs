@@ -111,13 +111,7 @@ impl NcArgs {
         if let Some(g) = self.max_gap_mm {
             o.max_gap_mm = g;
         }
-        if let Some(d) = self.decimals {
-            if d > solver::io::nc::MAX_DECIMALS {
-                return Err(CliError::usage(format!(
-                    "--decimals: {d} decimals asked for, at most {}",
-                    solver::io::nc::MAX_DECIMALS
-                )));
-            }
+        if let Some(d) = super::args::nc_decimals(self.decimals)? {
             o.decimals = d;
         }
         Ok(o)

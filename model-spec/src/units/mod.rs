@@ -74,9 +74,14 @@ pub fn short(x: f64) -> String {
     if !x.is_finite() {
         return s;
     }
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    match s {
-        "" | "-" => "0".to_string(),
+    without_trailing_zeros(&s)
+}
+
+/// A fixed-point decimal without its trailing zeros and point, no negative zero (`-0.000` is
+/// `0`).
+fn without_trailing_zeros(s: &str) -> String {
+    match s.trim_end_matches('0').trim_end_matches('.') {
+        "" | "-" | "-0" => "0".to_string(),
         s => s.to_string(),
     }
 }
@@ -129,8 +134,11 @@ pub fn compact(x: f64) -> String {
 /// assert_eq!(significant(0.0), "0");
 /// ```
 pub fn significant(x: f64) -> String {
-    if !x.is_finite() || x == 0.0 {
-        return if x == 0.0 { "0".into() } else { format!("{x}") };
+    if x == 0.0 {
+        return "0".into();
+    }
+    if !x.is_finite() {
+        return format!("{x}");
     }
     let exponent = x.abs().log10().floor();
     if !(-4.0..6.0).contains(&exponent) {
@@ -141,12 +149,11 @@ pub fn significant(x: f64) -> String {
     }
     let decimals = (5.0 - exponent).max(0.0) as usize;
     let s = format!("{x:.decimals$}");
-    let s = if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    if s.contains('.') {
+        without_trailing_zeros(&s)
     } else {
         s
-    };
-    if s == "-0" { "0".into() } else { s }
+    }
 }
 
 #[cfg(test)]

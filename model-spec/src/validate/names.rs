@@ -56,11 +56,11 @@ impl Validator<'_> {
         if n <= MAX_NAME_CHARS {
             return Ok(());
         }
-        let start: String = name.get_ref().chars().take(16).collect();
         self.err(
             name.span(),
             format!(
-                "{what} `{start}…` has {n} characters, more than {MAX_NAME_CHARS}, the longest name"
+                "{what} `{}` has {n} characters, more than {MAX_NAME_CHARS}, the longest name",
+                crate::text::quoted_start(name.get_ref())
             ),
         )
     }

@@ -871,3 +871,88 @@ fn out_of_range_values_are_usage_errors_naming_their_flag() {
     }
     assert_eq!(snapshot(&dir), before);
 }
+
+/// Sets field `col` (0-based) of the `row`-th data line (1-based) of the CSV `text` to
+/// `value`, and returns the text with that line's number in the file.
+fn with_field(text: &str, row: usize, col: usize, value: &str) -> (String, usize) {
+    let mut n = 0;
+    let mut at = 0;
+    let lines: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if l.starts_with('#') || l.starts_with(|c: char| c.is_ascii_alphabetic()) {
+                return l.to_string();
+            }
+            n += 1;
+            if n != row {
+                return l.to_string();
+            }
+            at = i + 1;
+            let mut f: Vec<&str> = l.split(',').collect();
+            f[col] = value;
+            f.join(",")
+        })
+        .collect();
+    (lines.join("\n") + "\n", at)
+}
+
+#[test]
+fn a_reading_no_head_gives_is_refused_at_its_line_with_a_short_number() {
+    let dir = temp_dir("sensor-1e308");
+    ok(
+        &dir,
+        &words("simulate --machine seed-ac --path K4 --instrument inclined-45 -o s.csv"),
+    );
+    let text = std::fs::read_to_string(dir.join("s.csv")).unwrap();
+    // Columns: X,Y,Z,A,C,s1_um,s2_um,s3_um,t_s.
+    let (reading, line) = with_field(&text, 9, 7, "1e308");
+    std::fs::write(dir.join("reading.csv"), reading).unwrap();
+    let (time, time_line) = with_field(&text, 9, 8, "1e308");
+    std::fs::write(dir.join("time.csv"), time).unwrap();
+    let mut cal = String::from("dx_um,dy_um,dz_um,s1_um,s2_um,s3_um\n");
+    for i in 1..=6 {
+        cal += &format!("{},{},{},{i},{i},{i}\n", 10 * i, 3 * i, 2 * i);
+    }
+    std::fs::write(dir.join("cal-d.csv"), with_field(&cal, 3, 0, "1e308").0).unwrap();
+    std::fs::write(dir.join("cal-s.csv"), with_field(&cal, 3, 3, "-1e308").0).unwrap();
+    let before = snapshot(&dir);
+    let identify =
+        "identify --machine seed-ac --model reduced --instrument inclined-45 --json id.json --data";
+    fails(
+        &dir,
+        &words(&format!("{identify} reading.csv")),
+        1,
+        &[&format!(
+            "reading.csv:{line}: column 8 `s3_um`: 1e308 µm is beyond the plausibility bound of a sensor's reading, ±12000 µm"
+        )],
+    );
+    let message = fails(
+        &dir,
+        &words(&format!("{identify} time.csv")),
+        1,
+        &[&format!(
+            "time.csv:{}: column 9 `t_s`: time 9 s is before the time of the previous sample (1e308 s, line {time_line})",
+            time_line + 1
+        )],
+    );
+    assert!(message.len() < 400, "{message}");
+    let calibrate = "instrument calibrate --instrument inclined-45 -o cal.toml --data";
+    fails(
+        &dir,
+        &words(&format!("{calibrate} cal-d.csv")),
+        1,
+        &[
+            "cal-d.csv:4: column 1 `dx_um`: 1e308 µm is beyond the plausibility bound of a known displacement, ±1000 µm",
+        ],
+    );
+    fails(
+        &dir,
+        &words(&format!("{calibrate} cal-s.csv")),
+        1,
+        &[
+            "cal-s.csv:4: column 4 `s1_um`: -1e308 µm is beyond the plausibility bound of a sensor's reading, ±12000 µm",
+        ],
+    );
+    assert_eq!(snapshot(&dir), before);
+}

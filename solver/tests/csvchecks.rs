@@ -258,7 +258,7 @@ fn path_files_are_checked_as_measurements_are() {
         )
         .unwrap_err()
         .to_string(),
-        "p.csv: 1 reading beyond the plausibility bound of 1000 µm: line 4 dz_um = -1000000"
+        "p.csv: 1 reading beyond the plausibility bound of 1000 µm: line 4 dz_um = -1e6"
     );
 }
 

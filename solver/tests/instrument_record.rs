@@ -122,9 +122,14 @@ fn bad_sensor_files_name_the_file_line_and_column() {
             "s.csv:1: a record of the sensor readings of instrument inclined-45 has the columns s1_um, s2_um, s3_um, not dx_um, dy_um, dz_um",
         ),
         (
-            // 20 mm on one sensor: no displacement puts the ball there.
-            "A,C,s1_um,s2_um,s3_um\n0,0,1,2,3\n0,1,20000,2,3\n",
+            // 11.9 mm on every sensor: no displacement puts the ball there.
+            "A,C,s1_um,s2_um,s3_um\n0,0,1,2,3\n0,1,11900,11900,11900\n",
             "s.csv:3: the readings of instrument inclined-45 give no error vector: ",
+        ),
+        (
+            // 20 mm: more than any plausible head reads (1 mm × gain 2 + a zero of 10 mm).
+            "A,C,s1_um,s2_um,s3_um\n0,0,1,2,3\n0,1,20000,2,3\n",
+            "s.csv:3: column 3 `s1_um`: 20000 µm is beyond the plausibility bound of a sensor's reading, ±12000 µm",
         ),
     ];
     for (text, want) in cases {

@@ -36,6 +36,7 @@ use super::contact::{ContactError, SensorGeometry};
 use super::head::SensorHead;
 use crate::fitting::least_squares::{Constraint, EstimateError, Fit, Tolerances, least_squares};
 use model_spec::instrument::{GAIN_RANGE, Instrument, MAX_ZERO_UM, Sensor};
+use model_spec::units::significant;
 use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
 
 /// A calibration record: known error vectors and the sensors' readings.
@@ -121,13 +122,24 @@ pub enum CalibrationError {
     },
     /// The iteration did not converge.
     #[error(
-        "sensor {sensor}: the calibration did not converge in {MAX_ITERATIONS} steps (last step {last_step_um:.3e} µm)"
+        "sensor {sensor}: the calibration did not converge in {MAX_ITERATIONS} steps (last step {} µm)", significant(*last_step_um)
     )]
     NotConverged {
         /// The sensor.
         sensor: String,
         /// The last step's largest change of a predicted reading, µm.
         last_step_um: f64,
+    },
+    /// A step of the iteration that is not finite: the record's readings are far from
+    /// anything the head can give.
+    #[error(
+        "sensor {sensor}: the calibration diverged at step {step} (a correction is not a finite number): check the record's readings against its known displacements"
+    )]
+    Diverged {
+        /// The sensor.
+        sensor: String,
+        /// The step, from 1.
+        step: usize,
     },
     /// A value beyond what a calibration of this head can find.
     #[error(
@@ -282,7 +294,10 @@ fn calibrate_sensor(
         iterations += 1;
         last_step = (&h * DVector::from_column_slice(d)).amax();
         if !last_step.is_finite() {
-            break;
+            return Err(CalibrationError::Diverged {
+                sensor: sensor.name.clone(),
+                step: iterations,
+            });
         }
         if last_step <= CONVERGED_MM {
             converged = true;

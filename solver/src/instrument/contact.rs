@@ -21,6 +21,7 @@
 //! vector from the ball centre to the tip centre.
 
 use model_spec::instrument::{Sensor, Tip};
+use model_spec::units::significant;
 use nalgebra::Vector3;
 
 /// The largest angle between a ball tip's plunger axis and the line from the ball centre to
@@ -32,7 +33,7 @@ pub const MAX_TIP_CONTACT_ANGLE_DEG: f64 = 60.0;
 pub enum ContactError {
     /// The contact point left a flat face.
     #[error(
-        "sensor {sensor}: the ball touches the flat face {lateral_mm:.4} mm from its centre, off the face (radius {face_radius_mm} mm)"
+        "sensor {sensor}: the ball touches the flat face {} mm from its centre, off the face (radius {} mm)", significant(*lateral_mm), significant(*face_radius_mm)
     )]
     OffFace {
         /// The sensor's name.
@@ -45,7 +46,7 @@ pub enum ContactError {
     /// A ball tip whose axis passes too far from the ball centre to touch it, or touches it
     /// beyond [`MAX_TIP_CONTACT_ANGLE_DEG`].
     #[error(
-        "sensor {sensor}: the ball tip cannot touch the ball on its face: the ball centre is {off_axis_mm:.4} mm off the plunger axis (the tip's ball touches within {limit_mm:.4} mm)"
+        "sensor {sensor}: the ball tip cannot touch the ball on its face: the ball centre is {} mm off the plunger axis (the tip's ball touches within {} mm)", significant(*off_axis_mm), significant(*limit_mm)
     )]
     NoContact {
         /// The sensor's name.
@@ -120,12 +121,14 @@ impl SensorGeometry {
                 let off_axis2 = (w.norm_squared() - b * b).max(0.0);
                 let limit = rho * MAX_TIP_CONTACT_ANGLE_DEG.to_radians().sin();
                 let disc = rho * rho - off_axis2;
+                // The message's distance from the perpendicular part itself: the difference
+                // of squares above loses it for a far-off ball (it can even be NaN).
                 let no_contact = || ContactError::NoContact {
                     sensor: self.name.clone(),
-                    off_axis_mm: off_axis2.sqrt(),
+                    off_axis_mm: (w - n * b).norm(),
                     limit_mm: limit,
                 };
-                if !(off_axis2.is_finite() && off_axis2 <= limit * limit && disc > 0.0) {
+                if !(w.norm_squared().is_finite() && off_axis2 <= limit * limit && disc > 0.0) {
                     return Err(no_contact());
                 }
                 let t = -b + disc.sqrt();

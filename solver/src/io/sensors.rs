@@ -24,8 +24,9 @@ use crate::io::csv::{
 };
 use crate::record::Record;
 use crate::simulation::paths::record_from_commands;
+use model_spec::instrument::{GAIN_RANGE, MAX_ZERO_UM};
 use model_spec::instrument::{Instrument, ReadingsFrame};
-use model_spec::units::{degrees_for, format_scaled, parse_scaled};
+use model_spec::units::{degrees_for, format_scaled, parse_scaled, significant};
 use model_spec::{AxisKind, Machine};
 use std::io::Read;
 use std::path::Path;
@@ -69,6 +70,12 @@ pub fn read_sensor_csv<R: Read>(
             continue;
         }
         let ((c, t, _), s) = header.row_with(&cx, line, text, m, &mut last_t)?;
+        let bound = max_sensor_reading_mm(opts.max_reading_mm);
+        for (k, &x) in s.iter().enumerate() {
+            if let Some(why) = beyond(x, bound, "a sensor's reading") {
+                return Err(cx.err(line, Some(header.extra_column(k)), why));
+            }
+        }
         timed &= t.is_some();
         times.push(t.unwrap_or(commands.len() as f64));
         commands.push(c);
@@ -88,6 +95,25 @@ pub fn read_sensor_csv<R: Read>(
     }
     record.lines = row_lines;
     Ok(SensorRecord { record, readings })
+}
+
+/// The largest magnitude of a sensor's reading, mm, when the error vector is bounded by
+/// `max_reading_mm` (mm, [`ReadOptions::max_reading_mm`]): that displacement read with the
+/// largest plausible gain ([`GAIN_RANGE`]) plus the largest zero ([`MAX_ZERO_UM`]). With the
+/// default bound of 1 mm it is 12 mm; beyond it a reading is refused where it is read.
+pub fn max_sensor_reading_mm(max_reading_mm: f64) -> f64 {
+    max_reading_mm * GAIN_RANGE.1 + MAX_ZERO_UM * 1e-3
+}
+
+/// `None` when `x` (mm) is within `bound_mm`, else why, for a field of `what`.
+fn beyond(x: f64, bound_mm: f64, what: &str) -> Option<String> {
+    (x.abs() > bound_mm).then(|| {
+        format!(
+            "{} µm is beyond the plausibility bound of {what}, ±{} µm",
+            significant(x * 1e3),
+            significant(bound_mm * 1e3)
+        )
+    })
 }
 
 /// Reads the sensor record file `path` of machine `m` taken with `instrument` and turns it
@@ -362,13 +388,29 @@ pub fn read_calibration<R: Read>(
                         return Err(cx.err(
                             line,
                             Some((i, names[i].as_str())),
-                            format!("time {f} s is before the time of the previous sample ({prev} s, line {prev_line}): times must not decrease"),
+                            format!("time {f} s is before the time of the previous sample ({} s, line {prev_line}): times must not decrease", significant(prev)),
                         ));
                     }
                     last_t = Some((x, line));
                 }
-                c if c < 3 => d[c] = x,
-                c => s[c - 3] = x,
+                c => {
+                    let (bound, what) = if c < 3 {
+                        (opts.max_reading_mm, "a known displacement")
+                    } else {
+                        (
+                            max_sensor_reading_mm(opts.max_reading_mm),
+                            "a sensor's reading",
+                        )
+                    };
+                    if let Some(why) = beyond(x, bound, what) {
+                        return Err(cx.err(line, Some((i, names[i].as_str())), why));
+                    }
+                    if c < 3 {
+                        d[c] = x;
+                    } else {
+                        s[c - 3] = x;
+                    }
+                }
             }
         }
         out.displacements.push(d);

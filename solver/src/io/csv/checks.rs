@@ -15,7 +15,7 @@
 use crate::io::csv::{CsvError, MEASURED, ReadOptions};
 use crate::simulation::exact::VirtualMachine;
 use model_spec::Machine;
-use model_spec::units::{compact, format_scaled, plural};
+use model_spec::units::{compact, plural, significant};
 
 /// How many offending samples a refusal lists.
 pub const LISTED: usize = 5;
@@ -145,7 +145,7 @@ impl<'m> SampleChecks<'m> {
             for (k, &x) in v.iter().enumerate() {
                 if !at_most(x.abs(), bound) {
                     off.add(line, || {
-                        format!("line {line} {} = {}", MEASURED[k], format_scaled(x, 3))
+                        format!("line {line} {} = {}", MEASURED[k], significant(x * 1e3))
                     });
                 }
             }
@@ -157,7 +157,7 @@ impl<'m> SampleChecks<'m> {
                 format!(
                     "{n} reading{} beyond the plausibility bound of {} µm",
                     plural(n, "s"),
-                    format_scaled(bound, 3)
+                    significant(bound * 1e3)
                 )
             },
             "",

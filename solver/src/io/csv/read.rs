@@ -10,7 +10,7 @@ use crate::io::csv::{
 };
 use crate::simulation::exact::{ExactError, VirtualMachine};
 use crate::simulation::paths::fill_linear_ik;
-use model_spec::units::parse_scaled;
+use model_spec::units::{parse_scaled, significant};
 use model_spec::{AxisKind, Machine};
 use std::io::Read;
 
@@ -224,7 +224,7 @@ impl Header {
                         return Err(cx.err(
                             line,
                             Some((i, self.names[i].as_str())),
-                            format!("time {f} s is before the time of the previous sample ({prev} s, line {prev_line}): times must not decrease"),
+                            format!("time {f} s is before the time of the previous sample ({} s, line {prev_line}): times must not decrease", significant(prev)),
                         ));
                     }
                     *last_t = Some((x, line));
@@ -237,6 +237,16 @@ impl Header {
 
     /// Why the field `f` of column `i` (holding `col`) on line `line` is not a number that can
     /// be read.
+    /// The column index and name of extra column `k` ([`Header::row_with`]'s order).
+    pub(crate) fn extra_column(&self, k: usize) -> (usize, &str) {
+        let i = self
+            .cols
+            .iter()
+            .position(|c| matches!(c, Col::Extra(j) if *j == k))
+            .unwrap_or(0);
+        (i, self.names.get(i).map_or("", String::as_str))
+    }
+
     fn bad_number(
         &self,
         cx: &Ctx,

@@ -269,6 +269,50 @@ fn damaged_and_foreign_files_are_refused_and_left_as_they_are() {
 }
 
 #[test]
+fn a_log_beside_the_database_that_is_not_a_regular_file_is_refused_every_way() {
+    let d = dir("companions");
+    let path = d.join("h.sqlite");
+    let bytes = database(&path, 2);
+    std::fs::create_dir(d.join("elsewhere")).unwrap();
+    std::fs::write(d.join("elsewhere/log"), b"").unwrap();
+    let cases = [
+        ("-wal", "elsewhere/log", "write-ahead log"),
+        ("-wal", "elsewhere/missing", "write-ahead log"),
+        ("-shm", "elsewhere/log", "shared-memory file"),
+        ("-journal", "elsewhere/log", "rollback journal"),
+    ];
+    for (suffix, target, what) in cases {
+        let side = d.join(format!("h.sqlite{suffix}"));
+        std::os::unix::fs::symlink(target, &side).unwrap();
+        let want = format!(
+            "SQLite's {what} beside it, `{}`, is a symbolic link (to `{target}`)",
+            side.display()
+        );
+        for e in [
+            Store::open(&path).err(),
+            Store::open_or_create(&path).err(),
+            Store::open_for_reading(&path).err(),
+        ] {
+            let e = e.expect("refused").to_string();
+            assert!(e.contains(&want), "`{want}` not in: {e}");
+        }
+        std::fs::remove_file(&side).unwrap();
+    }
+    // A directory in the log's place.
+    std::fs::create_dir(d.join("h.sqlite-wal")).unwrap();
+    let e = Store::open_for_reading(&path)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("is a directory"), "{e}");
+    std::fs::remove_dir(d.join("h.sqlite-wal")).unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), bytes);
+    assert_eq!(std::fs::read(d.join("elsewhere/log")).unwrap(), b"");
+    assert_eq!(names_in(&d), ["elsewhere", "h.sqlite"]);
+    assert_eq!(Store::open_for_reading(&path).unwrap().count().unwrap(), 2);
+}
+
+#[test]
 fn threads_with_their_own_connections_lose_no_check() {
     let d = dir("threads");
     let path = d.join("h.sqlite");

@@ -63,10 +63,14 @@ pub(crate) fn open_existing(path: &Path) -> Res<Connection> {
 /// writes nothing and reads in a directory one may not write ([`super::reading::connect`]).
 ///
 /// # Errors
-/// Those of [`open_existing`]; where it fails, an older schema (its migration needs write
+/// Those of [`open_existing`] (a `-wal`, `-shm` or `-journal` beside the database that is not
+/// a regular file is [`HistoryError::Failed`] in either case); where it fails, an older schema (its migration needs write
 /// access) is [`HistoryError::Failed`] saying so, and so is a read-only connection that
 /// fails too.
 pub(crate) fn open_for_reading(path: &Path) -> Res<Connection> {
+    // A log beside the database that SQLite cannot open is refused here too: the read-only
+    // connection would read the database without it.
+    check_companions(path)?;
     let written = match open_existing(path) {
         Err(HistoryError::Failed { file, message }) => (file, message),
         other => return other,
@@ -126,6 +130,7 @@ fn check_file(path: &Path) -> Res<()> {
             "it is empty (0 bytes); a history database is never empty: remove the file to start a new history",
         ));
     }
+    check_companions(path)?;
     let mut head = Vec::with_capacity(100);
     std::fs::File::open(path)
         .and_then(|f| f.take(100).read_to_end(&mut head))
@@ -135,6 +140,41 @@ fn check_file(path: &Path) -> Res<()> {
             path,
             "it is not an SQLite database (no SQLite header)",
         ));
+    }
+    Ok(())
+}
+
+/// Refuses the files SQLite keeps beside a database (`-wal`, `-shm`, `-journal`) when one is
+/// there but is not a regular file: SQLite opens none of them through a symbolic link, and
+/// would say only "unable to open database file" or "attempt to write a readonly database".
+fn check_companions(path: &Path) -> Res<()> {
+    for (suffix, what) in [
+        ("-wal", "write-ahead log"),
+        ("-shm", "shared-memory file"),
+        ("-journal", "rollback journal"),
+    ] {
+        let side = beside(path, suffix);
+        let Ok(meta) = std::fs::symlink_metadata(&side) else {
+            continue;
+        };
+        let kind = if meta.file_type().is_symlink() {
+            let to = std::fs::read_link(&side)
+                .map_or_else(|_| String::new(), |t| format!(" (to `{}`)", t.display()));
+            format!("a symbolic link{to}")
+        } else if meta.is_dir() {
+            "a directory".to_string()
+        } else if meta.is_file() {
+            continue;
+        } else {
+            "not a regular file".to_string()
+        };
+        return Err(HistoryError::Failed {
+            file: path.display().to_string(),
+            message: format!(
+                "SQLite's {what} beside it, `{}`, is {kind}: SQLite opens only a regular file there; move it away (the database's own {what} is a regular file that SQLite made)",
+                side.display()
+            ),
+        });
     }
     Ok(())
 }

@@ -148,24 +148,32 @@ pub fn classify(file: &str, text: &str) -> Result<Document, InputError> {
             },
         }
     };
-    if has(&["findings", "base_fit"]) {
+    let doc = if has(&["findings", "base_fit"]) {
         let r = serde_json::from_str(text).map_err(typed("diagnosis"))?;
-        Ok(Document::Diagnosis(Box::new(r)))
+        Document::Diagnosis(Box::new(r))
     } else if has(&["compensated", "left_out", "axes"]) {
         let r = serde_json::from_str(text).map_err(typed("compensation"))?;
-        Ok(Document::Compensation(Box::new(r)))
+        Document::Compensation(Box::new(r))
     } else if has(&["per_direction", "prediction"]) {
         let r = ValidationReport::from_json(file, text).map_err(read("validation"))?;
-        Ok(Document::Validation(Box::new(r)))
+        Document::Validation(Box::new(r))
     } else if has(&["parameters", "fingerprint", "refinement"]) {
         let r = IdentificationReport::from_json(file, text).map_err(read("identification"))?;
-        Ok(Document::Identification(Box::new(r)))
+        Document::Identification(Box::new(r))
     } else {
-        Err(InputError::Unknown {
+        return Err(InputError::Unknown {
             file: file.to_string(),
             why: "a JSON object without the fields of any of them (parameters, per_direction, findings, compensated)".into(),
-        })
+        });
+    };
+    if doc.machine().trim().is_empty() {
+        return Err(InputError::Field {
+            file: file.to_string(),
+            kind: doc.kind(),
+            why: "field `machine` is empty: a report names the machine it is of".into(),
+        });
     }
+    Ok(doc)
 }
 
 /// A figure ready for the page: its id (an HTML id), its SVG text and its caption (what it

@@ -155,6 +155,14 @@ impl Parser<'_> {
         for ((r, s), &given) in records.iter_mut().zip(&label_spans).zip(&setup_given) {
             if s.is_none() {
                 r.label = unique_label(&r.label, &taken);
+                check_label("the label made unique", &r.label).map_err(|e| {
+                    CampaignFileError::Invalid {
+                        file: self.file.to_string(),
+                        line: r.line,
+                        column: 1,
+                        message: format!("{}: give the record a `label`", e.0),
+                    }
+                })?;
                 if !given {
                     r.setup = r.label.clone();
                 }
@@ -274,8 +282,9 @@ impl Parser<'_> {
                             return Err(self.err(
                                 pv.span(),
                                 format!(
-                                    "`{field}`: {x} mm is beyond the largest length a machine may have, {} mm",
-                                    model_spec::limits::MAX_LENGTH_MM
+                                    "`{field}`: {} mm is beyond the largest length a machine may have, {} mm",
+                                    model_spec::units::significant(x),
+                                    model_spec::units::significant(model_spec::limits::MAX_LENGTH_MM)
                                 ),
                             ));
                         }
@@ -296,7 +305,10 @@ impl Parser<'_> {
                     if x.abs() > 1e9 {
                         return Err(self.err(
                             v.span(),
-                            format!("`start`: {x} s is beyond ±1e9 s (about 30 years)"),
+                            format!(
+                                "`start`: {} s is beyond ±1e9 s (about 30 years)",
+                                model_spec::units::significant(x)
+                            ),
                         ));
                     }
                     start_s = Some(x);
@@ -319,7 +331,16 @@ impl Parser<'_> {
         let label_span = label.as_ref().map(|(_, s)| s.clone());
         let label = match label {
             Some((l, _)) => l,
-            None => stem_label(&path),
+            None => {
+                let l = stem_label(&path);
+                check_label("`file`: the label made from its name", &l).map_err(|e| {
+                    self.err(
+                        file_span.clone(),
+                        format!("{}: give the record a `label`", e.0),
+                    )
+                })?;
+                l
+            }
         };
         let given = setup.is_some();
         let setup = setup.unwrap_or_else(|| label.clone());

@@ -301,8 +301,7 @@ fn a_log_beside_the_database_that_is_not_a_regular_file_is_refused_every_way() {
     // A directory in the log's place.
     std::fs::create_dir(d.join("h.sqlite-wal")).unwrap();
     let e = Store::open_for_reading(&path)
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string();
     assert!(e.contains("is a directory"), "{e}");
     std::fs::remove_dir(d.join("h.sqlite-wal")).unwrap();

@@ -864,6 +864,30 @@ fn out_of_range_values_are_usage_errors_naming_their_flag() {
             "path --machine seed-ac --test K4 --nc iso -o q.nc --decimals 12",
             &["--decimals: 12 decimals asked for, at most 9"],
         ),
+        (
+            "simulate --machine seed-ac --path K4 -o s.csv --noise-phi 1",
+            &["--noise-phi: `1` must be at least 0 and below 0.99"],
+        ),
+        (
+            "identify --machine seed-ac --model reduced --data k4.csv --stream --block 1000000000000",
+            &["--block", "1000000000000 is not in 1..=100000000"],
+        ),
+        (
+            "validate --machine seed-ac --params id.json --data k4.csv --max-error-um 0",
+            &["--max-error-um", "`0` is not a finite number above zero"],
+        ),
+        (
+            "diagnose --machine seed-ac --model reduced --data k4.csv --alpha 1.5",
+            &["--alpha", "strictly between 0 and 1"],
+        ),
+        (
+            "volumetric --machine seed-ac --laser X=x.csv --squareness s.csv --grid g.csv --pitch 0",
+            &["--pitch: `0` is not a positive number of mm"],
+        ),
+        (
+            "segment --machine seed-ac --plan p.csv --log k4.csv -o s.csv --min-readings 0",
+            &["--min-readings", "0 is not in 1..="],
+        ),
     ];
     for (args, needles) in cases {
         let e = fails(&dir, &words(args), 2, needles);

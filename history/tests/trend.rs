@@ -243,6 +243,20 @@ fn the_three_tests_on_a_hand_made_series() {
             .is_err()
         );
     }
+    // Numbers in the message are short.
+    let e = assess(
+        &s,
+        &Options {
+            alpha: 1e-320,
+            ..Options::default()
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.ends_with("the level alpha must be between 1e-6 and 0.2, not 9.99989e-321"),
+        "{e}"
+    );
     assert!(
         assess(
             &s,

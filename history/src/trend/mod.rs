@@ -29,7 +29,7 @@ pub use select::{LeftOut, Point, Series, SeriesHead, select};
 
 use crate::stats::{ALPHA_RANGE, normal_two_sided, student_p_value, student_two_sided};
 use crate::time::Timestamp;
-use model_spec::units::{fixed, symbol};
+use model_spec::units::{fixed, significant, symbol};
 use serde::Serialize;
 
 /// The default two-sided level of the change and trend tests.
@@ -280,15 +280,18 @@ pub fn assess(series: &Series, options: &Options) -> Result<Assessment, TrendErr
     let alpha = options.alpha;
     if !(ALPHA_RANGE.0..=ALPHA_RANGE.1).contains(&alpha) {
         return Err(TrendError::Alpha(format!(
-            "the level alpha must be between {} and {}, not {alpha}",
-            ALPHA_RANGE.0, ALPHA_RANGE.1
+            "the level alpha must be between {} and {}, not {}",
+            significant(ALPHA_RANGE.0),
+            significant(ALPHA_RANGE.1),
+            significant(alpha)
         )));
     }
     if let Some(l) = options.tolerance
         && !(l.is_finite() && l > 0.0)
     {
         return Err(TrendError::Tolerance(format!(
-            "a tolerance must be a positive number, not {l}"
+            "a tolerance must be a positive number, not {}",
+            significant(l)
         )));
     }
     let points = &series.points;

@@ -26,6 +26,7 @@ pub mod candidates;
 pub mod choose;
 pub mod predict;
 pub mod separate;
+pub mod update;
 
 use crate::fitting::campaign::design::{Design, design_matrix};
 use crate::fitting::least_squares::Tolerances;

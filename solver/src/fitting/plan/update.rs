@@ -230,8 +230,8 @@ fn decide(r: &Reduced, relative: f64, tol: &Tolerances) -> Result<Decision, Esti
         .collect();
     let rows = r.root.nrows().max(k);
     let mut a = DMatrix::zeros(rows, k);
-    for j in 0..k {
-        let col = r.root.column(j) / s[j];
+    for (j, sj) in s.iter().enumerate() {
+        let col = r.root.column(j) / *sj;
         a.view_mut((0, j), (r.root.nrows(), 1)).copy_from(&col);
     }
     let d = svd(a)?;

@@ -258,3 +258,30 @@ fn bad_input_is_refused_naming_the_flag_the_test_and_the_sample() {
     );
     assert!(entries(&dir).is_empty(), "{:?}", entries(&dir));
 }
+
+#[test]
+fn too_many_candidates_are_refused_before_the_work() {
+    // 25 ball positions, each moved along x, y and z both ways, times the 6 tests of the
+    // generator and the reversed and there-and-back K1, K2, K4: more than MAX_CANDIDATES.
+    let dir = temp_dir("bound");
+    let tests = ["K1", "K2", "K4"];
+    let paths: Vec<String> = (1..=25).map(|i| format!("{}:p{i}", tests[i % 3])).collect();
+    let balls: Vec<String> = (1..=25).map(|i| format!("p{i}:Zw={}", 211 + i)).collect();
+    let paths = paths.join(",");
+    let mut args = plan_args(&["--paths", &paths, "--json", "p.json"]);
+    for b in &balls {
+        args.extend_from_slice(&["--ball", b]);
+    }
+    fails(
+        &dir,
+        &args,
+        2,
+        &[
+            "--paths",
+            "candidate additions (182 ball positions × 12 tests)",
+            "more than the 2000",
+            "fewer ball positions (--ball",
+        ],
+    );
+    assert!(entries(&dir).is_empty(), "{:?}", entries(&dir));
+}

@@ -389,8 +389,9 @@ pub fn run(args: &PlanArgs) -> CliResult {
         NoiseModel::ar1(args.noise_phi, sigma_mm, NoiseSource::Declared)
     };
     let tol = Tolerances::default();
-    let predicted = plan.predict(&m, &model, &noise, &tol).map_err(fail)?;
+    // The candidates first: their number is bounded (`MAX_CANDIDATES`) before any prediction.
     let set = candidates::candidates(&m, &plan, args.ball_step_mm).map_err(fail)?;
+    let predicted = plan.predict(&m, &model, &noise, &tol).map_err(fail)?;
     let targets = Targets {
         um: args.target_um,
         urad: args.target_urad,

@@ -28,6 +28,13 @@ use crate::simulation::generator::{self, GeneratorError, Order, TestSpec};
 use model_spec::units::short;
 use model_spec::{Machine, SymbolId, Value};
 
+/// The most candidates (positions × tests) a plan may have evaluated. Each is generated and
+/// evaluated as an update of the plan's information (its own rows, not the plan's), so the
+/// bound caps the suggestion's time whatever the plan: a plan of one ball position has some
+/// tens of candidates; the bound is reached by some hundred ball positions, and is checked
+/// before any candidate is generated.
+pub const MAX_CANDIDATES: usize = 2000;
+
 /// A ball position a candidate is measured at.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CandidateBall {
@@ -181,7 +188,8 @@ pub fn candidate_tests(m: &Machine, plan: &Plan) -> Vec<TestSpec> {
 /// reason.
 ///
 /// # Errors
-/// A bad step ([`candidate_balls`]); a machine without tests; a failed computation of the
+/// A bad step ([`candidate_balls`]); more than [`MAX_CANDIDATES`] candidates; a machine
+/// without tests; a failed computation of the
 /// generator ([`GeneratorError::is_computation`]), naming the test and the position.
 pub fn candidates(m: &Machine, plan: &Plan, step_mm: f64) -> Result<CandidateSet, PlanError> {
     let balls = candidate_balls(m, plan, step_mm)?;
@@ -193,6 +201,14 @@ pub fn candidates(m: &Machine, plan: &Plan, step_mm: f64) -> Result<CandidateSet
             }
             .to_string(),
         ));
+    }
+    if balls.len() * tests.len() > MAX_CANDIDATES {
+        return Err(PlanError::Plan(format!(
+            "the plan has {} candidate additions ({} ball positions × {} tests), more than the {MAX_CANDIDATES} a plan may have evaluated; use fewer ball positions (--ball: each planned position brings its moved ones) or fewer kinds of tests in --paths",
+            balls.len() * tests.len(),
+            balls.len(),
+            tests.len()
+        )));
     }
     let mut set = CandidateSet {
         balls,

@@ -23,15 +23,15 @@
 //! candidate, best first.
 
 use super::candidates::CandidateSet;
-use super::predict::{Prediction, predict_design};
-use super::{Plan, PlanError, PlannedCampaign, Predicted};
-use crate::fitting::campaign::design::{Design, Layout, design_matrix};
+use super::predict::Prediction;
+use super::update::{Information, Outcome};
+use super::{Plan, PlanError, Predicted};
+use crate::fitting::campaign::design::design_matrix;
 use crate::fitting::campaign::{Campaign, CampaignRecord, Owner};
 use crate::fitting::least_squares::Tolerances;
 use crate::io::progress::{Progress, Unwatched};
 use crate::model::Model;
 use model_spec::Machine;
-use nalgebra::DMatrix;
 use std::cmp::Ordering;
 
 /// Two scores closer than this, relative to the larger, count as equal.
@@ -162,32 +162,28 @@ pub fn interest(p: &Prediction) -> Vec<usize> {
     }
 }
 
-/// The score of prediction `after` against the plan's prediction `before` on the parameters of
-/// interest `names` (see the module documentation); units and factors of `m`.
+/// The score of the plan with a candidate (`after`, its [`Outcome`] on the columns of interest
+/// `wanted` of the plan's prediction `before`) against the plan (see the module
+/// documentation); units and factors of `m`.
 pub fn score(
     m: &Machine,
     before: &Prediction,
-    after: &Prediction,
-    names: &[String],
+    after: &Outcome,
+    wanted: &[usize],
     targets: &Targets,
 ) -> Score {
     let mut newly = Vec::new();
     let mut largest: Option<Largest> = None;
     let mut sum = 0.0;
     let mut determined = 0;
-    for name in names {
-        let (Some(b), Some(a)) = (before.column(name), after.column(name)) else {
-            continue;
-        };
-        if !after.determined[a] {
-            continue;
-        }
+    for (&j, std) in wanted.iter().zip(&after.std) {
+        let Some(std) = *std else { continue };
+        let name = &before.names[j];
         determined += 1;
-        if !before.determined[b] {
+        if !before.determined[j] {
             newly.push(name.clone());
         }
-        let Some(std) = after.std[a] else { continue };
-        let term = &after.layout.columns[a].term;
+        let term = &before.layout.columns[j].term;
         let unit = term.unit(m);
         let shown = std * term.display_factor(m);
         let relative = shown / targets.of(unit);
@@ -204,10 +200,22 @@ pub fn score(
     Score {
         newly_determined: newly,
         rank: after.rank,
-        columns: after.names.len(),
+        columns: after.columns,
         determined,
         largest,
         sum_squares: sum,
+    }
+}
+
+/// The plan's own outcome: its rank, columns and the uncertainties of the columns `wanted`.
+fn own(p: &Prediction, wanted: &[usize]) -> Outcome {
+    Outcome {
+        rank: p.rank,
+        columns: p.names.len(),
+        std: wanted
+            .iter()
+            .map(|&j| if p.determined[j] { p.std[j] } else { None })
+            .collect(),
     }
 }
 
@@ -232,58 +240,6 @@ pub fn compare(a: &Score, b: &Score) -> Ordering {
             (x, y) => close_cmp(x, y),
         })
         .then_with(|| close_cmp(a.sum_squares, b.sum_squares))
-}
-
-/// The design matrix of the plan with `candidate` (record `k` of `batch`, whose design is
-/// `batch_design`) added as one more record: the campaign's layout of plan + candidate
-/// ([`Layout::new`]), each record's block as [`design_matrix`] computed it (`plan_design` for
-/// the plan's records), placed in the columns of its owners.
-fn with_candidate(
-    m: &Machine,
-    model: &Model,
-    planned: &PlannedCampaign,
-    plan_design: &Design,
-    candidate: CampaignRecord,
-    batch_design: &Design,
-    k: usize,
-) -> Result<Design, PlanError> {
-    let mut records = planned.campaign.records.clone();
-    records.push(candidate);
-    let campaign = Campaign::new(records)
-        .map_err(|e| PlanError::Plan(format!("the plan with a candidate: {e}")))?;
-    let layout = Layout::new(m, model, &campaign)?;
-    let rows: Vec<usize> = layout.rows();
-    let total: usize = 3 * rows.iter().sum::<usize>();
-    let mut h = DMatrix::zeros(total, layout.columns.len());
-    let mut at = 0;
-    let mut place = |source: &Design, from_record: usize, from_row: usize, to: usize| {
-        let n = 3 * source.layout.records[from_record].samples;
-        let cols = &source.layout.records[from_record].columns;
-        for (c, &src) in cols.iter().enumerate() {
-            let dst = layout.records[to].columns[c];
-            h.view_mut((at, dst), (n, 1))
-                .copy_from(&source.h.view((from_row, src), (n, 1)));
-        }
-        at += n;
-    };
-    let mut from_row = 0;
-    for r in 0..planned.campaign.records.len() {
-        place(plan_design, r, from_row, r);
-        from_row += 3 * plan_design.layout.records[r].samples;
-    }
-    let batch_row: usize = 3 * batch_design.layout.records[..k]
-        .iter()
-        .map(|r| r.samples)
-        .sum::<usize>();
-    place(batch_design, k, batch_row, planned.campaign.records.len());
-    Ok(Design {
-        h,
-        names: layout.names(),
-        owners: layout.owners(),
-        rows,
-        backend: plan_design.backend,
-        layout,
-    })
 }
 
 /// Every candidate of `set` added on its own to `plan` as `predicted` (its campaign, design
@@ -327,20 +283,29 @@ pub fn suggest_with_progress(
     let total = set.candidates.len() as u64;
     progress.update("candidates", 0, total);
     let before = &predicted.prediction;
-    let planned = &predicted.planned;
-    let plan_design = &predicted.design;
-    let noise = &before.noise;
+    let layout = &predicted.design.layout;
     let wanted = interest(before);
     let names: Vec<String> = wanted.iter().map(|&j| before.names[j].clone()).collect();
-    let baseline = score(m, before, before, &names, targets);
-    let zeroed = plan.zeroed;
-    let setup = |ball: usize, label: &str| -> String {
-        if plan.shared_setup {
-            set.balls[ball].name.clone()
-        } else {
-            label.to_string()
-        }
+    let baseline = score(m, before, &own(before, &wanted), &wanted, targets);
+    // With a shared set-up, a candidate at a planned ball position is measured on that
+    // position's set-up: it joins the plan's group of that set-up.
+    let joins = |ball: usize| -> Option<usize> {
+        let planned = set.balls[ball].planned?;
+        let name = &plan.balls[planned].name;
+        plan.shared_setup
+            .then(|| layout.setups.iter().position(|s| s == name))
+            .flatten()
     };
+    let joinable: Vec<bool> = (0..layout.setups.len())
+        .map(|s| (0..set.balls.len()).any(|b| joins(b) == Some(s)))
+        .collect();
+    let information = Information::new(
+        &predicted.design,
+        wanted.clone(),
+        &joinable,
+        &before.noise,
+        tol,
+    )?;
     let mut ranking = Vec::with_capacity(set.candidates.len());
     for b in 0..set.balls.len() {
         let at: Vec<usize> = (0..set.candidates.len())
@@ -349,38 +314,35 @@ pub fn suggest_with_progress(
         if at.is_empty() {
             continue;
         }
-        let record = |c: usize, label: String| {
-            let s = setup(b, &label);
-            CampaignRecord::new(
-                label,
-                set.candidates[c].record.clone(),
-                set.balls[b].params.clone(),
-                s,
-                zeroed,
-            )
+        let setup = |label: String| {
+            if plan.shared_setup {
+                set.balls[b].name.clone()
+            } else {
+                label
+            }
         };
         let batch = Campaign::new(
             at.iter()
                 .enumerate()
-                .map(|(k, &c)| record(c, format!("{CANDIDATE_LABEL}.{k}")))
+                .map(|(k, &c)| {
+                    let label = format!("{CANDIDATE_LABEL}.{k}");
+                    CampaignRecord::new(
+                        label.clone(),
+                        set.candidates[c].record.clone(),
+                        set.balls[b].params.clone(),
+                        setup(label),
+                        plan.zeroed,
+                    )
+                })
                 .collect(),
         )
         .map_err(|e| PlanError::Plan(format!("the candidates: {e}")))?;
         let batch_design = design_matrix(m, model, &batch)?;
         for (k, &c) in at.iter().enumerate() {
-            let design = with_candidate(
-                m,
-                model,
-                planned,
-                plan_design,
-                record(c, CANDIDATE_LABEL.to_string()),
-                &batch_design,
-                k,
-            )?;
-            let after = predict_design(&design, noise, tol)?;
+            let after = information.outcome(&batch_design, k, joins(b))?;
             ranking.push(Ranked {
                 candidate: c,
-                score: score(m, before, &after, &names, targets),
+                score: score(m, before, &after, &wanted, targets),
             });
             progress.update("candidates", ranking.len() as u64, total);
         }

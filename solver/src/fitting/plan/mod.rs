@@ -26,11 +26,14 @@ pub mod candidates;
 pub mod choose;
 pub mod predict;
 pub mod separate;
+pub mod update;
 
 use crate::fitting::campaign::design::{Design, design_matrix};
 use crate::fitting::least_squares::Tolerances;
 use crate::fitting::noise::NoiseModel;
-pub use candidates::{Candidate, CandidateBall, CandidateSet, Skipped, ball_symbols};
+pub use candidates::{
+    Candidate, CandidateBall, CandidateSet, MAX_CANDIDATES, Skipped, ball_symbols,
+};
 pub use choose::{Largest, Ranked, Score, Suggestion, Targets, suggest, suggest_with_progress};
 pub use predict::{Prediction, predict, predict_design};
 

@@ -299,7 +299,8 @@ pub fn items<'a>(flag: &str, list: &'a str, example: &str) -> CliResult<Vec<&'a 
             let item = item.trim();
             if item.is_empty() {
                 Err(CliError::usage(format!(
-                    "{flag}: empty item in `{list}` ({example})"
+                    "{flag}: empty item in `{}` ({example})",
+                    model_spec::text::quoted_start(list)
                 )))
             } else {
                 Ok(item)

@@ -186,7 +186,8 @@ fn ball(m: &Machine, text: &str, base: &[f64]) -> CliResult<BallPosition> {
     let example = "expected NAME:SYMBOL=VALUE,..., e.g. high:Zw=260";
     let Some((name, list)) = text.split_once(':') else {
         return Err(CliError::usage(format!(
-            "--ball: `{text}` has no `:` ({example})"
+            "--ball: `{}` has no `:` ({example})",
+            quoted_start(text)
         )));
     };
     let name = name.trim();
@@ -199,46 +200,7 @@ fn ball(m: &Machine, text: &str, base: &[f64]) -> CliResult<BallPosition> {
     }
     let flag = format!("--ball {name}");
     let mut params = base.to_vec();
-    let mut seen: Vec<&str> = Vec::new();
-    for item in items(&flag, list, example)? {
-        let Some((sym, v)) = item.split_once('=') else {
-            return Err(CliError::usage(format!(
-                "{flag}: `{item}` is not SYMBOL=VALUE"
-            )));
-        };
-        let (sym, v) = (sym.trim(), v.trim());
-        let Some(s) = m.symbol_by_name(sym) else {
-            let names: Vec<&str> = m.symbols.iter().map(|s| s.name.as_str()).collect();
-            return Err(CliError::usage(format!(
-                "{flag}: machine {} has no kinematic symbol `{sym}` (symbols: {})",
-                m.name,
-                if names.is_empty() {
-                    "none".to_string()
-                } else {
-                    names.join(", ")
-                }
-            )));
-        };
-        if seen.contains(&sym) {
-            return Err(CliError::usage(format!("{flag}: `{sym}` is given twice")));
-        }
-        seen.push(sym);
-        let x: f64 = v
-            .parse()
-            .ok()
-            .filter(|x: &f64| x.is_finite())
-            .ok_or_else(|| {
-                CliError::usage(format!("{flag}: `{item}`: `{v}` is not a finite number"))
-            })?;
-        if x.abs() > model_spec::limits::MAX_LENGTH_MM {
-            return Err(CliError::usage(format!(
-                "{flag}: `{sym}` = {} mm is beyond the largest length a machine may have, {} mm",
-                compact(x),
-                model_spec::limits::MAX_LENGTH_MM
-            )));
-        }
-        params[s] = x;
-    }
+    pose_args::override_params(m, &flag, list, &mut params)?;
     Ok(BallPosition {
         name: name.to_string(),
         params,
@@ -257,7 +219,7 @@ fn plan_of(m: &Machine, args: &PlanArgs) -> CliResult<Plan> {
         if balls.iter().any(|o| o.name == b.name) {
             return Err(CliError::usage(format!(
                 "--ball: `{}` is given twice",
-                b.name
+                quoted_start(&b.name)
             )));
         }
         balls.push(b);
@@ -434,3 +396,7 @@ pub fn run(args: &PlanArgs) -> CliResult {
     text.push_str(&wrote(&write(files)?));
     print_text(&text, stdout_taken)
 }
+
+#[cfg(test)]
+#[path = "plan_fuzz.rs"]
+mod fuzz;

@@ -4,6 +4,7 @@
 
 use super::args::items;
 use super::{CliError, CliResult};
+use model_spec::text::quoted_start;
 use model_spec::units::compact;
 use model_spec::{AxisId, Machine};
 
@@ -18,23 +19,35 @@ fn assignments(
     for item in items(flag, text, "expected NAME=VALUE,NAME=VALUE,...")? {
         let Some((name, value)) = item.split_once('=') else {
             return Err(CliError::usage(format!(
-                "{flag}: `{item}` is not NAME=VALUE"
+                "{flag}: `{}` is not NAME=VALUE",
+                quoted_start(item)
             )));
         };
         let (name, value) = (name.trim(), value.trim());
         if name.is_empty() {
-            return Err(CliError::usage(format!("{flag}: `{item}` has no name")));
+            return Err(CliError::usage(format!(
+                "{flag}: `{}` has no name",
+                quoted_start(item)
+            )));
         }
-        let x: f64 = value
-            .parse()
-            .map_err(|_| CliError::usage(format!("{flag}: `{item}`: `{value}` is not a number")))?;
+        let x: f64 = value.parse().map_err(|_| {
+            CliError::usage(format!(
+                "{flag}: `{}`: `{}` is not a number",
+                quoted_start(name),
+                quoted_start(value)
+            ))
+        })?;
         if !x.is_finite() {
             return Err(CliError::usage(format!(
-                "{flag}: `{item}`: the value must be a finite number"
+                "{flag}: `{}`: the value must be a finite number",
+                quoted_start(item)
             )));
         }
         if out.iter().any(|(n, _)| same(n, name)) {
-            return Err(CliError::usage(format!("{flag}: `{name}` is given twice")));
+            return Err(CliError::usage(format!(
+                "{flag}: `{}` is given twice",
+                quoted_start(name)
+            )));
         }
         out.push((name.to_string(), x));
     }
@@ -45,15 +58,22 @@ fn assignments(
 /// names).
 pub fn params(m: &Machine, text: Option<&str>) -> CliResult<Vec<f64>> {
     let mut params = m.default_parameters();
-    let Some(text) = text else {
-        return Ok(params);
-    };
-    for (name, x) in assignments("--param", text, |a, b| a == b)? {
+    if let Some(text) = text {
+        override_params(m, "--param", text, &mut params)?;
+    }
+    Ok(params)
+}
+
+/// Overrides `params` (mm, symbol order) with the `SYMBOL=VALUE,...` list `text` of `flag`
+/// (exact symbol names, each at most the largest length a machine may have).
+pub fn override_params(m: &Machine, flag: &str, text: &str, params: &mut [f64]) -> CliResult {
+    for (name, x) in assignments(flag, text, |a, b| a == b)? {
         let Some(s) = m.symbol_by_name(&name) else {
             let names: Vec<&str> = m.symbols.iter().map(|s| s.name.as_str()).collect();
             return Err(CliError::usage(format!(
-                "--param: machine {} has no kinematic symbol `{name}` (symbols: {})",
+                "{flag}: machine {} has no kinematic symbol `{}` (symbols: {})",
                 m.name,
+                quoted_start(&name),
                 if names.is_empty() {
                     "none".to_string()
                 } else {
@@ -63,14 +83,14 @@ pub fn params(m: &Machine, text: Option<&str>) -> CliResult<Vec<f64>> {
         };
         if x.abs() > model_spec::limits::MAX_LENGTH_MM {
             return Err(CliError::usage(format!(
-                "--param: `{name}` = {} mm is beyond the largest length a machine may have, {} mm",
+                "{flag}: `{name}` = {} mm is beyond the largest length a machine may have, {} mm",
                 compact(x),
                 model_spec::limits::MAX_LENGTH_MM
             )));
         }
         params[s] = x;
     }
-    Ok(params)
+    Ok(())
 }
 
 /// The axis positions of `--at` (axis names case-insensitive; linear mm, rotary degrees).
@@ -84,8 +104,9 @@ pub fn at(m: &Machine, text: &str) -> CliResult<Vec<(AxisId, f64)>> {
         else {
             let names: Vec<&str> = m.axes.iter().map(|a| a.name.as_str()).collect();
             return Err(CliError::usage(format!(
-                "--at: machine {} has no axis `{name}` (axes: {})",
+                "--at: machine {} has no axis `{}` (axes: {})",
                 m.name,
+                quoted_start(&name),
                 names.join(", ")
             )));
         };

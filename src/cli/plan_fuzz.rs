@@ -90,7 +90,7 @@ fn check(
                 .balls
                 .iter()
                 .flat_map(|b| &b.params)
-                .any(|x| !(x.abs() <= limit))
+                .any(|x| x.is_nan() || x.abs() > limit)
             {
                 return Err(TestCaseError::fail(
                     "parameters beyond the largest length".to_string(),

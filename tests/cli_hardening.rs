@@ -275,6 +275,13 @@ fn an_output_directory_holding_an_input_is_refused_before_any_work() {
     std::fs::copy(dir.join("k1.csv"), dir.join("p/k4-path.svg")).unwrap();
     std::fs::create_dir(dir.join("q")).unwrap();
     std::fs::hard_link(dir.join("k1.csv"), dir.join("q/k1-spectrum.svg")).unwrap();
+    // A machine description where --crate would write its copy, or linked to its README.
+    let seed = model_spec::write::source_text("seed-ac").unwrap();
+    std::fs::write(dir.join("m.toml"), &seed).unwrap();
+    std::fs::create_dir_all(dir.join("c/src")).unwrap();
+    std::fs::write(dir.join("c/src/lib.rs"), &seed).unwrap();
+    std::fs::create_dir(dir.join("r")).unwrap();
+    std::fs::hard_link(dir.join("m.toml"), dir.join("r/README.md")).unwrap();
     let before = snapshot(&dir);
     let cases: &[(&[&str], &str)] = &[
         (
@@ -294,6 +301,14 @@ fn an_output_directory_holding_an_input_is_refused_before_any_work() {
                 "diagnose --machine seed-ac --model reduced --data k4.csv --validate k1.csv --plot q",
             ),
             "--plot: `q/k1-spectrum.svg` is also the input of --validate",
+        ),
+        (
+            &words("generate --machine c/src/lib.rs --model reduced --crate c"),
+            "--crate: `c/src/lib.rs` is also the input of --machine",
+        ),
+        (
+            &words("generate --machine m.toml --model reduced --crate r"),
+            "--crate: `r/README.md` is also the input of --machine",
         ),
     ];
     for (args, message) in cases {

@@ -63,6 +63,14 @@ pub fn run(args: &GenerateArgs) -> CliResult {
     let models: Vec<&str> = args.model.iter().map(String::as_str).collect();
     match &args.crate_dir {
         Some(dir) => {
+            // An input among the files the crate would hold is named as such (a usage error)
+            // before the directory is refused as not empty.
+            let files: Vec<Target> = crate_files::NAMES
+                .iter()
+                .map(|name| Target::Path(dir.join(name)))
+                .collect();
+            let named: Vec<(&str, &Target)> = files.iter().map(|t| ("--crate", t)).collect();
+            output::refuse_overwriting_inputs(&inputs, &named).map_err(super::write_error)?;
             refuse_non_empty(dir)?;
             check_outputs(&inputs, &[], &[("--crate", dir)])?;
             let code = generate(&m, &models)?;

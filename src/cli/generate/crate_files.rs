@@ -20,6 +20,9 @@ pub fn package_name(machine: &str) -> String {
     format!("{prefix}{machine}-error-model")
 }
 
+/// The files of a crate, relative to its directory, in the order [`files`] gives them.
+pub const NAMES: [&str; 4] = ["Cargo.toml", "src/lib.rs", "README.md", "machine.toml"];
+
 /// The crate's files, as (path relative to the crate's directory, contents): the models
 /// `models` of `m` (every model when empty), `code` their generated code, `text` the
 /// description read.
@@ -29,11 +32,12 @@ pub fn files(m: &Machine, text: &str, models: &[&str], code: &str) -> Vec<(&'sta
     } else {
         models.to_vec()
     };
+    let [cargo, lib, readme_md, machine] = NAMES;
     vec![
-        ("Cargo.toml", cargo_toml(m)),
-        ("src/lib.rs", format!("{}\n{code}", lib_docs(m, &models))),
-        ("README.md", readme(m, &models)),
-        ("machine.toml", text.to_string()),
+        (cargo, cargo_toml(m)),
+        (lib, format!("{}\n{code}", lib_docs(m, &models))),
+        (readme_md, readme(m, &models)),
+        (machine, text.to_string()),
     ]
 }
 

@@ -441,9 +441,11 @@ fn read_named(named: &[Named], files: &mut Vec<InputFile>) -> Records {
             });
         }
         if n.field.starts_with("records[") && !n.role.starts_with("diagnosis") {
+            let at = n.at.display();
             records.insert(
                 (n.json.clone(), n.name.clone()),
-                read.map(|(bytes, _)| bytes),
+                read.map(|(bytes, _)| bytes)
+                    .map_err(|why| format!("{at}: {why}")),
             );
         }
     }

@@ -219,6 +219,23 @@ fn names_are_read_beside_the_report_or_in_the_data_directory() {
     assert_eq!(files[1].0, "./k4.csv", "{files:?}");
     assert_eq!(files[1].2, sha, "{files:?}");
     assert!(html.contains("<figure id=\"fig-k4-path\">"));
+    // A --data-dir that is no directory is refused, naming the flag.
+    let before = entries(&dir);
+    let args = [
+        "report",
+        "sub/id.json",
+        "--data-dir",
+        "k4.csv",
+        "-o",
+        "x.html",
+    ];
+    check_fails(
+        &run(Some(&dir), &args),
+        &args,
+        2,
+        &["--data-dir: `k4.csv` is not a directory"],
+    );
+    assert_eq!(entries(&dir), before);
     // A name inside the report's directory through `..` is accepted.
     naming(&dir, "sub/../k4.csv", &dir.join("inside.json"));
     ok(&dir, &["report", "inside.json", "-o", "inside.html"]);

@@ -108,6 +108,14 @@ pub fn run(args: &ReportArgs) -> CliResult {
     let machine_file = args.machine.as_deref().and_then(super::machine_file);
     inputs_list.extend(machine_file.map(|p| ("--machine", p)));
     check_outputs(&inputs_list, &[("-o", &args.output)], &[])?;
+    if let Some(dir) = &args.data_dir
+        && !dir.is_dir()
+    {
+        return Err(CliError::usage(format!(
+            "--data-dir: `{}` is not a directory",
+            dir.display()
+        )));
+    }
     let mut inputs = Inputs::new();
     let mut machine_read = None;
     let machine = match &args.machine {

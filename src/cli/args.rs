@@ -79,6 +79,9 @@ impl NoiseArgs {
     }
 }
 
+/// An instrument as loaded, with the frame of its displacements.
+pub type Loaded = (Instrument, ReadingsFrame);
+
 /// The instrument whose sensor readings the records hold. For the verbs that read or write
 /// records.
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -115,9 +118,7 @@ impl InstrumentArgs {
 
     /// [`InstrumentArgs::load`], with the file as read when `--instrument` names one (read
     /// once).
-    pub fn load_read(
-        &self,
-    ) -> CliResult<(Option<(Instrument, ReadingsFrame)>, Option<super::ReadFile>)> {
+    pub fn load_read(&self) -> CliResult<(Option<Loaded>, Option<super::ReadFile>)> {
         let Some(name) = &self.instrument else {
             return Ok((None, None));
         };

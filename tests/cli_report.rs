@@ -276,7 +276,8 @@ fn the_whole_check_from_json_files_and_from_the_verbs() {
     assert!(html.contains("<figure id=\"fig-k4-path\">"));
     assert!(html.contains("<figure id=\"fig-k1-path\">"));
     assert!(html.contains("k1.csv (validation): measured and predicted error"));
-    // Without the records (another working directory), the report says what is not drawn.
+    // Without the records (beside the reports), the report says what is not drawn and where
+    // each record was looked for.
     let away = dir.join("away");
     std::fs::create_dir(&away).unwrap();
     for f in ["id.json", "v1.json"] {
@@ -289,10 +290,11 @@ fn the_whole_check_from_json_files_and_from_the_verbs() {
         1,
         "the validation figure only"
     );
-    assert!(html_away.contains("k4.csv is not drawn: it could not be read here"));
-    assert!(html_away.contains("k1.csv is not drawn: it could not be read here"));
+    assert!(html_away.contains("k4.csv is not drawn: k4.csv: cannot be read here"));
+    assert!(html_away.contains("k1.csv is not drawn: k1.csv: cannot be read here"));
+    assert!(html_away.contains("not hashed: cannot be read here"));
     assert!(!html.contains(" in this report ("), "every part is given");
-    // The records the reports name are hashed when readable from here.
+    // The records the reports name are hashed, found beside the reports.
     for f in ["k4.csv", "k1.csv", "poses.csv", "id.json"] {
         assert!(
             html.contains(&format!("<td>{f}</td><td class=\"num\">")),

@@ -1,7 +1,8 @@
 //! The built-in machines (`model-spec/machines/*.toml`), compiled into the library.
 
 use crate::limits::MAX_FILE_BYTES;
-use crate::text::{TextError, read_text};
+use crate::sha256::Digest;
+use crate::text::{TextError, read_text_hashed};
 use crate::{Machine, SpecError, parse_machine};
 use std::path::Path;
 
@@ -69,22 +70,52 @@ pub fn load_machine(name_or_path: &str) -> Result<Machine, LoadError> {
 /// A machine given by built-in name or by the path of a TOML file, with the text it was read
 /// from (a file is read once: a FIFO or a file changed meanwhile cannot give two texts).
 pub fn load_machine_and_text(name_or_path: &str) -> Result<(Machine, String), LoadError> {
+    load_machine_read(name_or_path).map(|l| (l.machine, l.text))
+}
+
+/// A machine as it was loaded: what [`load_machine_read`] gives.
+#[derive(Clone, Debug)]
+pub struct LoadedMachine {
+    /// The machine.
+    pub machine: Machine,
+    /// The text it was parsed from.
+    pub text: String,
+    /// The digest of the file's bytes as read; `None` for a built-in machine.
+    pub digest: Option<Digest>,
+}
+
+/// A machine given by built-in name or by the path of a TOML file, with the text it was read
+/// from and, for a file, the digest of the bytes read (the file is opened once).
+pub fn load_machine_read(name_or_path: &str) -> Result<LoadedMachine, LoadError> {
     if let Some((n, text)) = BUILTIN.iter().find(|(n, _)| *n == name_or_path) {
         let m = parse_machine(&format!("<built-in {n}>"), text).map_err(LoadError::Spec)?;
-        return Ok((m, text.to_string()));
+        return Ok(LoadedMachine {
+            machine: m,
+            text: text.to_string(),
+            digest: None,
+        });
     }
-    let text = file_text(name_or_path)?;
+    let (text, digest) = file_text_hashed(name_or_path)?;
     let m = parse_machine(name_or_path, &text).map_err(LoadError::Spec)?;
-    Ok((m, text))
+    Ok(LoadedMachine {
+        machine: m,
+        text,
+        digest: Some(digest),
+    })
 }
 
 /// The text of the machine description file `path`: at most [`MAX_FILE_BYTES`] bytes of UTF-8.
 pub(crate) fn file_text(path: &str) -> Result<String, LoadError> {
+    file_text_hashed(path).map(|(text, _)| text)
+}
+
+/// [`file_text`], with the digest of the bytes read.
+fn file_text_hashed(path: &str) -> Result<(String, Digest), LoadError> {
     if !Path::new(path).exists() {
         return Err(LoadError::NotFound(path.to_string()));
     }
     // Named as given: the display of a path given as UTF-8 text is that text.
-    read_text(Path::new(path), MAX_FILE_BYTES).map_err(LoadError::Io)
+    read_text_hashed(Path::new(path), MAX_FILE_BYTES).map_err(LoadError::Io)
 }
 
 /// Why a machine could not be loaded.

@@ -74,6 +74,7 @@ pub mod locate;
 pub mod machine;
 pub mod pose;
 mod raw;
+pub mod sha256;
 pub mod surd;
 pub mod terms;
 pub mod text;
@@ -81,7 +82,10 @@ pub mod units;
 mod validate;
 pub mod write;
 
-pub use builtin::{BUILTIN, LoadError, all_builtin, builtin, load_machine, load_machine_and_text};
+pub use builtin::{
+    BUILTIN, LoadError, LoadedMachine, all_builtin, builtin, load_machine, load_machine_and_text,
+    load_machine_read,
+};
 pub use catalogue::{ErrorId, ErrorKind, ErrorTerm, Motion, canonical_name};
 pub use catalogue::{build_catalogue, default_squareness_order};
 pub use error::SpecError;

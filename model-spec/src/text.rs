@@ -2,7 +2,9 @@
 //! way lines are wrapped ([`wrap`]).
 //!
 //! [`read_text`] reads at most one byte more than its limit, so that a huge file, a device
-//! that never ends or a pipe fed without end is refused quickly and with bounded memory.
+//! that never ends or a pipe fed without end is refused quickly and with bounded memory;
+//! [`read_text_hashed`] gives the [`Digest`] of the bytes it read too, so that a verb names the
+//! file it read without opening it again.
 //! [`decode_text`] drops a UTF-8 byte-order mark (some editors write one) and refuses bytes
 //! that are not UTF-8 with the line and column of the first one, counted like every other
 //! location ([`crate::locate`]).
@@ -16,6 +18,7 @@
 //! ```
 
 use crate::locate::line_col;
+use crate::sha256::Digest;
 use std::io::Read;
 use std::path::Path;
 
@@ -73,24 +76,53 @@ fn bytes(n: u64) -> String {
 /// pipe): a longer one gives [`TextError::TooLarge`] without being read to its end. Messages
 /// name the file as `path.display()` writes it.
 pub fn read_text(path: &Path, max_bytes: u64) -> Result<String, TextError> {
+    read_text_hashed(path, max_bytes).map(|(text, _)| text)
+}
+
+/// [`read_text`], with the [`Digest`] of the bytes read (byte-order mark included): what
+/// identifies the file the text came from, hashed as it was read (the file is opened once).
+pub fn read_text_hashed(path: &Path, max_bytes: u64) -> Result<(String, Digest), TextError> {
+    let (bytes, digest) = read_bytes_hashed(path, max_bytes)?;
+    Ok((decode_text(&path.display().to_string(), bytes)?, digest))
+}
+
+/// The bytes of the file at `path`, at most `max_bytes` of them, with their [`Digest`]: opened
+/// once, read at most `max_bytes + 1` bytes whatever the file is (a longer one gives
+/// [`TextError::TooLarge`] without being read to its end). For a reader that decodes the
+/// bytes itself.
+pub fn read_bytes_hashed(path: &Path, max_bytes: u64) -> Result<(Vec<u8>, Digest), TextError> {
     let file = path.display().to_string();
     let io = |error| TextError::Io {
         file: file.clone(),
         error,
     };
     let handle = std::fs::File::open(path).map_err(io)?;
+    read_bytes_from(&file, handle, max_bytes)
+}
+
+/// At most `max_bytes` bytes of `source` (named `file` in messages) with their [`Digest`]:
+/// reads at most `max_bytes + 1` bytes, and a source with more gives [`TextError::TooLarge`].
+pub fn read_bytes_from(
+    file: &str,
+    source: impl Read,
+    max_bytes: u64,
+) -> Result<(Vec<u8>, Digest), TextError> {
     let mut bytes = Vec::new();
-    handle
+    source
         .take(max_bytes.saturating_add(1))
         .read_to_end(&mut bytes)
-        .map_err(io)?;
+        .map_err(|error| TextError::Io {
+            file: file.to_string(),
+            error,
+        })?;
     if bytes.len() as u64 > max_bytes {
         return Err(TextError::TooLarge {
-            file,
+            file: file.to_string(),
             limit: max_bytes,
         });
     }
-    decode_text(&file, bytes)
+    let digest = Digest::of(&bytes);
+    Ok((bytes, digest))
 }
 
 /// `bytes` as text: without a leading UTF-8 byte-order mark, or [`TextError::NotUtf8`] at the

@@ -2,6 +2,7 @@
 //! figures the verb that asks for the report has drawn, the input files with their SHA-256, and
 //! the checks that the reports belong together (one machine, one model, the same data).
 
+use model_spec::sha256::Digest;
 use serde_json::Value;
 use solver::io::report::compensate::CompensationReport;
 use solver::io::report::{DiagnosisReport, IdentificationReport, ValidationReport};
@@ -92,15 +93,18 @@ pub enum InputError {
     },
 }
 
-/// Reads the report in `path` and recognises its kind from its fields.
+/// Reads the report in `path` (opened once) and recognises its kind from its fields: the
+/// report, its text and the digest of the bytes read.
 ///
 /// # Errors
 /// [`InputError`]: unreadable, larger than 64 MiB, not UTF-8, not JSON, not a report of rtest,
 /// a field missing or malformed.
-pub fn read_document(path: &Path) -> Result<Document, InputError> {
+pub fn read_document(path: &Path) -> Result<(Document, String, Digest), InputError> {
     let file = path.display().to_string();
-    let text = model_spec::text::read_text(path, solver::io::report::read::MAX_REPORT_BYTES)?;
-    classify(&file, &text)
+    let (text, digest) =
+        model_spec::text::read_text_hashed(path, solver::io::report::read::MAX_REPORT_BYTES)?;
+    let doc = classify(&file, &text)?;
+    Ok((doc, text, digest))
 }
 
 /// The report in `text` (read from `file`), recognised by its fields: `findings` and
@@ -188,36 +192,52 @@ pub struct Figure {
     pub caption: String,
 }
 
-/// An input file of the check: its role, its path and, when it could be read, its SHA-256.
+/// An input file of the check: its role, its path and, when it was read, the size and SHA-256
+/// of the bytes read.
 #[derive(Clone, Debug, PartialEq)]
 pub struct InputFile {
     /// What it was (`--data`, `identification report`).
     pub role: String,
     /// The path as given.
     pub path: String,
-    /// SHA-256 (hex) and size in bytes of the file as read when the report was written;
-    /// `None` when it could not be read from there.
-    pub digest: Option<(String, u64)>,
+    /// Size and SHA-256 of the bytes read (by the verb, or by `rtest report` when it wrote
+    /// the report), or why the file was not hashed (one line: `not a regular file`).
+    pub digest: Result<Digest, String>,
     /// When the file was last modified, RFC 3339 UTC, as its file system says (the only date
     /// a record carries: its samples hold seconds from its start); `None` when unknown.
     pub modified: Option<String>,
 }
 
 impl InputFile {
-    /// `path` with its SHA-256, read now (`None` when it cannot be read: a path relative to
-    /// another working directory, a file since removed).
-    pub fn hashed(role: &str, path: &str) -> InputFile {
+    /// The file `path` (as shown), found at `at`, read as `digest` says: its modification
+    /// time is asked of the file system (`metadata`, which opens nothing).
+    pub fn read(role: &str, path: &str, at: &Path, digest: Digest) -> InputFile {
         InputFile {
             role: role.to_string(),
             path: path.to_string(),
-            digest: history::sha256::sha256_file(Path::new(path)).ok(),
-            modified: std::fs::metadata(path)
-                .and_then(|m| m.modified())
-                .ok()
-                .and_then(|t| history::Timestamp::of(t).ok())
-                .map(|t| t.to_string()),
+            digest: Ok(digest),
+            modified: modified(at),
         }
     }
+
+    /// The file `path` (as shown), not hashed, and `why` (one line).
+    pub fn not_hashed(role: &str, path: &str, at: Option<&Path>, why: &str) -> InputFile {
+        InputFile {
+            role: role.to_string(),
+            path: path.to_string(),
+            digest: Err(why.to_string()),
+            modified: at.and_then(modified),
+        }
+    }
+}
+
+/// When the file at `at` was last modified (RFC 3339 UTC), as its file system says.
+fn modified(at: &Path) -> Option<String> {
+    std::fs::metadata(at)
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| history::Timestamp::of(t).ok())
+        .map(|t| t.to_string())
 }
 
 /// The machine as its description gives it, when the verb has it (the reports name it only).

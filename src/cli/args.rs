@@ -10,7 +10,7 @@ use solver::fitting::noise::{NoiseChoice, NoiseModel};
 use solver::fitting::{Constraint, ValueLimits};
 use solver::io::csv::ReadOptions;
 use solver::model::{Effect, Model, Term};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The noise model of the tests and uncertainties: declared, from a static record, or
 /// estimated (the default). For `identify` and `diagnose`.
@@ -44,24 +44,25 @@ impl NoiseArgs {
     }
 
     /// The noise choice: `--noise`, or the model of the static record `--noise-record` (read
-    /// through the records' `instrument`, when they have one). A declared model is refused for
-    /// records read through an instrument, whose sensors' σ declare the noise already.
+    /// through the records' `instrument`, when they have one), with the static record as read.
+    /// A declared model is refused for records read through an instrument, whose sensors' σ
+    /// declare the noise already.
     pub fn choice(
         &self,
         m: &Machine,
         read: &ReadOptions,
-        instrument: &InstrumentArgs,
-    ) -> CliResult<NoiseChoice> {
+        instrument: super::campaign::Through,
+    ) -> CliResult<(NoiseChoice, Option<super::ReadFile>)> {
         let Some(path) = &self.noise_record else {
             let declared = self.declared()?;
-            if instrument.instrument.is_some() && matches!(declared, NoiseChoice::Model(_)) {
+            if instrument.is_some() && matches!(declared, NoiseChoice::Model(_)) {
                 return Err(CliError::usage(
                     "--noise: the records are read through --instrument, whose sensors' σ give each reading's covariance: a declared noise model would declare the noise a second time; leave --noise out (estimated over time from the rows whitened by the covariances) or give --noise white (the covariances' shape, the residual's scale)",
                 ));
             }
-            return Ok(declared);
+            return Ok((declared, None));
         };
-        let still = super::read_record(
+        let (still, digest) = super::read_record(
             "--noise-record",
             m,
             path,
@@ -71,9 +72,15 @@ impl NoiseArgs {
         )?;
         let model = NoiseModel::from_static_record(&still)
             .map_err(|e| CliError::input(format!("--noise-record: {}: {e}", path.display())))?;
-        Ok(NoiseChoice::Model(model))
+        Ok((
+            NoiseChoice::Model(model),
+            Some(super::ReadFile::new("--noise-record", path, digest)),
+        ))
     }
 }
+
+/// An instrument as loaded, with the frame of its displacements.
+pub type Loaded = (Instrument, ReadingsFrame);
 
 /// The instrument whose sensor readings the records hold. For the verbs that read or write
 /// records.
@@ -106,17 +113,28 @@ impl InstrumentArgs {
 
     /// The instrument and the frame of its displacements, when `--instrument` is given.
     pub fn load(&self) -> CliResult<Option<(Instrument, ReadingsFrame)>> {
+        self.load_read().map(|(i, _)| i)
+    }
+
+    /// [`InstrumentArgs::load`], with the file as read when `--instrument` names one (read
+    /// once).
+    pub fn load_read(&self) -> CliResult<(Option<Loaded>, Option<super::ReadFile>)> {
         let Some(name) = &self.instrument else {
-            return Ok(None);
+            return Ok((None, None));
         };
-        let i = instrument(name, "--instrument")?;
+        let (i, digest) =
+            model_spec::instrument::load_instrument_hashed(name).map_err(|e| match e {
+                InstrumentLoadError::NotFound(_) => CliError::usage(format!("--instrument: {e}")),
+                other => CliError::input(format!("--instrument: {other}")),
+            })?;
+        let read = digest.map(|d| super::ReadFile::new("--instrument", Path::new(name), d));
         let frame = match self.readings_frame.as_deref() {
             Some(f) => ReadingsFrame::parse(f).ok_or_else(|| {
                 CliError::usage(format!("--readings-frame: `{f}` is not tool or machine"))
             })?,
             None => i.frame,
         };
-        Ok(Some((i, frame)))
+        Ok((Some((i, frame)), read))
     }
 }
 

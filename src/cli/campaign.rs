@@ -2,14 +2,14 @@
 //! its own set-up and its own R-test zero; one file is a campaign of one) or of
 //! `--campaign FILE`, their checks, and the plausibility of a campaign's values.
 
-use super::{CliError, CliResult};
+use super::{CliError, CliResult, ReadFile};
 use model_spec::Machine;
 use model_spec::instrument::{Instrument, ReadingsFrame};
 use solver::fitting::Constraint;
 use solver::fitting::campaign::{Campaign, CampaignRecord, Layout};
 use solver::fitting::hmatrix::parameter_name;
 use solver::fitting::sanity::{ValueLimits, check_model_values};
-use solver::io::campaign::{CampaignFileError, labels_from_files, load_campaign, read_record_at};
+use solver::io::campaign::{CampaignFile, labels_from_files, read_campaign_file};
 use solver::io::csv::ReadOptions;
 use solver::model::Model;
 use std::path::{Path, PathBuf};
@@ -22,6 +22,9 @@ pub struct Loaded {
     pub files: Vec<String>,
     /// The campaign file, when the records came from one.
     pub source: Option<PathBuf>,
+    /// The files as read: the campaign file (when there is one), then each record's file, with
+    /// the digests of the bytes read.
+    pub read: Vec<ReadFile>,
 }
 
 /// The instrument the records are read through (sensor readings), if any.
@@ -42,13 +45,10 @@ pub fn from_files(
     record_count(flag, files)?;
     let labels = labels_from_files(files);
     let mut records = Vec::with_capacity(files.len());
+    let mut read_files = Vec::with_capacity(files.len());
     for (f, label) in files.iter().zip(&labels) {
-        let record = read_record_at(f, m, params, read, instrument).map_err(|e| {
-            CliError::input(format!(
-                "{flag}: {e}{}",
-                solver::io::campaign::parameters_note(m, params)
-            ))
-        })?;
+        let (record, digest) = super::read_record(flag, m, f, read, instrument, params)?;
+        read_files.push(ReadFile::new(flag, f, digest));
         records.push(CampaignRecord::new(
             label.clone(),
             record,
@@ -62,6 +62,7 @@ pub fn from_files(
         campaign,
         files: files.iter().map(|f| f.display().to_string()).collect(),
         source: None,
+        read: read_files,
     })
 }
 
@@ -74,19 +75,35 @@ pub fn record_count(flag: &str, files: &[PathBuf]) -> CliResult<()> {
         .map_err(|e| CliError::usage(format!("{flag}: {e}")))
 }
 
-/// The campaign of the campaign file `path` (given by `flag`), every record's CSV read at its
-/// kinematic parameters and through `instrument` when it is given.
+/// The campaign file `path` (given by `flag`) for machine `m`, read once (its records not yet
+/// read: [`from_file`]).
+pub fn read_file(flag: &str, m: &Machine, path: &Path) -> CliResult<(CampaignFile, ReadFile)> {
+    let (file, digest) =
+        read_campaign_file(path, m).map_err(|e| CliError::input(format!("{flag}: {e}")))?;
+    Ok((file, ReadFile::new(flag, path, digest)))
+}
+
+/// The campaign of the campaign file `path` (given by `flag`) as [`read_file`] read it (`read`
+/// its digest), every record's CSV read at its kinematic parameters and through `instrument`
+/// when it is given.
 pub fn from_file(
     flag: &str,
     m: &Machine,
     path: &Path,
+    (file, source): (CampaignFile, ReadFile),
     read: &ReadOptions,
     instrument: Through,
 ) -> CliResult<Loaded> {
-    let (file, campaign) = load_campaign(path, m, read, instrument).map_err(|e| match e {
-        e @ CampaignFileError::Text(_) => CliError::input(format!("{flag}: {e}")),
-        e => CliError::input(format!("{flag}: {e}")),
-    })?;
+    let (campaign, digests) = file
+        .load(m, read, instrument)
+        .map_err(|e| CliError::input(format!("{flag}: {e}")))?;
+    let mut read_files = vec![source];
+    read_files.extend(
+        file.records
+            .iter()
+            .zip(digests)
+            .map(|(r, d)| ReadFile::new(flag, &r.path, d)),
+    );
     Ok(Loaded {
         campaign,
         files: file
@@ -95,6 +112,7 @@ pub fn from_file(
             .map(|r| r.path.display().to_string())
             .collect(),
         source: Some(path.to_path_buf()),
+        read: read_files,
     })
 }
 

@@ -3,17 +3,20 @@
 //! tables.
 
 use super::args::ValueBounds;
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text, write, wrote};
 use model_spec::units::{compact, readable};
 use output::{Outputs, Target};
 use solver::compensation::kinematics::corrected_description;
 use solver::compensation::run::{CommandedPose, compensate_poses};
 use solver::compensation::tables::{Pitch, axis_tables};
 use solver::compensation::values::{CompensationError, MachineErrors};
-use solver::io::nc::{Dialect, WriteOptions, read_program};
-use solver::io::poses::{axis_words, from_file_units, read_pose_file, to_file_units};
+use solver::io::nc::{Dialect, WriteOptions, parse_program};
+use solver::io::poses::{
+    MAX_FILE_BYTES, axis_words, from_file_units, read_pose_csv, to_file_units,
+};
 use solver::io::report::compensate::{CompensationReport, CompensationSource, KinematicsReport};
-use solver::io::report::{read_identification, to_json};
+use solver::io::report::read::parse_identification;
+use solver::io::report::to_json;
 use solver::io::text::compensate::{compensation, kinematics_and_tables};
 use std::path::PathBuf;
 
@@ -126,7 +129,8 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         return Err(CliError::usage("--decimals applies to NC programs (--nc)"));
     }
     super::args::nc_decimals(args.decimals)?;
-    let (m, machine_text) = super::load_machine_and_text(&args.machine)?;
+    let machine = super::load_machine_read(&args.machine)?;
+    let (m, machine_text) = (machine.machine, machine.text);
     let mut inputs = vec![("--params", args.params.as_path())];
     inputs.extend(args.path.as_deref().map(|p| ("--path", p)));
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
@@ -150,8 +154,16 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         super::check_dir_inputs(&inputs, "--tables", dir, &table)?;
     }
     let params = super::pose_args::params(&m, args.param.as_deref())?;
-    let id = read_identification(&args.params, &m)
+    // --params is read once: its values, and the identification the report shows.
+    let params_file = args.params.display().to_string();
+    let (params_text, params_digest) = model_spec::text::read_text_hashed(
+        &args.params,
+        solver::io::report::read::MAX_REPORT_BYTES,
+    )
+    .map_err(|e| CliError::input(format!("--params: {e}")))?;
+    let id = parse_identification(&params_file, &params_text, &m)
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
+    let mut read_files = vec![ReadFile::new("--params", &args.params, params_digest)];
     let v = &id.values;
     super::campaign::check_campaign_values(&m, &v.layout, &v.values, &args.bounds.values())
         .map_err(|e| {
@@ -165,7 +177,6 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     let symbols_note = symbols_note(&m, &params, errors.record_params(), args.param.is_some());
     let mut files = Outputs::new();
     files.protect(&inputs);
-    let params_file = args.params.display().to_string();
     let mut source = CompensationSource::of(&m, &id.model_name, &params_file, &errors, &left_out);
     let mut summary = None;
     if let (Some(path), Some(out)) = (&args.path, &args.output) {
@@ -198,10 +209,12 @@ pub fn run(args: &CompensateArgs) -> CliResult {
                 other => CliError::input(format!("--path: {other}")),
             })
         };
+        let (path_text, digest) = read_keeping_bom(path)?;
+        read_files.push(ReadFile::new("--path", path, digest));
         let (text, rounding, format, s) = match &args.nc {
             Some(name) => {
                 let dialect = Dialect::from_name(name).expect("clap checks the dialect");
-                let program = read_program(path, dialect, &words)
+                let program = parse_program(&file, &path_text, dialect, &words)
                     .map_err(|e| CliError::input(format!("--path: {e}")))?;
                 let done = run(program.poses(), &values_at)?;
                 let corrected: Vec<Vec<f64>> = done.poses.iter().map(|q| to_deg(q)).collect();
@@ -213,7 +226,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
                 (written.text, Some(rounding), name.clone(), done.summary)
             }
             None => {
-                let table = read_pose_file(path, &words)
+                let table = read_pose_csv(&file, &path_text, &words)
                     .map_err(|e| CliError::input(format!("--path: {e}")))?;
                 let done = run(table.poses(), &values_at)?;
                 let corrected: Vec<Vec<f64>> = done.poses.iter().map(|q| to_deg(q)).collect();
@@ -291,11 +304,14 @@ pub fn run(args: &CompensateArgs) -> CliResult {
                 files.add("--json", target.clone(), json);
             }
             if let Some(target) = &args.report {
-                files.add(
-                    "--report",
-                    target.clone(),
-                    html_report(args, &m, &inputs, &report)?,
+                let machine_path = std::path::Path::new(&args.machine);
+                read_files.extend(
+                    machine
+                        .digest
+                        .map(|d| ReadFile::new("--machine", machine_path, d)),
                 );
+                let html = html_report(&params_file, &params_text, &m, &read_files, &report)?;
+                files.add("--report", target.clone(), html);
             }
             compensation(&report)
         }
@@ -315,25 +331,37 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     print_text(&text, stdout_taken)
 }
 
-/// The HTML report (`--report`) of the identification of `--params` and of `report`, the
-/// compensation just computed; `inputs` are hashed.
+/// The HTML report (`--report`) of the identification of `--params` (`params_text`, read from
+/// `params_file`) and of `report`, the compensation just computed; `inputs` as read.
 fn html_report(
-    args: &CompensateArgs,
+    params_file: &str,
+    params_text: &str,
     m: &model_spec::Machine,
-    inputs: &[(&str, &std::path::Path)],
+    inputs: &[ReadFile],
     report: &CompensationReport,
 ) -> CliResult<String> {
     let mut i = super::report::inputs_for(m, inputs);
     let fail = |e: ::report::InputError| CliError::input(format!("--params: {e}"));
-    let params = ::report::inputs::read_document(&args.params).map_err(fail)?;
-    let file = args.params.display().to_string();
-    i.add(&file, params).map_err(fail)?;
+    let params = ::report::inputs::classify(params_file, params_text).map_err(fail)?;
+    i.add(params_file, params).map_err(fail)?;
     i.add(
         "this run of rtest compensate",
         ::report::Document::Compensation(Box::new(report.clone())),
     )
     .map_err(|e| CliError::computation(format!("--report: {e}")))?;
     super::report::render("--report", &i)
+}
+
+/// The text of the commanded poses at `path` (at most [`MAX_FILE_BYTES`], UTF-8, a byte-order
+/// mark kept as its first character, so that the file written back keeps it too), with the
+/// digest of the bytes read (the file is opened once).
+fn read_keeping_bom(path: &std::path::Path) -> CliResult<(String, model_spec::sha256::Digest)> {
+    let fail = |e: model_spec::text::TextError| CliError::input(format!("--path: {e}"));
+    let (bytes, digest) =
+        model_spec::text::read_bytes_hashed(path, MAX_FILE_BYTES).map_err(fail)?;
+    let bom = bytes.starts_with(b"\xef\xbb\xbf");
+    let text = model_spec::text::decode_text(&path.display().to_string(), bytes).map_err(fail)?;
+    Ok((if bom { format!("\u{feff}{text}") } else { text }, digest))
 }
 
 /// The note on the machine's kinematic symbols: where the records of the identification were

@@ -157,10 +157,7 @@ fn html_report(result: &demo::Demo, check: Check) -> CliResult<String> {
             i.files.push(::report::InputFile {
                 role: "measurement".into(),
                 path: path.clone(),
-                digest: Some((
-                    history::sha256::sha256_hex(f.contents.as_bytes()),
-                    f.contents.len() as u64,
-                )),
+                digest: Ok(history::sha256::Digest::of(f.contents.as_bytes())),
                 modified: None,
             });
         }

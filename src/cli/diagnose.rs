@@ -4,7 +4,7 @@
 
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text, write, wrote};
 use output::{Outputs, Target};
 use solver::diagnosis::dictionary::DictionaryOptions;
 use solver::diagnosis::figures::figures;
@@ -216,7 +216,8 @@ fn parse_alpha(s: &str) -> Result<f64, String> {
 /// records (`--validate`, or `--validate-campaign`) read as two campaigns, one record being the
 /// campaign of that record, and diagnosed by [`diagnose`].
 pub fn run(args: &DiagnoseArgs) -> CliResult {
-    let (m, machine_text) = super::load_machine_and_text(&args.machine)?;
+    let machine = super::load_machine_read(&args.machine)?;
+    let (m, machine_text) = (machine.machine, machine.text);
     let (label, model) = args::model(&m, Some(&args.model), None)?;
     let held_files = match &args.validate {
         Some(list) => args::files("--validate", list)?,
@@ -255,27 +256,35 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
 
     let read = args.records.read_options();
     let params = super::pose_args::params(&m, args.param.as_deref())?;
-    let instrument = args.instrument.load()?;
+    let (instrument, instrument_read) = args.instrument.load_read()?;
     let through = instrument.as_ref().map(|(i, f)| (i, *f));
     // Progress bars on a terminal's standard error, unless the JSON report takes standard output.
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
     let fitted = match &args.campaign {
-        Some(path) => campaign::from_file("--campaign", &m, path, &read, through)?,
+        Some(path) => {
+            let file = campaign::read_file("--campaign", &m, path)?;
+            campaign::from_file("--campaign", &m, path, file, &read, through)?
+        }
         None => {
             let labels = labels_from_files(&files);
-            let records = read_records("--data", &m, &files, &params, args, shown)?
+            let (records, read_files) =
+                read_records("--data", &m, &files, &params, args, through, shown)?;
+            let records = records
                 .into_iter()
                 .zip(&labels)
                 .map(|(r, l)| CampaignRecord::new(l, r, params.clone(), l, args.zeroed))
                 .collect();
-            loaded(records, &files)?
+            loaded(records, &files, read_files)?
         }
     };
     // Held-out `--validate` files: on the fitted records' set-up when they have one (the ball
     // not moved), else each on a set-up of its own; labelled by their stems, unique among the
     // fitted records' labels.
     let held = match &args.validate_campaign {
-        Some(path) => campaign::from_file("--validate-campaign", &m, path, &read, through)?,
+        Some(path) => {
+            let file = campaign::read_file("--validate-campaign", &m, path)?;
+            campaign::from_file("--validate-campaign", &m, path, file, &read, through)?
+        }
         None => {
             let setups = fitted.campaign.setups();
             let mut taken: Vec<String> = fitted
@@ -290,7 +299,9 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
                 taken.push(l.clone());
                 labels.push(l);
             }
-            let records = read_records("--validate", &m, &held_files, &params, args, shown)?
+            let (records, read_files) =
+                read_records("--validate", &m, &held_files, &params, args, through, shown)?;
+            let records = records
                 .into_iter()
                 .zip(&labels)
                 .map(|(r, l)| {
@@ -301,7 +312,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
                     CampaignRecord::new(l, r, params.clone(), setup, args.zeroed)
                 })
                 .collect();
-            loaded(records, &held_files)?
+            loaded(records, &held_files, read_files)?
         }
     };
     let (fitted_inputs, held_inputs) = (fitted.inputs(), held.inputs());
@@ -327,7 +338,18 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     fitted.check_times(flag, &m, &model)?;
     held.check_times("--validate", &m, &model)?;
 
-    let opts = options(args, &m, &read)?;
+    let (opts, noise_read) = options(args, &m, &read, through)?;
+    // The files as read, with the digests of the bytes read, for --report.
+    let mut read_files: Vec<ReadFile> = fitted.read.clone();
+    read_files.extend(held.read.iter().cloned());
+    read_files.extend(noise_read);
+    read_files.extend(instrument_read);
+    let machine_path = Path::new(&args.machine);
+    read_files.extend(
+        machine
+            .digest
+            .map(|d| ReadFile::new("--machine", machine_path, d)),
+    );
     let bar = super::progress::Bar::new(shown, false);
     let d = diagnose(&m, &model, &fitted.campaign, &held.campaign, &opts, &bar);
     drop(bar);
@@ -408,7 +430,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         }
     }
     if let Some(target) = &args.report {
-        let mut i = super::report::inputs_for(&m, &inputs);
+        let mut i = super::report::inputs_for(&m, &read_files);
         if let Some(figs) = &figs {
             i.path_figures = ::report::figures::path_figures(figs)
                 .map_err(|e| CliError::computation(format!("--report: {e}")))?;
@@ -432,28 +454,37 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
 }
 
 /// The records of `files` (given by `flag`) at kinematic parameters `params` (mm), read through
-/// `--instrument` when it is given, each with a progress bar while it is read (`shown`).
+/// the `instrument` when it is given, each with a progress bar while it is read (`shown`); and
+/// the files as read.
 fn read_records(
     flag: &str,
     m: &model_spec::Machine,
     files: &[PathBuf],
     params: &[f64],
     args: &DiagnoseArgs,
+    instrument: campaign::Through,
     shown: bool,
-) -> CliResult<Vec<Record>> {
+) -> CliResult<(Vec<Record>, Vec<ReadFile>)> {
     campaign::record_count(flag, files)?;
     let read = args.records.read_options();
-    files
-        .iter()
-        .map(|f| {
-            let (_bar, read) = super::progress::reading(shown, f, &read);
-            super::read_record(flag, m, f, &read, &args.instrument, params)
-        })
-        .collect()
+    let mut records = Vec::with_capacity(files.len());
+    let mut read_files = Vec::with_capacity(files.len());
+    for f in files {
+        let (_bar, read) = super::progress::reading(shown, f, &read);
+        let (record, digest) = super::read_record(flag, m, f, &read, instrument, params)?;
+        records.push(record);
+        read_files.push(ReadFile::new(flag, f, digest));
+    }
+    Ok((records, read_files))
 }
 
-/// The campaign of `records` read from `files` (an empty campaign for no records).
-fn loaded(records: Vec<CampaignRecord>, files: &[PathBuf]) -> CliResult<campaign::Loaded> {
+/// The campaign of `records` read from `files` (as `read` says; an empty campaign for no
+/// records).
+fn loaded(
+    records: Vec<CampaignRecord>,
+    files: &[PathBuf],
+    read: Vec<ReadFile>,
+) -> CliResult<campaign::Loaded> {
     let campaign = if records.is_empty() {
         Campaign {
             records: Vec::new(),
@@ -465,6 +496,7 @@ fn loaded(records: Vec<CampaignRecord>, files: &[PathBuf]) -> CliResult<campaign
         campaign,
         files: files.iter().map(|f| f.display().to_string()).collect(),
         source: None,
+        read,
     })
 }
 
@@ -495,17 +527,19 @@ fn options(
     args: &DiagnoseArgs,
     m: &model_spec::Machine,
     read: &solver::io::csv::ReadOptions,
-) -> CliResult<DiagnoseOptions> {
+    instrument: campaign::Through,
+) -> CliResult<(DiagnoseOptions, Option<ReadFile>)> {
     let mut opts = DiagnoseOptions::default();
     opts.dictionary = DictionaryOptions::new(args.harmonics, args.poly, args.time);
     opts.alpha = args.alpha;
     opts.constraint = args::constraint(args.constraint.as_deref())?;
-    opts.noise = args.noise.choice(m, read, &args.instrument)?;
+    let (noise, noise_read) = args.noise.choice(m, read, instrument)?;
+    opts.noise = noise;
     if let Some(b) = &args.budget {
         opts.budget = solver::diagnosis::plausible::Budget::parse(b)
             .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
     }
-    Ok(opts)
+    Ok((opts, noise_read))
 }
 
 /// Adds the diagnosis just computed to the inputs of its HTML report (`--report`).

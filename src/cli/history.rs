@@ -2,9 +2,8 @@
 //! with its flags (table, figure, CSV, JSON); and the `--record` flags of `rtest identify`
 //! that put a check into it (docs/history.md).
 
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text, write, wrote};
 use history::report::{TrendReport, known_parameters, listing, listing_json};
-use history::sha256::sha256_file;
 use history::tolerance::{self, MAX_TOLERANCE_BYTES, Tolerances};
 use history::trend::{self, Options, TrendError};
 use history::{Check, HistoryError, InputFile, Provenance, Staged, Store, Timestamp};
@@ -67,14 +66,14 @@ impl RecordArgs {
         self.record.then(|| ("--db", self.db()))
     }
 
-    /// The recorder of a command whose input files are `inputs` (flag, path), or `None`
-    /// without --record. Checks the flags and an existing database now, before any work, and
-    /// hashes the inputs.
+    /// The recorder of a command, or `None` without --record. Checks the flags and an existing
+    /// database now, before any work; the input files are added as the command reads them
+    /// ([`Recorder::add_read`]).
     ///
     /// # Errors
     /// A usage error for missing or malformed flags; a bad input for a database that cannot
-    /// be used or an input that cannot be read.
-    pub fn recorder(&self, inputs: &[(&str, &Path)]) -> CliResult<Option<Recorder>> {
+    /// be used.
+    pub fn recorder(&self) -> CliResult<Option<Recorder>> {
         if !self.record {
             return Ok(None);
         }
@@ -114,18 +113,6 @@ impl RecordArgs {
             Err(HistoryError::NotFound { .. }) => None,
             Err(e) => return Err(history_error("--db", e)),
         };
-        let mut files = Vec::with_capacity(inputs.len());
-        for (flag, path) in inputs {
-            let (sha256, bytes) = sha256_file(path).map_err(|e| {
-                CliError::input(format!("{flag}: cannot read `{}`: {e}", path.display()))
-            })?;
-            files.push(InputFile {
-                role: (*flag).to_string(),
-                path: path.display().to_string(),
-                bytes,
-                sha256,
-            });
-        }
         Ok(Some(Recorder {
             db,
             store,
@@ -135,7 +122,7 @@ impl RecordArgs {
                 measured_at,
                 recorded_at: now,
                 rtest_version: env!("CARGO_PKG_VERSION").to_string(),
-                inputs: files,
+                inputs: Vec::new(),
             },
         }))
     }
@@ -170,12 +157,25 @@ impl Recorder {
 
     /// Adds an input file given by its bytes (`role`: what it was, `path`: its name).
     pub fn add_input(&mut self, role: &str, path: &str, bytes: &[u8]) {
+        let digest = ::history::sha256::Digest::of(bytes);
         self.provenance.inputs.push(InputFile {
             role: role.into(),
             path: path.into(),
-            bytes: bytes.len() as u64,
-            sha256: history::sha256::sha256_hex(bytes),
+            bytes: digest.bytes,
+            sha256: digest.sha256,
         });
+    }
+
+    /// Adds the input files the command read, with the digests of the bytes it read.
+    pub fn add_read(&mut self, files: &[ReadFile]) {
+        self.provenance
+            .inputs
+            .extend(files.iter().map(|f| InputFile {
+                role: f.flag.clone(),
+                path: f.path.clone(),
+                bytes: f.digest.bytes,
+                sha256: f.digest.sha256.clone(),
+            }));
     }
 
     /// The provenance of the check (machine id, paths, times, inputs).

@@ -4,7 +4,7 @@
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
 use super::history;
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text};
+use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text};
 use output::{Outputs, Target};
 use solver::fitting::campaign::{
     CampaignIdentification, CampaignValues, identify_campaign, identify_campaign_refined,
@@ -16,7 +16,7 @@ use solver::fitting::{EstimateError, IdentifyOptions, RefineError, RefineOptions
 use solver::io::report::identify::StreamingReport;
 use solver::io::report::{CampaignSource, IdentificationReport, to_json};
 use solver::io::text::identify::identification;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
 Identifies the errors of a model from a measurement CSV (axis columns in mm and degrees, \
@@ -182,7 +182,8 @@ pub struct IdentifyArgs {
 /// Runs `rtest identify`: one record or several, read as a campaign (a record is a campaign
 /// of one), fitted together, reported once; `--stream` reads one long record in blocks.
 pub fn run(args: &IdentifyArgs) -> CliResult {
-    let m = super::load_machine(&args.machine)?;
+    let machine = super::load_machine_read(&args.machine)?;
+    let m = machine.machine;
     let (label, model) = args::model(&m, args.model.as_deref(), args.terms.as_deref())?;
     let files = match &args.data {
         Some(list) => args::files("--data", list)?,
@@ -216,16 +217,18 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     // A progress bar while the records are read, on a terminal's standard error, unless the
     // JSON report takes standard output.
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
-    let instrument = args.instrument.load()?;
+    let (instrument, instrument_read) = args.instrument.load_read()?;
     let through = instrument.as_ref().map(|(i, f)| (i, *f));
     // The records' files: those of --data now; a campaign file's once it is read.
-    let file_list = match &args.campaign {
+    let campaign_file = match &args.campaign {
         Some(path) => {
             check_outputs(&[("--campaign", path.as_path())], &[], &[])?;
-            let f = solver::io::campaign::read_campaign_file(path, &m)
-                .map_err(|e| CliError::input(format!("--campaign: {e}")))?;
-            f.records.iter().map(|r| r.path.clone()).collect()
+            Some(campaign::read_file("--campaign", &m, path)?)
         }
+        None => None,
+    };
+    let file_list: Vec<PathBuf> = match &campaign_file {
+        Some((f, _)) => f.records.iter().map(|r| r.path.clone()).collect(),
         None => files.clone(),
     };
     let mut inputs: Vec<(&str, &std::path::Path)> = args
@@ -243,8 +246,11 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let mut all_inputs = inputs.clone();
     all_inputs.extend(db.as_ref().map(|(f, p)| (*f, p.as_path())));
     check_outputs(&all_inputs, &outputs, &[])?;
-    let mut recorder = args.history.recorder(&inputs)?;
-    let noise = args.noise.choice(&m, &read, &args.instrument)?;
+    let mut recorder = args.history.recorder()?;
+    let (noise, noise_read) = args.noise.choice(&m, &read, through)?;
+    // The files as read, with the digests of the bytes read, for --report and --record: the
+    // records' (and the campaign file), then the others.
+    let mut read_files: Vec<ReadFile> = Vec::new();
     let opts = IdentifyOptions::new().constraint(args::constraint(args.constraint.as_deref())?);
     let (ident, refinement, streaming, loaded) = if args.stream {
         let data_path = files[0].as_path();
@@ -252,7 +258,8 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         let opts = opts.clone().zeroed(args.zeroed);
         let fitted = identify_file(&m, &model, data_path, &opts, args.block as usize, &read);
         drop(bar);
-        let (ident, run) = fitted.map_err(|e| stream_error(e, data_path))?;
+        let (ident, run, digest) = fitted.map_err(|e| stream_error(e, data_path))?;
+        read_files.push(ReadFile::new("--data", data_path, digest));
         let streaming = StreamingReport {
             blocks: run.blocks,
             block: args.block as usize,
@@ -265,9 +272,11 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     } else {
         let loaded = {
             let (_bar, read) = super::progress::reading_all(shown, &file_list, &read);
-            match &args.campaign {
-                Some(path) => campaign::from_file("--campaign", &m, path, &read, through)?,
-                None => campaign::from_files(
+            match (&args.campaign, campaign_file) {
+                (Some(path), Some(file)) => {
+                    campaign::from_file("--campaign", &m, path, file, &read, through)?
+                }
+                _ => campaign::from_files(
                     "--data",
                     &m,
                     &files,
@@ -304,8 +313,17 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
                     .map_err(refine_error)?;
             (ident, Some(r))
         };
+        read_files.extend(loaded.read.iter().cloned());
         (ident, refinement, None, Some(loaded))
     };
+    read_files.extend(noise_read);
+    read_files.extend(instrument_read);
+    let machine_path = Path::new(&args.machine);
+    read_files.extend(
+        machine
+            .digest
+            .map(|d| ReadFile::new("--machine", machine_path, d)),
+    );
     campaign::check_campaign_values(&m, &ident.layout, &ident.fit.values, &args.bounds.values())
         .map_err(|e| implausible(&e))?;
     let data: Vec<String> = match &loaded {
@@ -346,12 +364,15 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         out.add("--json", target.clone(), json);
     }
     if let Some(target) = &args.report {
-        let html = html_report(&m, &inputs, &report, &ident, loaded.as_ref(), &label)?;
+        let html = html_report(&m, &read_files, &report, &ident, loaded.as_ref(), &label)?;
         out.add("--report", target.clone(), html);
     }
     let stdout_taken = [&args.json, &args.report]
         .iter()
         .any(|t| matches!(t, Some(Target::Stdout)));
+    if let Some(r) = recorder.as_mut() {
+        r.add_read(&read_files);
+    }
     let check = recorder
         .as_ref()
         .map(|r| ::history::Check::from_identification(&report, r.provenance()));
@@ -364,7 +385,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
 /// streamed record, whose samples were never held whole).
 fn html_report(
     m: &model_spec::Machine,
-    inputs: &[(&str, &std::path::Path)],
+    inputs: &[ReadFile],
     report: &IdentificationReport,
     ident: &CampaignIdentification,
     loaded: Option<&campaign::Loaded>,

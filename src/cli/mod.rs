@@ -26,6 +26,7 @@ pub mod simulate;
 pub mod validate;
 pub mod volumetric;
 
+use model_spec::sha256::Digest;
 use model_spec::{LoadError, Machine};
 use output::{Outputs, Target, WriteError, Written};
 use solver::io::csv::ReadOptions;
@@ -101,33 +102,62 @@ pub type CliResult<T = ()> = Result<T, CliError>;
 /// Loads the machine of `--machine` (a built-in name or a TOML file). An unknown name is a
 /// usage error; a file that cannot be read or does not validate is a bad input.
 pub fn load_machine(name_or_path: &str) -> CliResult<Machine> {
-    load_machine_and_text(name_or_path).map(|(m, _)| m)
+    load_machine_read(name_or_path).map(|l| l.machine)
 }
 
 /// [`load_machine`], with the text it was read from (read once).
 pub fn load_machine_and_text(name_or_path: &str) -> CliResult<(Machine, String)> {
-    model_spec::load_machine_and_text(name_or_path).map_err(|e| match e {
+    load_machine_read(name_or_path).map(|l| (l.machine, l.text))
+}
+
+/// [`load_machine`], with the text it was read from and, for a file, the digest of the bytes
+/// read (read once).
+pub fn load_machine_read(name_or_path: &str) -> CliResult<model_spec::LoadedMachine> {
+    model_spec::load_machine_read(name_or_path).map_err(|e| match e {
         LoadError::NotFound(_) => CliError::usage(format!("--machine: {e}")),
         _ => CliError::input(format!("--machine: {e}")),
     })
 }
 
+/// An input file a verb read: the flag that gave it, its path as given, and the digest of the
+/// bytes the verb read from it (taken while reading, never by opening the path again). What
+/// `--report` lists and `--record` keeps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReadFile {
+    /// The flag that gave it (`--data`, `--machine`).
+    pub flag: String,
+    /// The path, as given.
+    pub path: String,
+    /// Size and SHA-256 of the bytes read.
+    pub digest: Digest,
+}
+
+impl ReadFile {
+    /// The file at `path`, given by `flag`, read as `digest` says.
+    pub fn new(flag: &str, path: &Path, digest: Digest) -> ReadFile {
+        ReadFile {
+            flag: flag.to_string(),
+            path: path.display().to_string(),
+            digest,
+        }
+    }
+}
+
 /// The record of a measurement CSV given by `flag` (mm and rad inside), read with `options`:
-/// of error vectors, or of the sensor readings of `instrument` when it names one (turned into
-/// error vectors with their covariances, docs/instrument.md), planned at the kinematic parameters
-/// `params` (mm: the ball position among them). Every problem with the file is a
-/// bad input naming the flag, the file and the line.
+/// of error vectors, or of the sensor readings of the `instrument` it is read through
+/// (turned into error vectors with their covariances, docs/instrument.md), planned at the
+/// kinematic parameters `params` (mm: the ball position among them); with the digest of the
+/// bytes read. Every problem with the file is a bad input naming the flag, the file and the
+/// line.
 pub fn read_record(
     flag: &str,
     m: &Machine,
     path: &Path,
     options: &ReadOptions,
-    instrument: &args::InstrumentArgs,
+    instrument: campaign::Through,
     params: &[f64],
-) -> CliResult<Record> {
-    let instrument = instrument.load()?;
-    let through = instrument.as_ref().map(|(i, f)| (i, *f));
-    solver::io::campaign::read_record_at(path, m, params, options, through).map_err(|e| {
+) -> CliResult<(Record, Digest)> {
+    solver::io::campaign::read_record_at(path, m, params, options, instrument).map_err(|e| {
         CliError::input(format!(
             "{flag}: {e}{}",
             solver::io::campaign::parameters_note(m, params)

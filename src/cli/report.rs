@@ -3,9 +3,12 @@
 //! `identify`, `diagnose` and `compensate`, which renders what the verb just computed through
 //! the same function.
 
+use super::ReadFile;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use model_spec::sha256::Digest;
 use output::{Outputs, Target};
 use report::{InputFile, Inputs, MachineFacts};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
@@ -27,12 +30,15 @@ extended model. An identification or validation may be of one record or of a cam
 several: the report then lists the records with their ball positions (kinematic parameters that \
 differ from the machine's defaults) and set-ups, the shared values (the machine's errors), the \
 values of each set-up and record, and for each validated record its set-up (fitted, or new and \
-refitted on the record). The records and files the reports name are hashed when they can be \
-read from the working directory.
+refitted on the record). The records and files the reports name are looked for relative to the \
+directory of the report that names them (or to --data-dir DIR): an absolute name, or one that \
+leaves that directory, is refused. Regular files are read (at most their kind's size: 256 MiB \
+for a record) and hashed; anything else (a pipe, a device, a directory) is listed as not hashed \
+and never opened.
 
 The measured error against the identified model's prediction along each path (every record of \
 the identification and of the validations, against the axis that moves most) is drawn from the \
-records the reports name, read from the working directory at their kinematic parameters, with \
+records the reports name, read as above at their kinematic parameters, with \
 the identification's values on the exact virtual machine (a validated record on a new set-up \
 with its set-up errors refitted, as rtest validate did); a record that cannot be read is named \
 with why. The \
@@ -63,6 +69,10 @@ pub struct ReportArgs {
     /// of it (name, and the identification's fingerprint).
     #[arg(long, value_name = "NAME|FILE")]
     machine: Option<String>,
+    /// Where the records and files the reports name are looked for (names relative to DIR;
+    /// default: the directory of the report that names them).
+    #[arg(long, value_name = "DIR")]
+    data_dir: Option<PathBuf>,
 }
 
 /// The time the report is written, RFC 3339 UTC (`None` when the clock is unusable).
@@ -70,15 +80,15 @@ fn now() -> Option<String> {
     history::Timestamp::now().ok().map(|t| t.to_string())
 }
 
-/// A new set of inputs for a report of machine `m`, written now, with `files` (flag, path)
-/// hashed.
-pub fn inputs_for(m: &model_spec::Machine, files: &[(&str, &Path)]) -> Inputs {
+/// A new set of inputs for a report of machine `m`, written now, with the input `files` the
+/// verb read (their digests those of the bytes it read).
+pub fn inputs_for(m: &model_spec::Machine, files: &[ReadFile]) -> Inputs {
     let mut i = Inputs::new();
     i.machine = Some(MachineFacts::of(m));
     i.written_at = now();
     i.files = files
         .iter()
-        .map(|(flag, p)| InputFile::hashed(flag, &p.display().to_string()))
+        .map(|f| InputFile::read(&f.flag, &f.path, Path::new(&f.path), f.digest.clone()))
         .collect();
     i
 }
@@ -98,44 +108,66 @@ pub fn run(args: &ReportArgs) -> CliResult {
     let machine_file = args.machine.as_deref().and_then(super::machine_file);
     inputs_list.extend(machine_file.map(|p| ("--machine", p)));
     check_outputs(&inputs_list, &[("-o", &args.output)], &[])?;
+    if let Some(dir) = &args.data_dir
+        && !dir.is_dir()
+    {
+        return Err(CliError::usage(format!(
+            "--data-dir: `{}` is not a directory",
+            dir.display()
+        )));
+    }
     let mut inputs = Inputs::new();
+    let mut machine_read = None;
     let machine = match &args.machine {
-        Some(name) => Some(super::load_machine(name)?),
+        Some(name) => {
+            let loaded = super::load_machine_read(name)?;
+            machine_read = loaded
+                .digest
+                .map(|d| InputFile::read("--machine", name, Path::new(name), d));
+            inputs.machine = Some(MachineFacts::of(&loaded.machine));
+            Some(loaded.machine)
+        }
         None => None,
     };
-    if let Some(m) = &machine {
-        inputs.machine = Some(MachineFacts::of(m));
-    }
     inputs.written_at = now();
+    let mut files = Vec::new();
+    let mut texts = Vec::with_capacity(args.reports.len());
     for path in &args.reports {
-        let doc =
+        let (doc, text, digest) =
             report::inputs::read_document(path).map_err(|e| CliError::input(e.to_string()))?;
+        let file = path.display().to_string();
         inputs
-            .add(&path.display().to_string(), doc)
+            .add(&file, doc)
             .map_err(|e| CliError::input(e.to_string()))?;
+        files.push(InputFile::read("JSON report", &file, path, digest));
+        texts.push((file, text));
     }
-    inputs.files = named_files(&inputs, &args.reports, machine_file);
+    files.extend(machine_read);
+    let named = named_files(&inputs, args.data_dir.as_deref())?;
+    let records = read_named(&named, &mut files);
+    inputs.files = files;
     inputs.no_path_figures = Some(
         "The base and extended models' predictions along the paths are drawn by rtest diagnose --report; section 4 draws the identified model's.".into(),
     );
-    draw_paths(&mut inputs, machine, &args.reports)?;
+    draw_paths(&mut inputs, machine, &texts, &records)?;
     let html = render("-o", &inputs)?;
-    let mut files = Outputs::new();
-    files.add("-o", args.output.clone(), html);
+    let mut out = Outputs::new();
+    out.add("-o", args.output.clone(), html);
     let stdout_taken = matches!(args.output, Target::Stdout);
-    let text = wrote(&write(files)?);
+    let text = wrote(&write(out)?);
     print_text(&text, stdout_taken)
 }
 
 /// The identified model's prediction along the path of every record of the identification and
 /// of every validation, when the machine is known (`--machine`, or the built-in the reports
-/// name) and the records can be read from here; otherwise one line says why not. A validated
+/// name) and the records were read (`records`); otherwise one line says why not. A validated
 /// record on a set-up the identification did not fit has its set-up errors refitted on it, as
 /// `rtest validate` did.
 fn draw_paths(
     inputs: &mut Inputs,
     machine: Option<model_spec::Machine>,
-    reports: &[PathBuf],
+    texts: &[(String, String)],
+    records: &Records,
 ) -> CliResult<()> {
     let Some((id_file, id)) = &inputs.identification else {
         if !inputs.validations.is_empty() {
@@ -155,11 +187,11 @@ fn draw_paths(
             return Ok(());
         }
     };
-    let id_path = reports
+    let id_text = texts
         .iter()
-        .find(|p| p.display().to_string() == *id_file)
-        .map_or_else(|| PathBuf::from(id_file), PathBuf::clone);
-    let values = match solver::io::report::read_identification(&id_path, &m) {
+        .find(|(f, _)| f == id_file)
+        .map_or("", |(_, t)| t.as_str());
+    let values = match solver::io::report::read::parse_identification(id_file, id_text, &m) {
         Ok(v) => v.values,
         Err(e) => {
             inputs
@@ -168,17 +200,13 @@ fn draw_paths(
             return Ok(());
         }
     };
-    // The records the reports name, read here at their kinematic parameters, each on its
-    // set-up; one that cannot be read, or predicted, is named with why.
-    let mut named: Vec<(String, &'static str, CampaignRecordSpec)> = Vec::new();
-    for (r, data) in values
-        .layout
-        .records
-        .iter()
-        .zip(id.records.iter().map(|x| &x.data))
-    {
+    // The records the reports name, as read by `read_named`, at their kinematic parameters,
+    // each on its set-up; one that cannot be read, or predicted, is named with why.
+    let mut named: Vec<(&str, &str, &'static str, CampaignRecordSpec)> = Vec::new();
+    for (r, x) in values.layout.records.iter().zip(&id.records) {
         named.push((
-            data.clone(),
+            id_file,
+            &x.data,
             "fitted",
             CampaignRecordSpec {
                 label: r.label.clone(),
@@ -193,7 +221,7 @@ fn draw_paths(
         [s] => Some(s.clone()),
         _ => None,
     };
-    for (_, v) in &inputs.validations {
+    for (file, v) in &inputs.validations {
         for x in &v.records {
             let mut params = m.default_parameters();
             for (k, value) in &x.params.0 {
@@ -207,7 +235,8 @@ fn draw_paths(
                 x.setup.clone()
             };
             named.push((
-                x.data.clone(),
+                file,
+                &x.data,
                 "validation",
                 CampaignRecordSpec {
                     label: x.label.clone(),
@@ -221,9 +250,21 @@ fn draw_paths(
     }
     let mut read = Vec::new();
     let mut not_drawn = Vec::new();
-    for (name, role, spec) in named {
-        match solver::io::campaign::read_record_at(
-            Path::new(&name),
+    for (json, name, role, spec) in named {
+        let bytes = match records.get(&(json.to_string(), name.to_string())) {
+            Some(Ok(bytes)) => bytes,
+            Some(Err(why)) => {
+                not_drawn.push(format!("{name} is not drawn: {why}"));
+                continue;
+            }
+            None => {
+                not_drawn.push(format!("{name} is not drawn: it was not read"));
+                continue;
+            }
+        };
+        match solver::io::campaign::parse_record_at(
+            name,
+            bytes.as_slice(),
             &m,
             &spec.params,
             &solver::io::csv::ReadOptions::default(),
@@ -240,9 +281,7 @@ fn draw_paths(
                 r.start_s = spec.start_s;
                 read.push((name, role, r));
             }
-            Err(e) => not_drawn.push(format!(
-                "{name} is not drawn: it could not be read here ({e})"
-            )),
+            Err(e) => not_drawn.push(format!("{name} is not drawn: it could not be read ({e})")),
         }
     }
     let records: Vec<PathRecord<'_>> = read
@@ -266,42 +305,242 @@ struct CampaignRecordSpec {
     start_s: Option<f64>,
 }
 
-/// The files of a report given to `rtest report`: the JSON reports, the machine file, and
-/// every record and values file the reports name, each hashed when it can be read from here.
-fn named_files(inputs: &Inputs, reports: &[PathBuf], machine: Option<&Path>) -> Vec<InputFile> {
-    let mut out: Vec<InputFile> = reports
-        .iter()
-        .map(|p| InputFile::hashed("JSON report", &p.display().to_string()))
-        .collect();
-    out.extend(machine.map(|p| InputFile::hashed("--machine", &p.display().to_string())));
-    let mut named = |role: &str, path: &str| {
-        if !out.iter().any(|f| f.path == path) {
-            out.push(InputFile::hashed(role, path));
-        }
-    };
-    if let Some((_, r)) = &inputs.identification {
-        for x in &r.records {
-            named("identification: fitted record", &x.data);
-        }
-    }
-    for (_, v) in &inputs.validations {
-        for x in &v.records {
-            named("validation: record", &x.data);
-        }
-        named("validation: values", &v.params);
-    }
-    if let Some((_, d)) = &inputs.diagnosis {
-        named("diagnosis: fitted record", &d.data);
-        for (f, _) in &d.held_out {
-            named("diagnosis: held-out record", f);
-        }
-    }
-    if let Some((_, c)) = &inputs.compensation {
-        named("compensation: values", &c.params_file);
-        named("compensation: commanded poses", &c.input);
-    }
-    out
+/// The bytes of the records `rtest report` read, by (JSON report, name the report gives), or
+/// why a record was not read.
+type Records = BTreeMap<(String, String), Result<Vec<u8>, String>>;
+
+/// A file a report names: the report (its file as given), the field, the role in the check,
+/// the name, where it is looked for, and the most bytes a file of its kind may have.
+struct Named {
+    json: String,
+    field: String,
+    role: &'static str,
+    name: String,
+    at: PathBuf,
+    max_bytes: u64,
 }
+
+/// Every file the reports name, in the order of the report (identification, validations,
+/// diagnosis, compensation), each looked for relative to the directory of its report, or to
+/// `data_dir` when it is given.
+///
+/// # Errors
+/// A bad input naming the report, the field and the name, for an absolute name or one that
+/// leaves the directory (`..`).
+fn named_files(inputs: &Inputs, data_dir: Option<&Path>) -> CliResult<Vec<Named>> {
+    use solver::io::poses::MAX_FILE_BYTES as RECORD;
+    use solver::io::report::read::MAX_REPORT_BYTES as VALUES;
+    let mut raw: Vec<(&str, String, &'static str, &str, u64)> = Vec::new();
+    if let Some((f, r)) = &inputs.identification {
+        for (i, x) in r.records.iter().enumerate() {
+            let field = format!("records[{i}].data");
+            raw.push((f, field, "identification: fitted record", &x.data, RECORD));
+        }
+    }
+    for (f, v) in &inputs.validations {
+        for (i, x) in v.records.iter().enumerate() {
+            let field = format!("records[{i}].data");
+            raw.push((f, field, "validation: record", &x.data, RECORD));
+        }
+        raw.push((f, "params".into(), "validation: values", &v.params, VALUES));
+    }
+    if let Some((f, d)) = &inputs.diagnosis {
+        for (i, x) in d.records.iter().enumerate() {
+            let role = if x.role == "fitted" {
+                "diagnosis: fitted record"
+            } else {
+                "diagnosis: held-out record"
+            };
+            raw.push((f, format!("records[{i}].data"), role, &x.data, RECORD));
+        }
+        if d.records.is_empty() {
+            for x in d.data.split(',') {
+                raw.push((f, "data".into(), "diagnosis: fitted record", x, RECORD));
+            }
+            for (i, (x, _)) in d.held_out.iter().enumerate() {
+                let field = format!("held_out[{i}]");
+                raw.push((f, field, "diagnosis: held-out record", x, RECORD));
+            }
+        }
+    }
+    if let Some((f, c)) = &inputs.compensation {
+        raw.push((
+            f,
+            "params_file".into(),
+            "compensation: values",
+            &c.params_file,
+            VALUES,
+        ));
+        raw.push((
+            f,
+            "input".into(),
+            "compensation: commanded poses",
+            &c.input,
+            RECORD,
+        ));
+    }
+    raw.into_iter()
+        .filter(|(_, _, _, name, _)| !name.is_empty())
+        .map(|(json, field, role, name, max_bytes)| {
+            let at = resolve(json, &field, name, data_dir)?;
+            Ok(Named {
+                json: json.to_string(),
+                field,
+                role,
+                name: name.to_string(),
+                at,
+                max_bytes,
+            })
+        })
+        .collect()
+}
+
+/// Where the file `name`, given by field `field` of report `json`, is looked for: relative to
+/// the report's directory, or to `data_dir`.
+///
+/// # Errors
+/// A bad input for an absolute name, or one whose `..` leave that directory.
+fn resolve(json: &str, field: &str, name: &str, data_dir: Option<&Path>) -> CliResult<PathBuf> {
+    use std::path::Component;
+    let (base, dir_words) = match data_dir {
+        Some(d) => (d.to_path_buf(), "--data-dir"),
+        None => (
+            Path::new(json)
+                .parent()
+                .unwrap_or(Path::new(""))
+                .to_path_buf(),
+            "the report's directory",
+        ),
+    };
+    let refuse = |what: &str| {
+        CliError::input(format!(
+            "{json}: field `{field}`: `{name}` is {what}: rtest report reads the files a report names relative to {dir_words}, never elsewhere (give the files beside the report, or --data-dir DIR with the names relative to DIR)"
+        ))
+    };
+    let mut depth = 0usize;
+    for c in Path::new(name).components() {
+        match c {
+            Component::Prefix(_) | Component::RootDir => return Err(refuse("an absolute path")),
+            Component::CurDir => {}
+            Component::ParentDir => {
+                depth = depth
+                    .checked_sub(1)
+                    .ok_or_else(|| refuse(&format!("a path that leaves {dir_words}")))?;
+            }
+            Component::Normal(_) => depth += 1,
+        }
+    }
+    Ok(base.join(name))
+}
+
+/// Reads every regular file of `named` (at most its kind's bytes), hashed as read, and lists
+/// it in `files` (once: a file two reports name, or that is given itself, is listed once);
+/// anything else (a pipe, a device, a directory, a missing file) is listed as not hashed, and
+/// never opened. The records' bytes are kept for the figures.
+fn read_named(named: &[Named], files: &mut Vec<InputFile>) -> Records {
+    let mut records = Records::new();
+    for n in named {
+        let shown = n.at.display().to_string();
+        let read = read_regular(&n.at, n.max_bytes);
+        if !files.iter().any(|f| same_path(Path::new(&f.path), &n.at)) {
+            files.push(match &read {
+                Ok((_, digest)) => InputFile::read(n.role, &shown, &n.at, digest.clone()),
+                Err(why) => InputFile::not_hashed(n.role, &shown, Some(&n.at), why),
+            });
+        }
+        if n.field.starts_with("records[") && !n.role.starts_with("diagnosis") {
+            let at = n.at.display();
+            records.insert(
+                (n.json.clone(), n.name.clone()),
+                read.map(|(bytes, _)| bytes)
+                    .map_err(|why| format!("{at}: {why}")),
+            );
+        }
+    }
+    records
+}
+
+/// Whether `a` and `b` name the same file: equal once `./` prefixes are dropped, or both
+/// found and the same file (resolved without opening either).
+fn same_path(a: &Path, b: &Path) -> bool {
+    let plain = |p: &Path| {
+        p.components()
+            .filter(|c| *c != std::path::Component::CurDir)
+            .collect::<PathBuf>()
+    };
+    if plain(a) == plain(b) {
+        return true;
+    }
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// The bytes of the regular file at `path` (at most `max_bytes`) and their digest, or why it
+/// is not read (one line): not a regular file (a pipe, a device, a directory, or a link to
+/// one: told by `metadata`, and the file is opened without blocking so that one swapped in
+/// meanwhile cannot make the report wait), missing, unreadable or too large.
+fn read_regular(path: &Path, max_bytes: u64) -> Result<(Vec<u8>, Digest), String> {
+    const NOT_REGULAR: &str = "not a regular file";
+    let meta = std::fs::metadata(path).map_err(|e| format!("cannot be read here ({e})"))?;
+    if !meta.is_file() {
+        return Err(NOT_REGULAR.into());
+    }
+    let mut open = std::fs::OpenOptions::new();
+    open.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        open.custom_flags(O_NONBLOCK);
+    }
+    let file = open
+        .open(path)
+        .map_err(|e| format!("cannot be read here ({e})"))?;
+    if !file.metadata().is_ok_and(|m| m.is_file()) {
+        return Err(NOT_REGULAR.into());
+    }
+    model_spec::text::read_bytes_from(&path.display().to_string(), file, max_bytes).map_err(|e| {
+        match e {
+            model_spec::text::TextError::TooLarge { limit, .. } => {
+                format!("larger than {limit} bytes, the most a file of its kind may have")
+            }
+            model_spec::text::TextError::Io { error, .. } => {
+                format!("cannot be read here ({error})")
+            }
+            other => other.to_string(),
+        }
+    })
+}
+
+/// `O_NONBLOCK` of `open(2)`: opening a FIFO for reading returns at once instead of waiting
+/// for a writer (a regular file reads as without it).
+#[cfg(any(target_os = "linux", target_os = "android"))]
+const O_NONBLOCK: i32 = 0o4000;
+#[cfg(any(
+    target_os = "macos",
+    target_os = "ios",
+    target_os = "freebsd",
+    target_os = "netbsd",
+    target_os = "openbsd",
+    target_os = "dragonfly"
+))]
+const O_NONBLOCK: i32 = 0x0004;
+/// No known `O_NONBLOCK` here: the type told by `metadata` before opening decides alone.
+#[cfg(all(
+    unix,
+    not(any(
+        target_os = "linux",
+        target_os = "android",
+        target_os = "macos",
+        target_os = "ios",
+        target_os = "freebsd",
+        target_os = "netbsd",
+        target_os = "openbsd",
+        target_os = "dragonfly"
+    ))
+))]
+const O_NONBLOCK: i32 = 0;
 
 /// A record whose measured error is drawn against the identified model's prediction along
 /// its path.

@@ -143,20 +143,21 @@ pub fn run(args: &ValidateArgs) -> CliResult {
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
     let instrument = args.instrument.load()?;
     let through = instrument.as_ref().map(|(i, f)| (i, *f));
-    let file_list = match &args.campaign {
-        Some(path) => solver::io::campaign::read_campaign_file(path, &m)
-            .map_err(|e| CliError::input(format!("--campaign: {e}")))?
-            .records
-            .iter()
-            .map(|r| r.path.clone())
-            .collect(),
+    let campaign_file = match &args.campaign {
+        Some(path) => Some(campaign::read_file("--campaign", &m, path)?),
+        None => None,
+    };
+    let file_list: Vec<PathBuf> = match &campaign_file {
+        Some((f, _)) => f.records.iter().map(|r| r.path.clone()).collect(),
         None => files.clone(),
     };
     let mut loaded = {
         let (_bar, read) = super::progress::reading_all(shown, &file_list, &read);
-        match &args.campaign {
-            Some(path) => campaign::from_file("--campaign", &m, path, &read, through)?,
-            None => {
+        match (&args.campaign, campaign_file) {
+            (Some(path), Some(file)) => {
+                campaign::from_file("--campaign", &m, path, file, &read, through)?
+            }
+            _ => {
                 let params = super::pose_args::params(&m, args.param.as_deref())?;
                 campaign::from_files("--data", &m, &files, &params, args.zeroed, &read, through)?
             }

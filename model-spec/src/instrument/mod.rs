@@ -51,7 +51,7 @@ pub use validate::parse_instrument;
 
 use crate::SpecError;
 use crate::limits::MAX_FILE_BYTES;
-use crate::text::{TextError, read_text};
+use crate::text::{TextError, read_text_hashed};
 use std::path::Path;
 
 /// The noise σ of a sensor whose description gives none, µm: the repeatability of a good
@@ -286,15 +286,24 @@ pub enum InstrumentLoadError {
 }
 
 /// An instrument given by preset name or by the path of a TOML file (read with
-/// [`read_text`], at most [`MAX_FILE_BYTES`] bytes, named in messages as given).
+/// [`crate::text::read_text`], at most [`MAX_FILE_BYTES`] bytes, named in messages as given).
 pub fn load_instrument(name_or_path: &str) -> Result<Instrument, InstrumentLoadError> {
+    load_instrument_hashed(name_or_path).map(|(i, _)| i)
+}
+
+/// [`load_instrument`], with the digest of the file's bytes as read (the file is opened once;
+/// `None` for a preset).
+pub fn load_instrument_hashed(
+    name_or_path: &str,
+) -> Result<(Instrument, Option<crate::sha256::Digest>), InstrumentLoadError> {
     if let Some(found) = preset(name_or_path) {
-        return found.map_err(InstrumentLoadError::Spec);
+        return found.map(|i| (i, None)).map_err(InstrumentLoadError::Spec);
     }
     let path = Path::new(name_or_path);
     if !path.exists() {
         return Err(InstrumentLoadError::NotFound(name_or_path.to_string()));
     }
-    let text = read_text(path, MAX_FILE_BYTES).map_err(InstrumentLoadError::Io)?;
-    parse_instrument(name_or_path, &text).map_err(InstrumentLoadError::Spec)
+    let (text, digest) = read_text_hashed(path, MAX_FILE_BYTES).map_err(InstrumentLoadError::Io)?;
+    let i = parse_instrument(name_or_path, &text).map_err(InstrumentLoadError::Spec)?;
+    Ok((i, Some(digest)))
 }

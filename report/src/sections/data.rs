@@ -96,22 +96,22 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
             .files
             .iter()
             .map(|f| match &f.digest {
-                Some((hash, bytes)) => vec![
+                Ok(digest) => vec![
                     Cell::text(f.role.clone()),
                     Cell::text(f.path.clone()),
-                    Cell::number(bytes.to_string()),
+                    Cell::number(digest.bytes.to_string()),
                     Cell::text(f.modified.clone().unwrap_or_else(|| "–".into())),
                     Cell::Markup(format!(
                         "<span class=\"hash\">{}</span>",
-                        crate::html::escape(hash)
+                        crate::html::escape(&digest.sha256)
                     )),
                 ],
-                None => vec![
+                Err(why) => vec![
                     Cell::text(f.role.clone()),
                     Cell::text(f.path.clone()),
                     Cell::number("–"),
-                    Cell::text("–"),
-                    Cell::text("not readable from here: no hash"),
+                    Cell::text(f.modified.clone().unwrap_or_else(|| "–".into())),
+                    Cell::text(format!("not hashed: {why}")),
                 ],
             })
             .collect();

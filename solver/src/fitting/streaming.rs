@@ -193,7 +193,10 @@ pub fn identify_streaming<E: std::error::Error + 'static>(
 /// `dx0 dy0 dz0`). A model with `time:K` or `exp:TAU` terms costs one more pass over the file
 /// for the record's time span (`rate` and `warmup:TAU` do not: they count from time 0, and
 /// are read from a pipe in one pass); `velocity` terms are refused ([`identify_streaming`]).
-/// Fewer readings than parameters plus one is an error, as in memory.
+/// Fewer readings than parameters plus one is an error, as in memory. The [`Digest`] is that of
+/// the bytes of the pass that was fitted, hashed as they were read.
+///
+/// [`Digest`]: model_spec::sha256::Digest
 pub fn identify_file(
     m: &Machine,
     model: &Model,
@@ -201,7 +204,14 @@ pub fn identify_file(
     opts: &IdentifyOptions,
     block: usize,
     read: &ReadOptions,
-) -> Result<(Identification, StreamingIdentification), StreamingError<CsvError>> {
+) -> Result<
+    (
+        Identification,
+        StreamingIdentification,
+        model_spec::sha256::Digest,
+    ),
+    StreamingError<CsvError>,
+> {
     let fitted = opts.fitted_model(model);
     let mut source = gain_source(m, model, opts)?;
     let has_time = fitted
@@ -216,7 +226,16 @@ pub fn identify_file(
     } else {
         None
     };
-    let blocks = MeasurementBlocks::open(path, m, block, read).map_err(StreamingError::Read)?;
+    let file = path.display().to_string();
+    let opened = std::fs::File::open(path).map_err(|source| {
+        StreamingError::Read(CsvError::Io {
+            file: file.clone(),
+            source,
+        })
+    })?;
+    let mut hashed = model_spec::sha256::HashingReader::new(opened);
+    let blocks =
+        MeasurementBlocks::new(file, &mut hashed, m, block, read).map_err(StreamingError::Read)?;
     let run = identify_streaming(
         m,
         &fitted,
@@ -234,5 +253,5 @@ pub fn identify_file(
         opts.zeroed,
         &source,
     );
-    Ok((ident, run))
+    Ok((ident, run, hashed.digest()))
 }

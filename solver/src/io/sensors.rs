@@ -137,8 +137,23 @@ pub fn read_sensor_measurement(
         file: file.clone(),
         source,
     })?;
-    let sensors = read_sensor_csv(&file, f, m, instrument, opts)?;
-    sensor_measurement(&file, m, instrument, frame, &sensors, opts)
+    read_sensor_measurement_from(&file, f, m, instrument, frame, opts)
+}
+
+/// [`read_sensor_measurement`] of the bytes of `reader` (named `file` in messages).
+///
+/// # Errors
+/// As [`read_sensor_measurement`].
+pub fn read_sensor_measurement_from<R: Read>(
+    file: &str,
+    reader: R,
+    m: &Machine,
+    instrument: &Instrument,
+    frame: ReadingsFrame,
+    opts: &ReadOptions,
+) -> Result<Record, CsvError> {
+    let sensors = read_sensor_csv(file, reader, m, instrument, opts)?;
+    sensor_measurement(file, m, instrument, frame, &sensors, opts)
 }
 
 /// [`read_sensor_measurement`] of the text `text` (named `file` in messages).

@@ -25,9 +25,10 @@ mod parse;
 pub use parse::parse_campaign;
 
 use crate::fitting::campaign::{Campaign, CampaignError, CampaignRecord, label_char};
-use crate::io::csv::{CsvError, ReadOptions, read_measurement};
+use crate::io::csv::{CsvError, ReadOptions};
 use model_spec::Machine;
 use model_spec::instrument::{Instrument, ReadingsFrame};
+use model_spec::sha256::{Digest, HashingReader};
 use model_spec::text::TextError;
 use std::path::{Path, PathBuf};
 
@@ -163,7 +164,10 @@ pub fn machine_at(m: &Machine, params: &[f64]) -> Machine {
 /// Reads the measurement CSV at `path` planned at kinematic parameters `params` (mm): as
 /// [`read_measurement`] with the machine's defaults replaced by `params`; with an `instrument`
 /// (and the frame of its readings) a CSV of sensor readings turned into error vectors with
-/// their covariances ([`crate::io::sensors::read_sensor_measurement`]).
+/// their covariances ([`crate::io::sensors::read_sensor_measurement`]). The file is opened
+/// once; the [`Digest`] is that of the bytes read.
+///
+/// [`read_measurement`]: crate::io::csv::read_measurement
 ///
 /// # Errors
 /// As [`read_measurement`] and [`crate::io::sensors::read_sensor_measurement`].
@@ -173,11 +177,35 @@ pub fn read_record_at(
     params: &[f64],
     opts: &ReadOptions,
     instrument: Option<(&Instrument, ReadingsFrame)>,
+) -> Result<(crate::record::Record, Digest), CsvError> {
+    let file = path.display().to_string();
+    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    let mut source = HashingReader::new(f);
+    let record = parse_record_at(&file, &mut source, m, params, opts, instrument)?;
+    Ok((record, source.digest()))
+}
+
+/// [`read_record_at`] of the bytes of `reader` (named `file` in messages).
+///
+/// # Errors
+/// As [`read_record_at`].
+pub fn parse_record_at(
+    file: &str,
+    reader: impl std::io::Read,
+    m: &Machine,
+    params: &[f64],
+    opts: &ReadOptions,
+    instrument: Option<(&Instrument, ReadingsFrame)>,
 ) -> Result<crate::record::Record, CsvError> {
     let at = machine_at(m, params);
     match instrument {
-        None => read_measurement(path, &at, opts),
-        Some((i, frame)) => crate::io::sensors::read_sensor_measurement(path, &at, i, frame, opts),
+        None => crate::io::csv::read_csv(file, reader, &at, crate::io::csv::Need::Measured, opts),
+        Some((i, frame)) => {
+            crate::io::sensors::read_sensor_measurement_from(file, reader, &at, i, frame, opts)
+        }
     }
 }
 
@@ -202,35 +230,26 @@ pub fn parameters_note(m: &Machine, params: &[f64]) -> String {
     }
 }
 
-/// Reads the campaign file at `path` for machine `m` (records not loaded).
+/// Reads the campaign file at `path` for machine `m` (records not loaded), with the digest of
+/// the bytes read (the file is opened once). The records are read by [`CampaignFile::load`].
 ///
 /// # Errors
 /// [`CampaignFileError::Text`] or [`CampaignFileError::Invalid`].
-pub fn read_campaign_file(path: &Path, m: &Machine) -> Result<CampaignFile, CampaignFileError> {
-    let text = model_spec::text::read_text(path, MAX_CAMPAIGN_BYTES)?;
-    let dir = path.parent().unwrap_or(Path::new(""));
-    parse_campaign(&path.display().to_string(), &text, dir, m)
-}
-
-/// Reads the campaign file at `path` and every record's CSV (each at its own kinematic
-/// parameters, with `opts`): the file and the campaign.
-///
-/// # Errors
-/// As [`read_campaign_file`]; [`CampaignFileError::Record`] for a CSV that cannot be read;
-/// [`CampaignFileError::Campaign`] for records that do not make a campaign.
-pub fn load_campaign(
+pub fn read_campaign_file(
     path: &Path,
     m: &Machine,
-    opts: &ReadOptions,
-    instrument: Option<(&Instrument, ReadingsFrame)>,
-) -> Result<(CampaignFile, Campaign), CampaignFileError> {
-    let f = read_campaign_file(path, m)?;
-    let c = f.load(m, opts, instrument)?;
-    Ok((f, c))
+) -> Result<(CampaignFile, Digest), CampaignFileError> {
+    let (text, digest) = model_spec::text::read_text_hashed(path, MAX_CAMPAIGN_BYTES)?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    Ok((
+        parse_campaign(&path.display().to_string(), &text, dir, m)?,
+        digest,
+    ))
 }
 
 impl CampaignFile {
-    /// Reads every record's CSV at its kinematic parameters (with `opts`) into a campaign.
+    /// Reads every record's CSV at its kinematic parameters (with `opts`) into a campaign, with
+    /// the digest of each record's bytes as read (in record order).
     ///
     /// # Errors
     /// [`CampaignFileError::Record`] naming the record and the CSV's own line;
@@ -240,18 +259,17 @@ impl CampaignFile {
         m: &Machine,
         opts: &ReadOptions,
         instrument: Option<(&Instrument, ReadingsFrame)>,
-    ) -> Result<Campaign, CampaignFileError> {
+    ) -> Result<(Campaign, Vec<Digest>), CampaignFileError> {
         let mut records = Vec::with_capacity(self.records.len());
+        let mut digests = Vec::with_capacity(self.records.len());
         for e in &self.records {
-            let record =
-                read_record_at(&e.path, m, &e.params, opts, instrument).map_err(|error| {
-                    CampaignFileError::Record {
-                        at: parameters_note(m, &e.params),
-                        campaign: self.file.clone(),
-                        line: e.line,
-                        label: e.label.clone(),
-                        error: Box::new(error),
-                    }
+            let (record, digest) = read_record_at(&e.path, m, &e.params, opts, instrument)
+                .map_err(|error| CampaignFileError::Record {
+                    at: parameters_note(m, &e.params),
+                    campaign: self.file.clone(),
+                    line: e.line,
+                    label: e.label.clone(),
+                    error: Box::new(error),
                 })?;
             if e.start_s.is_some() && !record.has_times() {
                 return Err(CampaignFileError::Invalid {
@@ -274,10 +292,12 @@ impl CampaignFile {
             );
             r.start_s = e.start_s;
             records.push(r);
+            digests.push(digest);
         }
-        Campaign::new(records).map_err(|error| CampaignFileError::Campaign {
+        let campaign = Campaign::new(records).map_err(|error| CampaignFileError::Campaign {
             file: self.file.clone(),
             error,
-        })
+        })?;
+        Ok((campaign, digests))
     }
 }

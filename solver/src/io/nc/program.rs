@@ -260,3 +260,53 @@ pub(crate) fn parse(
         poses,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use model_spec::AxisKind::{Linear, Rotary};
+
+    fn axes() -> [AxisWord; 2] {
+        [
+            AxisWord {
+                letter: 'X',
+                kind: Linear,
+            },
+            AxisWord {
+                letter: 'C',
+                kind: Rotary,
+            },
+        ]
+    }
+
+    #[test]
+    fn a_program_over_the_pose_limit_is_refused() {
+        let text = "%\nG90 G1 X0 C0\nC1 (second)\n\nC2\nC3\nM30\n%\n";
+        let p = parse("p.nc", text.into(), Dialect::Iso, &axes(), 4).unwrap();
+        assert_eq!(p.pose_list().len(), 4);
+        let e = parse("p.nc", text.into(), Dialect::Iso, &axes(), 3).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "p.nc: more than 3 poses (blocks that move; line 6 holds the first beyond): rtest reads at most 3 poses from one program; split it"
+        );
+        // The refusal names the line of the first pose beyond the limit.
+        let e = parse("p.nc", text.into(), Dialect::Iso, &axes(), 2).unwrap_err();
+        assert!(
+            e.to_string().contains("line 5 holds the first beyond"),
+            "{e}"
+        );
+        let h = "1 L X+0 C+0 R0 FMAX\n2 L C+1\n; a comment\n; another\n3 L C+2\n";
+        let p = parse("p.h", h.into(), Dialect::Heidenhain, &axes(), 3).unwrap();
+        assert_eq!(p.pose_list().commands(2), [0.0, 2.0]);
+        assert_eq!(p.pose_list().line(2), 5);
+        let e = parse("p.h", h.into(), Dialect::Heidenhain, &axes(), 2).unwrap_err();
+        assert!(
+            e.to_string().contains("line 5 holds the first beyond"),
+            "{e}"
+        );
+        // A refused block before the limit is reached is what is reported.
+        let bad = "G90 G1 X0 C0\nC1\nG91\nC2\nC3\n";
+        let e = parse("p.nc", bad.into(), Dialect::Iso, &axes(), 2).unwrap_err();
+        assert!(e.to_string().starts_with("p.nc:3:1: `G91`"), "{e}");
+    }
+}

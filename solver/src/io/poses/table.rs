@@ -587,3 +587,36 @@ pub fn read_pose_file(path: &Path, axes: &[AxisWord]) -> Result<PoseTable, PoseC
     let text = read_keeping_bom(path).map_err(PoseCsvError::Text)?;
     read_table(&path.display().to_string(), text, axes, MAX_POSES)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use model_spec::AxisKind::{Linear, Rotary};
+
+    #[test]
+    fn a_table_over_the_pose_limit_is_refused() {
+        let axes = [
+            AxisWord {
+                letter: 'X',
+                kind: Linear,
+            },
+            AxisWord {
+                letter: 'C',
+                kind: Rotary,
+            },
+        ];
+        let text = "# poses\nid,X,C\n1,0,0\n2,0,1\n\n3,0,2\n";
+        let t = read_table("p.csv", text.into(), &axes, 3).unwrap();
+        assert_eq!(t.pose_list().line(2), 6);
+        for max in [2, 1] {
+            let e = read_table("p.csv", text.into(), &axes, max).unwrap_err();
+            assert_eq!(
+                e.to_string(),
+                format!(
+                    "p.csv:{}: more than {max} rows of poses: rtest reads at most {max} poses from one file; split it",
+                    if max == 2 { 6 } else { 4 }
+                )
+            );
+        }
+    }
+}

@@ -319,7 +319,7 @@ impl Correction<'_> {
     ) -> CliResult<Summary> {
         let m = self.m;
         let mut in_file_units = vec![0.0; m.axes.len()];
-        let mut sink = |_: usize, q: &[f64]| {
+        let sink = |_: usize, q: &[f64]| {
             to_file_units_into(m, q, &mut in_file_units);
             write(&in_file_units)
         };
@@ -331,7 +331,7 @@ impl Correction<'_> {
             self.file,
             &source,
             self.values_at,
-            &mut sink,
+            sink,
         )
         .map_err(|e| match e {
             Stopped::Run(e @ RunError::NotConverged { .. }) => {

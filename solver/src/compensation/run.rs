@@ -210,16 +210,15 @@ pub fn compensate_poses(
     values_at: &(dyn Fn(&[f64], &mut [f64]) + Sync),
 ) -> Result<Compensated, RunError> {
     let mut corrected = Vec::with_capacity(poses.len());
-    let mut keep = |_: usize, q: &[f64]| -> Result<(), Infallible> {
+    let keep = |_: usize, q: &[f64]| -> Result<(), Infallible> {
         corrected.push(q.to_vec());
         Ok(())
     };
-    let summary = compensate_each(m, errors, params, file, &poses, values_at, &mut keep).map_err(
-        |e| match e {
+    let summary =
+        compensate_each(m, errors, params, file, &poses, values_at, keep).map_err(|e| match e {
             Stopped::Run(e) => e,
             Stopped::Sink(never) => match never {},
-        },
-    )?;
+        })?;
     Ok(Compensated {
         poses: corrected,
         summary,
@@ -248,7 +247,7 @@ pub fn compensate_each<E>(
     file: &str,
     poses: &dyn PoseSource,
     values_at: &(dyn Fn(&[f64], &mut [f64]) + Sync),
-    sink: &mut dyn FnMut(usize, &[f64]) -> Result<(), E>,
+    mut sink: impl FnMut(usize, &[f64]) -> Result<(), E>,
 ) -> Result<Summary, Stopped<E>> {
     let run = |e: RunError| Stopped::Run(e);
     let n = poses.count();

@@ -5,9 +5,10 @@
 use crate::io::poses::CommandedPose;
 
 /// The most poses read from one file (an NC program or a CSV of commanded poses): 10⁷. A
-/// 256 MiB file ([`crate::io::poses::MAX_FILE_BYTES`]) of the shortest blocks could hold about
-/// 5·10⁷; 10⁷ poses of a five-axis machine hold 440 MB and take about 20 s to correct on two
-/// cores. A file with more is refused before any pose is corrected, without holding its poses.
+/// 256 MiB file ([`crate::io::poses::MAX_FILE_BYTES`]) of the shortest blocks (`C1` and a line
+/// end) could hold 9·10⁷; 10⁷ poses of a five-axis machine hold 440 MB and take about 20 s of
+/// processor time to correct. A file with more is refused before any pose is corrected,
+/// without holding its poses.
 pub const MAX_POSES: usize = 10_000_000;
 
 /// Commanded poses in the order of their file: per pose, its 1-based line and the command of

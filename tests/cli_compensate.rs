@@ -400,6 +400,70 @@ fn bad_input_refused_without_output() {
     }
 }
 
+/// A program of more poses than rtest reads, or poses outside a stroke by the dozen: refused
+/// before any pose is corrected, with the file and the limit, or the first poses and the count
+/// of the others; nothing written.
+#[test]
+fn too_many_poses_refused_before_the_correction() {
+    use solver::io::poses::MAX_POSES;
+    let dir = set_up("limit");
+    let d = &dir.0;
+    let mut long = String::with_capacity(3 * MAX_POSES + 64);
+    long.push_str("G90 G1 X0 Y0 Z0 A-30 C0\n");
+    for _ in 0..MAX_POSES {
+        long.push_str("C1\n");
+    }
+    std::fs::write(d.join("long.nc"), long).unwrap();
+    let args = [
+        "compensate",
+        "--machine",
+        "seed-ac",
+        "--params",
+        "id.json",
+        "--path",
+        "long.nc",
+        "--nc",
+        "iso",
+        "-o",
+        "o.nc",
+    ];
+    let limit = format!("more than {MAX_POSES} poses");
+    let err = fails(d, &args, 1, &["--path", "long.nc", &limit]);
+    assert!(err.contains(&format!("line {}", MAX_POSES + 1)), "{err}");
+    let mut far = String::from("X,Y,Z,A,C\n0,0,0,0,0\n");
+    for _ in 0..12 {
+        far.push_str("9999,0,0,0,0\n");
+    }
+    std::fs::write(d.join("far.csv"), far).unwrap();
+    let err = fails(
+        d,
+        &[
+            "compensate",
+            "--machine",
+            "seed-ac",
+            "--params",
+            "id.json",
+            "--path",
+            "far.csv",
+            "-o",
+            "o.csv",
+        ],
+        1,
+        &[
+            "far.csv: 12 commanded pose(s) are outside",
+            "line 3:",
+            "and 2 more",
+        ],
+    );
+    assert!(
+        err.contains("line 12:") && !err.contains("line 13:"),
+        "{err}"
+    );
+    for f in ["o.nc", "o.csv"] {
+        assert!(!d.join(f).exists(), "{f} written on failure");
+    }
+}
+
 /// The loop in commands: compensate K4, run the compensated path on the machine (the record
 /// labelled with the program's poses, as a compensating controller reports them), identify
 /// again: the compensated errors are gone (within the two identifications' noise), the ball's

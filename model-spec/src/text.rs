@@ -97,7 +97,14 @@ pub fn read_bytes_hashed(path: &Path, max_bytes: u64) -> Result<(Vec<u8>, Digest
         error,
     };
     let handle = std::fs::File::open(path).map_err(io)?;
-    read_bytes_from(&file, handle, max_bytes)
+    // Room for the whole file at once (a pipe's length is not known: then grown as read).
+    let size = handle.metadata().map_or(0, |m| m.len().min(max_bytes));
+    read_into(
+        &file,
+        handle,
+        max_bytes,
+        Vec::with_capacity(size as usize + 1),
+    )
 }
 
 /// At most `max_bytes` bytes of `source` (named `file` in messages) with their [`Digest`]:
@@ -107,7 +114,16 @@ pub fn read_bytes_from(
     source: impl Read,
     max_bytes: u64,
 ) -> Result<(Vec<u8>, Digest), TextError> {
-    let mut bytes = Vec::new();
+    read_into(file, source, max_bytes, Vec::new())
+}
+
+/// [`read_bytes_from`] into `bytes` (empty, with the capacity the caller expects).
+fn read_into(
+    file: &str,
+    source: impl Read,
+    max_bytes: u64,
+    mut bytes: Vec<u8>,
+) -> Result<(Vec<u8>, Digest), TextError> {
     source
         .take(max_bytes.saturating_add(1))
         .read_to_end(&mut bytes)

@@ -7,12 +7,13 @@ use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text
 use model_spec::units::{compact, readable};
 use output::{Outputs, Target};
 use solver::compensation::kinematics::corrected_description;
-use solver::compensation::run::{CommandedPose, compensate_poses};
+use solver::compensation::run::{PoseSource, RunError, Stopped, Summary, compensate_each};
 use solver::compensation::tables::{Pitch, axis_tables};
 use solver::compensation::values::{CompensationError, MachineErrors};
 use solver::io::nc::{Dialect, WriteOptions, parse_program};
 use solver::io::poses::{
-    MAX_FILE_BYTES, axis_words, from_file_units, read_pose_csv, to_file_units,
+    PoseList, axis_words, from_file_units, from_file_units_into, read_keeping_bom, read_pose_csv,
+    to_file_units_into,
 };
 use solver::io::report::compensate::{CompensationReport, CompensationSource, KinematicsReport};
 use solver::io::report::read::parse_identification;
@@ -182,58 +183,42 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     if let (Some(path), Some(out)) = (&args.path, &args.output) {
         let words = axis_words(&m);
         let file = path.display().to_string();
-        let to_rad = |c: &[f64]| from_file_units(&m, c);
-        let to_deg = |c: &[f64]| to_file_units(&m, c);
         let values_at = |q: &[f64], out: &mut [f64]| errors.values_at(&m, q, out);
-        let run = |poses: &[solver::io::poses::CommandedPose],
-                   values_at: &(dyn Fn(&[f64], &mut [f64]) + Sync)| {
-            let commanded: Vec<CommandedPose> = poses
-                .iter()
-                .map(|p| CommandedPose {
-                    line: p.line,
-                    commands: to_rad(&p.commands),
-                })
-                .collect();
-            compensate_poses(
-                &m,
-                errors.errors(),
-                params.clone(),
-                &file,
-                &commanded,
-                values_at,
-            )
-            .map_err(|e| match e {
-                solver::compensation::run::RunError::NotConverged { .. } => {
-                    CliError::computation(format!("--path: {e}"))
-                }
-                other => CliError::input(format!("--path: {other}")),
-            })
+        let correct = Correction {
+            m: &m,
+            errors: errors.errors(),
+            params: &params,
+            file: &file,
+            values_at: &values_at,
         };
-        let (path_text, digest) = read_keeping_bom(path)?;
+        let (path_text, digest) =
+            read_keeping_bom(path).map_err(|e| CliError::input(format!("--path: {e}")))?;
         read_files.push(ReadFile::new("--path", path, digest));
         let (text, rounding, format, s) = match &args.nc {
             Some(name) => {
                 let dialect = Dialect::from_name(name).expect("clap checks the dialect");
                 let program = parse_program(&file, &path_text, dialect, &words)
                     .map_err(|e| CliError::input(format!("--path: {e}")))?;
-                let done = run(program.poses(), &values_at)?;
-                let corrected: Vec<Vec<f64>> = done.poses.iter().map(|q| to_deg(q)).collect();
                 let options = WriteOptions::with_min_decimals(args.decimals.unwrap_or(0));
-                let written = program
-                    .write(&corrected, &options)
+                let mut writer = program
+                    .writer(&options)
                     .map_err(|e| CliError::input(format!("-o: {e}")))?;
-                let rounding = to_rad(&written.rounding);
-                (written.text, Some(rounding), name.clone(), done.summary)
+                let s = correct.run(program.pose_list(), |q| writer.pose(q))?;
+                let written = writer
+                    .finish()
+                    .map_err(|e| CliError::input(format!("-o: {e}")))?;
+                let rounding = from_file_units(&m, &written.rounding);
+                (written.text, Some(rounding), name.clone(), s)
             }
             None => {
                 let table = read_pose_csv(&file, &path_text, &words)
                     .map_err(|e| CliError::input(format!("--path: {e}")))?;
-                let done = run(table.poses(), &values_at)?;
-                let corrected: Vec<Vec<f64>> = done.poses.iter().map(|q| to_deg(q)).collect();
-                let text = table
-                    .write(&corrected)
+                let mut writer = table.writer();
+                let s = correct.run(table.pose_list(), |q| writer.pose(q))?;
+                let text = writer
+                    .finish()
                     .map_err(|e| CliError::input(format!("-o: {e}")))?;
-                (text, None, "csv".to_string(), done.summary)
+                (text, None, "csv".to_string(), s)
             }
         };
         files.add("-o", out.clone(), text);
@@ -331,6 +316,69 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     print_text(&text, stdout_taken)
 }
 
+/// The correction of the poses of `--path`: what [`compensate_each`] takes besides the poses.
+struct Correction<'a> {
+    m: &'a model_spec::Machine,
+    errors: &'a [model_spec::ErrorId],
+    params: &'a [f64],
+    file: &'a str,
+    values_at: &'a (dyn Fn(&[f64], &mut [f64]) + Sync),
+}
+
+impl Correction<'_> {
+    /// Corrects `poses` (mm and degrees, as the file holds them), handing each corrected pose
+    /// (mm and degrees) to `write`, the writer of `-o`; the summary.
+    fn run<E: std::fmt::Display>(
+        &self,
+        poses: &PoseList,
+        mut write: impl FnMut(&[f64]) -> Result<(), E>,
+    ) -> CliResult<Summary> {
+        let m = self.m;
+        let mut in_file_units = vec![0.0; m.axes.len()];
+        let sink = |_: usize, q: &[f64]| {
+            to_file_units_into(m, q, &mut in_file_units);
+            write(&in_file_units)
+        };
+        let source = InRadians { m, poses };
+        compensate_each(
+            m,
+            self.errors,
+            self.params.to_vec(),
+            self.file,
+            &source,
+            self.values_at,
+            sink,
+        )
+        .map_err(|e| match e {
+            Stopped::Run(e @ RunError::NotConverged { .. }) => {
+                CliError::computation(format!("--path: {e}"))
+            }
+            Stopped::Run(other) => CliError::input(format!("--path: {other}")),
+            Stopped::Sink(e) => CliError::input(format!("-o: {e}")),
+        })
+    }
+}
+
+/// The poses of a file (mm and degrees) as the compensation reads them (mm and rad).
+struct InRadians<'a> {
+    m: &'a model_spec::Machine,
+    poses: &'a PoseList,
+}
+
+impl PoseSource for InRadians<'_> {
+    fn count(&self) -> usize {
+        self.poses.len()
+    }
+
+    fn line(&self, i: usize) -> usize {
+        self.poses.line(i)
+    }
+
+    fn commands_into(&self, i: usize, out: &mut [f64]) {
+        from_file_units_into(self.m, self.poses.commands(i), out);
+    }
+}
+
 /// The HTML report (`--report`) of the identification of `--params` (`params_text`, read from
 /// `params_file`) and of `report`, the compensation just computed; `inputs` as read.
 fn html_report(
@@ -350,18 +398,6 @@ fn html_report(
     )
     .map_err(|e| CliError::computation(format!("--report: {e}")))?;
     super::report::render("--report", &i)
-}
-
-/// The text of the commanded poses at `path` (at most [`MAX_FILE_BYTES`], UTF-8, a byte-order
-/// mark kept as its first character, so that the file written back keeps it too), with the
-/// digest of the bytes read (the file is opened once).
-fn read_keeping_bom(path: &std::path::Path) -> CliResult<(String, model_spec::sha256::Digest)> {
-    let fail = |e: model_spec::text::TextError| CliError::input(format!("--path: {e}"));
-    let (bytes, digest) =
-        model_spec::text::read_bytes_hashed(path, MAX_FILE_BYTES).map_err(fail)?;
-    let bom = bytes.starts_with(b"\xef\xbb\xbf");
-    let text = model_spec::text::decode_text(&path.display().to_string(), bytes).map_err(fail)?;
-    Ok((if bom { format!("\u{feff}{text}") } else { text }, digest))
 }
 
 /// The note on the machine's kinematic symbols: where the records of the identification were

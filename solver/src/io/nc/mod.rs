@@ -12,7 +12,12 @@
 //! Two dialects ([`Dialect`]): ISO G-code ([`Dialect::Iso`]: `G90 G1 X10.5 Y-3 A0 C90 F2000`)
 //! and Heidenhain conversational ([`Dialect::Heidenhain`]: `7 L X+10.5 Y-3 A+0 C+90 R0 FMAX`).
 //!
-//! Written back ([`NcProgram::write`]), only the axis words of the blocks that move change:
+//! A program is held as its text and its poses ([`PoseList`]: 8 bytes per axis and 4 per pose),
+//! nothing per word: the writer reads the blocks again (the same reading, so the same words) to
+//! find the words it rewrites. At most [`MAX_POSES`] poses are read.
+//!
+//! Written back ([`NcProgram::writer`], pose after pose, or [`NcProgram::write`]), only the
+//! axis words of the blocks that move change:
 //! each keeps the decimals and the style of the program's word, and the words of axes a block
 //! left modal are inserted after its last axis word where the correction changes them. Every
 //! other byte is kept (lines, comments, block numbers, spaces, line ends). The largest
@@ -29,8 +34,8 @@
 //! ];
 //! let text = "%\nN10 G90 G0 X0 Y0 C0\nN20 G1 X10.5 F500 (cut)\n%\n";
 //! let p = parse_program("a.nc", text, Dialect::Iso, &axes).unwrap();
-//! assert_eq!(p.poses()[1].line, 3);
-//! assert_eq!(p.poses()[1].commands, [10.5, 0.0, 0.0]);
+//! assert_eq!(p.pose_list().line(1), 3);
+//! assert_eq!(p.pose_list().commands(1), [10.5, 0.0, 0.0]);
 //! let corrected = [vec![0.0, 0.0, 0.0], vec![10.52, 0.004, 0.0]];
 //! // At the program's resolution (0.1 mm for X, 1 mm for Y) nothing changes, at a cost:
 //! let w = p.write(&corrected, &WriteOptions::new()).unwrap();
@@ -55,11 +60,10 @@ mod number;
 mod program;
 mod write;
 
-use crate::io::poses::{AxisWord, CommandedPose, read_keeping_bom};
+use crate::io::poses::{AxisWord, CommandedPose, MAX_POSES, PoseList, read_keeping_bom};
 pub use error::NcError;
-use program::BlockAxes;
 use std::path::Path;
-pub use write::{MAX_DECIMALS, WriteOptions, Written};
+pub use write::{MAX_DECIMALS, ProgramWriter, WriteOptions, Written};
 
 /// A pose of a program: the 1-based line of the block and the command of every axis (in the
 /// order of the axis words; mm and degrees).
@@ -93,22 +97,36 @@ impl Dialect {
     }
 }
 
-/// A program as read: its text, its poses, and where the axis words of each pose stand.
+/// A program as read: its text and its poses.
 #[derive(Clone, Debug)]
 pub struct NcProgram {
     file: String,
     text: String,
     dialect: Dialect,
     axes: Vec<AxisWord>,
-    poses: Vec<NcPose>,
-    /// One per pose.
-    blocks: Vec<BlockAxes>,
+    poses: PoseList,
 }
 
 impl NcProgram {
-    /// The poses, one per block that moves, in the order of the program.
-    pub fn poses(&self) -> &[NcPose] {
+    /// The poses, one per block that moves, in the order of the program, held flat.
+    pub fn pose_list(&self) -> &PoseList {
         &self.poses
+    }
+
+    /// The poses, one per block that moves, in the order of the program, each copied out with
+    /// a vector of its own ([`PoseList::to_poses`]): for short programs and tests;
+    /// [`NcProgram::pose_list`] holds them without a copy.
+    pub fn poses(&self) -> Vec<NcPose> {
+        self.poses.to_poses()
+    }
+
+    /// The bytes the program holds on the heap: its text, its poses (8 bytes per axis and 4
+    /// per pose), its file name and axes. Besides the text, 44 bytes a pose of five axes.
+    pub fn held_bytes(&self) -> usize {
+        self.text.capacity()
+            + self.poses.held_bytes()
+            + self.file.capacity()
+            + self.axes.capacity() * size_of::<AxisWord>()
     }
 
     /// The dialect the program was read in.
@@ -128,15 +146,16 @@ impl NcProgram {
 /// # Errors
 /// [`NcError::Block`] for the first block that cannot be read or is refused, with its line,
 /// column and word; a move before every axis has a value; [`NcError::Program`] for a program
-/// without a move, or an axis letter that is a word of the dialect (`F`, `M`, …);
-/// [`NcError::Text`] for a text longer than [`crate::io::poses::MAX_FILE_BYTES`].
+/// without a move, with more than [`MAX_POSES`] moves, or an axis letter that is a word of the
+/// dialect (`F`, `M`, …); [`NcError::Text`] for a text longer than
+/// [`crate::io::poses::MAX_FILE_BYTES`].
 pub fn parse_program(
     file: &str,
     text: &str,
     dialect: Dialect,
     axes: &[AxisWord],
 ) -> Result<NcProgram, NcError> {
-    program::parse(file, text, dialect, axes)
+    program::parse(file, text.to_string(), dialect, axes, MAX_POSES)
 }
 
 /// Reads the program file at `path` (at most [`crate::io::poses::MAX_FILE_BYTES`], UTF-8, a
@@ -151,6 +170,6 @@ pub fn read_program(
     dialect: Dialect,
     axes: &[AxisWord],
 ) -> Result<NcProgram, NcError> {
-    let text = read_keeping_bom(path).map_err(NcError::Text)?;
-    parse_program(&path.display().to_string(), &text, dialect, axes)
+    let (text, _) = read_keeping_bom(path).map_err(NcError::Text)?;
+    program::parse(&path.display().to_string(), text, dialect, axes, MAX_POSES)
 }

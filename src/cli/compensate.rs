@@ -289,12 +289,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
                 files.add("--json", target.clone(), json);
             }
             if let Some(target) = &args.report {
-                let machine_path = std::path::Path::new(&args.machine);
-                read_files.extend(
-                    machine
-                        .digest
-                        .map(|d| ReadFile::new("--machine", machine_path, d)),
-                );
+                read_files.extend(ReadFile::machine(&args.machine, machine.digest));
                 let html = html_report(&params_file, &params_text, &m, &read_files, &report)?;
                 files.add("--report", target.clone(), html);
             }

@@ -344,12 +344,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     read_files.extend(held.read.iter().cloned());
     read_files.extend(noise_read);
     read_files.extend(instrument_read);
-    let machine_path = Path::new(&args.machine);
-    read_files.extend(
-        machine
-            .digest
-            .map(|d| ReadFile::new("--machine", machine_path, d)),
-    );
+    read_files.extend(ReadFile::machine(&args.machine, machine.digest));
     let bar = super::progress::Bar::new(shown, false);
     let d = diagnose(&m, &model, &fitted.campaign, &held.campaign, &opts, &bar);
     drop(bar);

@@ -16,7 +16,7 @@ use solver::fitting::{EstimateError, IdentifyOptions, RefineError, RefineOptions
 use solver::io::report::identify::StreamingReport;
 use solver::io::report::{CampaignSource, IdentificationReport, to_json};
 use solver::io::text::identify::identification;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
 Identifies the errors of a model from a measurement CSV (axis columns in mm and degrees, \
@@ -318,12 +318,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     };
     read_files.extend(noise_read);
     read_files.extend(instrument_read);
-    let machine_path = Path::new(&args.machine);
-    read_files.extend(
-        machine
-            .digest
-            .map(|d| ReadFile::new("--machine", machine_path, d)),
-    );
+    read_files.extend(ReadFile::machine(&args.machine, machine.digest));
     campaign::check_campaign_values(&m, &ident.layout, &ident.fit.values, &args.bounds.values())
         .map_err(|e| implausible(&e))?;
     let data: Vec<String> = match &loaded {

@@ -141,6 +141,12 @@ impl ReadFile {
             digest,
         }
     }
+
+    /// The machine file of `--machine ARG` read as `digest` says (`None`, and so no file,
+    /// for a built-in machine).
+    pub fn machine(arg: &str, digest: Option<Digest>) -> Option<ReadFile> {
+        digest.map(|d| ReadFile::new("--machine", Path::new(arg), d))
+    }
 }
 
 /// The record of a measurement CSV given by `flag` (mm and rad inside), read with `options`:

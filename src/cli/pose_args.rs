@@ -33,7 +33,7 @@ fn assignments(
         let x: f64 = value.parse().map_err(|_| {
             CliError::usage(format!(
                 "{flag}: `{}`: `{}` is not a number",
-                quoted_start(name),
+                quoted_start(item),
                 quoted_start(value)
             ))
         })?;

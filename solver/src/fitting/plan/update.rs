@@ -23,7 +23,7 @@
 //! The plan's other groups enter through their stacked square roots, compressed once; the
 //! candidate's prediction is then an SVD of at most `2·|K|` rows by `|K|` columns, scaled by the
 //! columns' norms over every row of the plan and the candidate. In exact arithmetic it is the
-//! prediction of the whole campaign ([`super::predict`]):
+//! prediction of the whole campaign ([`super::predict()`]):
 //!
 //! - rank = `Σ r_E` over the groups + the rank of the stacked square roots (tolerance relative
 //!   to the largest singular value met, at least 1: the column-scaled H has unit columns);

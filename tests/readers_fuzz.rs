@@ -3,66 +3,23 @@
 //! lengths within their limits, every number finite), and a file that does not is refused with
 //! a message that names it (and, for a campaign file, a line and column inside the text).
 //!
-//! The default run takes `CASES` cases per property; `RTEST_FUZZ_CASES=100000 cargo test
+//! The default run takes `fuzzing::CASES` cases per property; `RTEST_FUZZ_CASES=100000 cargo test
 //! --test readers_fuzz` runs the documented fuzzing pass (docs/conventions.md §9, "Fuzzing the
 //! readers"). Inputs are bounded (a few hundred kB at most), so memory is too.
 
 mod common;
+#[path = "support/fuzz.rs"]
+mod fuzzing;
 
 use common::{ok, temp_dir_tagged, words};
+use fuzzing::fuzz;
 use model_spec::Machine;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
 use solver::fitting::campaign::{MAX_LABEL_CHARS, MAX_RECORDS};
 use solver::io::campaign::{CampaignFileError, parse_campaign};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 use std::sync::OnceLock;
-
-/// Cases per property in the default suite.
-const CASES: u32 = 600;
-
-/// The cases of one property: `RTEST_FUZZ_CASES` when set, else `CASES`.
-fn config() -> Config {
-    let cases = std::env::var("RTEST_FUZZ_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(CASES);
-    Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    }
-}
-
-/// Runs `check` on `config()` cases of `strategy`, and asserts that the inputs were neither
-/// all read nor all refused (damage that always breaks or never breaks a file tests little).
-fn fuzz<S: Strategy>(
-    what: &str,
-    strategy: &S,
-    check: impl Fn(S::Value) -> Result<bool, TestCaseError>,
-    both: bool,
-) {
-    let read = std::cell::Cell::new(0u64);
-    let cases = std::cell::Cell::new(0u64);
-    TestRunner::new(config())
-        .run(strategy, |v| {
-            let r = check(v)?;
-            cases.set(cases.get() + 1);
-            read.set(read.get() + u64::from(r));
-            Ok(())
-        })
-        .unwrap();
-    eprintln!("{what}: {} of {} inputs read", read.get(), cases.get());
-    if both {
-        assert!(
-            read.get() > 0 && read.get() < cases.get(),
-            "{what}: {} of {} inputs read",
-            read.get(),
-            cases.get()
-        );
-    }
-}
 
 /// Text-level damage to a valid file; positions are fractions of the text or of its lines.
 #[derive(Clone, Debug)]

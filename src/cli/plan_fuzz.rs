@@ -10,27 +10,18 @@ use super::{PlanArgs, plan_error, plan_of};
 use crate::cli::EXIT_USAGE;
 use clap::Parser;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestCaseError, TestRunner};
+use proptest::test_runner::TestCaseError;
 use solver::fitting::plan;
 use std::panic::{AssertUnwindSafe, catch_unwind};
+
+#[path = "../../tests/support/fuzz.rs"]
+mod fuzzing;
 
 /// `rtest plan`'s flags alone.
 #[derive(Parser)]
 struct Flags {
     #[command(flatten)]
     args: PlanArgs,
-}
-
-fn config() -> Config {
-    let cases = std::env::var("RTEST_FUZZ_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(600);
-    Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    }
 }
 
 /// The plan arguments: `--paths`, the `--ball` values and `--param`.
@@ -192,16 +183,5 @@ fn arguments() -> impl Strategy<Value = Arguments> {
 #[test]
 fn plan_arguments_are_read_or_refused_as_usage_errors_naming_their_flag() {
     let m = model_spec::builtin("seed-ac").unwrap().unwrap();
-    let read = std::cell::Cell::new(0u32);
-    let cases = std::cell::Cell::new(0u32);
-    TestRunner::new(config())
-        .run(&arguments(), |a| {
-            let r = check(&m, &a)?;
-            cases.set(cases.get() + 1);
-            read.set(read.get() + u32::from(r));
-            Ok(())
-        })
-        .unwrap();
-    eprintln!("plan arguments: {} of {} read", read.get(), cases.get());
-    assert!(read.get() > 0 && read.get() < cases.get());
+    fuzzing::fuzz("plan arguments", &arguments(), |a| check(&m, &a), true);
 }

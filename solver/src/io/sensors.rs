@@ -64,15 +64,15 @@ pub fn read_sensor_csv<R: Read>(
     let (mut commands, mut times, mut readings, mut row_lines) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut last_t = None;
+    let reading_bound = max_sensor_reading_mm(opts.max_reading_mm);
     let mut timed = true;
     while let Some((line, text)) = lines.next_line(&cx)? {
         if !is_data(text) {
             continue;
         }
         let ((c, t, _), s) = header.row_with(&cx, line, text, m, &mut last_t)?;
-        let bound = max_sensor_reading_mm(opts.max_reading_mm);
         for (k, &x) in s.iter().enumerate() {
-            if let Some(why) = beyond(x, bound, "a sensor's reading") {
+            if let Some(why) = beyond(x, reading_bound, "a sensor's reading") {
                 return Err(cx.err(line, Some(header.extra_column(k)), why));
             }
         }
@@ -362,6 +362,7 @@ pub fn read_calibration<R: Read>(
     };
     let mut out = CalibrationRecord::default();
     let mut last_t: Option<(f64, usize)> = None;
+    let reading_bound = max_sensor_reading_mm(opts.max_reading_mm);
     while let Some((line, text)) = lines.next_line(&cx)? {
         if !is_data(text) {
             continue;
@@ -412,10 +413,7 @@ pub fn read_calibration<R: Read>(
                     let (bound, what) = if c < 3 {
                         (opts.max_reading_mm, "a known displacement")
                     } else {
-                        (
-                            max_sensor_reading_mm(opts.max_reading_mm),
-                            "a sensor's reading",
-                        )
+                        (reading_bound, "a sensor's reading")
                     };
                     if let Some(why) = beyond(x, bound, what) {
                         return Err(cx.err(line, Some((i, names[i].as_str())), why));

@@ -338,6 +338,24 @@ impl WhitenedFactored {
         layout: &[usize],
     ) -> Result<WhitenedFactored, EstimateError> {
         let ordinary = Factored::new(h, names, constraint, tol, h.nrows())?;
+        WhitenedFactored::with_ordinary(ordinary, h, names, constraint, tol, noise, layout)
+    }
+
+    /// As [`WhitenedFactored::new`] with `ordinary` the factorisation of `h` that
+    /// [`Factored::new`] makes with the same arguments (and `h.nrows()` rows): it is not made
+    /// again.
+    ///
+    /// # Errors
+    /// As [`WhitenedFactored::new`].
+    pub fn with_ordinary(
+        ordinary: Factored,
+        h: &DMatrix<f64>,
+        names: &[String],
+        constraint: &Constraint,
+        tol: &Tolerances,
+        noise: &NoiseModel,
+        layout: &[usize],
+    ) -> Result<WhitenedFactored, EstimateError> {
         if noise.is_uniform_white() {
             return Ok(WhitenedFactored {
                 ordinary,
@@ -423,16 +441,11 @@ impl Inner {
         noise: Option<&NoiseModel>,
         layout: &[usize],
     ) -> Result<Inner, EstimateError> {
+        let ordinary = Factored::new(h, names, constraint, tol, h.nrows())?;
         Ok(match noise {
-            None => Inner::Ordinary(Box::new(Factored::new(
-                h,
-                names,
-                constraint,
-                tol,
-                h.nrows(),
-            )?)),
-            Some(n) => Inner::Whitened(Box::new(WhitenedFactored::new(
-                h, names, constraint, tol, n, layout,
+            None => Inner::Ordinary(Box::new(ordinary)),
+            Some(n) => Inner::Whitened(Box::new(WhitenedFactored::with_ordinary(
+                ordinary, h, names, constraint, tol, n, layout,
             )?)),
         })
     }
@@ -527,6 +540,44 @@ impl<'a> RowsFactored<'a> {
             layout,
             weighted: Some((weights, ordinary, wh)),
             inner,
+        })
+    }
+
+    /// The factorisations for the fits under `noise` of the H, layout and weights of `self`, an
+    /// ordinary one ([`RowsFactored::new`] without a noise model, `h`, `names`, `constraint`
+    /// and `tol` its arguments): as [`RowsFactored::new`] makes them with `noise`, the
+    /// factorisation of the ordinary H (or the weighted H) taken from `self`, not made again.
+    ///
+    /// # Errors
+    /// As [`WhitenedFactored::new`]; [`EstimateError::Shape`] when `self` is not ordinary.
+    pub fn under(
+        &self,
+        h: &DMatrix<f64>,
+        names: &[String],
+        constraint: &Constraint,
+        tol: &Tolerances,
+        noise: &'a NoiseModel,
+    ) -> Result<RowsFactored<'a>, EstimateError> {
+        let (Inner::Ordinary(ordinary), None) = (&self.inner, self.noise) else {
+            return Err(EstimateError::Shape(
+                "a generalized fit's factorisations are made from an ordinary fit's".into(),
+            ));
+        };
+        let h = self.weighted.as_ref().map_or(h, |(_, _, wh)| wh);
+        let whitened = WhitenedFactored::with_ordinary(
+            ordinary.as_ref().clone(),
+            h,
+            names,
+            constraint,
+            tol,
+            noise,
+            self.layout,
+        )?;
+        Ok(RowsFactored {
+            noise: Some(noise),
+            layout: self.layout,
+            weighted: self.weighted.clone(),
+            inner: Inner::Whitened(Box::new(whitened)),
         })
     }
 

@@ -266,6 +266,7 @@ fn refine_under(
         noise,
         coordinates,
         weights: weights.as_ref(),
+        factored: None,
     };
     let model = ident.model.clone();
     let mut predict = |x: &[f64]| -> Result<DVector<f64>, RefineError> {
@@ -306,6 +307,9 @@ pub(crate) struct GaussNewton<'a> {
     pub coordinates: f64,
     /// The per-sample whitening of records read through an instrument; `None`: none.
     pub weights: Option<&'a SampleWhitening>,
+    /// The factorisations of `h` for these fits ([`RowsFactored::new`] with the arguments
+    /// above), when the caller has them; `None`: made at the first fit.
+    pub factored: Option<&'a RowsFactored<'a>>,
 }
 
 /// Refines the first-order fit `start` of `problem` against the exact machine's `predict`ion
@@ -327,16 +331,18 @@ pub(crate) fn gauss_newton(
         noise,
         coordinates,
         weights,
+        factored: given,
     } = *problem;
     // The fit of a residual: ordinary, or generalized under the noise model, rows weighted by
     // the samples' covariances when there are any (`fit_rows`). H is the same at every step:
-    // it is factorised once, at the first fit.
+    // it is factorised once, at the first fit (unless the caller has done it).
     let mut factored: Option<RowsFactored> = None;
     let mut fit_of = |r: &DVector<f64>| -> Result<(Fit, Option<f64>), EstimateError> {
         check_readings_of(h, r, &start.names)?;
-        let f = match &mut factored {
-            Some(f) => f,
-            none => none.insert(RowsFactored::new(
+        let f = match (given, &mut factored) {
+            (Some(f), _) => f,
+            (None, Some(f)) => &*f,
+            (None, none) => &*none.insert(RowsFactored::new(
                 h,
                 &start.names,
                 &start.constraint,
@@ -575,6 +581,7 @@ mod tests {
             noise: None,
             coordinates: 1.0,
             weights: None,
+            factored: None,
         };
         let mut calls = 0usize;
         let shape = DVector::from_fn(40, |i, _| if i % 2 == 0 { 1.0 } else { 0.3 });

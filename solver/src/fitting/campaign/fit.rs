@@ -267,16 +267,11 @@ pub fn identify_campaign_with(
     let (ordinary, weighted_sigma) =
         fit_rows(&h, &y, &names, c, t, None, &design.rows, weights.as_ref())?;
     if *noise == NoiseChoice::Ordinary {
-        let mut ident =
-            CampaignIdentification::new(m, model, design, to_layout_order(ordinary, &order));
-        if let (Some(w), Some(s)) = (&weights, weighted_sigma) {
-            ident.noise = NoiseModel::residual(
-                s * w.scale_mm,
-                "ordinary least squares of the rows whitened by each sample's covariance",
-            );
-            ident.whitened_sigma = Some(s);
-        }
-        return Ok(ident);
+        let ordinary = (ordinary, weighted_sigma);
+        let w = weights.as_ref();
+        return Ok(ordinary_identification(
+            m, model, design, &order, ordinary, w,
+        ));
     }
     let chosen = choose_campaign_noise_weighted(noise, &ordinary, &design.rows, weights.as_ref())?;
     let (fit, whitened_sigma) = fit_rows(
@@ -293,6 +288,28 @@ pub fn identify_campaign_with(
     ident.noise = chosen;
     ident.whitened_sigma = whitened_sigma;
     Ok(ident)
+}
+
+/// The ordinary identification of `model` on the campaign of `design` from `fit`, the fit of
+/// the system in solve `order` and the σ̂ of its rows whitened by `weights` (as
+/// [`crate::fitting::identify::fit_rows`] gives them).
+pub(crate) fn ordinary_identification(
+    m: &Machine,
+    model: &Model,
+    design: &Design,
+    order: &[usize],
+    (fit, weighted_sigma): (Fit, Option<f64>),
+    weights: Option<&SampleWhitening>,
+) -> CampaignIdentification {
+    let mut ident = CampaignIdentification::new(m, model, design, to_layout_order(fit, order));
+    if let (Some(w), Some(s)) = (weights, weighted_sigma) {
+        ident.noise = NoiseModel::residual(
+            s * w.scale_mm,
+            "ordinary least squares of the rows whitened by each sample's covariance",
+        );
+        ident.whitened_sigma = Some(s);
+    }
+    ident
 }
 
 impl CampaignIdentification {

@@ -398,6 +398,7 @@ pub fn validate_record(
                 noise: None,
                 coordinates,
                 weights: weights.as_ref(),
+                factored: None,
             };
             let start = first;
             let base = v.clone();

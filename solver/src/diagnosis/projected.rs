@@ -16,8 +16,10 @@
 //!   sees the model without a finding this way without changing what is held
 //!   ([`Projected::without`]): only a finding exchanged for another changes it.
 //!
-//! A step orthonormalises each candidate's columns into one matrix kept from step to step
-//! ([`Model::directions_into`]). The residual `P⊥Q·y` is computed from the span (one vector).
+//! A step scores each candidate from the small Gram matrix of its projected columns, read where
+//! they are held, without making its directions ([`Model::score`]); the directions are made
+//! for the few candidates a step compares ([`Model::directions`]). The residual `P⊥Q·y` is
+//! computed from the span (one vector).
 
 use super::select::{SPAN_TOLERANCE, Span};
 use nalgebra::{DMatrix, DVector};
@@ -73,11 +75,6 @@ impl Projected {
             columns,
             at,
         }
-    }
-
-    /// The width of the widest candidate held: what [`Model::directions_into`] writes at most.
-    pub fn widest(&self) -> usize {
-        self.at.iter().map(|a| a.1).max().unwrap_or(0)
     }
 
     /// The model held.
@@ -189,13 +186,60 @@ impl Model<'_> {
         out
     }
 
-    /// The directions of candidate `c` ([`Model::directions`]) written into `buffer` from
-    /// column `at` on (it must have room for the candidate's width); their number.
-    pub fn directions_into(&self, c: usize, buffer: &mut DMatrix<f64>, at: usize) -> usize {
-        let n = self.state.span.rows();
-        let out = &mut buffer.as_mut_slice()[n * at..];
-        let width = self.projected_into(c, out);
-        orthonormalise(&mut out[..n * width], n)
+    /// The number of directions candidate `c` adds to the model ([`Model::directions`]) and
+    /// the residual's coordinates on them, without making them: from the Gram matrix `CᵀC` of
+    /// its projected columns `C` and `Cᵀr`, read where they are held (without a term `W`,
+    /// `C' = C + W·A` with `A = Wᵀ·C̃` and `C ⊥ W`: `C'ᵀC' = CᵀC + AᵀA`, `C'ᵀr = Cᵀr + Aᵀ·Wᵀr`).
+    /// A Cholesky factorisation `L·Lᵀ` in column order drops a column as [`orthonormalise`]
+    /// does (the square root of its pivot is the norm of its part outside the previous
+    /// directions), and the coordinates are `L⁻¹·Cᵀr`. `None` when a column of norm above
+    /// [`SPAN_TOLERANCE`] has less than a tenth of it outside the previous ones: the Gram
+    /// matrix would lose digits that the directions keep, and they are made instead.
+    pub fn score(&self, c: usize) -> Option<(usize, DVector<f64>)> {
+        let (start, width) = self.state.at[c];
+        fn column(m: &DMatrix<f64>, j: usize) -> &[f64] {
+            &m.as_slice()[m.nrows() * j..][..m.nrows()]
+        }
+        let r = self.residual().as_slice();
+        let mut g = DMatrix::from_fn(width, width, |i, j| {
+            dot(
+                column(&self.state.columns, start + i),
+                column(&self.state.columns, start + j),
+            )
+        });
+        let mut b = DVector::from_fn(width, |j, _| dot(column(&self.state.columns, start + j), r));
+        if let Some(w) = &self.removed {
+            let a = DMatrix::from_fn(w.ncols(), width, |i, j| {
+                dot(w.column(i).as_slice(), column(&self.state.unit, start + j))
+            });
+            let wr = w.tr_mul(self.residual());
+            g += a.tr_mul(&a);
+            b += a.tr_mul(&wr);
+        }
+        // Row j of `l`: column j's coefficients on the directions kept before it.
+        let mut l = DMatrix::zeros(width, width);
+        let mut kept: Vec<usize> = Vec::with_capacity(width);
+        let mut coordinates: Vec<f64> = Vec::with_capacity(width);
+        let floor = SPAN_TOLERANCE * SPAN_TOLERANCE;
+        for j in 0..width {
+            let mut pivot = g[(j, j)];
+            for (k, &i) in kept.iter().enumerate() {
+                let s: f64 = (0..k).map(|m| l[(j, m)] * l[(i, m)]).sum();
+                l[(j, k)] = (g[(i, j)] - s) / l[(i, k)];
+                pivot -= l[(j, k)] * l[(j, k)];
+            }
+            if g[(j, j)] > floor && pivot < 1e-2 * g[(j, j)] {
+                return None;
+            }
+            if pivot > floor {
+                let k = kept.len();
+                l[(j, k)] = pivot.sqrt();
+                let s: f64 = (0..k).map(|m| l[(j, m)] * coordinates[m]).sum();
+                coordinates.push((b[j] - s) / l[(j, k)]);
+                kept.push(j);
+            }
+        }
+        Some((kept.len(), DVector::from_vec(coordinates)))
     }
 }
 
@@ -336,7 +380,7 @@ mod tests {
     fn groups() -> Vec<DMatrix<f64>> {
         let mut g: Vec<DMatrix<f64>> = (0..6).map(|k| matrix(40, 1 + k % 3, k as u64)).collect();
         // A candidate inside the span of candidates 0 and 1, one with a zero column, one
-        // nearly inside candidate 0.
+        // nearly inside candidate 0, one of two nearly dependent columns.
         let inside = &g[0].column(0) * 2.0 - &g[1].column(1) * 0.5;
         g.push(DMatrix::from_columns(&[inside]));
         let mut zero = matrix(40, 2, 9);
@@ -344,6 +388,9 @@ mod tests {
         g.push(zero);
         let near = g[0].column(0) + matrix(40, 1, 10).column(0) * 1e-9;
         g.push(DMatrix::from_columns(&[near]));
+        let x = matrix(40, 1, 11).column(0).into_owned();
+        let close = &x + matrix(40, 1, 12).column(0) * 1e-3;
+        g.push(DMatrix::from_columns(&[x, close]));
         g
     }
 
@@ -361,7 +408,6 @@ mod tests {
             assert_eq!(p.span().rank(), q.rank(), "model {model:?}");
             let r = q.project_out(&y);
             assert!((p.residual() - &r).norm() < 1e-12);
-            let mut buffer = DMatrix::zeros(40, 3);
             for (c, gc) in g.iter().enumerate() {
                 let scratch = q.new_directions(gc);
                 let here = p.directions(c);
@@ -370,9 +416,17 @@ mod tests {
                     scratch.ncols(),
                     "candidate {c}, model {model:?}"
                 );
-                let into = p.directions_into(c, &mut buffer, 0);
-                assert_eq!(into, here.ncols());
-                assert_eq!(buffer.columns(0, into), here, "candidate {c}");
+                // The score from the Gram matrix: the same width, the same coordinates (where
+                // it is made that way: not for the one of two nearly dependent columns).
+                let on = here.tr_mul(p.residual());
+                match (c, p.score(c)) {
+                    (9, score) => assert!(score.is_none(), "model {model:?}"),
+                    (_, Some((width, coordinates))) => {
+                        assert_eq!(width, here.ncols(), "candidate {c}");
+                        assert!((coordinates - &on).norm() <= 1e-12 * on.norm().max(1.0));
+                    }
+                    (_, None) => panic!("candidate {c}, model {model:?}"),
+                }
                 if here.ncols() > 0 {
                     let same = here.tr_mul(&scratch).norm_squared();
                     assert!((same - here.ncols() as f64).abs() < 1e-9, "{c}: {same}");

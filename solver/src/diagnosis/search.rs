@@ -126,27 +126,26 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
     } = *p;
     let n = y.len();
     // One selection step on `model` over the candidates `pool`: the significant candidate
-    // named, or why there is none. The candidates' directions are written into `buffer`.
-    let step = |model: &Model,
-                pool: &[usize],
-                seed: u64,
-                buffer: &mut DMatrix<f64>|
-     -> Result<Chosen, Stop> {
+    // named, or why there is none.
+    let step = |model: &Model, pool: &[usize], seed: u64| -> Result<Chosen, Stop> {
         let q = model.span();
         let r = model.residual();
         let rss = r.norm_squared();
         let total = pool.len() as u64;
         progress.update("selection", 0, total);
-        // Every candidate's directions made in `buffer` (one at a time: it stays in cache) and
-        // the residual's coordinates on them; the directions of the few candidates a step looks
-        // at are made again when asked for ([`Scored::directions`]).
+        // Every candidate's number of directions and the residual's coordinates on them, from
+        // its Gram matrix ([`Model::score`]; or from its directions where that would lose
+        // digits); the directions of the few candidates a step looks at are made when asked
+        // for ([`Scored::directions`]).
         let make = |c: usize| model.directions(c);
         let mut scored: Vec<Scored> = Vec::with_capacity(pool.len());
         for (k, &c) in pool.iter().enumerate() {
             progress.update("selection", k as u64 + 1, total);
-            let width = model.directions_into(c, buffer, 0);
+            let (width, on) = model.score(c).unwrap_or_else(|| {
+                let d = model.directions(c);
+                (d.ncols(), coordinates(&d.columns(0, d.ncols()), r))
+            });
             if width > 0 {
-                let on = coordinates(&buffer.columns(0, width), r);
                 scored.push(Scored::made_by(c, width, on, &make));
             }
         }
@@ -370,7 +369,6 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         candidates_live,
         &|c| group(nb + c),
     );
-    let mut buffer = DMatrix::zeros(n, state.widest());
     let mut chosen: Vec<Chosen> = Vec::new();
     let mut stop;
     let mut round = 0;
@@ -381,7 +379,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
                 Some(known) => known.clone(),
                 None => {
                     let seed = context_seed(o.seed, &context);
-                    let r = step(&state.model(), &pool_of(&chosen, None), seed, &mut buffer);
+                    let r = step(&state.model(), &pool_of(&chosen, None), seed);
                     taken.insert(context, r.clone());
                     r
                 }
@@ -424,7 +422,7 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
                     let (span, d) = without();
                     let seed = context_seed(o.seed, &context);
                     let model = state.without(span, d, y);
-                    let r = step(&model, &pool_of(&chosen, Some(j)), seed, &mut buffer);
+                    let r = step(&model, &pool_of(&chosen, Some(j)), seed);
                     taken.insert(context, r.clone());
                     r
                 }

@@ -106,28 +106,32 @@ fn shape(phi: f64, k: usize) -> f64 {
     6.0 - 8.0 * p + 2.0 * p * p
 }
 
-/// One fit of σ² ≥ 0, c ≥ 0 at fixed φ: `(σ², c, weighted residual)`.
-fn fit_at(phi: f64, lags: &[usize], v: &[f64], w: &[f64]) -> (f64, f64, f64) {
-    let scale = lags.last().map_or(1.0, |&l| (l as f64).powi(4));
-    let g: Vec<f64> = lags.iter().map(|&k| shape(phi, k)).collect();
-    let q: Vec<f64> = lags.iter().map(|&k| (k as f64).powi(4) / scale).collect();
-    let dot = |a: &[f64], b: &[f64]| -> f64 { (0..a.len()).map(|i| w[i] * a[i] * b[i]).sum() };
-    let ssr = |a: f64, c: f64| -> f64 {
-        (0..v.len())
-            .map(|i| w[i] * (v[i] - a * g[i] - c * q[i]).powi(2))
-            .sum()
-    };
-    let (gg, gq, qq, gv, qv) = (
-        dot(&g, &g),
-        dot(&g, &q),
-        dot(&q, &q),
-        dot(&g, v),
-        dot(&q, v),
+/// `Σ wᵢ·aᵢ·bᵢ`.
+fn weighted_dot(w: &[f64], a: &[f64], b: &[f64]) -> f64 {
+    (0..a.len()).map(|i| w[i] * a[i] * b[i]).sum()
+}
+
+/// The weighted residual `Σ wᵢ·(vᵢ − a·gᵢ − c·qᵢ)²`.
+fn weighted_ssr(w: &[f64], v: &[f64], (g, a): (&[f64], f64), (q, c): (&[f64], f64)) -> f64 {
+    (0..v.len())
+        .map(|i| w[i] * (v[i] - a * g[i] - c * q[i]).powi(2))
+        .sum()
+}
+
+/// One fit of σ² ≥ 0, c ≥ 0 at the noise's shape `g` of one φ (`shape(φ, k)` per lag), `q`
+/// the misfit's `k⁴` over `scale`: `(σ², c, weighted residual)`. `fixed` holds what does not
+/// depend on φ: `q·q`, `q·v` (weighted) and the weighted residual of `σ² = c = 0`.
+fn fit_at(g: &[f64], (q, scale): (&[f64], f64), v: &[f64], w: &[f64], fixed: [f64; 3]) -> [f64; 3] {
+    let [qq, qv, zero] = fixed;
+    let (gg, gq, gv) = (
+        weighted_dot(w, g, g),
+        weighted_dot(w, g, q),
+        weighted_dot(w, g, v),
     );
-    let mut best = (0.0, 0.0, ssr(0.0, 0.0));
+    let mut best = (0.0, 0.0, zero);
     let mut consider = |a: f64, c: f64| {
         if a >= 0.0 && c >= 0.0 && a.is_finite() && c.is_finite() {
-            let s = ssr(a, c);
+            let s = weighted_ssr(w, v, (g, a), (q, c));
             if s < best.2 {
                 best = (a, c, s);
             }
@@ -143,13 +147,21 @@ fn fit_at(phi: f64, lags: &[usize], v: &[f64], w: &[f64]) -> (f64, f64, f64) {
     if qq > 0.0 {
         consider(0.0, qv / qq);
     }
-    (best.0, best.1 / scale, best.2)
+    [best.0, best.1 / scale, best.2]
 }
 
 /// The best `(σ², φ)` of one direction's variogram over the grid of φ (see the module
-/// documentation).
+/// documentation). The noise's shapes at every φ of the grid and the misfit's are made once.
 fn fit_direction(lags: &[usize], pairs: &[usize], v: &[f64]) -> (f64, f64) {
     let steps = (MAX_ESTIMATED_PHI / PHI_GRID_STEP).round() as usize;
+    let grid: Vec<(f64, Vec<f64>)> = (0..=steps)
+        .map(|i| {
+            let phi = i as f64 * PHI_GRID_STEP;
+            (phi, lags.iter().map(|&k| shape(phi, k)).collect())
+        })
+        .collect();
+    let scale = lags.last().map_or(1.0, |&l| (l as f64).powi(4));
+    let q: Vec<f64> = lags.iter().map(|&k| (k as f64).powi(4) / scale).collect();
     let floor = v.iter().copied().fold(0.0, f64::max) * 1e-12 + f64::MIN_POSITIVE;
     let weights = |model: &dyn Fn(usize) -> f64| -> Vec<f64> {
         (0..lags.len())
@@ -157,12 +169,16 @@ fn fit_direction(lags: &[usize], pairs: &[usize], v: &[f64]) -> (f64, f64) {
             .collect()
     };
     let search = |w: &[f64]| -> (f64, f64, f64) {
+        let fixed = [
+            weighted_dot(w, &q, &q),
+            weighted_dot(w, &q, v),
+            weighted_ssr(w, v, (&grid[0].1, 0.0), (&q, 0.0)),
+        ];
         let mut best = (0.0, 0.0, 0.0, f64::INFINITY);
-        for i in 0..=steps {
-            let phi = i as f64 * PHI_GRID_STEP;
-            let (a, c, s) = fit_at(phi, lags, v, w);
+        for (phi, g) in &grid {
+            let [a, c, s] = fit_at(g, (&q, scale), v, w, fixed);
             if s < best.3 {
-                best = (a, phi, c, s);
+                best = (a, *phi, c, s);
             }
         }
         (best.0, best.1, best.2)

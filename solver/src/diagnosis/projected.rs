@@ -201,13 +201,12 @@ impl Model<'_> {
             &m.as_slice()[m.nrows() * j..][..m.nrows()]
         }
         let r = self.residual().as_slice();
+        // The upper triangle of `CᵀC` (the factorisation reads no other).
+        let held = |i: usize| column(&self.state.columns, start + i);
         let mut g = DMatrix::from_fn(width, width, |i, j| {
-            dot(
-                column(&self.state.columns, start + i),
-                column(&self.state.columns, start + j),
-            )
+            if i <= j { dot(held(i), held(j)) } else { 0.0 }
         });
-        let mut b = DVector::from_fn(width, |j, _| dot(column(&self.state.columns, start + j), r));
+        let mut b = DVector::from_fn(width, |j, _| dot(held(j), r));
         if let Some(w) = &self.removed {
             let a = DMatrix::from_fn(w.ncols(), width, |i, j| {
                 dot(w.column(i).as_slice(), column(&self.state.unit, start + j))

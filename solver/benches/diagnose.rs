@@ -24,6 +24,10 @@
 //! `cargo bench -p solver --bench diagnose`. The set-up prints the dictionary's size (candidate
 //! terms and H-matrix columns).
 
+#[path = "support/campaign.rs"]
+mod campaign;
+
+use campaign::campaign;
 use criterion::{Criterion, criterion_group, criterion_main};
 use model_spec::Machine;
 use solver::diagnosis::dictionary::{DictionaryOptions, dictionary, scanned};
@@ -55,44 +59,6 @@ fn records(m: &Machine, name: &str) -> Vec<(String, Record)> {
             (p.to_string(), simulate(m, &truth, &path).expect("simulate"))
         })
         .collect()
-}
-
-/// The five records of the campaign bench: (path, noise seed, ball raised) on `seed-ac-budget`,
-/// each simulated with the path planned at its ball position and the truth's real parameters
-/// moved by as much.
-fn campaign(m: &Machine) -> Campaign {
-    let truth = builtin_truth("seed-ac-budget", m)
-        .expect("built in")
-        .expect("valid");
-    let zw = m.symbol_by_name("Zw").expect("Zw");
-    let records = [
-        ("K4", 1, false),
-        ("K1", 2, false),
-        ("K2", 3, false),
-        ("K4", 4, true),
-        ("K1", 5, true),
-    ]
-    .into_iter()
-    .map(|(path, seed, raised)| {
-        let mut params = m.default_parameters();
-        let mut t = truth.clone();
-        t.seed = seed;
-        if raised {
-            params[zw] += 50.0;
-            t.params[zw] += 50.0;
-        }
-        let at = solver::io::campaign::machine_at(m, &params);
-        let planned = builtin_path(&at, path).expect("built in").expect("path");
-        let record = simulate(&at, &t, &planned).expect("simulate");
-        let (label, setup) = if raised {
-            (format!("{}-high", path.to_lowercase()), "high")
-        } else {
-            (path.to_lowercase(), "low")
-        };
-        CampaignRecord::new(label, record, params, setup, false)
-    })
-    .collect();
-    Campaign::new(records).expect("campaign")
 }
 
 fn bench_campaign(c: &mut Criterion) {

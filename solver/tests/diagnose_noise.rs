@@ -234,11 +234,15 @@ fn outside_with(
         let d = run(&m, &base, &noisy[..3], o);
         let a = d.adequacy.as_ref().expect("a noise model");
         let what = format!(
-            "{name} seed {seed}: noise {}; findings {:?}",
+            "{name} seed {seed}: noise {}; findings {:?}; groups {:?}",
             d.noise,
             d.findings
                 .iter()
-                .map(|f| f.term.spelling(&m))
+                .map(|f| (f.term.spelling(&m), f.in_model))
+                .collect::<Vec<_>>(),
+            d.groups
+                .iter()
+                .map(|g| (&g.group.name, g.gain_sd, &g.unjudged, g.confirmed))
                 .collect::<Vec<_>>()
         );
         assert!(!a.consistent_with_noise, "{what}: {a:?}");

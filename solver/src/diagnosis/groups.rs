@@ -18,11 +18,13 @@
 //! extended model (k = the number of directions its columns add), Bonferroni-corrected for the
 //! groups tried at the step; the most significant is added, and the test is repeated given it,
 //! until no group is significant at α. A group is then kept only when the judging records
-//! (held out, or every fitted record left out in turn) confirm it as a whole: the extended
-//! model with it predicts them better than without it by more than the noise explains
-//! ([`super::verdict::CONFIRM_SD`] standard deviations, as findings are judged,
-//! [`super::confirm`]): forwards in the order of selection, each given the groups kept before
-//! it, then backwards, each given every other group kept, until every group left is
+//! (held out, or every fitted record left out in turn) confirm it as a whole, by backward
+//! elimination from every group selected: each judged given every other group kept, by its
+//! gain on the judging records that can judge it ([`super::confirm`]: a record whose fit does
+//! not determine what the group changes in its prediction cannot) beyond
+//! [`super::verdict::CONFIRM_SD`] standard deviations, or, when no record can judge it, by its
+//! p-value ([`super::verdict::enters_unjudged`]); the worst of those not confirmed is taken out
+//! and the others judged again, until every group left is
 //! confirmed. A group is fitted with every
 //! member; the campaign need not determine them all (the report lists which combinations it
 //! does not, and `rtest identify --constraint min-norm` gives the values that carry the
@@ -70,10 +72,14 @@ pub struct GroupFinding {
     pub p: f64,
     /// The groups tried at its step.
     pub tried: usize,
-    /// Its held-out (or left-out) gain given every other group kept, in standard deviations
-    /// of a spurious gain; `None` when nothing judges.
+    /// Its held-out (or left-out) gain given every other group kept, over the judging records
+    /// that can judge it, in standard deviations of a spurious gain; `None` when none can.
     pub gain_sd: Option<f64>,
-    /// `gain_sd` above [`super::verdict::CONFIRM_SD`]: in the extended model.
+    /// The judging records that cannot judge it: the fit that predicts them does not determine
+    /// its part of their prediction ([`super::heldout::determined_sd`]).
+    pub unjudged: Vec<String>,
+    /// In the extended model: `gain_sd` above [`super::verdict::CONFIRM_SD`], or with no record
+    /// to judge it, `p` below [`super::verdict::enters_unjudged`]'s bound.
     pub confirmed: bool,
     /// The names of its parameters that the extended model's fit on the fitted records does
     /// not determine (their values then need `--constraint min-norm`).
@@ -220,6 +226,26 @@ pub(super) fn select(
     out
 }
 
+/// Judges group `f` by the gain of `with` over `without` on the judging records that can judge
+/// it; with none, it is confirmed on its p-value ([`Folds::enters_unjudged`]). Sets its gain, the
+/// records that cannot judge it and whether it is confirmed, which it returns.
+fn judge(
+    folds: &mut Folds,
+    f: &mut GroupFinding,
+    without: &[Term],
+    with: &[Term],
+    g: &Grouped,
+) -> Result<bool, DiagnoseError> {
+    let (z, unjudged) = folds.gain_sd(without, with, g.whitening)?;
+    f.gain_sd = z;
+    f.unjudged = unjudged;
+    f.confirmed = match z {
+        Some(z) => z > CONFIRM_SD,
+        None => folds.enters_unjudged(f.p),
+    };
+    Ok(f.confirmed)
+}
+
 /// The members of the confirmed groups, in order.
 pub(super) fn group_terms(found: &[GroupFinding]) -> Vec<Term> {
     found
@@ -327,44 +353,38 @@ pub(super) fn grouped(
             p: s.p,
             tried: s.tried,
             gain_sd: None,
+            unjudged: Vec::new(),
             confirmed: true,
             undetermined: Vec::new(),
         })
         .collect();
     // Confirmed as wholes: forwards in the order of selection, each given the groups kept
     // before it; then backwards, each given every other group kept, until all are confirmed.
-    for f in found.iter_mut() {
-        f.confirmed = false;
-    }
-    for k in 0..found.len() {
-        let without: Vec<Term> = g.terms.iter().copied().chain(group_terms(&found)).collect();
-        let mut with = without.clone();
-        with.extend(found[k].group.terms.iter().copied());
-        let z = folds.gain_sd(&without, &with, g.whitening)?;
-        found[k].gain_sd = Some(z);
-        found[k].confirmed = z > CONFIRM_SD;
-    }
+    // Confirmed as wholes by backward elimination: each judged given every other group kept,
+    // the one judged worst of those not confirmed taken out, and the others judged again,
+    // until every group left is confirmed.
     loop {
         let with: Vec<Term> = g.terms.iter().copied().chain(group_terms(&found)).collect();
-        let mut out = Vec::new();
+        let mut worst: Option<(usize, f64)> = None;
         let judged: Vec<usize> = (0..found.len()).filter(|&k| found[k].confirmed).collect();
-        for k in judged {
+        for &k in &judged {
             let without: Vec<Term> = with
                 .iter()
                 .copied()
                 .filter(|t| !found[k].group.terms.contains(t))
                 .collect();
-            let z = folds.gain_sd(&without, &with, g.whitening)?;
-            found[k].gain_sd = Some(z);
-            if z <= CONFIRM_SD {
-                out.push(k);
+            if !judge(folds, &mut found[k], &without, &with, g)? {
+                let z = found[k].gain_sd.unwrap_or(f64::NEG_INFINITY);
+                if worst.is_none_or(|(_, w)| z < w) {
+                    worst = Some((k, z));
+                }
             }
         }
-        if out.is_empty() {
+        let Some((out, _)) = worst else {
             break;
-        }
-        for k in out {
-            found[k].confirmed = false;
+        };
+        for k in judged {
+            found[k].confirmed = k != out;
         }
     }
     let added = group_terms(&found);

@@ -33,8 +33,9 @@ use crate::fitting::campaign::{
 };
 use crate::fitting::hmatrix::GainSource;
 use crate::fitting::validate::{ValidateError, ValidateOptions, statistics};
+use crate::model::Term;
 use model_spec::Machine;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 /// Relative size of `‖B·n‖` above which a held-out record needs a null direction of the fit.
 pub const NEEDS_TOLERANCE: f64 = 1e-6;
@@ -130,6 +131,35 @@ pub fn predict(
         .collect()
 }
 
+/// Record `r`'s columns of `ident`'s parameters (mm per unit; one per parameter of the fit,
+/// zero where the record's prediction does not use it), and the span of its refitted columns.
+fn record_columns(
+    m: &Machine,
+    ident: &CampaignIdentification,
+    r: &CampaignRecord,
+) -> Result<(DMatrix<f64>, Span), DiagnoseError> {
+    let values = estimable(ident);
+    let plan = record_plan(m, &values, r)?;
+    let mut source = GainSource::new(m, &plan.model.errors(), &r.params)?;
+    let h = block(m, &plan.model, &r.record, &mut source, plan.clock)?;
+    let rows = h.nrows();
+    let mut b = DMatrix::zeros(rows, ident.fit.names.len());
+    let mut refit = Vec::new();
+    for (k, s) in plan.sources.iter().enumerate() {
+        match s {
+            Some(c) => {
+                let mut target = b.column_mut(*c);
+                target += h.column(k);
+            }
+            None => refit.push(k),
+        }
+    }
+    let refit_span = Span::of_groups(rows, 0..refit.len(), &|i| {
+        h.columns(refit[i], 1).into_owned()
+    });
+    Ok((b, refit_span))
+}
+
 /// The confounded groups of `ident` (by name) the prediction on held-out record `r` needs: a
 /// null direction of the fit that changes the prediction, once the record's refitted columns
 /// have taken what they can.
@@ -146,26 +176,11 @@ pub fn needed_groups(
     if null.ncols() == 0 {
         return Ok(Vec::new());
     }
-    let values = estimable(ident);
-    let plan = record_plan(m, &values, r)?;
-    let mut source = GainSource::new(m, &plan.model.errors(), &r.params)?;
-    let h = block(m, &plan.model, &r.record, &mut source, plan.clock)?;
-    let rows = h.nrows();
-    let mut b = DMatrix::zeros(rows, fit.names.len());
-    let mut refit = Vec::new();
-    for (k, s) in plan.sources.iter().enumerate() {
-        match s {
-            Some(c) => {
-                let col = h.column(k) / fit.column_norms[*c];
-                let mut target = b.column_mut(*c);
-                target += col;
-            }
-            None => refit.push(k),
-        }
+    let (mut b, refit_span) = record_columns(m, ident, r)?;
+    for j in 0..b.ncols() {
+        let mut c = b.column_mut(j);
+        c /= fit.column_norms[j];
     }
-    let refit_span = Span::of_groups(rows, 0..refit.len(), &|i| {
-        h.columns(refit[i], 1).into_owned()
-    });
     let scale = (0..b.ncols())
         .map(|j| b.column(j).norm())
         .fold(0.0, f64::max);
@@ -192,6 +207,60 @@ pub fn needed_groups(
                 .collect()
         })
         .collect())
+}
+
+/// How well the fit `ident` determines a change `dp` of its prediction of record `r` (mm, one
+/// `[x, y, z]` per sample: what the terms `terms` added to the model change there): `Some(0)`
+/// when the prediction needs a null direction of the fit that moves a parameter of `terms` (the
+/// fit lacks the record that determines them); otherwise `dp`, after the record's refitted
+/// columns, over the standard uncertainty of the fit's prediction along it, `‖dp‖² / √(wᵀ·Σ·w)`
+/// with `w = Bᵀ·dp`, `B` the record's columns of the fit's parameters and `Σ` their covariance
+/// (the parameters with a value; for one term added alone, about its value over its standard
+/// uncertainty). `None` when `dp` is nothing or the fit gives no covariance.
+///
+/// # Errors
+/// A record whose columns cannot be built.
+pub fn determined_sd(
+    m: &Machine,
+    ident: &CampaignIdentification,
+    r: &CampaignRecord,
+    terms: &[Term],
+    dp: &[[f64; 3]],
+) -> Result<Option<f64>, DiagnoseError> {
+    let fit = &ident.fit;
+    let (b, refit_span) = record_columns(m, ident, r)?;
+    let scaled = DMatrix::from_fn(b.nrows(), b.ncols(), |i, j| b[(i, j)] / fit.column_norms[j]);
+    let scale = (0..b.ncols())
+        .map(|j| scaled.column(j).norm())
+        .fold(0.0, f64::max);
+    let null = &fit.identifiability.null_space;
+    for k in 0..null.ncols() {
+        let n = null.column(k);
+        let moves = (0..n.len())
+            .any(|j| n[j].abs() > NEEDS_TOLERANCE && terms.contains(&ident.layout.columns[j].term));
+        if moves && refit_span.project_out(&(&scaled * n)).norm() > NEEDS_TOLERANCE * scale {
+            return Ok(Some(0.0));
+        }
+    }
+    let d = refit_span.project_out(&DVector::from_iterator(
+        b.nrows(),
+        dp.iter().flat_map(|x| x.iter().copied()),
+    ));
+    let det: Vec<usize> = (0..fit.names.len())
+        .filter(|&j| fit.values[j].is_some())
+        .collect();
+    let w: Vec<f64> = det.iter().map(|&j| b.column(j).dot(&d)).collect();
+    let mut var = 0.0;
+    for (a, &i) in det.iter().enumerate() {
+        for (c, &j) in det.iter().enumerate() {
+            var += w[a] * fit.covariance[(i, j)] * w[c];
+        }
+    }
+    Ok(if var.is_finite() && var > 0.0 {
+        Some(d.norm_squared() / var.sqrt())
+    } else {
+        None
+    })
 }
 
 /// RMS of `residual` without the samples of `drop`, mm.

@@ -36,7 +36,7 @@ pub struct DiagnoseOptions {
     pub adequacy_draws: usize,
     /// Grouped candidates after the findings ([`super::groups`]): the error groups of a
     /// calibration standard, each tested as one candidate and confirmed as a whole (default
-    /// off).
+    /// on).
     pub groups: bool,
 }
 
@@ -53,7 +53,7 @@ impl Default for DiagnoseOptions {
             budget: Budget::default(),
             noise: NoiseChoice::Estimate,
             adequacy_draws: super::adequacy::DRAWS,
-            groups: false,
+            groups: true,
         }
     }
 }

@@ -49,6 +49,18 @@ pub struct Recommendation {
 /// and a finding's own gain, [`super::confirm`]).
 pub const CONFIRM_SD: f64 = 2.0;
 
+/// Whether a finding (or an error group) that no judging record can judge (none's fit
+/// determines what it predicts there, [`super::confirm`]) enters the extended model on the
+/// fitted records alone: its corrected p-value `p` below `alpha·Φ̄(CONFIRM_SD)`. A finding that
+/// is judged enters after two tests, the selection's at `alpha` and its own held-out gain
+/// beyond [`CONFIRM_SD`] standard deviations, which a spurious one passes with probability
+/// `Φ̄(CONFIRM_SD)` (2.3 %); one that is not judged must reach the same rate of false entry
+/// on the one test it has. The judging records' word is needed all the same where the fitted
+/// records are one path with records held out ([`super::confirm::Folds::enters_unjudged`]).
+pub fn enters_unjudged(p: f64, alpha: f64) -> bool {
+    p < alpha * crate::fitting::distributions::normal_upper_tail(CONFIRM_SD)
+}
+
 /// The gain of a change of prediction on held-out readings and its standard deviation were the
 /// change spurious (condition 5): per record the residuals `before` and `after` the change (mm,
 /// one `[x, y, z]` per sample) and the samples left out (outliers). With `Δp = before − after`,

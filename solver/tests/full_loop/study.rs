@@ -730,7 +730,7 @@ pub fn groups(seed: u64, k2_high: bool) -> (Vec<String>, Figure, Figure) {
     let mut described = Vec::new();
     for g in &d.groups {
         described.push(format!(
-            "{} ({}): {} directions of {} columns, F {:.1}, p {:.1e} ({} groups tried), left-out gain {} sd, {}",
+            "{} ({}): {} directions of {} columns, F {:.1}, p {:.1e} ({} groups tried), left-out gain {} sd{}, {}",
             g.group.name,
             g.group
                 .terms
@@ -744,6 +744,11 @@ pub fn groups(seed: u64, k2_high: bool) -> (Vec<String>, Figure, Figure) {
             g.p,
             g.tried,
             g.gain_sd.map_or("—".into(), |z| format!("{z:.1}")),
+            if g.unjudged.is_empty() {
+                String::new()
+            } else {
+                format!(" ({} cannot judge it)", g.unjudged.join(", "))
+            },
             if g.confirmed { "confirmed" } else { "not confirmed" }
         ));
         for t in &g.group.terms {

@@ -141,8 +141,16 @@ pub struct ConfirmationReport {
     /// Its held-out gain given the other findings of the extended model, in standard
     /// deviations of a spurious gain.
     pub gain_sd: f64,
-    /// Whether that exceeds 2: confirmed on its own.
+    /// Whether that exceeds 2: confirmed on its own; or, when no record could judge it, its
+    /// corrected p-value is below `α·Φ̄(2)` (docs/diagnosis.md §6).
     pub confirmed: bool,
+    /// No judging record could judge it: none's fit determines what it predicts there
+    /// (`gain_sd` is then 0, over no record).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub not_judged: bool,
+    /// The judging records that could not judge it (their labels).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unjudged: Vec<String>,
     /// The selection's finding this term replaces, the held-out records having chosen it among
     /// that finding's alternatives (`NAME@BASIS`); absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -152,6 +160,33 @@ pub struct ConfirmationReport {
     /// was tried.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub tried: Vec<TriedReport>,
+}
+
+/// An error group selected after the findings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GroupReport {
+    /// What it is (`component errors of A, once per revolution`).
+    pub name: String,
+    /// Its members (`NAME@BASIS`).
+    pub terms: Vec<String>,
+    /// The directions its columns add on the fitted records (k of its F-test).
+    pub directions: usize,
+    /// Its F statistic and its p-value, corrected for the groups tried at its step.
+    pub f: f64,
+    /// The corrected p-value.
+    pub p_value: f64,
+    /// Its gain on the judging records that can judge it, in standard deviations of a spurious
+    /// gain; absent when none can.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gain_sd: Option<f64>,
+    /// The judging records that cannot judge it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unjudged: Vec<String>,
+    /// In the extended model.
+    pub confirmed: bool,
+    /// Its parameters the fit does not determine (identify with `--constraint min-norm`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub undetermined: Vec<String>,
 }
 
 /// A term tried in a finding's place on the held-out records.
@@ -343,6 +378,10 @@ pub struct DiagnosisReport {
     /// absent when none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub dropped: Vec<DroppedReport>,
+    /// The error groups selected after the findings (docs/diagnosis.md §6, "Error groups"),
+    /// confirmed ones in the extended model; absent when none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<GroupReport>,
     /// Why the selection stopped.
     pub stop: StopReport,
     /// Candidates the extended model spans.

@@ -133,7 +133,24 @@ fn confirmation(f: &FindingReport) -> String {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    if let Some(original) = &c.replaces {
+    if !c.unjudged.is_empty() {
+        out.push_str(&format!(
+            "     {} cannot judge it: the fit on the other records does not determine what it predicts there{}\n",
+            c.unjudged.join(", "),
+            if c.not_judged {
+                " (determined only by the record left out: no other record can confirm it)"
+            } else {
+                ""
+            }
+        ));
+    }
+    if c.not_judged {
+        out.push_str(if c.confirmed {
+            "     in the extended model on the fitted records alone: its corrected p-value is below α·Φ̄(2), the rate a judged finding's two tests allow\n"
+        } else {
+            "     not in the extended model: judged by no record, and its corrected p-value is not below α·Φ̄(2), the rate a judged finding's two tests allow\n"
+        });
+    } else if let Some(original) = &c.replaces {
         out.push_str(&format!(
             "     chosen by {by} among the alternatives of {}: held-out gain {} standard deviations of a spurious one's (tried: {})\n",
             words(original),
@@ -589,6 +606,7 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
         out.push_str(&findings(r));
     }
     out.push_str(&stop(r));
+    out.push_str(&groups(r));
     for x in &r.dropped {
         out.push_str(&format!(
             "Dropped: {} (selected, but the fit of the extended model with it failed: {}).\n",
@@ -620,6 +638,50 @@ pub fn diagnosis(r: &DiagnosisReport) -> String {
     out.push_str(&recommendation(r));
     out.push('\n');
     out.push_str(&next_steps(r));
+    out
+}
+
+/// The error groups selected after the findings, each with what the judging records say.
+fn groups(r: &DiagnosisReport) -> String {
+    let mut out = String::new();
+    if r.groups.is_empty() {
+        return out;
+    }
+    out.push_str("Error groups, each one candidate of its directions after the findings:\n");
+    for g in &r.groups {
+        out.push_str(&format!(
+            "  {} ({}): {} directions, F = {}, p = {}; {}{}{}\n",
+            g.name,
+            g.terms.join(" "),
+            g.directions,
+            fixed(g.f, 1),
+            p_value(g.p_value),
+            match g.gain_sd {
+                Some(z) => format!(
+                    "gain on the records that judge it {} standard deviations",
+                    fixed(z, 1)
+                ),
+                None =>
+                    "no record can judge it: in the model on its p-value only below α·Φ̄(2)".into(),
+            },
+            if g.unjudged.is_empty() {
+                String::new()
+            } else {
+                format!(" ({} cannot judge it)", g.unjudged.join(", "))
+            },
+            if g.confirmed {
+                "; in the extended model"
+            } else {
+                "; not in the extended model"
+            }
+        ));
+        if g.confirmed && !g.undetermined.is_empty() {
+            out.push_str(&format!(
+                "    not determined by these records: {} (identify with --constraint min-norm)\n",
+                g.undetermined.join(" ")
+            ));
+        }
+    }
     out
 }
 

@@ -302,6 +302,8 @@ impl DiagnosisReport {
                         .into(),
                         gain_sd: finite(|| field("confirmation.gain_sd"), c.gain_sd)?,
                         confirmed: c.confirmed,
+                        not_judged: !c.judged,
+                        unjudged: c.unjudged.clone(),
                         replaces: c.replaces.map(|t| t.spelling(m)),
                         tried: c
                             .tried
@@ -427,6 +429,25 @@ impl DiagnosisReport {
                 .enumerate()
                 .map(|(i, u)| unexplained(i, u, &file_of))
                 .collect::<Result<_, _>>()?,
+            groups: d
+                .groups
+                .iter()
+                .enumerate()
+                .map(|(i, g)| {
+                    let field = |what: &str| format!("groups[{i}].{what}");
+                    Ok(GroupReport {
+                        name: g.group.name.clone(),
+                        terms: g.group.terms.iter().map(|t| t.spelling(m)).collect(),
+                        directions: g.directions,
+                        f: finite(|| field("f"), g.f)?,
+                        p_value: finite(|| field("p_value"), g.p)?,
+                        gain_sd: finite_opt(|| field("gain_sd"), g.gain_sd)?,
+                        unjudged: g.unjudged.clone(),
+                        confirmed: g.confirmed,
+                        undetermined: g.undetermined.clone(),
+                    })
+                })
+                .collect::<Result<_, NonFinite>>()?,
             dropped: d
                 .dropped
                 .iter()

@@ -5,8 +5,8 @@
 //!
 //! ```sh
 //! /usr/bin/time -f '%U %S %e' cargo run --release -p solver --example diagnose_campaign
-//! # The grouped candidates on (DiagnoseOptions::groups).
-//! cargo run --release -p solver --example diagnose_campaign -- --groups
+//! # The grouped candidates off (DiagnoseOptions::groups; on by default).
+//! cargo run --release -p solver --example diagnose_campaign -- --no-groups
 //! cargo run --release -p solver --example diagnose_campaign -- --dump > diagnosis.txt
 //! ```
 
@@ -21,11 +21,11 @@ use std::time::Instant;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    if let Some(a) = args.iter().find(|a| *a != "--groups" && *a != "--dump") {
-        eprintln!("diagnose_campaign: unknown argument `{a}` (--groups, --dump)");
+    if let Some(a) = args.iter().find(|a| *a != "--no-groups" && *a != "--dump") {
+        eprintln!("diagnose_campaign: unknown argument `{a}` (--no-groups, --dump)");
         std::process::exit(2);
     }
-    let options = DiagnoseOptions::default().groups(args.iter().any(|a| a == "--groups"));
+    let options = DiagnoseOptions::default().groups(!args.iter().any(|a| a == "--no-groups"));
     let m = model_spec::builtin("seed-ac")
         .expect("built-in")
         .expect("valid");

@@ -54,5 +54,6 @@ pub mod fitting;
 pub mod instrument;
 pub mod io;
 pub mod model;
+mod parallel;
 pub mod record;
 pub mod simulation;

@@ -257,19 +257,28 @@ fn zero_first(v: &mut DVector<f64>) {
     }
 }
 
-/// One draw of every residual under the null: the fitted record's noise and the residual of its
-/// fit, then every held-out record's noise minus the prediction that fit makes there.
+/// Each record's noise of one draw (AR(1) of `noise`, in the records' order): what a draw takes
+/// from the random numbers.
+fn draw_noise(noise: &NoiseModel, residuals: &[Residual], rng: &mut Rng) -> Vec<DVector<f64>> {
+    residuals
+        .iter()
+        .map(|r| draw(noise, r.residual.len() / 3, rng))
+        .collect()
+}
+
+/// One draw of every residual under the null from each record's drawn noise `drawn`: the
+/// fitted record's noise and the residual of its fit, then every held-out record's noise minus
+/// the prediction that fit makes there.
 fn draw_residuals(
     noise: &NoiseModel,
     residuals: &[Residual],
     fits: &[Option<DMatrix<f64>>],
-    rng: &mut Rng,
+    drawn: Vec<DVector<f64>>,
 ) -> Result<Vec<Vec<[f64; 3]>>, NoiseError> {
     let mut beta: Option<DVector<f64>> = None;
     let mut out = Vec::with_capacity(residuals.len());
-    for (r, pinv) in residuals.iter().zip(fits) {
+    for ((r, pinv), mut e) in residuals.iter().zip(fits).zip(drawn) {
         let samples = r.residual.len() / 3;
-        let mut e = draw(noise, samples, rng);
         if let (Some(h), Some(pinv)) = (r.fitted, pinv) {
             let mut ew = e.clone();
             noise.whiten_vector(&[samples], &mut ew)?;
@@ -286,6 +295,10 @@ fn draw_residuals(
     }
     Ok(out)
 }
+
+/// How many draws are drawn from the random numbers before their fits and noise estimates are
+/// made on every core.
+const DRAW_BATCH: usize = 32;
 
 /// Tests the residuals against `noise`; `estimated`: the noise model was estimated from the
 /// records (so each draw estimates it again); level `alpha`.
@@ -322,32 +335,46 @@ pub fn adequacy(
     let mut drawn_t = vec![[0.0f64; 3]; residuals.len()];
     // Every draw's ln T per record and direction (`None`: σ could not be estimated).
     let mut drawn_logs: Vec<Option<Vec<[f64; 3]>>> = Vec::with_capacity(draws);
-    for _ in 0..draws {
-        let drawn = draw_residuals(noise, residuals, &fits, &mut rng)?;
-        // A draw whose σ cannot be estimated counts as exceeding: conservative, it can only
-        // make the residuals look more consistent with the noise.
-        let Ok(s) = reference_sigma(noise, estimated, &drawn, false) else {
-            exceed.iter_mut().flatten().for_each(|x| *x += 1);
-            drawn_logs.push(None);
-            continue;
-        };
-        let mut this = Vec::with_capacity(drawn.len());
-        for (k, r) in drawn.iter().enumerate() {
-            let t = statistic(r, &s);
-            let mut l3 = [0.0; 3];
-            for d in 0..3 {
-                if t[d] >= stats[k][d] {
-                    exceed[k][d] += 1;
+    let mut left = draws;
+    while left > 0 {
+        // The random numbers in draw order, as one draw after the other takes them; the fits
+        // and estimates of the batch's draws on every core, taken in draw order.
+        let batch: Vec<Vec<DVector<f64>>> = (0..left.min(DRAW_BATCH))
+            .map(|_| draw_noise(noise, residuals, &mut rng))
+            .collect();
+        left -= batch.len();
+        let done = crate::parallel::map_in_order(&batch, |drawn| {
+            let drawn = draw_residuals(noise, residuals, &fits, drawn.clone())?;
+            Ok(reference_sigma(noise, estimated, &drawn, false)
+                .ok()
+                .map(|s| (drawn, s)))
+        });
+        for d in done {
+            // A draw whose σ cannot be estimated counts as exceeding: conservative, it can only
+            // make the residuals look more consistent with the noise.
+            let Some((drawn, s)) = d? else {
+                exceed.iter_mut().flatten().for_each(|x| *x += 1);
+                drawn_logs.push(None);
+                continue;
+            };
+            let mut this = Vec::with_capacity(drawn.len());
+            for (k, r) in drawn.iter().enumerate() {
+                let t = statistic(r, &s);
+                let mut l3 = [0.0; 3];
+                for d in 0..3 {
+                    if t[d] >= stats[k][d] {
+                        exceed[k][d] += 1;
+                    }
+                    drawn_t[k][d] += t[d];
+                    let l = t[d].max(f64::MIN_POSITIVE).ln();
+                    logs[k][d].0 += l;
+                    logs[k][d].1 += l * l;
+                    l3[d] = l;
                 }
-                drawn_t[k][d] += t[d];
-                let l = t[d].max(f64::MIN_POSITIVE).ln();
-                logs[k][d].0 += l;
-                logs[k][d].1 += l * l;
-                l3[d] = l;
+                this.push(l3);
             }
-            this.push(l3);
+            drawn_logs.push(Some(this));
         }
-        drawn_logs.push(Some(this));
     }
     // The overall test is the maximum over records and directions of ln T standardised by the
     // draws (Westfall and Young's max-T): its null distribution is drawn with the others, so the

@@ -258,15 +258,13 @@ impl<'a> Folds<'a> {
                 fits: Vec::new(),
                 predictions: Vec::new(),
             });
-            for f in &self.folds {
-                match extend::fit_refined(
-                    self.m,
-                    &model,
-                    &f.fitted,
-                    self.o,
-                    self.noise,
-                    &self.refine,
-                ) {
+            // The folds' fits are independent: made on every core, taken in fold order as a
+            // loop over the folds would take them (the first that does not converge ends it).
+            let fits = crate::parallel::map_in_order(&self.folds, |f| {
+                extend::fit_refined(self.m, &model, &f.fitted, self.o, self.noise, &self.refine)
+            });
+            for (f, fit) in self.folds.iter().zip(fits) {
+                match fit {
                     Ok(fit) => {
                         let p = heldout::predict(self.m, &fit, &f.judged)?;
                         if let Some(e) = e.as_mut() {

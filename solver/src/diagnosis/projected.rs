@@ -306,8 +306,9 @@ pub fn project_out(q: &DMatrix<f64>, m: &mut DMatrix<f64>) {
         }
     } else {
         // A few directions: column by column, each column kept in cache for both passes.
-        let mut c = [0.0f64; SMALL_RANK];
-        for column in m.as_mut_slice().chunks_exact_mut(n) {
+        // The columns are independent: shared out over the cores.
+        crate::parallel::for_each_column(m.as_mut_slice(), n, |column| {
+            let mut c = [0.0f64; SMALL_RANK];
             for _ in 0..2 {
                 for (u, c) in q.column_iter().zip(c.iter_mut()) {
                     *c = dot(u.as_slice(), column);
@@ -316,7 +317,7 @@ pub fn project_out(q: &DMatrix<f64>, m: &mut DMatrix<f64>) {
                     axpy(-c, u.as_slice(), column);
                 }
             }
-        }
+        });
     }
 }
 

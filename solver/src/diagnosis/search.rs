@@ -138,17 +138,20 @@ pub(super) fn select(p: &Problem) -> (Vec<Chosen>, Stop) {
         // digits); the directions of the few candidates a step looks at are made when asked
         // for ([`Scored::directions`]).
         let make = |c: usize| model.directions(c);
-        let mut scored: Vec<Scored> = Vec::with_capacity(pool.len());
-        for (k, &c) in pool.iter().enumerate() {
-            progress.update("selection", k as u64 + 1, total);
-            let (width, on) = model.score(c).unwrap_or_else(|| {
+        // Scored on every core (each candidate alone), taken in the pool's order.
+        let scores = crate::parallel::map_in_order(pool, |&c| {
+            model.score(c).unwrap_or_else(|| {
                 let d = model.directions(c);
                 (d.ncols(), coordinates(&d.columns(0, d.ncols()), r))
-            });
-            if width > 0 {
-                scored.push(Scored::made_by(c, width, on, &make));
-            }
-        }
+            })
+        });
+        progress.update("selection", total, total);
+        let scored: Vec<Scored> = pool
+            .iter()
+            .zip(scores)
+            .filter(|(_, (width, _))| *width > 0)
+            .map(|(&c, (width, on))| Scored::made_by(c, width, on, &make))
+            .collect();
         let Some(best) = scored
             .iter()
             .max_by(|a, b| a.delta_rss.total_cmp(&b.delta_rss))

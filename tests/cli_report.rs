@@ -523,3 +523,83 @@ fn the_report_of_a_campaign_and_its_validation() {
     assert_eq!(c["kind"], "campaign");
     assert_eq!(c["records"][1]["params"]["Zw"], 251.537);
 }
+
+/// The error groups of a campaign's diagnosis: the five records of `seed-ac-budget` (every
+/// error of the topology) diagnosed from the command line; the groups selected after the
+/// findings are in the JSON, in the text and, with what the records left out in turn say of
+/// each, in the HTML report, the same in every one.
+#[test]
+fn the_error_groups_of_a_campaign_diagnosis_are_reported() {
+    let dir = temp_dir("groups");
+    let run = |line: &str| ok(&dir, &common::words(line));
+    for (path, seed, file, zw) in [
+        ("K4", 1, "k4", ""),
+        ("K1", 2, "k1", ""),
+        ("K2", 3, "k2", ""),
+        ("K4", 4, "k4-high", " --param Zw=261.537"),
+        ("K1", 5, "k1-high", " --param Zw=261.537"),
+    ] {
+        run(&format!(
+            "simulate --machine seed-ac --path {path} --truth seed-ac-budget --seed {seed}{zw} -o {file}.csv"
+        ));
+    }
+    let mut campaign = String::from("machine = \"seed-ac\"\n");
+    for (file, setup) in [
+        ("k4", "low"),
+        ("k1", "low"),
+        ("k2", "low"),
+        ("k4-high", "high"),
+        ("k1-high", "high"),
+    ] {
+        campaign.push_str(&format!(
+            "[[record]]\nfile = \"{file}.csv\"\nsetup = \"{setup}\"\n"
+        ));
+        if setup == "high" {
+            campaign.push_str("params = { Zw = 261.537 }\n");
+        }
+    }
+    std::fs::write(dir.join("c.toml"), campaign).unwrap();
+    let text = run(
+        "diagnose --machine seed-ac --model reduced --campaign c.toml --json d.json --report d.html",
+    );
+    let json: serde_json::Value = serde_json::from_str(&read(&dir, "d.json")).unwrap();
+    let groups = json["groups"].as_array().expect("groups in the JSON");
+    assert!(!groups.is_empty(), "no group selected: {text}");
+    assert!(text.contains("Error groups"), "{text}");
+    let html = read(&dir, "d.html");
+    check_self_contained(&html);
+    assert!(
+        html.contains("<h3>Error groups</h3>"),
+        "{:?}",
+        headings(&html)
+    );
+    for g in groups {
+        let name = g["name"].as_str().unwrap();
+        assert!(text.contains(name), "{name} in the text");
+        let escaped = name.replace('\'', "&#39;");
+        assert!(
+            html.contains(&format!("<td>{escaped}</td>")),
+            "{name} in the HTML"
+        );
+        let in_model = if g["confirmed"].as_bool().unwrap() {
+            "in"
+        } else {
+            "left out"
+        };
+        let members = g["terms"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t.as_str().unwrap())
+            .collect::<Vec<_>>()
+            .join(" ");
+        assert!(
+            html.contains(&format!("<td>{members}</td>")),
+            "{name}'s members"
+        );
+        // Its row ends with whether it is in the extended model.
+        let row = &html[html.find(&format!("<td>{escaped}</td>")).unwrap()..];
+        let row = &row[..row.find("</tr>").unwrap()];
+        assert!(row.ends_with(&format!("<td>{in_model}</td>")), "{row}");
+    }
+}

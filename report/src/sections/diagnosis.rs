@@ -6,7 +6,7 @@ use super::{num, unit, value_std};
 use crate::html::{Body, Cell};
 use crate::inputs::{Figure, Inputs};
 use model_spec::units::{fixed, p_value, short};
-use solver::io::report::diagnose::{DiagnosisReport, FindingReport};
+use solver::io::report::diagnose::{DiagnosisReport, FindingReport, GroupReport};
 
 /// A finding's value(s) with uncertainties; a harmonic with its amplitude and phase.
 fn finding_value(f: &FindingReport) -> String {
@@ -134,6 +134,7 @@ pub fn write(
             &rows,
         );
     }
+    groups(b, d);
     if !d.dropped.is_empty() {
         let lines: Vec<String> = d
             .dropped
@@ -382,5 +383,62 @@ fn gain_row(role: &str, g: &solver::io::report::diagnose::GainRow) -> Vec<Cell> 
                     .join("; ")
             )
         }),
+    ]
+}
+
+/// The error groups selected after the findings: each one candidate of its directions, what
+/// the judging records say of it, and whether it is in the extended model.
+fn groups(b: &mut Body, d: &DiagnosisReport) {
+    if d.groups.is_empty() {
+        return;
+    }
+    b.subheading("Error groups");
+    let rows: Vec<Vec<Cell>> = d.groups.iter().map(group_row).collect();
+    b.table(
+        "Error groups, each one candidate of its directions after the findings",
+        &[
+            "Group",
+            "Members",
+            "Directions",
+            "F",
+            "p (corrected)",
+            "Judging records",
+            "Extended model",
+        ],
+        &rows,
+    );
+    let undetermined: Vec<String> = d
+        .groups
+        .iter()
+        .filter(|g| g.confirmed && !g.undetermined.is_empty())
+        .map(|g| format!("{}: {}", g.name, g.undetermined.join(", ")))
+        .collect();
+    if !undetermined.is_empty() {
+        b.paragraph(
+            "Members these records do not determine (the extended model is identified with --constraint min-norm):",
+        );
+        b.list(&undetermined);
+    }
+}
+
+/// One group's row.
+fn group_row(g: &GroupReport) -> Vec<Cell> {
+    let judged = match g.gain_sd {
+        Some(z) => format!("gain {} standard deviations", fixed(z, 1)),
+        None => "none can judge it: in the model on its p-value only below α·Φ̄(2)".into(),
+    };
+    let judged = if g.unjudged.is_empty() {
+        judged
+    } else {
+        format!("{judged}; {} cannot judge it", g.unjudged.join(", "))
+    };
+    vec![
+        Cell::text(g.name.clone()),
+        Cell::text(g.terms.join(" ")),
+        Cell::number(g.directions.to_string()),
+        Cell::number(fixed(g.f, 1)),
+        Cell::number(p_value(g.p_value)),
+        Cell::text(judged),
+        Cell::text(if g.confirmed { "in" } else { "left out" }.to_string()),
     ]
 }

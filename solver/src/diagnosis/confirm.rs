@@ -15,7 +15,7 @@
 //!   others predicts it from records that do not determine it). The gains below are over the
 //!   records that can judge; a finding no record can judge enters the extended model on the
 //!   fitted records alone when several records are fitted and its corrected p-value is below
-//!   [`verdict::enters_unjudged`]'s bound ([`Folds::enters_unjudged`]).
+//!   [`verdict::enters_unjudged`]'s bound (`Folds::enters_unjudged`).
 //! - **Drop-one.** For every plausible finding, the extended model without it against with
 //!   it: its held-out gain `Σ (r_without² − r_with²)` over the judging readings, in standard
 //!   deviations of the gain of a spurious change of the predictions

@@ -56,7 +56,7 @@ pub const CONFIRM_SD: f64 = 2.0;
 /// beyond [`CONFIRM_SD`] standard deviations, which a spurious one passes with probability
 /// `Φ̄(CONFIRM_SD)` (2.3 %); one that is not judged must reach the same rate of false entry
 /// on the one test it has. The judging records' word is needed all the same where the fitted
-/// records are one path with records held out ([`super::confirm::Folds::enters_unjudged`]).
+/// records are one path with records held out (`confirm::Folds::enters_unjudged`).
 pub fn enters_unjudged(p: f64, alpha: f64) -> bool {
     p < alpha * crate::fitting::distributions::normal_upper_tail(CONFIRM_SD)
 }

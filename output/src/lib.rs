@@ -111,8 +111,18 @@ mod outputs;
 mod signals;
 mod target;
 mod temp;
-#[doc(hidden)]
+/// Hooks for this crate's own tests (feature `testing`): fixed temporary names, and code run
+/// between the stages of a write. Without the feature the hooks are no-ops the compiler removes.
+#[cfg(feature = "testing")]
 pub mod testing;
+#[cfg(not(feature = "testing"))]
+mod testing {
+    pub(crate) fn next_name_bits() -> Option<u64> {
+        None
+    }
+    pub(crate) fn after_staging() {}
+    pub(crate) fn after_rename() {}
+}
 
 pub use check::{check_dir, check_targets, refuse_inputs_in_dir, refuse_overwriting_inputs};
 pub use error::{Cause, WriteError};

@@ -1,5 +1,5 @@
 //! How code generation scales with the length of the chain: for synthetic machines of 1 to 16
-//! rotary axes (`codegen/tests/support/chains.rs`: a serial arm on the tool side, a table stack
+//! rotary axes (`codeg../tests/all/support/chains.rs`: a serial arm on the tool side, a table stack
 //! on the work side, each machine the one before with one more axis, directions x, z, y and an
 //! inclined one in turn, every offset a symbol), the time of the derivation, of derivation
 //! plus CSE, of the whole Rust source, and the size of the program of the full model; then
@@ -8,7 +8,7 @@
 //! `cargo run --release -p codegen --example chain_scaling [MAX_AXES [MAX_TABLE_AXES]]`
 //! (defaults 16 and 10). Times are wall-clock medians of several runs on this computer.
 
-#[path = "../tests/support/chains.rs"]
+#[path = "../tests/all/support/chains.rs"]
 mod chains;
 
 use codegen::table::{Format, render};

@@ -7,7 +7,7 @@
 //! or a NaN further on (a stroke of `±1e308` mm would make `inf` of every result that divides by
 //! or adds to it).
 //!
-//! `docs/model-spec.md` lists them with the reasons; the tests in `model-spec/tests/limits.rs`
+//! `docs/model-spec.md` lists them with the reasons; the tests in `model-spec/tests/all/limits.rs`
 //! check each message.
 
 /// The largest machine description, in bytes (1 MiB). The built-in descriptions have under

@@ -21,12 +21,12 @@
 //! with the reduced model as base, identified with the reduced model, the diagnosis's extended
 //! model and the truth's own terms, and each identification's shared errors are compensated on
 //! 200 random five-axis poses with the ball at `Zw + 25` mm; the machine's own error is measured
-//! on the exact virtual machine before and after (the study is `solver/tests/full_loop/study.rs`,
-//! the test `solver/tests/full_loop.rs` asserts its gate).
+//! on the exact virtual machine before and after (the study is `solv../tests/all/full_loop/study.rs`,
+//! the test `solver/tests/all/full_loop.rs` asserts its gate).
 
 // The test `full_loop` uses the rest of the study.
 #[allow(dead_code)]
-#[path = "../tests/full_loop/study.rs"]
+#[path = "../tests/all/full_loop/study.rs"]
 mod study;
 
 fn main() {

@@ -14,7 +14,7 @@ use proptest::test_runner::TestCaseError;
 use solver::fitting::plan;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-#[path = "../../tests/support/fuzz.rs"]
+#[path = "../../tests/all/support/fuzz.rs"]
 mod fuzzing;
 
 /// `rtest plan`'s flags alone.

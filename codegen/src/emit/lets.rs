@@ -13,7 +13,7 @@
 //! plain ASCII, so that `prettyplease` would have printed it on one line as written: the
 //! markers sit in function bodies at most three levels deep, twelve spaces, well within its
 //! margin of 89 columns. A longer statement (a kinematic parameter with a long name) goes
-//! through `syn` as before. `codegen/tests/emitted.rs` checks that the generated files are a
+//! through `syn` as before. `codegen/tests/all/emitted.rs` checks that the generated files are a
 //! fixed point of `syn` and `prettyplease` (printing the parsed file again gives the same
 //! text) for every built-in machine and for long synthetic chains.
 

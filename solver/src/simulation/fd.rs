@@ -6,7 +6,7 @@
 //! angular ones; orientation rows in 1/mm (always 0) and rad/rad. They are computed as
 //! `(v(+h) − v(−h)) / 2h`: this is the reference the symbolic engine is tested against.
 //!
-//! Step sizes ([`FdSteps::default`]), from the step study in `tests/fd.rs` (largest deviation
+//! Step sizes ([`FdSteps::default`]), from the step study in `tests/all/fd.rs` (largest deviation
 //! from the seed's Table 2 over 20 random poses of `seed-ac`, lever arms ≈ 250 mm):
 //! - translational errors enter the exact chain linearly (a translation moves the end points by
 //!   a fixed vector and turns no frame), so the difference quotient has no truncation error and

@@ -1,0 +1,8 @@
+//! The integration tests of the calibration history, in one test binary (one link instead of one
+//! per file): each file of this directory is a module, and `cargo test -p history --test all
+//! NAME::` runs one of them.
+
+mod common;
+
+mod store;
+mod trend;

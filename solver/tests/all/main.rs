@@ -1,0 +1,66 @@
+//! The integration tests of the solver, in one test binary (one link instead of one per
+//! file): each file of this directory is a module, and `cargo test -p solver --test all NAME::`
+//! runs one of them.
+
+mod common;
+mod csvfiles;
+
+mod axis_tables;
+mod campaign;
+mod campaign_heights;
+mod compensation_engine;
+mod compensation_firmware;
+mod compensation_loop;
+mod compensation_values;
+mod corrected_kinematics;
+mod csvblocks;
+mod csvchecks;
+mod csvio;
+mod csvlines;
+mod csvprop;
+mod diagnose;
+mod diagnose_adequacy;
+mod diagnose_campaign;
+mod diagnose_convergence;
+mod diagnose_extra_causes;
+mod diagnose_families;
+mod diagnose_honesty;
+mod diagnose_instrument_knock;
+mod diagnose_noise;
+mod diagnose_same_finding;
+mod diagnose_trunnion;
+mod estimate;
+mod exact_machine;
+mod fd;
+mod full_loop;
+mod generator;
+mod generator_orders;
+mod hmatrix;
+mod identify_exact;
+mod identify_noise;
+mod instrument_calibration;
+mod instrument_description;
+mod instrument_fit;
+mod instrument_geometry;
+mod instrument_record;
+mod nc_measure;
+mod nc_programs;
+mod noise_model;
+mod offsets;
+mod paths;
+mod plan;
+mod plan_reversal;
+mod plan_update;
+mod pose_csv;
+mod pose_memory;
+mod readers_prop;
+mod report_versions;
+mod segment;
+mod simulate;
+mod streaming;
+mod templates;
+mod timebases;
+mod truth;
+mod validate;
+mod vocabulary;
+mod volumetric;

@@ -5,8 +5,8 @@
 use std::path::Path;
 use std::process::Output;
 
-use crate::common;
-use common::{TempDir, entries, json_here as json, ok_here as ok, seed_file, stderr, triple};
+use crate::common::{self, temp_dir};
+use common::{entries, json_here as json, ok_here as ok, seed_file, stderr, triple};
 
 fn rtest_in(dir: Option<&Path>, args: &[&str]) -> Output {
     common::run(dir, args)
@@ -18,10 +18,6 @@ fn fails(args: &[&str], code: i32, needles: &[&str]) -> String {
 
 fn fails_in(dir: Option<&Path>, args: &[&str], code: i32, needles: &[&str]) -> String {
     common::check_fails(&rtest_in(dir, args), args, code, needles)
-}
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli", name)
 }
 
 fn rtest(args: &[&str]) -> Output {

@@ -3,19 +3,14 @@
 //! column and field named; nothing written). The diagnosis of a campaign: `tests/all/cli_diagnose.rs`.
 
 use model_spec::Machine;
-use serde_json::Value;
 use solver::model::{Model, Term};
 use solver::simulation::paths::{fill_linear_ik, record_from_commands};
 use solver::simulation::readings::simulate;
 use solver::simulation::truth::Truth;
 use std::path::Path;
 
-use crate::common;
-use common::{TempDir, entries, fails, ok, read_json};
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-campaign", name)
-}
+use crate::common::{self, param, temp_dir};
+use common::{entries, fails, ok, read_json};
 
 /// Simulates the built-in `path` of seed-ac with the reduced truth and noise into `dir/out`.
 fn simulate_seed(dir: &Path, path: &str, out: &str, seed: &str, extra: &[&str]) {
@@ -36,15 +31,6 @@ fn simulate_seed(dir: &Path, path: &str, out: &str, seed: &str, extra: &[&str]) 
     ];
     args.extend_from_slice(extra);
     ok(dir, &args);
-}
-
-fn param<'a>(json: &'a Value, name: &str) -> &'a Value {
-    json["parameters"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|p| p["name"] == name)
-        .unwrap_or_else(|| panic!("{name} in {json}"))
 }
 
 #[test]

@@ -11,16 +11,8 @@ use std::path::Path;
 
 // ---------------------------------------------------------------- helpers
 
-use crate::common;
+use crate::common::{self, num, temp_dir};
 use common::{TempDir, entries, fails, ok, read_json};
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-diag", name)
-}
-
-fn num(v: &Value) -> f64 {
-    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
-}
 
 /// Simulates K4, K1 and K2 of seed-ac with `truth` (and `extra` flags) into k4.csv, k1.csv and
 /// k2.csv of `dir`, with different noise seeds.

@@ -4,18 +4,14 @@
 //! file changed. Everything happens in fresh temporary directories: FIFOs, symlinks, hard links
 //! and read-only files are made there; no system path is opened.
 
-use crate::common;
+use crate::common::{self, mkfifo, temp_dir};
 
-use common::{TempDir, check_fails, fails, ok, run, stderr, words};
+use common::{check_fails, fails, ok, run, stderr, words};
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::os::unix::fs::{MetadataExt, PermissionsExt};
 use std::path::Path;
 use std::process::Command;
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("hard", name)
-}
 
 /// Every entry of `dir` (recursively): its kind, mode and contents.
 fn snapshot(dir: &Path) -> BTreeMap<String, (String, u32, Vec<u8>)> {
@@ -60,14 +56,6 @@ fn simulate(dir: &Path, path: &str, out: &str) {
             "simulate --machine seed-ac --path {path} --truth seed-ac-reduced -o {out}"
         )),
     );
-}
-
-fn mkfifo(path: &Path) {
-    let s = Command::new("mkfifo")
-        .arg(path)
-        .status()
-        .expect("mkfifo runs");
-    assert!(s.success(), "mkfifo {}", path.display());
 }
 
 /// A thread that reads the FIFO `path` to its end.

@@ -4,18 +4,14 @@
 //! input: one stderr line, exit code 2 for usage errors and 1 for bad inputs, the database
 //! left as it was).
 
-use crate::common;
+use crate::common::{self, temp_dir};
 
-use common::{TempDir, entries, fails, ok, read_json};
+use common::{entries, fails, ok, read_json};
 use history::sha256::sha256_hex;
 use serde_json::Value;
 use solver::simulation::truth::Truth;
 use solver::simulation::{builtin_path, simulate};
 use std::path::Path;
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-history", name)
-}
 
 /// Writes a K4 measurement of seed-ac to `dir/name`: the reduced truth with XOC = `xoc` µm,
 /// 0.6 µm of noise from `seed`.

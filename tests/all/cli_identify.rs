@@ -15,12 +15,8 @@ use std::path::Path;
 
 // ---------------------------------------------------------------- helpers
 
-use crate::common;
+use crate::common::{self, temp_dir};
 use common::{TempDir, entries, fails, ok, read_json};
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-id", name)
-}
 
 /// Two JSON values equal, numbers to 1e-9 relative.
 fn assert_close(a: &Value, b: &Value) {

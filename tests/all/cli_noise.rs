@@ -5,12 +5,8 @@
 
 use serde_json::Value;
 
-use crate::common;
-use common::{TempDir, fails, ok, read_json, words};
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-noise", name)
-}
+use crate::common::{self, temp_dir};
+use common::{fails, ok, read_json, words};
 
 /// Simulates K4 on seed-ac with the reduced truth and `extra` flags into `dir/k4.csv`.
 fn simulate_k4(dir: &std::path::Path, extra: &str) {

@@ -4,15 +4,10 @@
 //! machine's probe length; a campaign sharing a pivot length and refusing records that disagree
 //! on it; a sub-model of a description with a symbol; bad terms and symbol names refused.
 
-use serde_json::Value;
 use std::path::Path;
 
-use crate::common;
-use common::{TempDir, fails, ok, read_json, words};
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-offsets", name)
-}
+use crate::common::{self, param, temp_dir};
+use common::{fails, ok, read_json, words};
 
 /// head-table-bc's location errors that pair-B-C separates (µm, µrad), its pivot length
 /// 40 µm shorter than the description's -250 mm, reading noise 0.3 µm.
@@ -39,15 +34,6 @@ const DETERMINED: &str = "COY,BOZ,XOW,YOW,ZOW,AOB,COB,XOC,YOC,AOC,BOC,Zt";
 
 fn write(dir: &Path, name: &str, text: &str) {
     std::fs::write(dir.join(name), text).unwrap();
-}
-
-fn param<'a>(json: &'a Value, name: &str) -> &'a Value {
-    json["parameters"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|p| p["name"] == name)
-        .unwrap_or_else(|| panic!("{name} in {json}"))
 }
 
 /// Simulates `path` of head-table-bc with [`HEAD_TABLE_TRUTH`] (`seed`) into `dir/out`.

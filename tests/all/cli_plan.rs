@@ -3,23 +3,15 @@
 //! the JSON, AR(1) noise, and bad input (one stderr line naming the flag, the test and the
 //! sample; exit code 2 for usage errors; no output file left behind).
 
-use crate::common;
-use common::{TempDir, entries, fails, ok, read_json};
+use crate::common::{self, num, temp_dir};
+use common::{entries, fails, ok, read_json};
 use serde_json::Value;
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-plan", name)
-}
 
 /// `plan --machine seed-ac --model reduced` with `rest`.
 fn plan_args<'a>(rest: &[&'a str]) -> Vec<&'a str> {
     let mut v = vec!["plan", "--machine", "seed-ac", "--model", "reduced"];
     v.extend_from_slice(rest);
     v
-}
-
-fn num(v: &Value) -> f64 {
-    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
 #[test]

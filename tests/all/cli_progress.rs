@@ -6,12 +6,8 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use crate::common;
+use crate::common::{self, temp_dir};
 use common::{TempDir, stderr};
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-progress", name)
-}
 
 /// Runs the binary in `dir` with `args`, the delay before a bar set to `delay_ms` when given.
 fn run(dir: &Path, args: &[&str], delay_ms: Option<&str>) -> Output {

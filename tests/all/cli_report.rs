@@ -6,12 +6,8 @@
 
 use std::path::Path;
 
-use crate::common;
+use crate::common::{self, temp_dir};
 use common::{TempDir, entries, fails, ok};
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-report", name)
-}
 
 /// k4.csv and k1.csv of seed-ac with the demo truth, and `id.json`: the reduced model
 /// identified on K4, and `v1.json`: its validation on K1.

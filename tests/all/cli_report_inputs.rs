@@ -11,13 +11,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::common;
+use crate::common::{self, mkfifo, temp_dir};
 use common::{TempDir, check_fails, entries, ok, run};
 use history::sha256::sha256_hex;
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-report-inputs", name)
-}
 
 /// `k4.csv` of seed-ac with the demo truth, and `id.json`: the reduced model identified on it.
 fn set_up(name: &str) -> TempDir {
@@ -62,15 +58,6 @@ fn naming(dir: &Path, name: &str, to: &Path) {
     let quoted = serde_json::to_string(name).unwrap();
     assert!(text.contains("\"k4.csv\""));
     std::fs::write(to, text.replace("\"k4.csv\"", &quoted)).unwrap();
-}
-
-/// A FIFO at `path`, made by `mkfifo`.
-fn mkfifo(path: &Path) {
-    let status = Command::new("mkfifo")
-        .arg(path)
-        .status()
-        .expect("mkfifo runs");
-    assert!(status.success(), "mkfifo {}", path.display());
 }
 
 /// Runs the binary with `args` in `dir`, for at most 60 s (then it is killed and the test

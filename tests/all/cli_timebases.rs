@@ -5,13 +5,8 @@
 //! of `rtest compensate` and listed; bad spellings are refused with the flag, file, line and
 //! column.
 
-use crate::common;
-use common::{TempDir, fails, ok, read_json};
-use serde_json::Value;
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-timebases", name)
-}
+use crate::common::{self, param, temp_dir};
+use common::{fails, ok, read_json};
 
 /// The reduced truth of seed-ac with a drift of dx0 of 0.02 µm/s and a warm-up of EXZ to 3 µm
 /// with a time constant of 40 s, noise free.
@@ -33,15 +28,6 @@ EXZ = { "warmup:40" = 3.0 }
 "#;
 
 const TERMS: &str = "dx0@rate,EXZ@warmup:40";
-
-fn param<'a>(json: &'a Value, name: &str) -> &'a Value {
-    json["parameters"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|p| p["name"] == name)
-        .unwrap_or_else(|| panic!("no parameter {name} in {json}"))
-}
 
 /// K4's poses every 2.5 s from `t0` s (a path file: rotary axes and times), 600 s in all,
 /// simulated with `truth.toml` into `out`.

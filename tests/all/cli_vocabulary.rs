@@ -3,13 +3,8 @@
 //! `rtest simulate`, identified back by `rtest identify --terms` (values in µm, ms and 1), read
 //! by `rtest validate`, and refused on a record without times.
 
-use crate::common;
-use common::{TempDir, fails, ok, read_json};
-use serde_json::Value;
-
-fn temp_dir(name: &str) -> TempDir {
-    common::temp_dir_tagged("cli-vocab", name)
-}
+use crate::common::{self, param, temp_dir};
+use common::{fails, ok, read_json};
 
 /// The reduced truth of seed-ac plus one term of every new family (values in µm, ms, 1).
 const TRUTH: &str = r#"machine = "seed-ac"
@@ -35,15 +30,6 @@ SXY = 0.03
 "#;
 
 const TERMS: &str = "EXX@period:10,EXX@step:100,EAA@velocity,dy0@exp:20,SXY";
-
-fn param<'a>(json: &'a Value, name: &str) -> &'a Value {
-    json["parameters"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|p| p["name"] == name)
-        .unwrap_or_else(|| panic!("no parameter {name} in {json}"))
-}
 
 #[test]
 fn new_terms_are_simulated_identified_and_validated() {

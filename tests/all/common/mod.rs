@@ -161,3 +161,33 @@ fn next_scratch_number() -> usize {
     static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
+
+/// A fresh temporary directory for the test `name` (numbered, so that tests with the same name
+/// in different files do not meet), removed when dropped.
+pub fn temp_dir(name: &str) -> TempDir {
+    temp_dir_tagged("cli", name)
+}
+
+/// The parameter `name` of a report's JSON (`parameters[].name`).
+pub fn param<'a>(json: &'a Value, name: &str) -> &'a Value {
+    json["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == name)
+        .unwrap_or_else(|| panic!("no parameter {name} in {json}"))
+}
+
+/// A JSON number as `f64`.
+pub fn num(v: &Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+/// Makes a FIFO at `path` (inside a test's temporary directory).
+pub fn mkfifo(path: &Path) {
+    let status = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
+    assert!(status.success(), "mkfifo {}", path.display());
+}

@@ -15,7 +15,7 @@ use std::path::Path;
 
 // ---------------------------------------------------------------- helpers
 
-use crate::common::{self, temp_dir};
+use crate::common::{self, num, temp_dir};
 use common::{TempDir, entries, fails, ok, read_json};
 
 /// Two JSON values equal, numbers to 1e-9 relative.
@@ -854,6 +854,45 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
     let start = std::time::Instant::now();
     let out = ok(&dir, &["demo"]);
     let elapsed = start.elapsed();
+    // What the demo diagnoses (the same steps as `rtest diagnose`), checked on this one run.
+    {
+        for s in [
+            "Diagnosis (rtest diagnose --machine seed-ac --model reduced --data rtest-demo/k4.csv --validate rtest-demo/k1.csv,rtest-demo/k2.csv)",
+            "  1. ECC harmonic:2: angular positioning error of C, twice per revolution: ",
+            "rtest-demo/k1.csv (held out)",
+            "Check against the truth",
+            "ECC@harmonic:2 found: ",
+            "against the truth 8, 6 µrad",
+            "rtest-demo/diagnose.json",
+            "rtest-demo/seed-ac-extended.toml",
+            "rtest-demo/k4-path.svg",
+            "rtest-demo/k2-spectrum.svg",
+        ] {
+            assert!(out.contains(s), "`{s}` not in:\n{out}");
+        }
+        // The hand-made extension from the truth is gone.
+        assert!(!out.contains("Added to the model"), "{out}");
+        assert!(!out.contains("NOT found") && !out.contains("false finding"));
+        let demo = dir.join("rtest-demo");
+        let j = read_json(&demo.join("diagnose.json"));
+        assert_eq!(j["findings"][0]["error"], "ECC");
+        assert_eq!(j["findings"][0]["basis"], "harmonic:2");
+        for v in j["gain"]["validation"].as_array().unwrap() {
+            assert!(num(&v["residual_rms_um_after"]) < 0.5 * num(&v["residual_rms_um_before"]));
+        }
+        ok(
+            &demo,
+            &[
+                "identify",
+                "--machine",
+                "seed-ac-extended.toml",
+                "--model",
+                "extended",
+                "--data",
+                "k4.csv",
+            ],
+        );
+    }
     let files = [
         "compensate-k1.json",
         "diagnose.json",

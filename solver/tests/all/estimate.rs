@@ -107,6 +107,19 @@ fn noise_free_first_order_data_are_recovered_exactly() {
 
 #[test]
 fn uncertainties_are_calibrated_over_many_seeds() {
+    uncertainties_are_calibrated(50);
+}
+
+/// The same over 400 noise seeds.
+#[test]
+#[ignore = "study: 400 noise seeds of the reduced model's fit on K4"]
+fn study_uncertainties_are_calibrated_over_400_seeds() {
+    uncertainties_are_calibrated(400);
+}
+
+/// The standardised errors of `seeds` fits of the reduced model on K4 (0.5 µm white noise)
+/// have mean 0 and standard deviation 1, and σ̂ is the noise's σ.
+fn uncertainties_are_calibrated(seeds: usize) {
     let m = builtin("seed-ac");
     let model = reduced(&m);
     let rec = k4(&m);
@@ -115,8 +128,7 @@ fn uncertainties_are_calibrated_over_many_seeds() {
     let x = truth();
     let sigma = 0.5e-3; // 0.5 µm
     let (mut z_all, mut beyond4, mut sigma_hat) = (Vec::new(), 0, 0.0);
-    let seeds = 400;
-    for seed in 0..seeds {
+    for seed in 0..seeds as u64 {
         let y = synthetic(&h, &x, sigma, seed, false);
         let fit = least_squares(&h, &y, &names, &Constraint::None, &Tolerances::default()).unwrap();
         sigma_hat += fit.sigma.unwrap() / seeds as f64;
@@ -135,10 +147,15 @@ fn uncertainties_are_calibrated_over_many_seeds() {
         "{seeds} seeds × 11: z mean {mean:.4}, z std {sd:.4}, |z| > 4: {beyond4}, mean σ̂ {:.4} µm",
         sigma_hat * 1e3
     );
+    // The bounds of 400 seeds, widened as the standard error grows with fewer seeds.
+    let widen = (400.0 / seeds as f64).sqrt();
     assert!(beyond4 <= 1, "{beyond4} estimates beyond 4 std");
-    assert!((sd - 1.0).abs() < 0.05, "std of z-scores {sd}");
-    assert!(mean.abs() < 0.05, "mean of z-scores {mean}");
-    assert!((sigma_hat / sigma - 1.0).abs() < 0.01, "mean σ̂ {sigma_hat}");
+    assert!((sd - 1.0).abs() < 0.05 * widen, "std of z-scores {sd}");
+    assert!(mean.abs() < 0.05 * widen, "mean of z-scores {mean}");
+    assert!(
+        (sigma_hat / sigma - 1.0).abs() < 0.01 * widen,
+        "mean σ̂ {sigma_hat}"
+    );
 }
 
 #[test]

@@ -9,7 +9,7 @@
 use crate::fitting::identifiability::{Identifiability, near_confounded, null_space_groups};
 use crate::fitting::least_squares::{Constraint, EstimateError, Fit, Tolerances, WhitenedFit};
 use crate::fitting::noise::{NoiseError, NoiseModel, SampleWhitening};
-use nalgebra::{DMatrix, DVector, SVD};
+use nalgebra::{DMatrix, DVector, Dyn, QR, SVD};
 
 /// The factorisation of one H (m × n, mm per unit of each parameter) under one constraint and
 /// set of tolerances: everything of a fit but what the readings change (the solution, the
@@ -30,8 +30,8 @@ pub struct Factored {
     norms: Vec<f64>,
     /// Singular values of the scaled H of the free columns, descending.
     sv: Vec<f64>,
-    /// Left singular vectors (the scaled H padded with zero rows to at least n rows).
-    u: DMatrix<f64>,
+    /// The left singular vectors, as the readings meet them.
+    left: Left,
     /// Right singular vectors, as columns.
     v: DMatrix<f64>,
     /// Numerical rank.
@@ -48,6 +48,85 @@ pub struct Factored {
     correlation: DMatrix<f64>,
     /// What the data determine.
     identifiability: Identifiability,
+}
+
+/// The left singular vectors of the scaled H of the free columns.
+#[derive(Clone, Debug)]
+enum Left {
+    /// `U` itself, of a system with no more rows than free columns (padded with zero rows to
+    /// as many), or of a tall one whose triangular factor's SVD failed its check.
+    Vectors(DMatrix<f64>),
+    /// A tall system (more rows than free columns): the Householder QR of the scaled H and the
+    /// left singular vectors of its small triangular factor R, so that `U = Q·U_R`. The SVD then
+    /// costs what it costs for n × n, and `U` (rows × n) is never formed: the tall part of the
+    /// work is the QR (as in the streaming fold) and one `Qᵀ·y` per fit.
+    Qr {
+        /// The QR of the scaled H.
+        qr: QR<f64, Dyn, Dyn>,
+        /// The left singular vectors of R (n × n).
+        u_r: DMatrix<f64>,
+    },
+}
+
+impl Left {
+    /// `Uᵀ·y` for the first `rank` singular vectors (`y` padded to the rows of the scaled H).
+    fn project(&self, y: &DVector<f64>, rank: usize) -> Vec<f64> {
+        match self {
+            Left::Vectors(u) => (0..rank).map(|i| u.column(i).dot(y)).collect(),
+            Left::Qr { qr, u_r } => {
+                let mut qty = y.clone();
+                qr.q_tr_mul(&mut qty);
+                let top = qty.rows(0, u_r.nrows());
+                (0..rank).map(|i| u_r.column(i).dot(&top)).collect()
+            }
+        }
+    }
+}
+
+/// Singular values (descending), left and right singular vectors (as columns).
+type Svd = (Vec<f64>, DMatrix<f64>, DMatrix<f64>);
+
+/// The SVD of `a` (rows × nf, nf ≥ 1), to the iteration limit of `m` readings.
+fn svd_of(a: DMatrix<f64>, m: usize) -> Result<Svd, EstimateError> {
+    let nf = a.ncols();
+    let svd = SVD::try_new(a, true, true, f64::EPSILON, 1000 + 200 * nf)
+        .ok_or(EstimateError::Svd(m, nf))?;
+    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+        return Err(EstimateError::Svd(m, nf));
+    };
+    Ok((svd.singular_values.as_slice().to_vec(), u, vt.transpose()))
+}
+
+/// The SVD of `a` (rows × nf, rows ≥ nf ≥ 1) that rebuilds `a` to 1e-10 of its norm, taken
+/// directly or as the SVD of `aᵀ` (`aᵀ = U'·Σ·V'ᵀ`, so `a = V'·Σ·U'ᵀ`), in the order
+/// `transposed_first` says; `None` when neither rebuilds it. nalgebra's SVD of an
+/// upper-triangular factor with an exactly dependent column has been seen to return a wrong
+/// largest singular value (the factor rebuilt 7 % off) while its SVD of the transpose was right:
+/// no factorisation is used unchecked.
+fn checked_svd(
+    a: &DMatrix<f64>,
+    m: usize,
+    transposed_first: bool,
+) -> Result<Option<Svd>, EstimateError> {
+    let norm = a.norm();
+    for transposed in [transposed_first, !transposed_first] {
+        let (sv, u, v) = if transposed && a.nrows() == a.ncols() {
+            let (sv, u_t, v_t) = svd_of(a.transpose(), m)?;
+            (sv, v_t, u_t)
+        } else if transposed {
+            continue;
+        } else {
+            svd_of(a.clone(), m)?
+        };
+        let mut rebuilt = u.columns(0, sv.len()).into_owned();
+        for (j, s) in sv.iter().enumerate() {
+            rebuilt.column_mut(j).scale_mut(*s);
+        }
+        if (rebuilt * v.transpose() - a).norm() <= 1e-10 * norm {
+            return Ok(Some((sv, u, v)));
+        }
+    }
+    Ok(None)
 }
 
 /// Checks the shapes of `h` (m × n) against `readings` values and `names`.
@@ -148,15 +227,27 @@ impl Factored {
                 a[(i, k)] = h[(i, j)] / norms[j];
             }
         }
-        let (sv, u, v) = if nf == 0 {
-            (Vec::new(), DMatrix::zeros(rows, 0), DMatrix::zeros(0, 0))
+        let (sv, left, v) = if nf == 0 {
+            (
+                Vec::new(),
+                Left::Vectors(DMatrix::zeros(rows, 0)),
+                DMatrix::zeros(0, 0),
+            )
+        } else if rows > nf {
+            let qr = a.qr();
+            let r = qr.r();
+            match checked_svd(&r, m, true)? {
+                Some((sv, u_r, v)) => (sv, Left::Qr { qr, u_r }, v),
+                None => {
+                    // The SVD of the whole scaled H, rebuilt from its factors.
+                    let (sv, u, v) =
+                        checked_svd(&(qr.q() * r), m, false)?.ok_or(EstimateError::Svd(m, nf))?;
+                    (sv, Left::Vectors(u), v)
+                }
+            }
         } else {
-            let svd = SVD::try_new(a, true, true, f64::EPSILON, 1000 + 200 * nf)
-                .ok_or(EstimateError::Svd(m, nf))?;
-            let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
-                return Err(EstimateError::Svd(m, nf));
-            };
-            (svd.singular_values.as_slice().to_vec(), u, vt.transpose())
+            let (sv, u, v) = checked_svd(&a, m, false)?.ok_or(EstimateError::Svd(m, nf))?;
+            (sv, Left::Vectors(u), v)
         };
         let smax = sv.first().copied().unwrap_or(0.0);
         let tau = smax
@@ -207,7 +298,7 @@ impl Factored {
             free,
             norms,
             sv,
-            u,
+            left,
             v,
             rank,
             tau,
@@ -255,9 +346,8 @@ impl Factored {
         let mut ypad = DVector::<f64>::zeros(m.max(nf));
         ypad.rows_mut(0, m).copy_from(y);
         let mut z = DVector::<f64>::zeros(nf);
-        for (i, s) in sv.iter().enumerate().take(rank) {
-            let c = self.u.column(i).dot(&ypad) / s;
-            z.axpy(c, &self.v.column(i), 1.0);
+        for (i, (uty, s)) in self.left.project(&ypad, rank).iter().zip(sv).enumerate() {
+            z.axpy(uty / s, &self.v.column(i), 1.0);
         }
         let mut x = vec![0.0; n];
         for (k, &j) in free.iter().enumerate() {
@@ -633,6 +723,47 @@ impl<'a> RowsFactored<'a> {
 mod tests {
     use super::*;
     use crate::simulation::rng::Rng;
+
+    /// A square upper-triangular H with a dependent column (the reduced system the streaming
+    /// fold hands over) fits as the tall H it came from: the SVD that does not rebuild it is
+    /// not used.
+    #[test]
+    fn a_triangular_factor_fits_as_the_tall_system() {
+        let mut rng = Rng::new(5);
+        let (m, n) = (300, 6);
+        let mut h = DMatrix::from_fn(m, n, |_, _| rng.normal());
+        let combined = h.column(0) * 2.0 - h.column(1) * 3.0;
+        h.set_column(5, &combined);
+        h.column_mut(2).scale_mut(1e3);
+        let y = DVector::from_fn(m, |_, _| rng.normal());
+        let names: Vec<String> = (0..n).map(|j| format!("p{j}")).collect();
+        let qr = h.clone().qr();
+        let r = qr.r();
+        let mut qty = y.clone();
+        qr.q_tr_mul(&mut qty);
+        let top = qty.rows(0, n).into_owned();
+        let c = Constraint::MinimumNorm;
+        let tall = Factored::new(&h, &names, &c, &Tolerances::default(), m).unwrap();
+        let square = Factored::new(&r, &names, &c, &Tolerances::default(), m).unwrap();
+        let (a, b) = (
+            tall.fit(&h, &y, 0.0).unwrap(),
+            square.fit(&r, &top, 0.0).unwrap(),
+        );
+        assert_eq!((tall.rank(), square.rank()), (5, 5));
+        for j in 0..n {
+            assert!(
+                (a.solution[j] - b.solution[j]).abs() <= 1e-10 * a.solution[j].abs().max(1e-3),
+                "{j}: {} vs {}",
+                a.solution[j],
+                b.solution[j]
+            );
+        }
+        let gradient = h.transpose() * (&y - &h * DVector::from_column_slice(&a.solution));
+        assert!(
+            gradient.norm() < 1e-9 * y.norm(),
+            "not a least-squares solution"
+        );
+    }
 
     /// A fit made from a factorisation is the minimum-norm least-squares solution with the
     /// singular values and rank of the scaled H; a column that is a combination of two others

@@ -724,11 +724,9 @@ mod tests {
     use super::*;
     use crate::simulation::rng::Rng;
 
-    /// A square upper-triangular H with a dependent column (the reduced system the streaming
-    /// fold hands over) fits as the tall H it came from: the SVD that does not rebuild it is
-    /// not used.
-    #[test]
-    fn a_triangular_factor_fits_as_the_tall_system() {
+    /// A 300 × 6 H of random columns, the sixth `2·h₀ − 3·h₁`, the third 1000 times the others,
+    /// random readings, and the parameter names `p0` … `p5`.
+    fn rank_deficient() -> (DMatrix<f64>, DVector<f64>, Vec<String>) {
         let mut rng = Rng::new(5);
         let (m, n) = (300, 6);
         let mut h = DMatrix::from_fn(m, n, |_, _| rng.normal());
@@ -736,7 +734,16 @@ mod tests {
         h.set_column(5, &combined);
         h.column_mut(2).scale_mut(1e3);
         let y = DVector::from_fn(m, |_, _| rng.normal());
-        let names: Vec<String> = (0..n).map(|j| format!("p{j}")).collect();
+        (h, y, (0..n).map(|j| format!("p{j}")).collect())
+    }
+
+    /// A square upper-triangular H with a dependent column (the reduced system the streaming
+    /// fold hands over) fits as the tall H it came from: the SVD that does not rebuild it is
+    /// not used.
+    #[test]
+    fn a_triangular_factor_fits_as_the_tall_system() {
+        let (h, y, names) = rank_deficient();
+        let (m, n) = h.shape();
         let qr = h.clone().qr();
         let r = qr.r();
         let mut qty = y.clone();
@@ -770,14 +777,8 @@ mod tests {
     /// leaves them undetermined.
     #[test]
     fn a_factorisation_fits_as_the_svd_solves() {
-        let mut rng = Rng::new(5);
-        let (m, n) = (300, 6);
-        let mut h = DMatrix::from_fn(m, n, |_, _| rng.normal());
-        let combined = h.column(0) * 2.0 - h.column(1) * 3.0;
-        h.set_column(5, &combined);
-        h.column_mut(2).scale_mut(1e3);
-        let y = DVector::from_fn(m, |_, _| rng.normal());
-        let names: Vec<String> = (0..n).map(|j| format!("p{j}")).collect();
+        let (h, y, names) = rank_deficient();
+        let (m, n) = h.shape();
         let f = Factored::new(
             &h,
             &names,

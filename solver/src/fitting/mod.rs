@@ -30,6 +30,7 @@ pub mod plan;
 pub mod refine;
 pub mod sanity;
 pub mod streaming;
+mod svd;
 pub mod validate;
 
 pub use hmatrix::{Backend, GainSource, HMatrixError, h_matrix};

@@ -1,7 +1,7 @@
 //! `rtest`: geometric error models of machine tools from R-test measurements.
 //!
 //! A thin command line: every verb parses its flags, calls the libraries (`model-spec`,
-//! `codegen`, `solver`, `plots`, `output`, `perf`) and prints. Verbs live in [`cli`], one
+//! `codegen`, the numeric crates, `plots`, `output`, `perf`) and prints. Verbs live in [`cli`], one
 //! module each.
 
 mod cli;

@@ -3,10 +3,10 @@
 //! the caller knows: the machine id, the test paths, the time of the measurement and the input
 //! files.
 
-use crate::time::Timestamp;
+use formats::time::Timestamp;
+use report::json::IdentificationReport;
+use report::json::identify::ParameterReport;
 use serde::Serialize;
-use solver::io::report::IdentificationReport;
-use solver::io::report::identify::ParameterReport;
 
 /// The longest machine id, test-path label, or text field of a check, in characters.
 pub const MAX_LABEL_CHARS: usize = 200;

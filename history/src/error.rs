@@ -9,7 +9,7 @@ pub enum HistoryError {
     /// No database at that path (reading a history that was never recorded).
     #[error(
         "{file}: no history database there (rtest identify --record --db {} creates it)",
-        solver::io::text::shell(file)
+        report::text::shell(file)
     )]
     NotFound {
         /// The path.

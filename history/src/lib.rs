@@ -30,11 +30,11 @@ pub mod schema;
 pub mod sha256;
 pub mod stats;
 pub mod store;
-pub mod time;
+
 pub mod tolerance;
 pub mod trend;
 
 pub use check::{Check, CheckKind, InputFile, Parameter, Provenance};
 pub use error::HistoryError;
+pub use formats::time::Timestamp;
 pub use store::{DEFAULT_FILE, MachineSummary, RecordedCheck, Staged, Store};
-pub use time::Timestamp;

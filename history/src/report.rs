@@ -89,7 +89,7 @@ pub fn listing(db: &str, machines: &[MachineSummary], checks: &[RecordedCheck]) 
             let _ = writeln!(
                 t,
                 "  Errors of the latest check (rtest history --machine-id {} --error NAME): {}",
-                solver::io::text::shell(&m.machine_id),
+                report::text::shell(&m.machine_id),
                 names.join(" ")
             );
         }

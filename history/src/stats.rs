@@ -1,11 +1,11 @@
 //! The two quantiles the drift flags need: the two-sided quantile of the standard normal
 //! distribution (the change against the baseline) and of Student's t (the trend's slope).
 //!
-//! Both invert the tails of `solver::fitting::distributions` (the normal tail by Numerical
+//! Both invert the tails of `fitting::distributions` (the normal tail by Numerical
 //! Recipes' `erfcc`, fractional error below 1.2e-7; Student's t by the regularized incomplete
 //! beta function) by bisection to the last bit, and are checked against tabulated values.
 
-use solver::fitting::distributions::{normal_upper_tail, t_two_sided};
+use fitting::distributions::{normal_upper_tail, t_two_sided};
 
 /// The smallest and largest two-sided level the flags accept.
 pub const ALPHA_RANGE: (f64, f64) = (1e-6, 0.2);

@@ -2,7 +2,7 @@
 //!
 //! This list is the single definition of how an axis is composed (the seed's eqs. (1)–(2):
 //! `offset · location · component(command)`). The symbolic engine (`codegen`) and the exact
-//! simulator (`solver`) both walk it, so they cannot disagree on the order of the factors.
+//! simulator (`simulation`) both walk it, so they cannot disagree on the order of the factors.
 //!
 //! The homogeneous transform of a chain is the product of its steps from the bed outwards:
 //! `T = S1 · S2 · … · Sn`; a point of the end frame is mapped to the bed frame by `T`.

@@ -3,7 +3,7 @@
 //! message points at the same place in any editor, whatever the text's non-ASCII letters.
 //!
 //! Every reader of a text file for people (machine descriptions, and the truth, JSON and CSV
-//! files of the solver) locates its messages with [`line_col`], so that they agree.
+//! files of the numeric crates) locates its messages with [`line_col`], so that they agree.
 //!
 //! ```
 //! use model_spec::locate::{Locator, line_col};

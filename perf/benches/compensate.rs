@@ -10,9 +10,9 @@
 //!   and written back, with the values of the demo truth's recommended model identified on K4:
 //!   what `rtest compensate --nc iso` does between reading and writing its files.
 
+use compensation::correct::Compensator;
 use criterion::{Criterion, criterion_group, criterion_main};
 use generated::seed_ac::{PARAMETERS, Params, full};
-use solver::compensation::correct::Compensator;
 use std::hint::black_box;
 
 fn compensate(c: &mut Criterion) {
@@ -20,7 +20,7 @@ fn compensate(c: &mut Criterion) {
     let errors = m.model_errors("full").unwrap().to_vec();
     let params = m.default_parameters();
     let mut commands = [0.0, -0.4, 0.9, 0.0, 0.0];
-    solver::simulation::exact::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
+    simulation::exact::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
     let values: Vec<f64> = (0..errors.len())
         .map(|i| {
             let size = if m.catalogue[errors[i]].is_angular() {
@@ -68,20 +68,20 @@ fn compensate(c: &mut Criterion) {
 }
 
 fn program(c: &mut Criterion) {
-    use solver::compensation::run::{CommandedPose, compensate_poses};
-    use solver::compensation::values::MachineErrors;
-    use solver::fitting::{IdentifyOptions, RefineOptions, identify_refined};
-    use solver::io::nc::{Dialect, WriteOptions, parse_program};
-    use solver::io::poses::{axis_words, from_file_units, to_file_units};
-    use solver::io::report::read::parse_identification;
-    use solver::io::report::{IdentificationReport, IdentificationSource, to_json};
+    use compensation::run::{CommandedPose, compensate_poses};
+    use compensation::values::MachineErrors;
+    use fitting::{IdentifyOptions, RefineOptions, identify_refined};
+    use formats::nc::{Dialect, WriteOptions, parse_program};
+    use formats::poses::{axis_words, from_file_units, to_file_units};
+    use report::json::read::parse_identification;
+    use report::json::{IdentificationReport, IdentificationSource, to_json};
     let m = model_spec::builtin("seed-ac").unwrap().unwrap();
-    let truth = solver::simulation::builtin_truth("seed-ac-demo", &m)
+    let truth = simulation::builtin_truth("seed-ac-demo", &m)
         .unwrap()
         .unwrap();
-    let k4 = solver::simulation::builtin_path(&m, "K4").unwrap().unwrap();
-    let record = solver::simulation::simulate(&m, &truth, &k4).unwrap();
-    let mut model = solver::model::Model::of(&m, "reduced").unwrap();
+    let k4 = simulation::builtin_path(&m, "K4").unwrap().unwrap();
+    let record = simulation::simulate(&m, &truth, &k4).unwrap();
+    let mut model = simulation::model::Model::of(&m, "reduced").unwrap();
     model
         .terms
         .push(model_spec::terms::Term::parse(&m, "ECC@harmonic:2").unwrap());

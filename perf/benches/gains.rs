@@ -1,5 +1,5 @@
 //! The generated code against its baselines, in one run (BENCHMARKS.md):
-//! `cargo bench -p solver --bench gains`.
+//! `cargo bench -p perf --bench gains`.
 //! - `gains/*`: all 44 × 6 gains of seed-ac at one pose (sines and cosines included) by
 //!   (a) the generated code, (b) the IR evaluator, (c) the exact HTM chain with central finite
 //!   differences, (d) the runtime first-order product;
@@ -18,9 +18,9 @@ fn gains(c: &mut Criterion) {
     let model = codegen::GainModel::derive(&m, &errors);
     let program = codegen::compile(&m, &model);
     let chain = perf::first_order::FirstOrderChain::new(&m, &errors);
-    let vm = solver::simulation::exact::VirtualMachine::new(&m);
+    let vm = simulation::exact::VirtualMachine::new(&m);
     let mut commands = vec![0.0, -0.4, 0.9, 0.0, 0.0];
-    solver::simulation::exact::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
+    simulation::exact::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
     let typed = Params::default();
     let mut g = c.benchmark_group("gains");
     g.bench_function("a-generated", |b| {
@@ -50,13 +50,13 @@ fn gains(c: &mut Criterion) {
             black_box(&out);
         })
     });
-    let steps = solver::simulation::fd::FdSteps {
+    let steps = simulation::fd::FdSteps {
         richardson: false,
         ..Default::default()
     };
     g.bench_function("c-htm-finite-differences", |b| {
         b.iter(|| {
-            black_box(solver::simulation::fd::fd_gains_with(
+            black_box(simulation::fd::fd_gains_with(
                 &vm,
                 black_box(&commands),
                 &params,

@@ -8,7 +8,7 @@
 use model_spec::kinematics::{Step, chain_steps};
 use model_spec::{AxisKind, ErrorId, Machine, Side, Value};
 use nalgebra::{Matrix3, Vector3};
-use solver::simulation::exact::{coordinate_rotation, frame_rotation};
+use simulation::exact::{coordinate_rotation, frame_rotation};
 
 /// A machine's chains lowered once, for repeated evaluation.
 #[derive(Clone, Debug)]

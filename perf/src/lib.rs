@@ -23,16 +23,16 @@ pub mod report;
 
 use crate::first_order::FirstOrderChain;
 use codegen::{GainModel, compile};
+use fitting::hmatrix::GainSource;
+use fitting::streaming::identify_streaming;
+use fitting::{Constraint, Tolerances};
 use generated::seed_ac::{Params, Pose, full};
 use model_spec::{AxisKind, Machine};
-use solver::fitting::hmatrix::GainSource;
-use solver::fitting::streaming::identify_streaming;
-use solver::fitting::{Constraint, Tolerances};
-use solver::model::Model;
-use solver::record::{Record, Sample};
-use solver::simulation::exact::{VirtualMachine, tool_centre_point_ik};
-use solver::simulation::fd::{FdSteps, fd_gains_with};
-use solver::simulation::rng::Rng;
+use simulation::exact::{VirtualMachine, tool_centre_point_ik};
+use simulation::fd::{FdSteps, fd_gains_with};
+use simulation::model::Model;
+use simulation::record::{Record, Sample};
+use simulation::rng::Rng;
 use std::hint::black_box;
 use std::time::Instant;
 

@@ -5,9 +5,9 @@
 use codegen::{GainModel, compile};
 use model_spec::AxisKind;
 use perf::first_order::FirstOrderChain;
-use solver::simulation::exact::tool_centre_point_ik;
-use solver::simulation::fd::fd_gains;
-use solver::simulation::rng::Rng;
+use simulation::exact::tool_centre_point_ik;
+use simulation::fd::fd_gains;
+use simulation::rng::Rng;
 
 #[test]
 fn generated_evaluator_finite_differences_and_first_order_product_agree() {

@@ -1,12 +1,12 @@
 //! The report's figures, drawn by the `plots` crate: measured against predicted error along
-//! each path (from the series of `solver::diagnosis::figures`, which the verb that computed the
+//! each path (from the series of `diagnosis::figures`, which the verb that computed the
 //! predictions hands over), the residual RMS per direction of each validation, and the residual
 //! components of a diagnosis before and after the extension (both from the reports' numbers).
 
 use crate::inputs::Figure;
+use crate::json::{DiagnosisReport, ValidationReport};
+use diagnosis::figures::{Figures, PathFigure, Series};
 use plots::PlotError;
-use solver::diagnosis::figures::{Figures, PathFigure, Series};
-use solver::io::report::{DiagnosisReport, ValidationReport};
 
 /// An HTML id from a file name (`k4-path.svg` → `fig-k4-path`): letters, digits and `-` only.
 pub fn figure_id(name: &str) -> String {

@@ -2,10 +2,10 @@
 //! figures the verb that asks for the report has drawn, the input files with their SHA-256, and
 //! the checks that the reports belong together (one machine, one model, the same data).
 
+use crate::json::compensate::CompensationReport;
+use crate::json::{DiagnosisReport, IdentificationReport, ValidationReport};
 use model_spec::sha256::Digest;
 use serde_json::Value;
-use solver::io::report::compensate::CompensationReport;
-use solver::io::report::{DiagnosisReport, IdentificationReport, ValidationReport};
 use std::path::Path;
 
 /// One report of rtest, recognised by its content.
@@ -47,7 +47,7 @@ impl Document {
 #[derive(Debug, thiserror::Error)]
 pub enum InputError {
     /// The file cannot be read as text: an I/O error, more than
-    /// [`solver::io::report::read::MAX_REPORT_BYTES`], or not UTF-8 (the message names the
+    /// [`crate::json::read::MAX_REPORT_BYTES`], or not UTF-8 (the message names the
     /// file).
     #[error("{0}")]
     Read(#[from] model_spec::text::TextError),
@@ -102,7 +102,7 @@ pub enum InputError {
 pub fn read_document(path: &Path) -> Result<(Document, String, Digest), InputError> {
     let file = path.display().to_string();
     let (text, digest) =
-        model_spec::text::read_text_hashed(path, solver::io::report::read::MAX_REPORT_BYTES)?;
+        model_spec::text::read_text_hashed(path, crate::json::read::MAX_REPORT_BYTES)?;
     let doc = classify(&file, &text)?;
     Ok((doc, text, digest))
 }
@@ -135,17 +135,17 @@ pub fn classify(file: &str, text: &str) -> Result<Document, InputError> {
         }
     };
     let read = |kind: &'static str| {
-        move |e: solver::io::report::ReportError| InputError::Field {
+        move |e: crate::json::ReportError| InputError::Field {
             file: file.to_string(),
             kind,
             why: match e {
-                solver::io::report::ReportError::Json {
+                crate::json::ReportError::Json {
                     line,
                     column,
                     message,
                     ..
                 } => format!("{message} at line {line} column {column}"),
-                solver::io::report::ReportError::Field { field, message, .. } => {
+                crate::json::ReportError::Field { field, message, .. } => {
                     format!("field `{field}`: {message}")
                 }
                 other => other.to_string(),
@@ -236,7 +236,7 @@ fn modified(at: &Path) -> Option<String> {
     std::fs::metadata(at)
         .and_then(|m| m.modified())
         .ok()
-        .and_then(|t| history::Timestamp::of(t).ok())
+        .and_then(|t| formats::time::Timestamp::of(t).ok())
         .map(|t| t.to_string())
 }
 

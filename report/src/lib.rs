@@ -1,5 +1,11 @@
-//! One self-contained HTML report per R-test check, for the calibration engineer who reads it on
-//! screen or prints it to PDF.
+//! Every result of rtest for people and tools: its JSON ([`json`]), its text ([`text`]) and
+//! one self-contained HTML report per R-test check, for the calibration engineer who reads it
+//! on screen or prints it to PDF.
+//!
+//! - [`json`]: the reports of identification, validation, diagnosis, compensation, planning
+//!   and the gain tables as serde types, written as JSON; an identification read back;
+//! - [`text`]: the same results as text for a terminal;
+//! - the HTML report, below.
 //!
 //! The report is built from the reports rtest writes ([`inputs`]: the JSON of `identify`,
 //! `validate`, `diagnose` and `compensate`, recognised by their content and checked to belong
@@ -28,9 +34,11 @@ pub mod base64;
 pub mod figures;
 pub mod html;
 pub mod inputs;
+pub mod json;
 pub mod sections;
 pub mod style;
 pub mod svg;
+pub mod text;
 
 pub use inputs::{Document, Figure, InputError, InputFile, Inputs, MachineFacts};
 

@@ -3,13 +3,13 @@
 //! is a usage error (exit code 2).
 
 use super::{CliError, CliResult};
+use fitting::noise::{NoiseChoice, NoiseModel};
+use fitting::{Constraint, ValueLimits};
+use formats::csv::ReadOptions;
 use model_spec::instrument::{Instrument, InstrumentLoadError, ReadingsFrame, load_instrument};
 use model_spec::units::{UM_PER_MM, significant};
 use model_spec::{ErrorId, Machine};
-use solver::fitting::noise::{NoiseChoice, NoiseModel};
-use solver::fitting::{Constraint, ValueLimits};
-use solver::io::csv::ReadOptions;
-use solver::model::{Effect, Model, Term};
+use simulation::model::{Effect, Model, Term};
 use std::path::{Path, PathBuf};
 
 /// The noise model of the tests and uncertainties: declared, from a static record, or
@@ -204,12 +204,12 @@ pub fn between(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone
     }
 }
 
-/// `--decimals` of an NC program, when given: at most [`solver::io::nc::MAX_DECIMALS`].
+/// `--decimals` of an NC program, when given: at most [`formats::nc::MAX_DECIMALS`].
 ///
 /// # Errors
 /// A usage error naming `--decimals` and the limit.
 pub fn nc_decimals(d: Option<usize>) -> CliResult<Option<usize>> {
-    let max = solver::io::nc::MAX_DECIMALS;
+    let max = formats::nc::MAX_DECIMALS;
     match d {
         Some(d) if d > max => Err(CliError::usage(format!(
             "--decimals: {d} decimals asked for, at most {max}"

@@ -3,15 +3,16 @@
 //! `--campaign FILE`, their checks, and the plausibility of a campaign's values.
 
 use super::{CliError, CliResult, ReadFile};
+use fitting::Constraint;
+use fitting::campaign::Layout;
+use fitting::hmatrix::parameter_name;
+use fitting::sanity::{ValueLimits, check_model_values};
+use formats::campaign::{CampaignFile, labels_from_files, read_campaign_file};
+use formats::csv::ReadOptions;
 use model_spec::Machine;
 use model_spec::instrument::{Instrument, ReadingsFrame};
-use solver::fitting::Constraint;
-use solver::fitting::campaign::{Campaign, CampaignRecord, Layout};
-use solver::fitting::hmatrix::parameter_name;
-use solver::fitting::sanity::{ValueLimits, check_model_values};
-use solver::io::campaign::{CampaignFile, labels_from_files, read_campaign_file};
-use solver::io::csv::ReadOptions;
-use solver::model::Model;
+use simulation::campaign::{Campaign, CampaignRecord};
+use simulation::model::Model;
 use std::path::{Path, PathBuf};
 
 /// A campaign read from the command line, with the file of each record.
@@ -71,7 +72,7 @@ pub fn from_files(
 /// # Errors
 /// A usage error naming `flag` and the limit.
 pub fn record_count(flag: &str, files: &[PathBuf]) -> CliResult<()> {
-    solver::fitting::campaign::check_record_count(files.len())
+    simulation::campaign::check_record_count(files.len())
         .map_err(|e| CliError::usage(format!("{flag}: {e}")))
 }
 
@@ -134,7 +135,7 @@ impl Loaded {
         for (r, f) in self.campaign.records.iter().zip(&self.files) {
             let mut local = model.clone();
             if r.zeroed {
-                local = solver::fitting::with_offsets(&local);
+                local = fitting::with_offsets(&local);
             }
             let named = if one {
                 flag.to_string()
@@ -192,7 +193,7 @@ pub fn check_campaign_values(
     layout: &Layout,
     values: &[Option<f64>],
     limits: &ValueLimits,
-) -> Result<(), solver::fitting::Implausible> {
+) -> Result<(), fitting::Implausible> {
     check_model_values(m, &columns_model(layout), &layout.names(), values, limits)
 }
 
@@ -212,7 +213,7 @@ pub fn constraint_for(
     let [r] = campaign.records.as_slice() else {
         return Constraint::Zero(names);
     };
-    let spec = solver::fitting::campaign::RecordSpec {
+    let spec = fitting::campaign::RecordSpec {
         label: r.label.clone(),
         setup: r.setup.clone(),
         params: r.params.clone(),

@@ -4,21 +4,21 @@
 
 use super::args::ValueBounds;
 use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text, write, wrote};
-use model_spec::units::{compact, readable};
-use output::{Outputs, Target};
-use solver::compensation::kinematics::corrected_description;
-use solver::compensation::run::{PoseSource, RunError, Stopped, Summary, compensate_each};
-use solver::compensation::tables::{Pitch, axis_tables};
-use solver::compensation::values::{CompensationError, MachineErrors};
-use solver::io::nc::{Dialect, WriteOptions, parse_program};
-use solver::io::poses::{
+use compensation::kinematics::corrected_description;
+use compensation::run::{PoseSource, RunError, Stopped, Summary, compensate_each};
+use compensation::tables::{Pitch, axis_tables};
+use compensation::values::{CompensationError, MachineErrors};
+use formats::nc::{Dialect, WriteOptions, parse_program};
+use formats::poses::{
     PoseList, axis_words, from_file_units, from_file_units_into, read_keeping_bom, read_pose_csv,
     to_file_units_into,
 };
-use solver::io::report::compensate::{CompensationReport, CompensationSource, KinematicsReport};
-use solver::io::report::read::parse_identification;
-use solver::io::report::to_json;
-use solver::io::text::compensate::{compensation, kinematics_and_tables};
+use model_spec::units::{compact, readable};
+use output::{Outputs, Target};
+use report::json::compensate::{CompensationReport, CompensationSource, KinematicsReport};
+use report::json::read::parse_identification;
+use report::json::to_json;
+use report::text::compensate::{compensation, kinematics_and_tables};
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -157,11 +157,9 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     let params = super::pose_args::params(&m, args.param.as_deref())?;
     // --params is read once: its values, and the identification the report shows.
     let params_file = args.params.display().to_string();
-    let (params_text, params_digest) = model_spec::text::read_text_hashed(
-        &args.params,
-        solver::io::report::read::MAX_REPORT_BYTES,
-    )
-    .map_err(|e| CliError::input(format!("--params: {e}")))?;
+    let (params_text, params_digest) =
+        model_spec::text::read_text_hashed(&args.params, report::json::read::MAX_REPORT_BYTES)
+            .map_err(|e| CliError::input(format!("--params: {e}")))?;
     let id = parse_identification(&params_file, &params_text, &m)
         .map_err(|e| CliError::input(format!("--params: {e}")))?;
     let mut read_files = vec![ReadFile::new("--params", &args.params, params_digest)];

@@ -1,9 +1,9 @@
-//! `rtest demo`: the seed's experiment on the virtual seed machine (`solver::demo`), written to
+//! `rtest demo`: the seed's experiment on the virtual seed machine (`app::demo`), written to
 //! `./rtest-demo/`.
 
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, write};
+use app::demo;
 use output::Outputs;
-use solver::demo;
 use std::path::Path;
 use std::time::Instant;
 
@@ -123,7 +123,7 @@ fn record(recorder: &mut super::history::Recorder, files: &[demo::DemoFile]) -> 
         &format!("{OUT_DIR}/k4.csv"),
         k4.contents.as_bytes(),
     );
-    let report: solver::io::report::IdentificationReport =
+    let report: report::json::IdentificationReport =
         serde_json::from_str(&file("identify.json")?.contents)
             .map_err(|e| CliError::computation(format!("demo: identify.json: {e}")))?;
     let check = history::Check::from_identification(&report, recorder.provenance());

@@ -5,16 +5,16 @@
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
 use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text, write, wrote};
+use diagnosis::dictionary::DictionaryOptions;
+use diagnosis::figures::figures;
+use diagnosis::{DiagnoseError, DiagnoseOptions, diagnose};
+use fitting::check_values;
+use formats::campaign::{labels_from_files, stem_label, unique_label};
 use output::{Outputs, Target};
-use solver::diagnosis::dictionary::DictionaryOptions;
-use solver::diagnosis::figures::figures;
-use solver::diagnosis::{DiagnoseError, DiagnoseOptions, diagnose};
-use solver::fitting::campaign::{Campaign, CampaignRecord};
-use solver::fitting::check_values;
-use solver::io::campaign::{labels_from_files, stem_label, unique_label};
-use solver::io::report::{DiagnosisReport, DiagnosisSource, to_json};
-use solver::io::text::diagnose::diagnosis;
-use solver::record::Record;
+use report::json::{DiagnosisReport, DiagnosisSource, to_json};
+use report::text::diagnose::diagnosis;
+use simulation::campaign::{Campaign, CampaignRecord};
+use simulation::record::Record;
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
@@ -349,8 +349,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
     let d = diagnose(&m, &model, &fitted.campaign, &held.campaign, &opts, &bar);
     drop(bar);
     let d = d.map_err(|e| match e {
-        DiagnoseError::Estimate(e)
-        | DiagnoseError::Refine(solver::fitting::RefineError::Estimate(e)) => {
+        DiagnoseError::Estimate(e) | DiagnoseError::Refine(fitting::RefineError::Estimate(e)) => {
             super::identify::estimate_error(e)
         }
         DiagnoseError::Campaign(e) => CliError::usage(format!("{flag}: {e}")),
@@ -521,7 +520,7 @@ fn data_arguments(args: &DiagnoseArgs, data: &str) -> Vec<String> {
 fn options(
     args: &DiagnoseArgs,
     m: &model_spec::Machine,
-    read: &solver::io::csv::ReadOptions,
+    read: &formats::csv::ReadOptions,
     instrument: campaign::Through,
 ) -> CliResult<(DiagnoseOptions, Option<ReadFile>)> {
     let mut opts = DiagnoseOptions::default();
@@ -531,7 +530,7 @@ fn options(
     let (noise, noise_read) = args.noise.choice(m, read, instrument)?;
     opts.noise = noise;
     if let Some(b) = &args.budget {
-        opts.budget = solver::diagnosis::plausible::Budget::parse(b)
+        opts.budget = diagnosis::plausible::Budget::parse(b)
             .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
     }
     Ok((opts, noise_read))

@@ -1,9 +1,9 @@
-//! The diagnosis figures drawn: the plain series of `solver::diagnosis::figures` handed to the
+//! The diagnosis figures drawn: the plain series of `diagnosis::figures` handed to the
 //! `plots` crate (path figures through `report::figures::path_svg`, the one conversion the
 //! HTML report uses too), which returns SVG text.
 
 use super::{CliError, CliResult};
-use solver::diagnosis::figures::Figures;
+use diagnosis::figures::Figures;
 
 /// Every figure as (file name, what it shows, SVG text).
 pub fn svgs(figures: &Figures) -> CliResult<Vec<(String, String, String)>> {

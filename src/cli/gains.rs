@@ -7,10 +7,10 @@ use codegen::atoms::AtomKind;
 use codegen::poly::Poly;
 use codegen::table::{self, render};
 use model_spec::{AxisKind, Machine};
-use solver::io::report::gains::COLUMNS;
-use solver::io::report::{GainTableReport, PoseGains, PoseGainsReport, to_json};
-use solver::io::text::gains::{pose_gains, title};
-use solver::simulation::pose::{Pose, PoseError, complete};
+use report::json::gains::COLUMNS;
+use report::json::{GainTableReport, PoseGains, PoseGainsReport, to_json};
+use report::text::gains::{pose_gains, title};
+use simulation::pose::{Pose, PoseError, complete};
 
 const LONG_ABOUT: &str = "\
 Error-gain functions of a machine (the seed's Tables 1 and 2): how each error of the model moves \

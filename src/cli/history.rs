@@ -8,7 +8,7 @@ use history::tolerance::{self, MAX_TOLERANCE_BYTES, Tolerances};
 use history::trend::{self, Options, TrendError};
 use history::{Check, HistoryError, InputFile, Provenance, Staged, Store, Timestamp};
 use output::{Outputs, Target};
-use solver::io::text::shell;
+use report::text::shell;
 use std::path::{Path, PathBuf};
 
 /// The `--record` flags of `rtest identify`.

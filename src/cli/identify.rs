@@ -5,17 +5,17 @@ use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
 use super::history;
 use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text};
-use output::{Outputs, Target};
-use solver::fitting::campaign::{
+use fitting::campaign::{
     CampaignIdentification, CampaignValues, identify_campaign, identify_campaign_refined,
 };
-use solver::fitting::hmatrix::HMatrixError;
-use solver::fitting::noise::NoiseChoice;
-use solver::fitting::streaming::{StreamingError, identify_file};
-use solver::fitting::{EstimateError, IdentifyOptions, RefineError, RefineOptions};
-use solver::io::report::identify::StreamingReport;
-use solver::io::report::{CampaignSource, IdentificationReport, to_json};
-use solver::io::text::identify::identification;
+use fitting::hmatrix::HMatrixError;
+use fitting::noise::NoiseChoice;
+use fitting::streaming::{StreamingError, identify_file};
+use fitting::{EstimateError, IdentifyOptions, RefineError, RefineOptions};
+use output::{Outputs, Target};
+use report::json::identify::StreamingReport;
+use report::json::{CampaignSource, IdentificationReport, to_json};
+use report::text::identify::identification;
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -265,7 +265,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             block: args.block as usize,
             first_block: run.first_block,
         };
-        let record_label = solver::io::campaign::stem_label(data_path);
+        let record_label = formats::campaign::stem_label(data_path);
         let ident = CampaignIdentification::of_record(&m, &ident, &record_label, params.clone())
             .map_err(estimate_error)?;
         (ident, None, Some(streaming), None)
@@ -302,7 +302,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             .iter()
             .map(|r| (r.label.as_str(), r.params.as_slice()))
             .collect();
-        solver::fitting::offsets::check_shared_symbols(&m, &model, &labelled)
+        fitting::offsets::check_shared_symbols(&m, &model, &labelled)
             .map_err(|e| CliError::input(format!("{flag}: {e}")))?;
         let (ident, refinement) = if args.first_order {
             let ident = identify_campaign(&m, &model, c, &opts, &noise).map_err(estimate_error)?;
@@ -419,7 +419,7 @@ fn html_report(
 
 /// A streaming error as a verb's error.
 fn stream_error(
-    e: StreamingError<solver::io::csv::CsvError>,
+    e: StreamingError<formats::csv::CsvError>,
     data_path: &std::path::Path,
 ) -> CliError {
     match e {
@@ -444,7 +444,7 @@ fn parameters_text(m: &model_spec::Machine, params: &[f64]) -> String {
 }
 
 /// An implausible result as a verb's error.
-fn implausible(e: &solver::fitting::Implausible) -> CliError {
+fn implausible(e: &fitting::Implausible) -> CliError {
     CliError::computation(format!(
         "--data: implausible result: {e}; the fit does not describe this machine (too few or unsuitable data, or a model the data cannot determine; --max-error-um, --max-error-urad change the bounds)"
     ))

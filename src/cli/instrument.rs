@@ -2,18 +2,16 @@
 //! the calibration of an instrument's own errors from known displacements.
 
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use fitting::calibrate::{Calibration, CalibrationError, PARAMETERS, SensorCalibration, calibrate};
+use formats::csv::ReadOptions;
+use formats::sensors::read_calibration_file;
 use model_spec::instrument::{
     Instrument, PRESETS, ReadingsFrame, Tip, parse_instrument, preset, smallest_singular_value,
     write::to_toml,
 };
 use model_spec::units::{fixed, format_scaled};
 use output::{Outputs, Target};
-use solver::instrument::calibrate::{
-    Calibration, CalibrationError, PARAMETERS, SensorCalibration, calibrate,
-};
-use solver::instrument::head::SensorHead;
-use solver::io::csv::ReadOptions;
-use solver::io::sensors::read_calibration_file;
+use simulation::instrument::head::SensorHead;
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\

@@ -26,11 +26,11 @@ pub mod simulate;
 pub mod validate;
 pub mod volumetric;
 
+use formats::csv::ReadOptions;
 use model_spec::sha256::Digest;
 use model_spec::{LoadError, Machine};
 use output::{Outputs, Target, WriteError, Written};
-use solver::io::csv::ReadOptions;
-use solver::record::Record;
+use simulation::record::Record;
 use std::fmt;
 use std::io::Write as _;
 use std::path::Path;
@@ -163,10 +163,10 @@ pub fn read_record(
     instrument: campaign::Through,
     params: &[f64],
 ) -> CliResult<(Record, Digest)> {
-    solver::io::campaign::read_record_at(path, m, params, options, instrument).map_err(|e| {
+    formats::campaign::read_record_at(path, m, params, options, instrument).map_err(|e| {
         CliError::input(format!(
             "{flag}: {e}{}",
-            solver::io::campaign::parameters_note(m, params)
+            formats::campaign::parameters_note(m, params)
         ))
     })
 }
@@ -178,7 +178,7 @@ pub fn check_times(
     flag: &str,
     path: &Path,
     m: &Machine,
-    model: &solver::model::Model,
+    model: &simulation::model::Model,
     record: &Record,
 ) -> CliResult<()> {
     if let Some(t) = model.terms.iter().find(|t| t.basis.starts_at_zero()) {

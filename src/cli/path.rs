@@ -4,15 +4,15 @@
 //! ([`csv_text`]), so that other formats of the same poses are one more writer.
 
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, pose_args, print_text, write};
+use formats::csv::{ReadOptions, format_record};
+use formats::paths::parse_path;
 use model_spec::units::short;
 use model_spec::{AxisKind, Machine};
 use output::{Outputs, Target};
-use solver::io::csv::{ReadOptions, format_record};
-use solver::record::Record;
-use solver::simulation::generator::{
+use simulation::generator::{
     self, Clearance, GeneratorError, GeneratorOptions, Order, SampleProblem, TestKind, TestSpec,
 };
-use solver::simulation::paths::parse_path;
+use simulation::record::Record;
 
 const LONG_ABOUT: &str = "\
 The R-test tests of a machine, in the spirit of ISO 10791-6 (docs/paths.md): `turn-R` for every \
@@ -79,7 +79,7 @@ pub struct PathArgs {
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     step_deg: Option<f64>,
     /// Time between two samples, s.
-    #[arg(long, value_name = "S", default_value_t = solver::simulation::paths::SAMPLE_PERIOD_S,
+    #[arg(long, value_name = "S", default_value_t = simulation::paths::SAMPLE_PERIOD_S,
           allow_negative_numbers = true)]
     period_s: f64,
     /// Largest angle between the tool axis and the table normal, degrees (0 to 180).
@@ -365,7 +365,7 @@ pub fn run(args: &PathArgs) -> CliResult {
 /// than the readers accept: `simulate`, `identify` and the other readers check the nest on the
 /// ball at the defaults.
 fn off_default_note(m: &Machine, record: &Record) -> String {
-    let vm = solver::simulation::VirtualMachine::new(m);
+    let vm = simulation::VirtualMachine::new(m);
     let defaults = m.default_parameters();
     let worst = record
         .samples
@@ -376,7 +376,7 @@ fn off_default_note(m: &Machine, record: &Record) -> String {
                 .norm()
         })
         .fold(0.0, f64::max);
-    let tol = solver::simulation::pose::ON_BALL_TOLERANCE_MM;
+    let tol = simulation::pose::ON_BALL_TOLERANCE_MM;
     if worst > tol {
         format!(
             "Note: at the description's default parameters this path leaves the nest up to {} mm off the ball, beyond the {} mm the measurement readers accept: give the same --param to `simulate` and `identify` (or `params` to the record in a campaign file), which then read it at that ball position.\n",

@@ -2,14 +2,14 @@
 //! plan, from the record of poses `rtest path` computed (docs/measurement-programs.md).
 
 use super::{CliError, CliResult};
+use formats::nc::Dialect;
 use model_spec::Machine;
 use output::Target;
-use solver::io::nc::Dialect;
-use solver::io::nc::measure::{
+use programs::measure::{
     ContinuousTiming, MeasureMode, MeasureOptions, StaticMotion, StaticTiming, format_plan,
     measurement_program, plan_comments,
 };
-use solver::record::Record;
+use simulation::record::Record;
 use std::path::PathBuf;
 
 /// Flags of the measurement program (with `--nc`).
@@ -130,9 +130,7 @@ pub fn program(
 ) -> CliResult<(String, String, String)> {
     let o = args.options(m, dialect, test, params)?;
     let p = measurement_program(m, record, &o).map_err(|e| match e {
-        solver::io::nc::measure::MeasureError::Options(why) => {
-            CliError::usage(format!("--nc: {why}"))
-        }
+        programs::measure::MeasureError::Options(why) => CliError::usage(format!("--nc: {why}")),
         other => CliError::computation(format!("--nc: {other}")),
     })?;
     let plan = format_plan(m, &p.plan, &plan_comments(m, &o, &p))

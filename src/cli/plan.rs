@@ -3,22 +3,20 @@
 
 use super::args::{self, items, positive};
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, pose_args, print_text, write, wrote};
+use fitting::EstimateError;
+use fitting::Tolerances;
+use fitting::noise::{MAX_PHI, NoiseModel, NoiseSource};
+use fitting::plan::{
+    self, BASE_BALL, BallPosition, Plan, PlanError, PlannedTest, Targets, candidates,
+    suggest_with_progress,
+};
 use model_spec::Machine;
 use model_spec::text::quoted_start;
 use model_spec::units::{UM_PER_MM, compact};
 use output::{Outputs, Target};
-use solver::fitting::EstimateError;
-use solver::fitting::Tolerances;
-use solver::fitting::noise::{MAX_PHI, NoiseModel, NoiseSource};
-use solver::fitting::plan::{
-    self, BASE_BALL, BallPosition, Plan, PlanError, PlannedTest, Targets, candidates,
-    suggest_with_progress,
-};
-use solver::io::report::plan::{PlanReport, PlanSource};
-use solver::io::report::to_json;
-use solver::simulation::generator::{
-    self, Clearance, GeneratorError, GeneratorOptions, SampleProblem,
-};
+use report::json::plan::{PlanReport, PlanSource};
+use report::json::to_json;
+use simulation::generator::{self, Clearance, GeneratorError, GeneratorOptions, SampleProblem};
 
 const LONG_ABOUT: &str = "\
 Predicts, before measuring, what a campaign of R-test tests will determine: the rank and the \
@@ -130,7 +128,7 @@ pub struct PlanArgs {
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
     step_deg: Option<f64>,
     /// Time between two samples, s.
-    #[arg(long, value_name = "S", default_value_t = solver::simulation::paths::SAMPLE_PERIOD_S,
+    #[arg(long, value_name = "S", default_value_t = simulation::paths::SAMPLE_PERIOD_S,
           allow_negative_numbers = true)]
     period_s: f64,
     /// Largest angle between the tool axis and the table normal, degrees (0 to 180).
@@ -329,11 +327,11 @@ pub fn run(args: &PlanArgs) -> CliResult {
         };
         CliError::usage(format!("{flag}: {e}"))
     })?;
-    if args.noise_um > solver::simulation::truth::MAX_NOISE_UM {
+    if args.noise_um > simulation::truth::MAX_NOISE_UM {
         return Err(CliError::usage(format!(
             "--noise-um: {} µm is beyond {} µm, the largest reading noise rtest takes",
             compact(args.noise_um),
-            solver::simulation::truth::MAX_NOISE_UM
+            simulation::truth::MAX_NOISE_UM
         )));
     }
     let plan = plan_of(&m, args)?;
@@ -386,7 +384,7 @@ pub fn run(args: &PlanArgs) -> CliResult {
     };
     let report =
         PlanReport::new(&m, source).map_err(|e| CliError::computation(format!("plan: {e}")))?;
-    let mut text = solver::io::text::plan::plan(&report, args.top as usize);
+    let mut text = report::text::plan::plan(&report, args.top as usize);
     let mut files = Outputs::new();
     if let Some(target) = &args.json {
         let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;

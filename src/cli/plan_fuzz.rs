@@ -9,9 +9,9 @@
 use super::{PlanArgs, plan_error, plan_of};
 use crate::cli::EXIT_USAGE;
 use clap::Parser;
+use fitting::plan;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
-use solver::fitting::plan;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 #[path = "../../tests/all/support/fuzz.rs"]

@@ -1,7 +1,7 @@
 //! Progress bars on standard error for the long work of a verb: reading a measurement file or
 //! the records of a campaign, validating a campaign's records, the suggestion of `rtest plan`,
 //! a diagnosis. The library reports progress
-//! (`solver::io::progress`); this module alone draws.
+//! (`formats::progress`); this module alone draws.
 //!
 //! A bar is drawn only when standard error is a terminal, never when standard output carries
 //! the JSON report (`--json -`: the text for people then goes to standard error), and only once
@@ -9,8 +9,8 @@
 //! draws nothing. The bar is cleared when the work ends, finished or failed, so nothing else
 //! on standard error changes.
 
+use formats::progress::{Progress, ReadProgress};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use solver::io::progress::{Progress, ReadProgress};
 use std::io::IsTerminal;
 use std::path::Path;
 use std::sync::Arc;
@@ -162,8 +162,8 @@ impl Drop for Bar {
 pub fn reading(
     wanted: bool,
     path: &Path,
-    read: &solver::io::csv::ReadOptions,
-) -> (Bar, solver::io::csv::ReadOptions) {
+    read: &formats::csv::ReadOptions,
+) -> (Bar, formats::csv::ReadOptions) {
     let bar = Bar::new(wanted, true);
     let mut read = read.clone();
     read.progress = bar.read_hook(path);
@@ -175,8 +175,8 @@ pub fn reading(
 pub fn reading_all(
     wanted: bool,
     paths: &[std::path::PathBuf],
-    read: &solver::io::csv::ReadOptions,
-) -> (Bar, solver::io::csv::ReadOptions) {
+    read: &formats::csv::ReadOptions,
+) -> (Bar, formats::csv::ReadOptions) {
     let bar = Bar::new(wanted, true);
     let mut read = read.clone();
     read.progress = bar.read_all_hook(paths);

@@ -191,7 +191,7 @@ fn draw_paths(
         .iter()
         .find(|(f, _)| f == id_file)
         .map_or("", |(_, t)| t.as_str());
-    let values = match solver::io::report::read::parse_identification(id_file, id_text, &m) {
+    let values = match report::json::read::parse_identification(id_file, id_text, &m) {
         Ok(v) => v.values,
         Err(e) => {
             inputs
@@ -262,16 +262,16 @@ fn draw_paths(
                 continue;
             }
         };
-        match solver::io::campaign::parse_record_at(
+        match formats::campaign::parse_record_at(
             name,
             bytes.as_slice(),
             &m,
             &spec.params,
-            &solver::io::csv::ReadOptions::default(),
+            &formats::csv::ReadOptions::default(),
             None,
         ) {
             Ok(record) => {
-                let mut r = solver::fitting::campaign::CampaignRecord::new(
+                let mut r = simulation::campaign::CampaignRecord::new(
                     spec.label,
                     record,
                     spec.params,
@@ -328,8 +328,8 @@ struct Named {
 /// A bad input naming the report, the field and the name, for an absolute name or one that
 /// leaves the directory (`..`).
 fn named_files(inputs: &Inputs, data_dir: Option<&Path>) -> CliResult<Vec<Named>> {
-    use solver::io::poses::MAX_FILE_BYTES as RECORD;
-    use solver::io::report::read::MAX_REPORT_BYTES as VALUES;
+    use formats::poses::MAX_FILE_BYTES as RECORD;
+    use report::json::read::MAX_REPORT_BYTES as VALUES;
     let mut raw: Vec<(&str, String, &'static str, &str, u64)> = Vec::new();
     if let Some((f, r)) = &inputs.identification {
         for (i, x) in r.records.iter().enumerate() {
@@ -551,7 +551,7 @@ pub struct PathRecord<'a> {
     pub role: &'static str,
     /// The record with its label, set-up, kinematic parameters and zeroing, read as the
     /// identification (or the validation) read it.
-    pub record: &'a solver::fitting::campaign::CampaignRecord,
+    pub record: &'a simulation::campaign::CampaignRecord,
 }
 
 /// Measured against predicted error along the path of each record, the prediction that of
@@ -565,13 +565,13 @@ pub struct PathRecord<'a> {
 pub fn path_figures(
     flag: &str,
     m: &model_spec::Machine,
-    values: &solver::fitting::campaign::CampaignValues,
+    values: &fitting::campaign::CampaignValues,
     label: &str,
     records: &[PathRecord<'_>],
 ) -> CliResult<(Vec<report::Figure>, Vec<String>)> {
-    use solver::diagnosis::figures::{Figures, validation_figure};
-    use solver::fitting::ValidateOptions;
-    use solver::fitting::campaign::validate_record;
+    use diagnosis::figures::{Figures, validation_figure};
+    use fitting::ValidateOptions;
+    use fitting::campaign::validate_record;
     let mut figures = Figures::default();
     let mut not_drawn = Vec::new();
     let mut taken = Vec::new();

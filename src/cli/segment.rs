@@ -3,11 +3,11 @@
 
 use super::args::RecordLimits;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use formats::csv::{CsvError, parse_measurement};
 use model_spec::units::{UM_PER_MM, short};
 use output::{Outputs, Target};
-use solver::io::csv::{CsvError, parse_measurement};
-use solver::io::nc::measure::{PlanKind, read_plan};
-use solver::io::segment::{
+use programs::measure::{PlanKind, read_plan};
+use programs::segment::{
     LogClock, SegmentError, SegmentOptions, Segmented, format_segmented, format_windows,
     segment_file,
 };

@@ -3,14 +3,15 @@
 
 use super::args::RecordLimits;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write};
+use formats::csv::{format_record, parse_measurement};
+use formats::paths::{PathFileError, load_path};
 use model_spec::units::parse_scaled;
 use output::{Outputs, Target};
-use solver::io::csv::{format_record, parse_measurement};
-use solver::io::text::simulation;
-use solver::simulation::paths::PathError;
-use solver::simulation::readings::SimulateError;
-use solver::simulation::truth::{MAX_NOISE_PHI, MAX_NOISE_UM, MAX_SEED, Truth, TruthError};
-use solver::simulation::{load_path, provenance, simulate};
+use report::text::simulation;
+use simulation::paths::PathError;
+use simulation::readings::SimulateError;
+use simulation::truth::{MAX_NOISE_PHI, MAX_NOISE_UM, MAX_SEED, Truth, TruthError};
+use simulation::{provenance, simulate};
 use std::path::Path;
 
 const LONG_ABOUT: &str = "\
@@ -133,8 +134,8 @@ fn noise_phi(text: &str) -> CliResult<f64> {
 /// The truth of `--truth`, else the machine's demo truth, else the nominal machine.
 fn truth(m: &model_spec::Machine, name: Option<&str>) -> CliResult<Truth> {
     let found = match name {
-        Some(n) => solver::simulation::load_truth(n, m),
-        None => solver::simulation::truth::default_truth(m),
+        Some(n) => simulation::load_truth(n, m),
+        None => simulation::truth::default_truth(m),
     };
     found.map_err(|e| match e {
         TruthError::NotFound(_) => CliError::usage(format!("--truth: {e}")),
@@ -144,8 +145,12 @@ fn truth(m: &model_spec::Machine, name: Option<&str>) -> CliResult<Truth> {
 
 /// Writes the poses of the pose file `file` (one per sample of `record`, mm and degrees) as
 /// the record's commands.
-fn relabel(m: &model_spec::Machine, record: &mut solver::record::Record, file: &Path) -> CliResult {
-    let table = solver::io::poses::read_pose_file(file, &solver::io::poses::axis_words(m))
+fn relabel(
+    m: &model_spec::Machine,
+    record: &mut simulation::record::Record,
+    file: &Path,
+) -> CliResult {
+    let table = formats::poses::read_pose_file(file, &formats::poses::axis_words(m))
         .map_err(|e| CliError::input(format!("--commanded: {e}")))?;
     let poses = table.poses();
     if poses.len() != record.samples.len() {
@@ -157,7 +162,7 @@ fn relabel(m: &model_spec::Machine, record: &mut solver::record::Record, file: &
         )));
     }
     for (sample, pose) in record.samples.iter_mut().zip(poses) {
-        sample.commands = solver::io::poses::from_file_units(m, &pose.commands);
+        sample.commands = formats::poses::from_file_units(m, &pose.commands);
     }
     Ok(())
 }
@@ -189,10 +194,10 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     for ((real, p), d) in truth.params.iter_mut().zip(&params).zip(&defaults) {
         *real += p - d;
     }
-    let m = solver::io::campaign::machine_at(&m, &params);
+    let m = formats::campaign::machine_at(&m, &params);
     let read = args.records.read_options();
     let path = load_path(&m, &args.path, &read).map_err(|e| match e {
-        PathError::NotFound { .. } | PathError::NotAC { .. } => {
+        PathFileError::NotFound { .. } | PathFileError::Builtin(PathError::NotAC { .. }) => {
             CliError::usage(format!("--path: {e}"))
         }
         other => CliError::input(format!("--path: {other}")),
@@ -239,12 +244,12 @@ fn run_instrument(
     args: &SimulateArgs,
     m: &model_spec::Machine,
     truth: &Truth,
-    path: &solver::record::Record,
+    path: &simulation::record::Record,
     instrument: &model_spec::instrument::Instrument,
     frame: model_spec::instrument::ReadingsFrame,
 ) -> CliResult {
-    use solver::instrument::simulate::{SensorSimulationError, simulate_sensors};
-    use solver::io::sensors::{format_sensor_record, parse_sensor_measurement};
+    use formats::sensors::{format_sensor_record, parse_sensor_measurement};
+    use simulation::instrument::simulate::{SensorSimulationError, simulate_sensors};
     let mut sensors = simulate_sensors(m, truth, path, instrument, frame).map_err(|e| match e {
         SensorSimulationError::Simulate(e @ SimulateError::Times { .. }) => {
             CliError::input(format!("--path {}: {e}", args.path))

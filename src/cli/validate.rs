@@ -4,12 +4,12 @@
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use fitting::campaign::validate::validate_campaign_with_progress;
+use fitting::validate::Unidentified;
+use fitting::{ValidateError, ValidateOptions};
 use output::{Outputs, Target};
-use solver::fitting::campaign::validate::validate_campaign_with_progress;
-use solver::fitting::validate::Unidentified;
-use solver::fitting::{ValidateError, ValidateOptions};
-use solver::io::report::{ValidationReport, ValidationSource, read_identification, to_json};
-use solver::io::text::validate::validation;
+use report::json::{ValidationReport, ValidationSource, read_identification, to_json};
+use report::text::validate::validation;
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -166,7 +166,7 @@ pub fn run(args: &ValidateArgs) -> CliResult {
     if args.campaign.is_none() {
         let setup = match &args.setup {
             Some(setup) => {
-                solver::fitting::campaign::check_label("--setup", setup)
+                simulation::campaign::check_label("--setup", setup)
                     .map_err(|e| CliError::usage(e.to_string()))?;
                 Some(setup.clone())
             }
@@ -225,8 +225,8 @@ pub fn run(args: &ValidateArgs) -> CliResult {
 /// other paths: the usual check of one record on another); `None` (each record on a new set-up
 /// of its own, refitted) otherwise.
 fn fitted_setup(
-    values: &solver::fitting::campaign::CampaignValues,
-    c: &solver::fitting::campaign::Campaign,
+    values: &fitting::campaign::CampaignValues,
+    c: &simulation::campaign::Campaign,
 ) -> Option<String> {
     let layout = &values.layout;
     let [setup] = layout.setups.as_slice() else {
@@ -240,7 +240,7 @@ fn fitted_setup(
 }
 
 /// Values that cannot be a machine's, as a verb's error.
-fn implausible(args: &ValidateArgs, e: &solver::fitting::Implausible) -> CliError {
+fn implausible(args: &ValidateArgs, e: &fitting::Implausible) -> CliError {
     CliError::input(format!(
         "--params: {}: {e}: these cannot be the errors of a machine tool (--max-error-um, --max-error-urad change the bounds)",
         args.params.display()

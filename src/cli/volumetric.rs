@@ -2,15 +2,15 @@
 //! measurements taken at the tool end (docs/volumetric.md).
 
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
-use model_spec::{AxisKind, Machine};
-use output::{Outputs, Target};
-use solver::compensation::volumetric::path::correct_poses;
-use solver::compensation::volumetric::summary::{SetSummary, VolumetricReport};
-use solver::compensation::volumetric::{
+use compensation::volumetric::path::correct_poses;
+use compensation::volumetric::summary::{SetSummary, VolumetricReport};
+use compensation::volumetric::{
     AxisMeasurement, GridSpec, VolumetricError, VolumetricModel, format_grid, read_laser,
     read_squareness,
 };
-use solver::io::poses::{axis_words, read_pose_file};
+use formats::poses::{axis_words, read_pose_file};
+use model_spec::{AxisKind, Machine};
+use output::{Outputs, Target};
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\

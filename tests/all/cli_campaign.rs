@@ -3,10 +3,10 @@
 //! column and field named; nothing written). The diagnosis of a campaign: `tests/all/cli_diagnose.rs`.
 
 use model_spec::Machine;
-use solver::model::{Model, Term};
-use solver::simulation::paths::{fill_linear_ik, record_from_commands};
-use solver::simulation::readings::simulate;
-use solver::simulation::truth::Truth;
+use simulation::model::{Model, Term};
+use simulation::paths::{fill_linear_ik, record_from_commands};
+use simulation::readings::simulate;
+use simulation::truth::Truth;
 use std::path::Path;
 
 use crate::common::{self, param, temp_dir};
@@ -265,7 +265,7 @@ fn head_head_record(m: &Machine, params: &[f64], a_deg: f64, setup: [f64; 3], se
         zeroed: false,
     };
     let r = simulate(m, &truth, &path).unwrap();
-    solver::io::csv::format_record(m, &r, &[]).unwrap()
+    formats::csv::format_record(m, &r, &[]).unwrap()
 }
 
 #[test]

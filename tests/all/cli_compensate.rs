@@ -3,10 +3,10 @@
 //! library's; every line but the corrected words kept; the corrected description and the
 //! tables written; bad input refused with one stderr line, the right exit code and no output.
 
+use compensation::run::{CommandedPose, compensate_poses};
+use compensation::values::MachineErrors;
 use model_spec::{AxisKind, Machine};
-use solver::compensation::run::{CommandedPose, compensate_poses};
-use solver::compensation::values::MachineErrors;
-use solver::io::report::read_identification;
+use report::json::read_identification;
 use std::path::Path;
 
 use crate::common;
@@ -405,7 +405,7 @@ fn bad_input_refused_without_output() {
 /// of the others; nothing written.
 #[test]
 fn too_many_poses_refused_before_the_correction() {
-    use solver::io::poses::MAX_POSES;
+    use formats::poses::MAX_POSES;
     let dir = set_up("limit");
     let d = &dir.0;
     let mut long = String::with_capacity(3 * MAX_POSES + 64);
@@ -746,7 +746,7 @@ fn a_seed_campaign_compensates_the_shared_errors() {
     );
     // The machine alone: the demo truth without its ball set-up and noise.
     let demo = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("solver/truths/seed-ac-demo.toml"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("simulation/truths/seed-ac-demo.toml"),
     )
     .unwrap();
     let machine: String = demo

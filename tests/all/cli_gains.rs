@@ -97,7 +97,7 @@ fn gains_fill_missing_linear_axes_by_inverse_kinematics() {
     let mut commands = vec![0.0; m.axes.len()];
     commands[m.axis_by_name("A").unwrap()] = 30f64.to_radians();
     commands[m.axis_by_name("C").unwrap()] = 45f64.to_radians();
-    solver::simulation::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
+    simulation::tool_centre_point_ik(&m, &mut commands, &params).unwrap();
     let model = codegen::GainModel::derive(&m, &m.errors);
     let want = model.evaluate(&commands, &params);
 

@@ -9,8 +9,8 @@ use crate::common::{self, temp_dir};
 use common::{entries, fails, ok, read_json};
 use history::sha256::sha256_hex;
 use serde_json::Value;
-use solver::simulation::truth::Truth;
-use solver::simulation::{builtin_path, simulate};
+use simulation::truth::Truth;
+use simulation::{builtin_path, simulate};
 use std::path::Path;
 
 /// Writes a K4 measurement of seed-ac to `dir/name`: the reduced truth with XOC = `xoc` µm,
@@ -23,7 +23,7 @@ fn k4(dir: &Path, name: &str, xoc: f64, seed: u64) {
     let t = Truth::parse("truth", &text, &m).unwrap();
     let path = builtin_path(&m, "K4").unwrap().unwrap();
     let record = simulate(&m, &t, &path).unwrap();
-    let csv = solver::io::csv::format_record(&m, &record, &[]).unwrap();
+    let csv = formats::csv::format_record(&m, &record, &[]).unwrap();
     std::fs::write(dir.join(name), csv).unwrap();
 }
 

@@ -5,12 +5,12 @@
 //! naming the flag, exit code 2 for usage errors and 1 for other failures, no output file left
 //! behind).
 
+use fitting::IdentifyOptions;
 use model_spec::Machine;
 use serde_json::Value;
-use solver::fitting::IdentifyOptions;
-use solver::model::Model;
-use solver::record::Record;
-use solver::simulation::truth::{Truth, builtin_truth};
+use simulation::model::Model;
+use simulation::record::Record;
+use simulation::truth::{Truth, builtin_truth};
 use std::path::Path;
 
 // ---------------------------------------------------------------- helpers
@@ -54,7 +54,7 @@ fn truth(m: &Machine, name: &str) -> Truth {
 fn truth_values(m: &Machine, t: &Truth) -> Vec<(String, f64)> {
     t.entries(m)
         .into_iter()
-        .filter(|e| e.values.len() == 1 && e.term.basis == solver::model::Basis::Const)
+        .filter(|e| e.values.len() == 1 && e.term.basis == simulation::model::Basis::Const)
         .map(|e| (e.name, e.values[0]))
         .collect()
 }
@@ -830,16 +830,16 @@ fn hidden_bias(m: &Machine, t: &Truth, k4: &Record) -> Vec<f64> {
         .flat_map(|x| t.coefficient(x).unwrap().to_vec())
         .map(Some)
         .collect();
-    let measured = solver::fitting::refine::exact_prediction(m, &hidden, &values, k4, &t.params)
-        .expect("prediction");
+    let measured =
+        fitting::refine::exact_prediction(m, &hidden, &values, k4, &t.params).expect("prediction");
     let alone = Record {
         samples: k4.samples.clone(),
         measured,
         lines: k4.lines.clone(),
         ..Default::default()
     };
-    let fit = solver::fitting::identify(m, &reduced, &alone, &IdentifyOptions::default())
-        .expect("identify");
+    let fit =
+        fitting::identify(m, &reduced, &alone, &IdentifyOptions::default()).expect("identify");
     reduced
         .terms
         .iter()
@@ -974,10 +974,10 @@ fn demo_writes_everything_and_recovers_the_demo_truth() {
 
     let m = machine();
     let t = truth(&m, "seed-ac-demo");
-    let k4 = solver::io::csv::read_measurement(
+    let k4 = formats::csv::read_measurement(
         &demo.join("k4.csv"),
         &m,
-        &solver::io::csv::ReadOptions::default(),
+        &formats::csv::ReadOptions::default(),
     )
     .unwrap();
     assert_eq!(k4.samples.len(), 241);

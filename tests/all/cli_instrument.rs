@@ -150,7 +150,7 @@ fn a_sensor_record_identifies_like_the_ball_centre_record_of_the_same_run() {
 #[test]
 fn an_instrument_is_calibrated_and_its_description_written() {
     use model_spec::instrument::preset;
-    use solver::instrument::head::SensorHead;
+    use simulation::instrument::head::SensorHead;
     let d = temp("calibrate");
     let mut real = preset("inclined-45").unwrap().unwrap();
     real.sensors[1].gain = 1.002;

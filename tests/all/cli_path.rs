@@ -2,10 +2,11 @@
 //! CSV that reads back to the generator's poses bit for bit, `simulate --path NAME` on any
 //! machine, and bad input refused with one stderr line, the right exit code and no file.
 
+use formats::csv::ReadOptions;
+use formats::paths::parse_path;
 use model_spec::Machine;
-use solver::io::csv::ReadOptions;
-use solver::simulation::generator::{GeneratorOptions, generate};
-use solver::simulation::paths::{builtin_path, parse_path};
+use simulation::generator::{GeneratorOptions, generate};
+use simulation::paths::builtin_path;
 
 use crate::common;
 use common::{entries, fails, ok, read_json, temp_dir_tagged};
@@ -336,8 +337,8 @@ fn bad_input_is_refused_and_writes_nothing() {
 
 #[test]
 fn the_nc_program_of_a_test_reads_back_to_its_poses_in_both_dialects() {
-    use solver::io::nc::{Dialect, parse_program};
-    use solver::io::poses::axis_words;
+    use formats::nc::{Dialect, parse_program};
+    use formats::poses::axis_words;
     let dir = temp_dir_tagged("cli-path", "nc");
     for (machine_name, test, param) in [
         ("seed-ac", "K4", None),
@@ -390,7 +391,7 @@ fn the_nc_program_of_a_test_reads_back_to_its_poses_in_both_dialects() {
             }
             // The timing plan is written beside the program, one row per pose.
             let plan_file = dir.join(std::path::Path::new(file).with_extension("plan.csv"));
-            let plan = solver::io::nc::measure::read_plan(&plan_file, &m).unwrap();
+            let plan = programs::measure::read_plan(&plan_file, &m).unwrap();
             assert_eq!(plan.rows.len(), path.samples.len());
         }
     }

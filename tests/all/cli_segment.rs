@@ -4,12 +4,12 @@
 use crate::common;
 
 use common::{fails, ok, temp_dir_tagged, words};
-use solver::io::nc::Dialect;
-use solver::io::nc::measure::{
+use formats::nc::Dialect;
+use programs::measure::{
     MeasureMode, MeasureOptions, StaticTiming, format_plan, measurement_program,
 };
-use solver::simulation::stream::{StreamOptions, write_stream};
-use solver::simulation::{builtin_path, builtin_truth};
+use programs::stream::{StreamOptions, write_stream};
+use simulation::{builtin_path, builtin_truth};
 use std::path::Path;
 
 /// Writes `plan.csv` (K4 of seed-ac, static, every other pose) and `log.csv` (its simulated

@@ -15,7 +15,7 @@ fn temp_dir(name: &str) -> common::TempDir {
 }
 
 /// The templates with rotary axes, and what their own paths cannot separate (set-up errors
-/// named with their set-up, `s`); the reasons are given in `solver/tests/all/templates.rs`.
+/// named with their set-up, `s`); the reasons are given in `fitting/tests/all/templates.rs`.
 const TEMPLATES: [(&str, &[&[&str]]); 6] = [
     (
         "head-table-bc",

@@ -3,15 +3,15 @@
 //! and the summary checked against the library; every kind of bad input refused with one
 //! stderr line, the right exit code and no output file.
 
-use model_spec::Machine;
-use serde_json::Value;
-use solver::compensation::volumetric::path::correct_poses;
-use solver::compensation::volumetric::simulate::{LaserPlan, measure};
-use solver::compensation::volumetric::{
+use compensation::volumetric::path::correct_poses;
+use compensation::volumetric::simulate::{LaserPlan, measure};
+use compensation::volumetric::{
     VolumetricModel, correct, format_laser, format_squareness, parse_squareness,
 };
-use solver::io::poses::{axis_words, read_pose_csv};
-use solver::simulation::Truth;
+use formats::poses::{axis_words, read_pose_csv};
+use model_spec::Machine;
+use serde_json::Value;
+use simulation::Truth;
 
 use crate::common;
 use common::{TempDir, entries, fails, ok};

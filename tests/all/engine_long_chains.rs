@@ -6,7 +6,7 @@
 //! At random on-ball poses (rotary commands across ±180°, linear commands by the nominal
 //! tool-centre-point inverse kinematics) and random kinematic offsets:
 //! - the gains of every error equal central finite differences of the exact, untruncated chain
-//!   (`solver::simulation::fd::fd_gains`), position and orientation rows;
+//!   (`simulation::fd::fd_gains`), position and orientation rows;
 //! - the compiled program (in-process evaluator) equals the symbolic gains;
 //! - a gain the engine made an exact zero is zero in the compiled program (a literal `0`, not
 //!   a computed value), and zero in the exact chain.
@@ -52,7 +52,7 @@ fn check(rotary: usize, cases: u32) {
         .run(&proptest::collection::vec(0.0f64..1.0, 64), |unit| {
             let (commands, params) = pose(&m, &unit);
             let symbolic = model.evaluate(&commands, &params);
-            let numeric = solver::simulation::fd::fd_gains(&m, &commands, &params, &errors);
+            let numeric = simulation::fd::fd_gains(&m, &commands, &params, &errors);
             let inputs = model.atoms.values(&commands, &params);
             let mut ir = vec![0.0; program.outputs.len()];
             program.eval(&inputs, &mut Vec::new(), &mut ir);

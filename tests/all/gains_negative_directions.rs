@@ -20,8 +20,8 @@ use codegen::{GainModel, compile};
 use model_spec::{AxisKind, Machine, Side, parse_machine};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
-use solver::simulation::exact::chain_transform;
-use solver::simulation::fd::fd_gains;
+use simulation::exact::chain_transform;
+use simulation::fd::fd_gains;
 
 /// The two test machines with negative directions.
 fn machines() -> Vec<Machine> {
@@ -115,10 +115,7 @@ fn symbolic_gains_equal_finite_differences_and_the_compiled_program() {
 
 /// The largest difference (mm, or rad for the entries of the rotation) between two chain
 /// transforms.
-fn distance(
-    a: &solver::simulation::exact::Transform,
-    b: &solver::simulation::exact::Transform,
-) -> f64 {
+fn distance(a: &simulation::exact::Transform, b: &simulation::exact::Transform) -> f64 {
     (a.to_homogeneous() - b.to_homogeneous()).abs().max()
 }
 
@@ -129,7 +126,7 @@ fn chain_with(
     commands: &[f64],
     error: &str,
     value: f64,
-) -> solver::simulation::exact::Transform {
+) -> simulation::exact::Transform {
     let mut errors = vec![0.0; m.catalogue.len()];
     errors[m.error_by_name(error).expect("the error exists")] = value;
     let side = m.catalogue[m.error_by_name(error).unwrap()]

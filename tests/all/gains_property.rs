@@ -32,7 +32,7 @@ fn symbolic_gains_equal_finite_differences_of_the_exact_chain() {
             for (m, model) in machines.iter().zip(&models) {
                 let (commands, params) = pose(m, &unit);
                 let symbolic = model.evaluate(&commands, &params);
-                let numeric = solver::simulation::fd::fd_gains(m, &commands, &params, &model.errors);
+                let numeric = simulation::fd::fd_gains(m, &commands, &params, &model.errors);
                 for (i, (s, n)) in symbolic.iter().zip(&numeric).enumerate() {
                     for k in 0..6 {
                         prop_assert!(

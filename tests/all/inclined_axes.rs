@@ -17,8 +17,8 @@
 
 use codegen::GainModel;
 use model_spec::{Machine, Side, builtin, parse_machine};
-use solver::simulation::exact::{chain_transform, error_vector, tool_centre_point_ik};
-use solver::simulation::fd::fd_gains;
+use simulation::exact::{chain_transform, error_vector, tool_centre_point_ik};
+use simulation::fd::fd_gains;
 
 use crate::common;
 use common::gains::{close, pose};

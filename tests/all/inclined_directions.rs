@@ -78,7 +78,7 @@ fn gains_equal_finite_differences_for_exact_and_numeric_directions() {
                 .collect();
             let (commands, params) = pose(&m, &unit);
             let symbolic = model.evaluate(&commands, &params);
-            let numeric = solver::simulation::fd::fd_gains(&m, &commands, &params, &model.errors);
+            let numeric = simulation::fd::fd_gains(&m, &commands, &params, &model.errors);
             let inputs = model.atoms.values(&commands, &params);
             let (mut scratch, mut ir) = (Vec::new(), vec![0.0; program.outputs.len()]);
             program.eval(&inputs, &mut scratch, &mut ir);

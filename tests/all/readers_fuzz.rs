@@ -11,11 +11,11 @@ use crate::common;
 use crate::support::fuzz as fuzzing;
 
 use common::{ok, temp_dir_tagged, words};
+use formats::campaign::{CampaignFileError, parse_campaign};
 use fuzzing::fuzz;
 use model_spec::Machine;
 use proptest::prelude::*;
-use solver::fitting::campaign::{MAX_LABEL_CHARS, MAX_RECORDS};
-use solver::io::campaign::{CampaignFileError, parse_campaign};
+use simulation::campaign::{MAX_LABEL_CHARS, MAX_RECORDS};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 use std::sync::OnceLock;

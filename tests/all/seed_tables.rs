@@ -4,7 +4,7 @@
 //! three-axis paper's Table II (transcribed, typos included, in `seed_tables/printed.rs`) is
 //! evaluated at random poses and random kinematic symbols (fixed seed) and compared with the
 //! symbolic engine (`codegen::GainModel`); the engine is checked against finite differences of
-//! the exact chain (`solver::simulation::fd_gains`) at the same samples. Every disagreement must be in the
+//! the exact chain (`simulation::fd_gains`) at the same samples. Every disagreement must be in the
 //! documented list (`seed_tables/expected.rs`, the source of `docs/seed-tables.md`), and every
 //! documented disagreement must still disagree, so the document cannot go stale.
 //!
@@ -32,7 +32,7 @@ fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs())) + 1e-9
 }
 
-/// Engine against finite differences (steps and Richardson extrapolation of `solver::simulation::fd`).
+/// Engine against finite differences (steps and Richardson extrapolation of `simulation::fd`).
 fn close_fd(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-6 * (1.0 + a.abs().max(b.abs()))
 }
@@ -90,7 +90,7 @@ fn sample(
         params[m.symbol_by_name(name).expect("symbol of the machine")] = v;
     }
     match linear {
-        None => solver::simulation::tool_centre_point_ik(m, &mut commands, &params)
+        None => simulation::tool_centre_point_ik(m, &mut commands, &params)
             .expect("the linear axes reach the workpiece point"),
         Some(q) => {
             for (i, v) in m.linear_axes().zip(q) {
@@ -462,7 +462,7 @@ fn seed_tables_against_the_derivation() {
                 let fd = if setting == Setting::FiveAxisFree {
                     g.clone()
                 } else {
-                    solver::simulation::fd_gains(&m, &s.commands, &s.params, &d.ids)
+                    simulation::fd_gains(&m, &s.commands, &s.params, &d.ids)
                 };
                 for (i, row) in rows.iter().enumerate() {
                     for c in 0..6 {
@@ -628,7 +628,7 @@ fn seed_tables_against_the_derivation() {
             rows.extend(table.missing_rows);
             let d = derive(&m, &rows);
             let g = d.model.evaluate(&s.commands, &s.params);
-            let fd = solver::simulation::fd_gains(&m, &s.commands, &s.params, &d.ids);
+            let fd = simulation::fd_gains(&m, &s.commands, &s.params, &d.ids);
             let on_workpiece = setting != Setting::FiveAxisFree;
             for e in EXPECTED.iter().filter(|e| e.table == table.id) {
                 let i = rows.iter().position(|r| *r == e.row).expect("row");
@@ -692,7 +692,7 @@ fn seed_tables_against_the_derivation() {
         rows.extend(table.missing_rows);
         let d = derive(&m, &rows);
         let g = d.model.evaluate(&s.commands, &s.params);
-        let fd = solver::simulation::fd_gains(&m, &s.commands, &s.params, &d.ids);
+        let fd = simulation::fd_gains(&m, &s.commands, &s.params, &d.ids);
         for (i, row) in rows.iter().enumerate() {
             for c in 0..table.columns.len() {
                 let missing = match table.rows.get(i) {

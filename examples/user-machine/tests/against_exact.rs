@@ -1,5 +1,5 @@
 //! The code that `build.rs` generated from `machine.toml`, checked against rtest's exact
-//! virtual machine (`solver::simulation::exact`: homogeneous transforms with exact small
+//! virtual machine (`simulation::exact`: homogeneous transforms with exact small
 //! rotations, no linearisation), which shares no code with the symbolic engine but the list of
 //! elementary steps of each chain.
 //!
@@ -14,8 +14,8 @@
 //!   the workpiece's frame, where the nominal machine has them at the commanded pose.
 
 use model_spec::{ErrorId, Machine, Side};
-use solver::simulation::exact::{Transform, chain_transform, error_vector, tool_centre_point_ik};
-use solver::simulation::fd::fd_gains;
+use simulation::exact::{Transform, chain_transform, error_vector, tool_centre_point_ik};
+use simulation::fd::fd_gains;
 use user_machine_example::trunnion_bc::{self, Params, Pose, full, location};
 use user_machine_example::{Command, correct_pose, predicted_error};
 

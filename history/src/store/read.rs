@@ -4,7 +4,7 @@
 use super::Store;
 use crate::check::{Check, CheckKind, InputFile, Parameter};
 use crate::error::HistoryError;
-use crate::time::Timestamp;
+use formats::time::Timestamp;
 use rusqlite::{Row, params};
 use serde::Serialize;
 use std::collections::HashMap;

@@ -28,7 +28,7 @@ mod select;
 pub use select::{LeftOut, Point, Series, SeriesHead, select};
 
 use crate::stats::{ALPHA_RANGE, normal_two_sided, student_p_value, student_two_sided};
-use crate::time::Timestamp;
+use formats::time::Timestamp;
 use model_spec::units::{fixed, significant, symbol};
 use serde::Serialize;
 

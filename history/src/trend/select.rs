@@ -8,7 +8,7 @@
 use super::TrendError;
 use crate::check::{Check, Parameter, canonical_key, same_name};
 use crate::store::RecordedCheck;
-use crate::time::Timestamp;
+use formats::time::Timestamp;
 use serde::Serialize;
 
 /// One check of a series: its value of the error with its standard uncertainty.

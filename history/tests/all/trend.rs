@@ -11,7 +11,7 @@ use history::trend::{
     Assessment, Options, Point, Series, SeriesHead, Test, TrendError, assess, select, slope,
 };
 use history::{Check, Provenance, RecordedCheck, Store, Timestamp};
-use solver::simulation::rng::Rng;
+use simulation::rng::Rng;
 
 const ALPHA: f64 = 0.01;
 
@@ -465,11 +465,11 @@ fn truth_text(xoc: f64, noise_um: f64, seed: u64) -> String {
 
 #[test]
 fn the_real_pipeline_flags_a_drifting_location_error() {
-    use solver::fitting::{IdentifyOptions, RefineOptions, identify_refined};
-    use solver::io::report::{IdentificationReport, IdentificationSource};
-    use solver::model::Model;
-    use solver::simulation::truth::Truth;
-    use solver::simulation::{builtin_path, simulate};
+    use fitting::{IdentifyOptions, RefineOptions, identify_refined};
+    use report::json::{IdentificationReport, IdentificationSource};
+    use simulation::model::Model;
+    use simulation::truth::Truth;
+    use simulation::{builtin_path, simulate};
 
     let m = model_spec::builtin("seed-ac").unwrap().unwrap();
     let model = Model::of(&m, "reduced").unwrap();

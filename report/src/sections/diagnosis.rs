@@ -5,8 +5,8 @@
 use super::{num, unit, value_std};
 use crate::html::{Body, Cell};
 use crate::inputs::{Figure, Inputs};
+use crate::json::diagnose::{DiagnosisReport, FindingReport, GroupReport};
 use model_spec::units::{fixed, p_value, short};
-use solver::io::report::diagnose::{DiagnosisReport, FindingReport, GroupReport};
 
 /// A finding's value(s) with uncertainties; a harmonic with its amplitude and phase.
 fn finding_value(f: &FindingReport) -> String {
@@ -365,7 +365,7 @@ fn records(b: &mut Body, d: &DiagnosisReport) {
     );
 }
 
-fn gain_row(role: &str, g: &solver::io::report::diagnose::GainRow) -> Vec<Cell> {
+fn gain_row(role: &str, g: &crate::json::diagnose::GainRow) -> Vec<Cell> {
     vec![
         Cell::text(g.data.clone()),
         Cell::text(role),

@@ -6,8 +6,8 @@
 use super::{num, opt, unit, value_std};
 use crate::html::{Body, Cell};
 use crate::inputs::{Inputs, MachineFacts};
+use crate::json::identify::{IdentificationReport, ParameterReport, RecordReport};
 use model_spec::units::{fixed, short};
-use solver::io::report::identify::{IdentificationReport, ParameterReport, RecordReport};
 
 /// What a parameter's status is, in words.
 fn status(p: &ParameterReport) -> String {

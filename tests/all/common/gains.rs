@@ -29,7 +29,7 @@ pub fn pose(m: &Machine, unit: &[f64]) -> (Vec<f64>, Vec<f64>) {
             }
         })
         .collect();
-    solver::simulation::exact::tool_centre_point_ik(m, &mut commands, &params)
+    simulation::exact::tool_centre_point_ik(m, &mut commands, &params)
         .expect("three independent linear axes");
     (commands, params)
 }

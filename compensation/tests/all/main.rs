@@ -1,0 +1,14 @@
+//! The integration tests of the `compensation` crate, in one test binary (one link instead of one
+//! per file): each file of this directory is a module, and
+//! `cargo test -p compensation --test all NAME::` runs one of them.
+
+#[path = "../../../simulation/tests/all/common/mod.rs"]
+mod common;
+
+mod axis_tables;
+mod compensation_engine;
+mod compensation_firmware;
+mod corrected_kinematics;
+mod full_loop;
+mod timebases;
+mod volumetric;

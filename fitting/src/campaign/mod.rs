@@ -1,0 +1,89 @@
+//! Campaigns: several records, each measured with its own set-up, fitted together.
+//!
+//! A measurement campaign is several R-test records: several paths, often several ball
+//! positions or heights. The machine's errors are the same in every record; what changes from
+//! record to record is
+//!
+//! - the **kinematic parameters** the record was planned and is modelled with
+//!   ([`CampaignRecord::params`], mm, symbol order): the ball's position lives there;
+//! - the **ball set-up errors** `XOW YOW ZOW` (the set-up terms of the model, catalogue errors
+//!   of kind [`model_spec::ErrorKind::Setup`]): one set per *set-up*
+//!   ([`CampaignRecord::setup`]); records with the same set-up label share them (one ball
+//!   mounting, several paths);
+//! - the **R-test's zero** `dx0 dy0 dz0` ([`simulation::model::Effect::SensorOffset`]): one per
+//!   record, joined when the record's readings were zeroed at its first sample
+//!   ([`CampaignRecord::zeroed`]);
+//! - the **clock**: terms of a time basis (`time:K`, `exp:TAU`) describe a drift within a
+//!   record, on its own clock, unless every record says when it started on one campaign clock
+//!   ([`CampaignRecord::start_s`]).
+//!
+//! [`design::Layout`] says which column belongs to whom, [`design::design_matrix`] stacks the
+//! records' H matrices into one, [`fit::identify_campaign`] fits it (first order, ordinary or
+//! generalized least squares), [`refine::identify_campaign_refined`] refines the fit against
+//! the exact machine (each record with its own parameters and set-up values), and
+//! [`validate::validate_campaign`] predicts other records, refitting the set-up errors of a
+//! set-up that was not fitted (and a record's own zero) with the machine's errors held.
+//! `docs/campaigns.md` describes the campaign file and a worked campaign.
+
+pub mod clock;
+pub mod design;
+pub mod fit;
+pub mod refine;
+pub mod validate;
+
+pub use design::{Column, Design, Layout, Owner, RecordColumns, RecordSpec, design_matrix};
+pub use fit::{
+    CampaignIdentification, RecordFit, choose_campaign_noise, identify_campaign,
+    identify_campaign_with,
+};
+pub use refine::{exact_campaign_prediction, identify_campaign_refined, refine_campaign};
+pub use validate::{
+    CampaignValidation, CampaignValues, RecordPlan, RecordValidation, Refitted, record_plan,
+    validate_campaign, validate_record,
+};
+
+use simulation::campaign::Campaign;
+use simulation::record::Record;
+
+/// The per-sample whitening of `campaign`'s readings, stacked in record order, when its
+/// records were read through an instrument (every record carries per-sample covariances,
+/// [`Record::covariance`]); `None` when none does.
+///
+/// # Errors
+/// [`crate::EstimateError::Noise`] when some records carry covariances and others do not (their
+/// rows could not be weighted alike), when a covariance cannot whiten, or when `noise` is a
+/// declared model (the sensors' σ already declare the noise).
+pub fn whitening(
+    campaign: &Campaign,
+    noise: &crate::noise::NoiseChoice,
+) -> Result<Option<crate::noise::SampleWhitening>, crate::EstimateError> {
+    let with: Vec<&str> = campaign
+        .records
+        .iter()
+        .filter(|r| !r.record.covariance.is_empty())
+        .map(|r| r.label.as_str())
+        .collect();
+    if with.is_empty() {
+        return Ok(None);
+    }
+    if with.len() != campaign.records.len() {
+        let without: Vec<&str> = campaign
+            .records
+            .iter()
+            .filter(|r| r.record.covariance.is_empty())
+            .map(|r| r.label.as_str())
+            .collect();
+        return Err(crate::noise::NoiseError::Whitening(format!(
+            "records {} were read through an instrument (per-sample covariances) and records {} were not: a campaign weights all its records alike, so read every record through the instrument or none",
+            with.join(", "),
+            without.join(", ")
+        ))
+        .into());
+    }
+    let mut all = Record::default();
+    for r in &campaign.records {
+        all.samples.extend(r.record.samples.iter().cloned());
+        all.covariance.extend(r.record.covariance.iter().copied());
+    }
+    crate::identify::sample_whitening(&all, noise)
+}

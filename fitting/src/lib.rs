@@ -1,0 +1,90 @@
+//! From records to values: the H matrix, least squares with identifiability, the refinement
+//! against the exact machine, streaming identification, and validation on other records.
+//!
+//! - [`hmatrix`]: the design matrix of a model on a record, with gains from compiled code or
+//!   the in-process evaluator ([`hmatrix::GainSource`]);
+//! - [`mod@least_squares`]: column-scaled least squares with a stated numerical rank,
+//!   uncertainties, and no number for what the data cannot determine;
+//! - [`mod@identify`]: a model identified on a record (first order), with what the sensor
+//!   offsets swallow;
+//! - [`identifiability`]: what the data can and cannot tell apart;
+//! - [`offsets`]: kinematic offsets (symbols of the description) as unknowns: their gains,
+//!   their changes in the exact machine, who owns them in a campaign;
+//! - [`noise`]: the reading noise (white or AR(1) per direction: declared, from a static
+//!   record, or estimated without trusting the model) and the prewhitening that makes it white;
+//! - [`refine`]: Gauss–Newton against the exact machine, removing the second-order bias;
+//! - [`streaming`]: identification of long records in blocks, memory bounded by the model;
+//! - [`mod@validate`]: the identified model's prediction against another record;
+//! - [`distributions`]: the F and t distributions of the significance tests;
+//! - [`mod@calibrate`]: an instrument's own errors (sensor gain errors, zeros, direction
+//!   errors) from a calibration record of known displacements.
+//!
+//! It builds on [`simulation`] (the model, the record, the campaign, the exact machine) and
+//! [`formats`] (records read in blocks by the streaming identification); the diagnosis and the
+//! compensation build on it.
+//!
+//! Units inside: lengths and translational errors in mm, rotary commands and angular errors in
+//! rad. Conversions to degrees, µm and µrad happen at the boundaries people see
+//! ([`model_spec::units`]), not here.
+//!
+//! # Example: simulate, identify, validate
+//!
+//! ```
+//! use model_spec::builtin;
+//! use fitting::{IdentifyOptions, ValidateOptions, identify, validate};
+//! use simulation::model::Model;
+//! use simulation::{builtin_path, builtin_truth, simulate};
+//!
+//! let m = builtin("seed-ac").unwrap().unwrap();
+//! // The seed's reduced model, and a virtual machine whose errors are exactly its terms.
+//! let model = Model::of(&m, "reduced").unwrap();
+//! let truth = builtin_truth("seed-ac-reduced", &m).unwrap().unwrap();
+//! let k4 = simulate(&m, &truth, &builtin_path(&m, "K4").unwrap().unwrap()).unwrap();
+//! let k1 = simulate(&m, &truth, &builtin_path(&m, "K1").unwrap().unwrap()).unwrap();
+//!
+//! // Identify on K4 (first order; `fitting::identify_refined` removes the second-order bias).
+//! let ident = identify(&m, &model, &k4, &IdentifyOptions::default()).unwrap();
+//! let xoc = ident.fit.names.iter().position(|n| n == "XOC").unwrap();
+//! let truth_xoc = truth.coefficient(&model.terms[7]).unwrap()[0];
+//! assert!((ident.fit.values[xoc].unwrap() - truth_xoc).abs() < 1e-5); // mm
+//!
+//! // The identified values predict K1, a path they were not fitted on, to well below 0.01 µm.
+//! let v = validate(&m, &ident.model, &ident.fit.values, &k1, &ValidateOptions::default()).unwrap();
+//! assert!(v.overall.residual_rms < 1e-5); // mm
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod calibrate;
+pub mod campaign;
+pub mod distributions;
+pub mod factored;
+pub mod hmatrix;
+pub mod identifiability;
+pub mod identify;
+pub mod least_squares;
+pub mod noise;
+pub mod offsets;
+pub mod plan;
+pub mod refine;
+pub mod sanity;
+pub mod streaming;
+mod svd;
+pub mod validate;
+
+pub use hmatrix::{Backend, GainSource, HMatrixError, h_matrix};
+pub use identify::{
+    Identification, IdentifyOptions, check_readings, choose_noise, gain_source, identify,
+    identify_noise, identify_with, identify_with_noise, measurement_vector, with_offsets,
+};
+pub use least_squares::{
+    Constraint, EstimateError, Fit, RANK_RELATIVE_TOLERANCE, Tolerances, WhitenedFit,
+    least_squares, least_squares_reduced, least_squares_whitened,
+};
+pub use noise::{NoiseChoice, NoiseModel, NoiseSource};
+pub use refine::{
+    RefineError, RefineOptions, Refinement, identify_refined, identify_refined_noise,
+    identify_refined_with, identify_refined_with_noise,
+};
+pub use sanity::{Implausible, ValueLimits, check_values};
+pub use validate::{ValidateError, ValidateOptions, Validation, validate};

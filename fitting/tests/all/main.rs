@@ -1,0 +1,22 @@
+//! The integration tests of the `fitting` crate, in one test binary (one link instead of one
+//! per file): each file of this directory is a module, and
+//! `cargo test -p fitting --test all NAME::` runs one of them.
+
+#[path = "../../../simulation/tests/all/common/mod.rs"]
+mod common;
+
+mod campaign;
+mod campaign_heights;
+mod estimate;
+mod hmatrix;
+mod identify_exact;
+mod identify_noise;
+mod instrument_calibration;
+mod instrument_fit;
+mod noise_model;
+mod plan;
+mod plan_reversal;
+mod plan_update;
+mod streaming;
+mod templates;
+mod vocabulary;

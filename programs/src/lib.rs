@@ -1,0 +1,16 @@
+//! Measurement programs and what comes back from running them.
+//!
+//! - [`measure`]: the NC program that takes the machine through an R-test's poses (ISO G-code
+//!   or Heidenhain), with its timing plan;
+//! - [`segment`]: a time-stamped R-test log of that program's run cut into one sample per
+//!   pose of the timing plan;
+//! - [`stream`]: a simulated R-test log of a measurement program's run, streamed row by row.
+//!
+//! It builds on [`simulation`] and [`formats`] (NC programs, the measurement CSV); nothing in
+//! the fit, the diagnosis or the compensation depends on it.
+
+#![warn(missing_docs)]
+
+pub mod measure;
+pub mod segment;
+pub mod stream;

@@ -1,0 +1,9 @@
+//! The integration tests of the `programs` crate, in one test binary (one link instead of one
+//! per file): each file of this directory is a module, and
+//! `cargo test -p programs --test all NAME::` runs one of them.
+
+#[path = "../../../simulation/tests/all/common/mod.rs"]
+mod common;
+
+mod nc_measure;
+mod segment;

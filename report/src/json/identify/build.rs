@@ -1,0 +1,275 @@
+//! The identification report built from an identification: of a campaign
+//! ([`IdentificationReport::of_campaign`]), or of one record's
+//! ([`IdentificationReport::new`], [`IdentificationReport::of_record`]: its campaign of one).
+
+use super::super::fit_summary::{
+    fit_report, noise_report, notes, parameter_report, refinement_report,
+};
+use super::super::{NonFinite, Ordered, finite};
+use super::{
+    CAMPAIGN_KIND, CampaignSource, ClockReport, IdentificationReport, IdentificationSource,
+    REPORT_VERSION, RecordReport, RecordReportError, SetupReport, SwallowedReport, backend_name,
+};
+use fitting::Identification;
+use fitting::campaign::{CampaignIdentification, Owner};
+use fitting::hmatrix::parameter_name;
+use fitting::refine::Refinement;
+use model_spec::Machine;
+use model_spec::units::UM_PER_MM;
+
+impl IdentificationReport {
+    /// The report of `ident`, one record identified on machine `m` at the machine's default
+    /// kinematic parameters, except the symbols identified as terms (`Zt`), at the values the
+    /// identification modelled them with; see [`IdentificationReport::of_record`].
+    ///
+    /// # Errors
+    /// As [`IdentificationReport::of_record`].
+    pub fn new(
+        m: &Machine,
+        source: IdentificationSource,
+        ident: &Identification,
+        refinement: Option<&Refinement>,
+    ) -> Result<IdentificationReport, RecordReportError> {
+        let mut params = m.default_parameters();
+        for (j, (t, _)) in ident.model.columns().into_iter().enumerate() {
+            if let (Some(s), Some(Some(v))) = (
+                ident.model.terms[t].effect.symbol(),
+                ident.nominal_mm.get(j),
+            ) {
+                params[s] = *v;
+            }
+        }
+        IdentificationReport::of_record(m, source, ident, params, refinement)
+    }
+
+    /// The report of `ident`, one record identified on machine `m` at the kinematic parameters
+    /// `params` (mm, symbol order): the campaign of that record (labelled by the stem of its
+    /// file, on a set-up of that label) reported by [`IdentificationReport::of_campaign`].
+    ///
+    /// # Errors
+    /// [`RecordReportError::NonFinite`] when a value, uncertainty or statistic is not finite;
+    /// [`RecordReportError::Record`] when the identification's model does not fit `m` or
+    /// `params` are not one per symbol.
+    pub fn of_record(
+        m: &Machine,
+        source: IdentificationSource,
+        ident: &Identification,
+        params: Vec<f64>,
+        refinement: Option<&Refinement>,
+    ) -> Result<IdentificationReport, RecordReportError> {
+        let label = formats::campaign::stem_label(std::path::Path::new(source.data));
+        let campaign =
+            CampaignIdentification::of_record(m, ident, &label, params).map_err(|e| {
+                RecordReportError::Record {
+                    data: source.data.to_string(),
+                    why: e.to_string(),
+                }
+            })?;
+        let data = [source.data.to_string()];
+        let source = CampaignSource {
+            label: source.label,
+            base_model: source.base_model,
+            data: &data,
+        };
+        Ok(IdentificationReport::of_campaign(
+            m, source, &campaign, refinement,
+        )?)
+    }
+
+    /// The report of `ident` on machine `m`, refined as `refinement` says (`None`: first
+    /// order): a record's report when it has one record, a campaign's otherwise (see the module
+    /// documentation).
+    ///
+    /// # Errors
+    /// [`NonFinite`] when a value, uncertainty or statistic is not finite.
+    pub fn of_campaign(
+        m: &Machine,
+        source: CampaignSource,
+        ident: &CampaignIdentification,
+        refinement: Option<&Refinement>,
+    ) -> Result<IdentificationReport, NonFinite> {
+        let fit = &ident.fit;
+        let layout = &ident.layout;
+        let one = layout.records.len() == 1;
+        // A record's report names its columns as a single fit does, in its model's order.
+        let names: Vec<String> = if one {
+            layout
+                .columns
+                .iter()
+                .map(|c| parameter_name(m, &c.term, c.component))
+                .collect()
+        } else {
+            layout.names()
+        };
+        let order: Vec<usize> = if one {
+            layout.records[0].columns.clone()
+        } else {
+            (0..layout.columns.len()).collect()
+        };
+        let nominal = layout.nominal_mm();
+        let mut parameters = Vec::with_capacity(order.len());
+        for &j in &order {
+            let c = &layout.columns[j];
+            let owner = match (one, c.owner) {
+                (true, _) => None,
+                (false, Owner::Shared) => Some(("shared", None)),
+                (false, Owner::Setup(_)) => Some(("setup", Some(layout.owner_label(c.owner)))),
+                (false, Owner::Record(_)) => Some(("record", Some(layout.owner_label(c.owner)))),
+            };
+            parameters.push(parameter_report(
+                m,
+                &c.term,
+                c.component,
+                fit,
+                j,
+                names[j].clone(),
+                nominal[j],
+                owner,
+            )?);
+        }
+        let rename = |n: &String| -> String {
+            layout
+                .columns
+                .iter()
+                .position(|c| c.name == *n)
+                .map_or_else(|| n.clone(), |j| names[j].clone())
+        };
+        let swallowed: Vec<(Vec<String>, Vec<String>)> = ident
+            .swallowed
+            .iter()
+            .map(|s| {
+                (
+                    s.offsets.iter().map(rename).collect(),
+                    s.errors.iter().map(rename).collect(),
+                )
+            })
+            .collect();
+        let refinement = refinement_report(refinement, fit)?;
+        let mut summary = fit_report(fit, &names)?;
+        if let fitting::Constraint::Zero(zero) = &fit.constraint {
+            let zero: Vec<String> = zero.iter().map(rename).collect();
+            summary.constraint = format!("zero: {}", zero.join(", "));
+        }
+        let mut all_notes = notes(fit, &names, &swallowed, &refinement);
+        all_notes.extend(setup_notes(ident, &names));
+        let records = layout
+            .records
+            .iter()
+            .zip(&ident.records)
+            .enumerate()
+            .map(|(r, (rc, rf))| {
+                Ok(RecordReport {
+                    label: rc.label.clone(),
+                    data: source.data.get(r).cloned().unwrap_or_default(),
+                    setup: layout.setups[rc.setup].clone(),
+                    params: Ordered(
+                        m.symbols
+                            .iter()
+                            .zip(&rc.params)
+                            .map(|(s, &v)| (s.name.clone(), v + 0.0))
+                            .collect(),
+                    ),
+                    zeroed: rc.zeroed,
+                    start_s: rc.start_s,
+                    samples: rc.samples,
+                    residual_rms_um: finite(
+                        || format!("records[{r}].residual_rms_um"),
+                        rf.residual_rms() * UM_PER_MM,
+                    )?,
+                })
+            })
+            .collect::<Result<Vec<_>, NonFinite>>()?;
+        let terms = if one {
+            &layout.records[0].model
+        } else {
+            &ident.model
+        };
+        Ok(IdentificationReport {
+            version: REPORT_VERSION,
+            kind: (!one).then(|| CAMPAIGN_KIND.to_string()),
+            machine: m.name.clone(),
+            fingerprint: m.fingerprint(),
+            data: one.then(|| records[0].data.clone()),
+            model: source.label.to_string(),
+            base_model: source.base_model.map(str::to_string),
+            terms: terms.terms.iter().map(|t| t.spelling(m)).collect(),
+            setups: layout
+                .setups
+                .iter()
+                .enumerate()
+                .map(|(s, label)| SetupReport {
+                    label: label.clone(),
+                    records: layout
+                        .records
+                        .iter()
+                        .filter(|r| r.setup == s)
+                        .map(|r| r.label.clone())
+                        .collect(),
+                })
+                .collect(),
+            zeroed: one.then(|| records[0].zeroed),
+            records,
+            clock: layout.clock.map(|(a, b)| ClockReport {
+                start_s: a,
+                end_s: b,
+            }),
+            parameters,
+            residual_rms_um: summary.residual_rms_um,
+            rank: summary.rank,
+            free_parameters: summary.free_parameters,
+            condition: summary.condition,
+            confounded: summary.confounded,
+            samples: ident.records.iter().map(|r| r.samples).sum(),
+            readings: summary.readings,
+            dof: summary.dof,
+            constraint: summary.constraint,
+            sigma_um: summary.sigma_um,
+            near_confounded: summary.near_confounded,
+            swallowed: swallowed
+                .into_iter()
+                .map(|(offsets, errors)| SwallowedReport { offsets, errors })
+                .collect(),
+            gains: backend_name(ident.backend).into(),
+            refinement,
+            noise_model: Some(noise_report(&ident.noise, ident.whitened_sigma)?),
+            streaming: None,
+            notes: all_notes,
+        })
+    }
+}
+
+/// The set-up errors the records cannot separate from the machine's, named by `names`.
+fn setup_notes(ident: &CampaignIdentification, names: &[String]) -> Vec<String> {
+    let fit = &ident.fit;
+    let layout = &ident.layout;
+    let mut out = Vec::new();
+    for g in &fit.identifiability.confounded {
+        let of = |owner: fn(Owner) -> bool| -> Vec<&str> {
+            g.iter()
+                .filter(|&&j| owner(layout.columns[j].owner))
+                .map(|&j| names[j].as_str())
+                .collect()
+        };
+        let setup = of(|o| matches!(o, Owner::Setup(_)));
+        let shared = of(|o| o == Owner::Shared);
+        if !setup.is_empty() && !shared.is_empty() {
+            out.push(format!(
+                "the set-up error{} {} cannot be told from the machine's {} on {}{}",
+                if setup.len() > 1 { "s" } else { "" },
+                setup.join(", "),
+                shared.join(", "),
+                if layout.records.len() > 1 {
+                    "these records"
+                } else {
+                    "this record"
+                },
+                if fit.constraint == fitting::Constraint::None {
+                    ": no number for either"
+                } else {
+                    ""
+                }
+            ));
+        }
+    }
+    out
+}

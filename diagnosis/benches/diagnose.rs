@@ -32,13 +32,13 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use diagnosis::dictionary::{DictionaryOptions, dictionary, scanned};
 use diagnosis::{DiagnoseOptions, diagnose, one_record};
 use formats::progress::Unwatched;
+use formats::truth::builtin_truth;
 use model_spec::Machine;
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::Model;
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::builtin_truth;
 use std::hint::black_box;
 
 fn seed_ac() -> Machine {

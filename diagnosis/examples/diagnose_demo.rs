@@ -22,7 +22,7 @@ use simulation::record::Record;
 fn main() {
     let m = model_spec::builtin("seed-ac").unwrap().unwrap();
     let name = std::env::args().nth(1).unwrap_or("seed-ac-demo".into());
-    let mut truth = simulation::truth::load_truth(&name, &m).unwrap();
+    let mut truth = formats::truth::load_truth(&name, &m).unwrap();
     println!("{}", truth.summary(&m));
     let mut rec = vec![];
     for p in ["K4", "K1", "K2"] {

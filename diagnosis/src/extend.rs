@@ -240,10 +240,10 @@ pub(super) fn extend(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use formats::truth::builtin_truth;
     use simulation::campaign::CampaignRecord;
     use simulation::paths::builtin_path;
     use simulation::readings::simulate;
-    use simulation::truth::builtin_truth;
 
     #[test]
     fn a_finding_whose_fit_does_not_converge_is_dropped_and_the_others_kept() {

@@ -32,6 +32,23 @@
 //!    or a term of time, and a candidate of the other kind that the fitted records cannot tell
 //!    from it (the axis moving monotonically in time), reported with the test that separates
 //!    them.
+//!
+//! The modules, beside those named above: [`confirm`] (each finding confirmed by records that
+//! were not fitted), `extend` (the refined fits of the base and extended models), [`figures`]
+//! (the diagnosis figures' data), [`groups`] (sets of errors tested as one), [`harmonic`]
+//! (a harmonic finding as amplitude and phase), [`hidden`] (what a model lacks by a known
+//! truth, for simulations), `jump` (a jump in time on a record described), `lack_of_fit`
+//! (the test of what remains on every record), `options` ([`DiagnoseOptions`]), `outcome`
+//! (what a diagnosis finds: [`Diagnosis`]), `parallel` (independent work on every core, results
+//! in order), [`plausible`] (a finding named only at a size a machine can have), `projected`
+//! (the candidates with the model's span projected out), `search` (the selection with its
+//! exchange pass), [`structure`] (a residual's structure per direction), [`tones`] (periodic
+//! disturbances in time), `weights` (per-sample weights of records read through an
+//! instrument), `columns` (the design matrices the selection works on), `confounded` (what the
+//! data cannot see apart) and `noise_model` (where the noise model comes from).
+//!
+//! It builds on [`simulation`], [`formats`] (progress of long reads) and [`fitting`]; the
+//! compensation and the reports build on it.
 
 #![warn(missing_docs)]
 

@@ -9,12 +9,13 @@ use fitting::hmatrix::GainSource;
 use fitting::refine::{RefineOptions, refine};
 use fitting::validate::{ValidateOptions, validate};
 use fitting::{Identification, IdentifyOptions, Tolerances, identify};
+use formats::truth::builtin_truth;
 use model_spec::{ErrorKind, Machine, builtin};
 use simulation::model::{Effect, Model};
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::{Truth, builtin_truth};
+use simulation::truth::Truth;
 
 /// Per path: name, max |measured| per direction, max |residual| per direction, RMS before and
 /// after (µm).

@@ -16,6 +16,12 @@
 //! - [`streaming`]: identification of long records in blocks, memory bounded by the model;
 //! - [`mod@validate`]: the identified model's prediction against another record;
 //! - [`distributions`]: the F and t distributions of the significance tests;
+//! - [`plan`]: the records to measure next for a target uncertainty, chosen from the machine's
+//!   tests;
+//! - [`sanity`]: plausibility limits on identified values;
+//! - [`factored`] (the fits on one factorization of the scaled H) and `svd` (QR first for a
+//!   tall H, then the SVD of R, every SVD checked by rebuilding its matrix): the numerics
+//!   behind [`mod@least_squares`];
 //! - [`mod@calibrate`]: an instrument's own errors (sensor gain errors, zeros, direction
 //!   errors) from a calibration record of known displacements.
 //!
@@ -33,7 +39,8 @@
 //! use model_spec::builtin;
 //! use fitting::{IdentifyOptions, ValidateOptions, identify, validate};
 //! use simulation::model::Model;
-//! use simulation::{builtin_path, builtin_truth, simulate};
+//! use formats::truth::builtin_truth;
+//! use simulation::{builtin_path, simulate};
 //!
 //! let m = builtin("seed-ac").unwrap().unwrap();
 //! // The seed's reduced model, and a virtual machine whose errors are exactly its terms.

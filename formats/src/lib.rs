@@ -2,7 +2,9 @@
 //!
 //! Every reader bounds what it reads (bytes, lines, rows), refuses bad input with the file,
 //! line, column and field, and never returns a partial result; every writer writes what its
-//! reader reads back, bit for bit.
+//! reader reads back, bit for bit. The TOML files (truths, campaigns, and the squareness and
+//! tolerance files of the crates above) are read through one helper, [`located`], so their
+//! messages are located and worded alike.
 //!
 //! - [`mod@campaign`]: the campaign file (records, set-ups, ball positions, zeroing, clock);
 //! - [`csv`]: the R-test measurement CSV, read whole or in blocks, written so that it reads
@@ -12,7 +14,9 @@
 //! - [`poses`]: commanded poses, their axis words and their CSV, read and written back;
 //! - [`sensors`]: records of an R-test head's sensor readings, and calibration records;
 //! - [`progress`]: how far a long read has come, for progress bars;
-//! - [`time`]: UTC times as files write them (RFC 3339, whole seconds).
+//! - [`time`]: UTC times as files write them (RFC 3339, whole seconds);
+//! - [`truth`]: truth files (what a simulated machine's errors really are) and the built-in
+//!   truths.
 //!
 //! It builds on [`simulation`] (a record's linear axes follow the ball by the nominal inverse
 //! kinematics, and every pose read is checked against the machine) and imports nothing from
@@ -22,9 +26,11 @@
 
 pub mod campaign;
 pub mod csv;
+pub mod located;
 pub mod nc;
 pub mod paths;
 pub mod poses;
 pub mod progress;
 pub mod sensors;
 pub mod time;
+pub mod truth;

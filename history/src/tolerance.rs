@@ -20,9 +20,9 @@
 //! `--tolerance XOC=5` gives one.
 
 use crate::check::canonical_key;
-use model_spec::locate::line_col;
+use formats::located::{Located, TomlText, in_order};
 use std::ops::Range;
-use toml::de::{DeTable, DeValue};
+use toml::de::DeValue;
 
 /// The largest tolerance file read, bytes.
 pub const MAX_TOLERANCE_BYTES: u64 = 1 << 20;
@@ -42,6 +42,17 @@ pub struct ToleranceError {
     pub column: usize,
     /// What is wrong, naming the field.
     pub message: String,
+}
+
+impl From<Located> for ToleranceError {
+    fn from(e: Located) -> Self {
+        ToleranceError {
+            file: e.file,
+            line: e.line,
+            column: e.column,
+            message: e.message,
+        }
+    }
 }
 
 /// One tolerance and where it was given.
@@ -148,27 +159,17 @@ fn name_ok(name: &str) -> bool {
 /// # Errors
 /// [`ToleranceError`] naming the file, the line, the column and the field.
 pub fn parse_file(file: &str, text: &str) -> Result<Tolerances, ToleranceError> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let err = |span: Range<usize>, message: String| {
-        let (line, column) = line_col(text, span.start);
-        ToleranceError {
-            file: file.to_string(),
-            line,
-            column,
-            message,
-        }
-    };
-    let root =
-        DeTable::parse(text).map_err(|e| err(e.span().unwrap_or(0..0), e.message().to_string()))?;
-    let mut entries: Vec<_> = root.get_ref().iter().collect();
-    entries.sort_by_key(|(k, _)| k.span().start);
+    let src = TomlText::new(file, text);
+    let err = |span: Range<usize>, message: String| ToleranceError::from(src.at(span, message));
+    let root = src.root()?;
+    let entries = in_order(root.get_ref());
     let mut out = Tolerances::default();
     for (k, v) in entries {
         let name = k.get_ref().as_ref();
         if name == MACHINE_KEY {
             match v.get_ref() {
                 DeValue::String(s) => {
-                    out.machine_id = Some((s.to_string(), line_col(text, k.span().start)));
+                    out.machine_id = Some((s.to_string(), src.line_col(k.span().start)));
                     continue;
                 }
                 other => {
@@ -221,7 +222,7 @@ pub fn parse_file(file: &str, text: &str) -> Result<Tolerances, ToleranceError> 
             name: name.to_string(),
             limit,
             file: file.to_string(),
-            at: line_col(text, k.span().start),
+            at: src.line_col(k.span().start),
         })?;
     }
     Ok(out)

@@ -76,7 +76,7 @@ fn program(c: &mut Criterion) {
     use report::json::read::parse_identification;
     use report::json::{IdentificationReport, IdentificationSource, to_json};
     let m = model_spec::builtin("seed-ac").unwrap().unwrap();
-    let truth = simulation::builtin_truth("seed-ac-demo", &m)
+    let truth = formats::truth::builtin_truth("seed-ac-demo", &m)
         .unwrap()
         .unwrap();
     let k4 = simulation::builtin_path(&m, "K4").unwrap().unwrap();

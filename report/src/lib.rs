@@ -5,7 +5,9 @@
 //! - [`json`]: the reports of identification, validation, diagnosis, compensation, planning
 //!   and the gain tables as serde types, written as JSON; an identification read back;
 //! - [`text`]: the same results as text for a terminal;
-//! - the HTML report, below.
+//! - the HTML report, below: [`inputs`] (the JSON reports it is built from), [`sections`],
+//!   [`html`], [`figures`] and [`svg`], [`style`] (with the embedded font, encoded by
+//!   [`base64`]).
 //!
 //! The report is built from the reports rtest writes ([`inputs`]: the JSON of `identify`,
 //! `validate`, `diagnose` and `compensate`, recognised by their content and checked to belong

@@ -17,7 +17,7 @@
 //! - [`generator`]: the test catalogue of any machine and the generation of its tests within
 //!   strokes, ranges and the clearance rule;
 //! - [`paths`]: the built-in test paths, the linear axes following the ball;
-//! - [`truth`]: what a virtual machine's errors really are (TOML files and built-in truths);
+//! - [`truth`]: what a virtual machine's errors really are (read from TOML files by `formats`);
 //! - [`readings`]: simulated R-test readings of a truth along a path, with noise and zeroing;
 //! - [`rng`]: the platform-independent noise generator;
 //! - [`pose`]: one pose from the axis positions a person gives, checked against the machine.
@@ -49,4 +49,4 @@ pub use exact::{
 pub use fd::{FdSteps, fd_gains, fd_gains_with};
 pub use paths::builtin_path;
 pub use readings::{SimulateError, provenance, simulate};
-pub use truth::{Truth, builtin_truth, load_truth};
+pub use truth::Truth;

@@ -5,12 +5,13 @@ use super::args::RecordLimits;
 use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write};
 use formats::csv::{format_record, parse_measurement};
 use formats::paths::{PathFileError, load_path};
+use formats::truth::TruthError;
 use model_spec::units::parse_scaled;
 use output::{Outputs, Target};
 use report::text::simulation;
 use simulation::paths::PathError;
 use simulation::readings::SimulateError;
-use simulation::truth::{MAX_NOISE_PHI, MAX_NOISE_UM, MAX_SEED, Truth, TruthError};
+use simulation::truth::{MAX_NOISE_PHI, MAX_NOISE_UM, MAX_SEED, Truth};
 use simulation::{provenance, simulate};
 use std::path::Path;
 
@@ -134,8 +135,8 @@ fn noise_phi(text: &str) -> CliResult<f64> {
 /// The truth of `--truth`, else the machine's demo truth, else the nominal machine.
 fn truth(m: &model_spec::Machine, name: Option<&str>) -> CliResult<Truth> {
     let found = match name {
-        Some(n) => simulation::load_truth(n, m),
-        None => simulation::truth::default_truth(m),
+        Some(n) => formats::truth::load_truth(n, m),
+        None => formats::truth::default_truth(m),
     };
     found.map_err(|e| match e {
         TruthError::NotFound(_) => CliError::usage(format!("--truth: {e}")),

@@ -746,7 +746,7 @@ fn a_seed_campaign_compensates_the_shared_errors() {
     );
     // The machine alone: the demo truth without its ball set-up and noise.
     let demo = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("simulation/truths/seed-ac-demo.toml"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("formats/truths/seed-ac-demo.toml"),
     )
     .unwrap();
     let machine: String = demo

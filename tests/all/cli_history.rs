@@ -9,7 +9,6 @@ use crate::common::{self, temp_dir};
 use common::{entries, fails, ok, read_json};
 use history::sha256::sha256_hex;
 use serde_json::Value;
-use simulation::truth::Truth;
 use simulation::{builtin_path, simulate};
 use std::path::Path;
 
@@ -20,7 +19,7 @@ fn k4(dir: &Path, name: &str, xoc: f64, seed: u64) {
     let text = format!(
         "noise_um = 0.6\nseed = {seed}\n[errors]\nXOW = 12.0\nYOW = -18.0\nZOW = 15.0\nYOA = 20.0\nZOA = -15.0\nBOA = 25.0\nCOA = -18.0\nXOC = {xoc}\nYOC = -22.0\nAOC = 30.0\nBOC = -12.0\n"
     );
-    let t = Truth::parse("truth", &text, &m).unwrap();
+    let t = formats::truth::parse_truth("truth", &text, &m).unwrap();
     let path = builtin_path(&m, "K4").unwrap().unwrap();
     let record = simulate(&m, &t, &path).unwrap();
     let csv = formats::csv::format_record(&m, &record, &[]).unwrap();

@@ -6,11 +6,12 @@
 //! behind).
 
 use fitting::IdentifyOptions;
+use formats::truth::builtin_truth;
 use model_spec::Machine;
 use serde_json::Value;
 use simulation::model::Model;
 use simulation::record::Record;
-use simulation::truth::{Truth, builtin_truth};
+use simulation::truth::Truth;
 use std::path::Path;
 
 // ---------------------------------------------------------------- helpers

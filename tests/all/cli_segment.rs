@@ -5,11 +5,12 @@ use crate::common;
 
 use common::{fails, ok, temp_dir_tagged, words};
 use formats::nc::Dialect;
+use formats::truth::builtin_truth;
 use programs::measure::{
     MeasureMode, MeasureOptions, StaticTiming, format_plan, measurement_program,
 };
 use programs::stream::{StreamOptions, write_stream};
-use simulation::{builtin_path, builtin_truth};
+use simulation::builtin_path;
 use std::path::Path;
 
 /// Writes `plan.csv` (K4 of seed-ac, static, every other pose) and `log.csv` (its simulated

@@ -11,7 +11,6 @@ use compensation::volumetric::{
 use formats::poses::{axis_words, read_pose_csv};
 use model_spec::Machine;
 use serde_json::Value;
-use simulation::Truth;
 
 use crate::common;
 use common::{TempDir, entries, fails, ok};
@@ -47,7 +46,7 @@ fn machine() -> Machine {
 fn set_up(name: &str) -> (TempDir, VolumetricModel) {
     let m = machine();
     let dir = common::temp_dir_tagged("cli-vol", name);
-    let t = Truth::parse("t.toml", TRUTH, &m).unwrap();
+    let t = formats::truth::parse_truth("t.toml", TRUTH, &m).unwrap();
     let s = measure(&m, &t, &LaserPlan::over_strokes(&m, 21).unwrap()).unwrap();
     for x in &s.measurements {
         let file = format!("{}.csv", m.axes[x.axis].name.to_lowercase());

@@ -7,12 +7,12 @@ use compensation::run::{CommandedPose, compensate_poses};
 use compensation::values::MachineErrors;
 use compensation::verify::machine_error_rms;
 use diagnosis::Diagnosis;
+use fitting::campaign::{CampaignIdentification, CampaignValues};
 use fitting::{IdentifyOptions, RefineOptions, identify_refined};
 use formats::poses::to_file_units;
 use model_spec::Machine;
 use model_spec::units::format_scaled;
 use report::json::compensate::{CompensationReport, CompensationSource};
-use report::json::read::parse_identification;
 use report::json::{IdentificationReport, IdentificationSource, to_json};
 use simulation::model::Model;
 use simulation::truth::Truth;
@@ -96,9 +96,11 @@ pub(crate) fn compensate_held_out(
     let report = IdentificationReport::new(m, source, &ident, Some(&refinement))
         .map_err(failed("compensation"))?;
     let json = to_json(&report).map_err(failed("compensation"))?;
-    let values = parse_identification("identify-recommended.json", &json, m)
+    // The values as identified, in process (the JSON above is the file the demo writes).
+    let record = CampaignIdentification::of_record(m, &ident, "k4", m.default_parameters())
         .map_err(failed("compensation"))?;
-    let (errors, left_out) = MachineErrors::from_values(m, &values.values, &values.file)
+    let values = CampaignValues::of(&record);
+    let (errors, left_out) = MachineErrors::from_values(m, &values, "identify-recommended.json")
         .map_err(failed("compensation"))?;
     files.push(DemoFile {
         name: "identify-recommended.json".into(),

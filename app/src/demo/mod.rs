@@ -19,6 +19,7 @@ use fitting::sanity::{ValueLimits, check_values};
 use fitting::{IdentifyOptions, RefineOptions, ValidateOptions, identify_refined};
 use formats::csv::format_record;
 use formats::progress::Unwatched;
+use formats::truth::builtin_truth;
 use model_spec::FULL_MODEL;
 use report::json::{
     DiagnosisReport, DiagnosisSource, IdentificationReport, IdentificationSource, ValidationReport,
@@ -27,7 +28,7 @@ use report::json::{
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::Model;
 use simulation::record::Record;
-use simulation::truth::{Truth, builtin_truth};
+use simulation::truth::Truth;
 use simulation::{builtin_path, provenance, simulate};
 
 /// The machine of the demo.

@@ -28,7 +28,7 @@
 //! use simulation::Truth;
 //!
 //! let m = model_spec::builtin("seed-3axis").unwrap().unwrap();
-//! let truth = Truth::parse(
+//! let truth = formats::truth::parse_truth(
 //!     "t.toml",
 //!     "[errors]\nEXX = { \"poly:1\" = 12.0 }\nCOX = 20.0\n",
 //!     &m,
@@ -140,4 +140,15 @@ pub enum VolumetricError {
     /// non-finite value, a correction that does not converge.
     #[error("{0}")]
     Computation(String),
+}
+
+impl From<formats::located::Located> for VolumetricError {
+    fn from(e: formats::located::Located) -> Self {
+        VolumetricError::Toml {
+            file: e.file,
+            line: e.line,
+            column: e.column,
+            message: e.message,
+        }
+    }
 }

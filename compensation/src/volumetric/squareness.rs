@@ -18,12 +18,12 @@
 //! the letter O. Every problem is an error naming the file, line and column.
 
 use super::{MAX_ANGLE_RAD, VolumetricError};
+use formats::located::{TomlText, in_order};
 use model_spec::units::{format_scaled, parse_scaled};
 use model_spec::{ErrorId, ErrorKind, Machine, canonical_name};
 use std::ops::Range;
 use std::path::Path;
-use toml::Spanned;
-use toml::de::{DeTable, DeValue};
+use toml::de::DeValue;
 
 /// The largest squareness file read, bytes.
 pub const MAX_SQUARENESS_BYTES: u64 = 1 << 16;
@@ -78,9 +78,6 @@ pub fn read_squareness(path: &Path, m: &Machine) -> Result<Squareness, Volumetri
     parse_squareness(&path.display().to_string(), &text, m)
 }
 
-type Key<'i> = Spanned<std::borrow::Cow<'i, str>>;
-type Val<'i> = Spanned<DeValue<'i>>;
-
 /// Parses a squareness file of machine `m`; `file` names it in messages.
 ///
 /// # Errors
@@ -92,24 +89,15 @@ pub fn parse_squareness(
     text: &str,
     m: &Machine,
 ) -> Result<Squareness, VolumetricError> {
-    let err = |span: Range<usize>, message: String| {
-        let (line, column) = model_spec::locate::line_col(text, span.start);
-        VolumetricError::Toml {
-            file: file.to_string(),
-            line,
-            column,
-            message,
-        }
-    };
-    let root =
-        DeTable::parse(text).map_err(|e| err(e.span().unwrap_or(0..0), e.message().into()))?;
+    let src = TomlText::new(file, text);
+    let err = |span: Range<usize>, message: String| VolumetricError::from(src.at(span, message));
+    let root = src.root()?;
     let root = root.get_ref();
     let ids = squareness_errors(m);
     let names: Vec<&str> = ids.iter().map(|&e| m.catalogue[e].name.as_str()).collect();
     let mut values: Vec<Option<(f64, Range<usize>)>> = vec![None; ids.len()];
     let mut reference = vec![0.0; m.axes.len()];
-    let mut entries: Vec<(&Key<'_>, &Val<'_>)> = root.iter().collect();
-    entries.sort_by_key(|(k, _)| k.span().start);
+    let entries = in_order(root);
     for (k, v) in entries {
         let key = k.get_ref().as_ref();
         match key {
@@ -138,8 +126,7 @@ pub fn parse_squareness(
                         ),
                     ));
                 };
-                let mut rows: Vec<(&Key<'_>, &Val<'_>)> = t.iter().collect();
-                rows.sort_by_key(|(k, _)| k.span().start);
+                let rows = in_order(t);
                 for (ak, av) in rows {
                     let a = ak.get_ref().as_ref();
                     let Some(i) = m.axis_by_name(a) else {
@@ -153,8 +140,7 @@ pub fn parse_squareness(
                             ),
                         ));
                     };
-                    let (x, text_x) = number(av, &format!("reference {a} (mm)"))
-                        .map_err(|msg| err(av.span(), msg))?;
+                    let (x, text_x) = src.number(av, &format!("reference {a} (mm)"))?;
                     let [lo, hi] = m.axes[i].limits;
                     let tol = model_spec::pose::LIMIT_TOLERANCE;
                     if x < lo - tol || x > hi + tol {
@@ -183,14 +169,14 @@ pub fn parse_squareness(
                     ));
                 };
                 if let Some((_, first)) = &values[j] {
-                    let (line, _) = model_spec::locate::line_col(text, first.start);
+                    let (line, _) = src.line_col(first.start);
                     return Err(err(
                         k.span(),
                         format!("{canonical} is given twice (first on line {line})"),
                     ));
                 }
                 let what = format!("{canonical} (µrad)");
-                let (x, text_x) = number(v, &what).map_err(|msg| err(v.span(), msg))?;
+                let (x, text_x) = src.number(v, &what)?;
                 let rad = parse_scaled(&text_x, -6).unwrap_or(x * 1e-6);
                 if rad.abs() > MAX_ANGLE_RAD {
                     return Err(err(
@@ -232,24 +218,6 @@ pub fn parse_squareness(
             .collect(),
         reference,
     })
-}
-
-/// A finite number and the decimal text it was written as; the message when it is not.
-fn number(v: &Val<'_>, what: &str) -> Result<(f64, String), String> {
-    let text = match v.get_ref() {
-        DeValue::Float(f) => f.as_str().to_string(),
-        DeValue::Integer(i) => match i.radix() {
-            10 => i.as_str().to_string(),
-            r => i64::from_str_radix(i.as_str(), r)
-                .map(|x| x.to_string())
-                .map_err(|_| format!("{what}: integer out of range"))?,
-        },
-        other => return Err(format!("{what} must be a number, not {}", other.type_str())),
-    };
-    match text.parse::<f64>() {
-        Ok(x) if x.is_finite() => Ok((x, text)),
-        _ => Err(format!("{what} must be a finite number, not `{text}`")),
-    }
 }
 
 /// The TOML text of `sq` (machine `m`): `comments` as `# ` lines, `machine`, the squareness

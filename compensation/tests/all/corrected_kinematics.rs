@@ -16,7 +16,6 @@ use simulation::model::{Model, Term};
 use simulation::paths::{builtin_path, fill_linear_ik, record_from_commands};
 use simulation::record::Record;
 use simulation::simulate;
-use simulation::truth::Truth;
 
 const SHARED: &str = include_str!("../../../tests/machines/shared-offsets.toml");
 
@@ -377,7 +376,7 @@ fn check(rows: &[Compared], folded: &[String], m: &Machine) {
 fn seed_ac_identified_again_with_the_corrected_description_has_its_location_offsets_at_zero() {
     let m = builtin("seed-ac");
     let text = model_spec::write::source_text("seed-ac").unwrap();
-    let truth = Truth::parse(
+    let truth = formats::truth::parse_truth(
         "truth.toml",
         "noise_um = 0.3\nseed = 5\n[errors]\nXOC = 14.0\nYOC = -9.0\nYOA = 6.5\nZOA = -11.0\nBOA = 25.0\nCOA = -18.0\nAOC = 12.0\nBOC = -20.0\nXOW = 4.0\nYOW = -3.0\nZOW = 2.0\nECC = { \"harmonic:2\" = [8.0, -5.0] }\n",
         &m,
@@ -422,7 +421,7 @@ fn head_table_bc_identified_again_with_the_corrected_description_has_its_locatio
             .any(|a| a.kind == AxisKind::Rotary && a.side == Side::Tool)
     );
     let text = model_spec::write::source_text("head-table-bc").unwrap();
-    let truth = Truth::parse(
+    let truth = formats::truth::parse_truth(
         "truth.toml",
         "noise_um = 0.3\nseed = 9\n[errors]\nXOB = 7.0\nZOB = -5.0\nAOB = 15.0\nCOB = -10.0\nYOC = 8.0\nAOC = 20.0\nBOC = -14.0\nXOW = 3.0\nYOW = 2.0\n",
         &m,

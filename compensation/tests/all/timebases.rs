@@ -206,10 +206,10 @@ EXZ = { "warmup:40" = 3.0 }
 fn a_truth_with_a_rate_and_a_warm_up_writes_and_reads_back_the_same() {
     let m = builtin("seed-ac");
     let t = truth(&m, 0);
-    let text = t.to_toml(&m);
+    let text = formats::truth::truth_to_toml(&t, &m);
     assert!(text.contains("dx0 = { \"rate\" = 0.02 }"), "{text}");
     assert!(text.contains("\"warmup:40\" = 3"), "{text}");
-    let back = Truth::parse("back.toml", &text, &m).unwrap();
+    let back = formats::truth::parse_truth("back.toml", &text, &m).unwrap();
     assert_eq!(back.model, t.model);
     assert_eq!(back.coefficients, t.coefficients);
     let units: Vec<(String, &str)> = t
@@ -228,7 +228,7 @@ fn a_truth_with_a_rate_and_a_warm_up_writes_and_reads_back_the_same() {
 }
 
 fn truth(m: &Machine, seed: u64) -> Truth {
-    let mut t = Truth::parse("truth.toml", TRUTH, m).unwrap();
+    let mut t = formats::truth::parse_truth("truth.toml", TRUTH, m).unwrap();
     t.seed = seed;
     t
 }
@@ -446,7 +446,8 @@ fn a_warm_up_refuses_samples_before_its_start_and_a_rate_does_not() {
     }
     let h = h_matrix_auto(&m, &model(&m, &["dx0@rate"]), &rec, &p).unwrap();
     assert_eq!(h[(0, 0)], -3.0);
-    let t = Truth::parse("t.toml", "[errors]\nEXZ = { \"warmup:40\" = 3.0 }\n", &m).unwrap();
+    let t = formats::truth::parse_truth("t.toml", "[errors]\nEXZ = { \"warmup:40\" = 3.0 }\n", &m)
+        .unwrap();
     let e = simulate(&m, &t, &rec).unwrap_err().to_string();
     assert!(e.contains("before it"), "{e}");
     // Without real times neither can be evaluated.

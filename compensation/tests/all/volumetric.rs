@@ -64,7 +64,7 @@ fn machine() -> Machine {
 }
 
 fn truth(m: &Machine) -> Truth {
-    Truth::parse("volumetric-truth.toml", TRUTH, m).unwrap()
+    formats::truth::parse_truth("volumetric-truth.toml", TRUTH, m).unwrap()
 }
 
 /// 41 positions per axis over the whole stroke (X every 20 mm, Y and Z every 15 mm), the other
@@ -712,7 +712,7 @@ fn a_path_keeps_its_other_columns_and_refuses_poses_it_cannot_correct() {
 fn the_abbe_terms_of_a_reflector_off_the_axis_line_are_a_cross_product() {
     let m = machine();
     let text = "[parameters]\nXx = 70.0\nYx = 40.0\nZx = 100.0\nZt = 150.0\n[errors]\nEAY = { \"poly:1\" = 30.0 }\nEBY = { \"poly:1\" = 40.0 }\nECY = { \"poly:1\" = 50.0 }\n";
-    let t = Truth::parse("abbe.toml", text, &m).unwrap();
+    let t = formats::truth::parse_truth("abbe.toml", text, &m).unwrap();
     let s = simulated(&m, &t);
     let y = m.axis_by_name("Y").unwrap();
     let meas = s.measurements.iter().find(|x| x.axis == y).unwrap();

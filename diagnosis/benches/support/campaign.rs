@@ -1,11 +1,11 @@
 //! The campaign of the diagnosis bench (`diagnose-campaign/budget-five`), shared with the
 //! example `diagnose_campaign`.
 
+use formats::truth::builtin_truth;
 use model_spec::Machine;
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
-use simulation::truth::builtin_truth;
 
 /// The five records of the campaign bench: (path, noise seed, ball raised) on `seed-ac-budget`,
 /// each simulated with the path planned at its ball position and the truth's real parameters

@@ -542,7 +542,7 @@ fn visibility() {
 #[ignore]
 fn budget_on_more_paths() {
     let m = machine();
-    let mut truth = simulation::truth::builtin_truth("seed-ac-budget", &m)
+    let mut truth = formats::truth::builtin_truth("seed-ac-budget", &m)
         .expect("built in")
         .expect("valid");
     let mut recs = vec![];

@@ -4,13 +4,13 @@
 
 use diagnosis::{DiagnoseOptions, diagnose};
 use formats::progress::Unwatched;
+use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::{Model, Term};
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::builtin_truth;
 
 fn machine() -> Machine {
     builtin("seed-ac").unwrap().unwrap()

@@ -17,13 +17,13 @@
 use diagnosis::{DiagnoseOptions, Diagnosis, diagnose, one_record};
 use formats::csv::{ReadOptions, format_record, parse_measurement};
 use formats::progress::Unwatched;
+use formats::truth::builtin_truth;
 use model_spec::Machine;
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::Model;
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::builtin_truth;
 
 fn machine() -> Machine {
     model_spec::builtin("seed-ac").unwrap().unwrap()

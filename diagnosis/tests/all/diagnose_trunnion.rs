@@ -62,7 +62,7 @@ fn truth(m: &Machine, zw: f64, setup: [f64; 3], seed: u64, ebb: Option<&str>) ->
         setup[1],
         setup[2]
     );
-    Truth::parse("<trunnion>", &text, m).unwrap()
+    formats::truth::parse_truth("<trunnion>", &text, m).unwrap()
 }
 
 /// The records of `tests` at one ball height (`zw`, mm), one mounting labelled `setup`.

@@ -6,13 +6,14 @@ use fitting::campaign::{Owner, design_matrix, identify_campaign, identify_campai
 use fitting::noise::NoiseChoice;
 use fitting::refine::{RefineOptions, identify_refined_noise};
 use fitting::{Fit, IdentifyOptions, identify_noise};
+use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use simulation::campaign::{Campaign, CampaignError, CampaignRecord};
 use simulation::model::Model;
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::{Truth, builtin_truth};
+use simulation::truth::Truth;
 
 fn machine() -> Machine {
     builtin("seed-ac").unwrap().unwrap()

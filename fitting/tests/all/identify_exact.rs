@@ -6,12 +6,13 @@ use fitting::hmatrix::h_matrix;
 use fitting::refine::{self, RefineOptions};
 use fitting::validate::{ValidateOptions, validate};
 use fitting::{Constraint, Identification, IdentifyOptions, identify};
+use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use simulation::model::{Effect, Model};
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::{Truth, builtin_truth};
+use simulation::truth::Truth;
 
 fn machine() -> Machine {
     builtin("seed-ac").unwrap().unwrap()

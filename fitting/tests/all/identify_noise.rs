@@ -7,12 +7,13 @@
 
 use fitting::noise::{NoiseChoice, NoiseModel, NoiseSource};
 use fitting::{IdentifyOptions, RefineOptions, identify_noise, identify_refined_noise};
+use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use simulation::model::Model;
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::{Truth, builtin_truth};
+use simulation::truth::Truth;
 
 const SEEDS: u64 = 20;
 

@@ -9,6 +9,7 @@ use fitting::{
     EstimateError, IdentifyOptions, RefineOptions, gain_source, identify_noise,
     identify_refined_noise, identify_with,
 };
+use formats::truth::builtin_truth;
 use model_spec::instrument::{Instrument, ReadingsFrame, preset};
 use model_spec::{Machine, builtin};
 use simulation::instrument::convert::{SensorRecord, to_record};
@@ -17,7 +18,7 @@ use simulation::instrument::simulate::simulate_sensors;
 use simulation::model::{Effect, Model, Term};
 use simulation::record::Record;
 use simulation::rng::Rng;
-use simulation::{builtin_path, builtin_truth, simulate};
+use simulation::{builtin_path, simulate};
 
 fn seed_ac() -> Machine {
     builtin("seed-ac").unwrap().unwrap()

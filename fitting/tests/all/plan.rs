@@ -25,13 +25,14 @@ use fitting::plan::{
     Prediction, Suggestion, Targets, candidates, check_model, predict_design, suggest,
 };
 use fitting::{IdentifyOptions, Tolerances};
+use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use nalgebra::{DMatrix, SVD};
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::generator::{GeneratorError, GeneratorOptions, SampleProblem};
 use simulation::model::{Model, Term};
 use simulation::readings::simulate;
-use simulation::truth::{Truth, builtin_truth};
+use simulation::truth::Truth;
 
 /// Monte-Carlo campaigns per check. The relative standard error of a sample standard deviation
 /// over n values is 1/√(2(n − 1)): 2.2 % at 1000, so the 10 % band is 4.5 standard errors

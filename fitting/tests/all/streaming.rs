@@ -3,13 +3,13 @@
 use fitting::hmatrix::{GainSource, h_matrix, parameter_names};
 use fitting::streaming::identify_streaming;
 use fitting::{Constraint, Tolerances, least_squares, measurement_vector, with_offsets};
+use formats::truth::builtin_truth;
 use model_spec::builtin;
 use model_spec::terms::Term;
 use simulation::model::Model;
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::builtin_truth;
 
 fn blocks(r: &Record, size: usize) -> Vec<Result<Record, std::io::Error>> {
     (0..r.samples.len())

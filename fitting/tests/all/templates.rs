@@ -61,7 +61,7 @@ fn truth(m: &Machine, seed: u64) -> Truth {
     for (i, n) in names.iter().enumerate() {
         text += &format!("{n} = {}\n", values[i % values.len()]);
     }
-    Truth::parse("<test truth>", &text, m).unwrap_or_else(|e| panic!("{e}"))
+    formats::truth::parse_truth("<test truth>", &text, m).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The confounded groups of the identification, by name.

@@ -10,12 +10,13 @@ use common::builtin;
 use fitting::hmatrix::{HMatrixError, h_matrix_auto};
 use fitting::refine::{RefineOptions, identify_refined};
 use fitting::{IdentifyOptions, identify};
+use formats::truth::builtin_truth;
 use model_spec::Machine;
 use simulation::model::{Model, Term};
 use simulation::paths::builtin_path;
 use simulation::readings::{SimulateError, simulate};
 use simulation::record::Record;
-use simulation::truth::{Truth, builtin_truth};
+use simulation::truth::Truth;
 
 /// Truth lines (appended to seed-ac's reduced truth) and the term each adds.
 const CASES: &[(&str, &str)] = &[
@@ -49,8 +50,8 @@ fn reduced_truth(m: &Machine) -> Truth {
 
 /// The reduced truth with `line` added to its errors.
 fn with_line(m: &Machine, line: &str) -> Truth {
-    let text = reduced_truth(m).to_toml(m) + line + "\n";
-    Truth::parse("case.toml", &text, m).unwrap()
+    let text = formats::truth::truth_to_toml(&reduced_truth(m), m) + line + "\n";
+    formats::truth::parse_truth("case.toml", &text, m).unwrap()
 }
 
 #[test]

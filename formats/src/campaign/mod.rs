@@ -84,6 +84,17 @@ pub enum CampaignFileError {
     },
 }
 
+impl From<crate::located::Located> for CampaignFileError {
+    fn from(e: crate::located::Located) -> Self {
+        CampaignFileError::Invalid {
+            file: e.file,
+            line: e.line,
+            column: e.column,
+            message: e.message,
+        }
+    }
+}
+
 /// One record of a campaign file, before its CSV is read.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CampaignEntry {

@@ -4,15 +4,13 @@
 use super::{
     CampaignEntry, CampaignFile, CampaignFileError, RECORD_KEYS, TOP_KEYS, stem_label, unique_label,
 };
+use crate::located::{TomlText, Val, in_order};
 use model_spec::Machine;
 use simulation::campaign::{check_label, check_record_count};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
-type Key<'i> = Spanned<std::borrow::Cow<'i, str>>;
-type Val<'i> = Spanned<DeValue<'i>>;
 type Res<T> = Result<T, CampaignFileError>;
 
 /// Parses the text of a campaign file (`file` names it in messages; `dir` is the directory
@@ -21,68 +19,35 @@ type Res<T> = Result<T, CampaignFileError>;
 /// # Errors
 /// [`CampaignFileError::Invalid`] naming the line, the column and the field.
 pub fn parse_campaign(file: &str, text: &str, dir: &Path, m: &Machine) -> Res<CampaignFile> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let p = Parser { file, text, m };
-    let root = DeTable::parse(text).map_err(|e| p.err(e.span().unwrap_or(0..0), e.message()))?;
+    let p = Parser {
+        t: TomlText::new(file, text),
+        m,
+    };
+    let root = p.t.root()?;
     p.campaign(root.get_ref(), dir)
 }
 
 /// The validator of one file.
 struct Parser<'a> {
-    file: &'a str,
-    text: &'a str,
+    t: TomlText<'a>,
     m: &'a Machine,
-}
-
-/// The entries of a table in file order.
-fn in_order<'t, 'i>(t: &'t DeTable<'i>) -> Vec<(&'t Key<'i>, &'t Val<'i>)> {
-    let mut v: Vec<_> = t.iter().collect();
-    v.sort_by_key(|(k, _)| k.span().start);
-    v
 }
 
 impl Parser<'_> {
     fn err(&self, span: Range<usize>, message: impl Into<String>) -> CampaignFileError {
-        let (line, column) = model_spec::locate::line_col(self.text, span.start);
-        CampaignFileError::Invalid {
-            file: self.file.to_string(),
-            line,
-            column,
-            message: message.into(),
-        }
+        self.t.at(span, message).into()
     }
 
     fn line(&self, span: &Range<usize>) -> usize {
-        model_spec::locate::line_col(self.text, span.start).0
+        self.t.line(span)
     }
 
     fn string(&self, field: &str, v: &Val<'_>) -> Res<String> {
-        match v.get_ref() {
-            DeValue::String(s) => Ok(s.to_string()),
-            other => Err(self.err(
-                v.span(),
-                format!("`{field}` must be a string, not {}", other.type_str()),
-            )),
-        }
+        Ok(self.t.string(v, &format!("`{field}`"))?)
     }
 
     fn number(&self, field: &str, v: &Val<'_>) -> Res<f64> {
-        let x = match v.get_ref() {
-            DeValue::Float(f) => f.as_str().parse::<f64>().ok(),
-            DeValue::Integer(i) => i64::from_str_radix(i.as_str(), i.radix())
-                .ok()
-                .map(|x| x as f64),
-            other => {
-                return Err(self.err(
-                    v.span(),
-                    format!("`{field}` must be a number, not {}", other.type_str()),
-                ));
-            }
-        };
-        match x {
-            Some(x) if x.is_finite() => Ok(x),
-            _ => Err(self.err(v.span(), format!("`{field}` must be a finite number"))),
-        }
+        Ok(self.t.number(v, &format!("`{field}`"))?.0)
     }
 
     fn campaign(&self, root: &DeTable<'_>, dir: &Path) -> Res<CampaignFile> {
@@ -157,7 +122,7 @@ impl Parser<'_> {
                 r.label = unique_label(&r.label, &taken);
                 check_label("the label made unique", &r.label).map_err(|e| {
                     CampaignFileError::Invalid {
-                        file: self.file.to_string(),
+                        file: self.t.file().to_string(),
                         line: r.line,
                         column: 1,
                         message: format!("{}: give the record a `label`", e.0),
@@ -175,7 +140,7 @@ impl Parser<'_> {
             };
             if let Some(k) = (0..r.params.len()).find(|&k| r.params[k] != o.params[k]) {
                 return Err(CampaignFileError::Invalid {
-                    file: self.file.to_string(),
+                    file: self.t.file().to_string(),
                     line: r.line,
                     column: 1,
                     message: format!(
@@ -192,7 +157,7 @@ impl Parser<'_> {
             }
         }
         Ok(CampaignFile {
-            file: self.file.to_string(),
+            file: self.t.file().to_string(),
             description,
             records,
         })

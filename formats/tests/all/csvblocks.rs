@@ -1,11 +1,11 @@
 //! Reading a measurement file in blocks gives exactly the slices of the whole-file record.
 
 use formats::csv::{MeasurementBlocks, ReadOptions, format_record, parse_measurement};
+use formats::truth::builtin_truth;
 use model_spec::builtin;
 use simulation::paths::{builtin_path, fill_linear_ik, record_from_commands};
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::builtin_truth;
 use std::io::Cursor;
 
 fn concatenated(text: &str, m: &model_spec::Machine, block: usize) -> Record {

@@ -278,8 +278,7 @@ fn the_builtin_paths_lie_within_the_strokes_and_ranges_of_seed_ac() {
         let rec = if name == "K4" {
             k4_record(&m)
         } else {
-            simulation::readings::simulate(&m, &simulation::truth::seed_ac_demo_truth(), &p)
-                .unwrap()
+            simulation::readings::simulate(&m, &formats::truth::seed_ac_demo_truth(), &p).unwrap()
         };
         let text = format_record(&m, &rec, &[]).unwrap();
         parse_measurement("m.csv", &text, &m, &opts()).unwrap();

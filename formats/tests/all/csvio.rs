@@ -7,11 +7,11 @@ use crate::common;
 
 use common::{Scratch, builtin};
 use formats::csv::{CsvError, ReadOptions, format_record, parse_measurement, read_measurement};
+use formats::truth::seed_ac_demo_truth;
 use model_spec::Machine;
 use simulation::paths::builtin_path;
 use simulation::readings::{provenance, simulate};
 use simulation::record::Record;
-use simulation::truth::seed_ac_demo_truth;
 
 fn seed_ac() -> Machine {
     builtin("seed-ac")

@@ -4,6 +4,7 @@
 
 use formats::csv::{CsvError, ReadOptions};
 use formats::sensors::{format_sensor_record, parse_sensor_measurement};
+use formats::truth::builtin_truth;
 use model_spec::instrument::{Instrument, ReadingsFrame, preset};
 use model_spec::{Machine, builtin};
 use simulation::instrument::convert::{SensorRecord, to_record};
@@ -11,8 +12,7 @@ use simulation::instrument::head::SensorHead;
 use simulation::instrument::simulate::simulate_sensors;
 use simulation::paths::{fill_linear_ik, record_from_commands};
 use simulation::record::Record;
-use simulation::truth::Truth;
-use simulation::{builtin_path, builtin_truth, simulate};
+use simulation::{builtin_path, simulate};
 
 fn seed_ac() -> Machine {
     builtin("seed-ac").unwrap().unwrap()
@@ -227,7 +227,7 @@ ZOB = -10.0
 AOB = 40.0
 XOW = 8.0
 "#;
-    let truth = Truth::parse("bc.toml", text, &m).unwrap();
+    let truth = formats::truth::parse_truth("bc.toml", text, &m).unwrap();
     let path = bc_path(&m);
     let vectors = simulate(&m, &truth, &path).unwrap();
     let mut i = instrument("orthogonal");

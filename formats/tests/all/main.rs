@@ -17,3 +17,4 @@ mod nc_programs;
 mod paths;
 mod pose_csv;
 mod pose_memory;
+mod truth;

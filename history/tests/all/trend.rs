@@ -468,7 +468,6 @@ fn the_real_pipeline_flags_a_drifting_location_error() {
     use fitting::{IdentifyOptions, RefineOptions, identify_refined};
     use report::json::{IdentificationReport, IdentificationSource};
     use simulation::model::Model;
-    use simulation::truth::Truth;
     use simulation::{builtin_path, simulate};
 
     let m = model_spec::builtin("seed-ac").unwrap().unwrap();
@@ -485,7 +484,8 @@ fn the_real_pipeline_flags_a_drifting_location_error() {
             let noise = rng.uniform_in(0.5, 0.8);
             let xoc = 10.0 + 0.5 * (k - 7).max(0) as f64;
             let seed = 1000 * s + k as u64;
-            let t = Truth::parse("truth", &truth_text(xoc, noise, seed), &m).unwrap();
+            let t =
+                formats::truth::parse_truth("truth", &truth_text(xoc, noise, seed), &m).unwrap();
             let record = simulate(&m, &t, &k4).unwrap();
             let (ident, refinement) = identify_refined(
                 &m,

@@ -9,6 +9,7 @@ use common::{Scratch, builtin};
 use fitting::{IdentifyOptions, identify};
 use formats::csv::{ReadOptions, parse_measurement};
 use formats::nc::Dialect;
+use formats::truth::builtin_truth;
 use model_spec::Machine;
 use programs::measure::{
     ContinuousTiming, MeasureMode, MeasureOptions, StaticTiming, TimingPlan, measurement_program,
@@ -19,7 +20,7 @@ use programs::segment::{
 };
 use programs::stream::{StreamOptions, write_stream};
 use simulation::model::Model;
-use simulation::{Truth, builtin_path, builtin_truth, simulate};
+use simulation::{Truth, builtin_path, simulate};
 
 /// seed-ac, the plan of K4 (every `every`-th pose, at most `count` of them) in `mode`, and the
 /// reduced truth with noise σ = `noise_um`.

@@ -17,6 +17,7 @@ use compensation::verify::machine_error_rms;
 use diagnosis::{DiagnoseOptions, diagnose, one_record};
 use fitting::{IdentifyOptions, RefineOptions, ValidateOptions, identify_refined, validate};
 use formats::progress::Unwatched;
+use formats::truth::builtin_truth;
 use model_spec::basis::BasisContext;
 use model_spec::{Machine, builtin};
 use report::json::read::parse_identification;
@@ -25,7 +26,7 @@ use simulation::exact::VirtualMachine;
 use simulation::model::{Effect, Model};
 use simulation::record::Record;
 use simulation::rng::Rng;
-use simulation::{Truth, builtin_path, builtin_truth, simulate};
+use simulation::{Truth, builtin_path, simulate};
 
 /// Poses with the kinematic parameters of each (the workpiece point varies on a random path).
 type Poses = Vec<(Vec<f64>, Vec<f64>)>;

@@ -17,7 +17,6 @@ use report::json::{IdentificationReport, IdentificationSource, IdentifiedValues,
 use simulation::model::{Model, Term};
 use simulation::paths::{builtin_path, record_from_commands};
 use simulation::simulate;
-use simulation::truth::Truth;
 
 /// The model of `spellings` on `m`.
 fn model(m: &Machine, spellings: &[&str]) -> Model {
@@ -212,7 +211,7 @@ fn undetermined_values_are_refused_with_the_terms_and_what_to_do() {
 /// offsets. Identified by rtest, written as JSON and read back as `rtest compensate` would.
 fn zeroed_identification(constraint: Constraint) -> (Machine, IdentifiedValues) {
     let m = builtin("seed-ac");
-    let mut truth = Truth::parse(
+    let mut truth = formats::truth::parse_truth(
         "truth.toml",
         "[errors]\nXOC = 12.0\nYOC = -8.0\nYOA = 5.0\nZOA = -6.0\nBOA = 20.0\nCOA = -15.0\nAOC = 10.0\nBOC = -12.0\nXOW = 3.0\nYOW = 2.0\nZOW = 1.0\n",
         &m,

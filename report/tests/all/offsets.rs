@@ -142,7 +142,7 @@ fn head_table_truth(m: &Machine, noise_um: f64, seed: u64, all: bool) -> Truth {
     for (n, v) in errors {
         text += &format!("{n} = {v}\n");
     }
-    Truth::parse("head-table.toml", &text, m).unwrap()
+    formats::truth::parse_truth("head-table.toml", &text, m).unwrap()
 }
 
 /// The location model of head-table-bc without [`CONFOUNDED_ON_PAIR`], with the pivot length
@@ -426,7 +426,7 @@ YOC = -22.0
 AOC = 30.0
 BOC = -12.0
 "#;
-    let truth = Truth::parse("zp.toml", text, &m).unwrap();
+    let truth = formats::truth::parse_truth("zp.toml", text, &m).unwrap();
     let rec = simulate(&m, &truth, &k4).unwrap();
     // The reduced model with Zp: Zp and ZOA both move the nest along z of the (unturned) tool
     // frame at every pose, so K4 cannot separate them.

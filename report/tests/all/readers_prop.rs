@@ -4,14 +4,15 @@
 //! descriptions theirs in model-spec's `robustness.rs`.)
 
 use fitting::{IdentifyOptions, identify};
+use formats::truth::builtin_truth;
+use formats::truth::{BUILTIN_TRUTHS, TruthError};
 use model_spec::Machine;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use report::json::read::parse_identification_bytes;
 use report::json::{IdentificationReport, IdentificationSource, ReportError, to_json};
 use simulation::model::Model;
-use simulation::truth::{BUILTIN_TRUTHS, Truth, TruthError};
-use simulation::{builtin_path, builtin_truth, simulate};
+use simulation::{builtin_path, simulate};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 fn seed_ac() -> Machine {
@@ -116,7 +117,7 @@ fn apply(text: &[u8], damages: &[Damage]) -> Vec<u8> {
 fn check_truth(m: &Machine, bytes: &[u8]) {
     let result = catch_unwind(AssertUnwindSafe(|| {
         let text = model_spec::text::decode_text("t.toml", bytes.to_vec())?;
-        Truth::parse("t.toml", &text, m).map_err(TruthErrorOrText::Truth)
+        formats::truth::parse_truth("t.toml", &text, m).map_err(TruthErrorOrText::Truth)
     }));
     let Ok(result) = result else {
         panic!(

@@ -10,4 +10,3 @@ mod generator_orders;
 mod instrument_description;
 mod instrument_geometry;
 mod simulate;
-mod truth;

@@ -8,19 +8,20 @@ use crate::common;
 use common::context;
 
 use common::builtin;
+use formats::truth::{seed_ac_demo_truth, seed_ac_reduced_truth};
 use model_spec::Machine;
 use simulation::VirtualMachine;
 use simulation::paths::{builtin_path, record_from_commands};
 use simulation::readings::{SimulateError, simulate};
 use simulation::record::Record;
-use simulation::truth::{Truth, seed_ac_demo_truth, seed_ac_reduced_truth};
+use simulation::truth::Truth;
 
 fn seed_ac() -> Machine {
     builtin("seed-ac")
 }
 
 fn truth(m: &Machine, text: &str) -> Truth {
-    Truth::parse("t.toml", text, m).unwrap()
+    formats::truth::parse_truth("t.toml", text, m).unwrap()
 }
 
 /// One sample at A = `a`°, C = `c`° with the linear axes by inverse kinematics.
@@ -86,9 +87,9 @@ fn readings_are_the_exact_error_vector_plus_offsets() {
     let k4 = builtin_path(&m, "K4").unwrap().unwrap();
     let mut t = seed_ac_demo_truth();
     t.noise_mm = 0.0;
-    let mut text = t.to_toml(&m);
+    let mut text = formats::truth::truth_to_toml(&t, &m);
     text += "dx0 = 1.5\ndz0 = { \"time:1\" = -2.0 }\n";
-    let t = Truth::parse("t.toml", &text, &m).unwrap();
+    let t = formats::truth::parse_truth("t.toml", &text, &m).unwrap();
     let r = simulate(&m, &t, &k4).unwrap();
     let vm = VirtualMachine::new(&m);
     for (i, s) in k4.samples.iter().enumerate() {

@@ -26,12 +26,13 @@ use diagnosis::{DiagnoseOptions, Diagnosis, diagnose};
 use fitting::campaign::{CampaignIdentification, CampaignValues, Owner, identify_campaign_refined};
 use fitting::least_squares::Constraint;
 use fitting::{IdentifyOptions, NoiseChoice, RefineOptions};
+use formats::truth::builtin_truth;
 use model_spec::Machine;
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::exact::VirtualMachine;
 use simulation::model::Model;
 use simulation::rng::Rng;
-use simulation::{Truth, builtin_path, builtin_truth, simulate};
+use simulation::{Truth, builtin_path, simulate};
 
 /// The random poses of the check.
 pub const POSES: usize = 200;

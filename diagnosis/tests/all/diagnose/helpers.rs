@@ -5,13 +5,14 @@
 
 use diagnosis::{DiagnoseOptions, Diagnosis, diagnose, one_record};
 use formats::progress::Unwatched;
+use formats::truth::builtin_truth;
 use model_spec::Machine;
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::{Model, Term};
 use simulation::paths::{builtin_path, fill_linear_ik, record_from_commands};
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::{Truth, builtin_truth};
+use simulation::truth::Truth;
 
 /// Reading noise of every scenario, mm (0.5 µm).
 pub const NOISE_MM: f64 = 0.5e-3;

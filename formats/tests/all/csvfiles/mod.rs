@@ -3,11 +3,11 @@
 #![allow(dead_code)]
 
 use formats::csv::format_record;
+use formats::truth::seed_ac_demo_truth;
 use model_spec::Machine;
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
 use simulation::record::Record;
-use simulation::truth::seed_ac_demo_truth;
 use std::cell::Cell;
 use std::io::Read;
 use std::rc::Rc;

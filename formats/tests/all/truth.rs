@@ -5,21 +5,22 @@ use crate::common;
 use common::context;
 
 use common::{Scratch, builtin, commands, id};
+use formats::truth::{
+    BUILTIN_TRUTHS, TruthError, builtin_truth, load_truth, seed_ac_demo_truth,
+    seed_ac_reduced_truth,
+};
 use model_spec::{Dir, Machine};
 use simulation::model::Basis;
 use simulation::model::{Effect, Term};
 use simulation::record::Sample;
-use simulation::truth::{
-    BUILTIN_TRUTHS, Truth, TruthError, builtin_truth, load_truth, seed_ac_demo_truth,
-    seed_ac_reduced_truth,
-};
+use simulation::truth::Truth;
 
 fn seed_ac() -> Machine {
     builtin("seed-ac")
 }
 
 fn parse(text: &str) -> Result<Truth, TruthError> {
-    Truth::parse("t.toml", text, &seed_ac())
+    formats::truth::parse_truth("t.toml", text, &seed_ac())
 }
 
 fn message(text: &str) -> String {
@@ -160,8 +161,8 @@ dz0 = { "time:2" = 1e-3 }
     )
     .unwrap();
     t.coefficients[0] = 0.1 + 0.2; // an awkward number
-    let text = t.to_toml(&m);
-    let back = Truth::parse("t.toml", &text, &m).unwrap();
+    let text = formats::truth::truth_to_toml(&t, &m);
+    let back = formats::truth::parse_truth("t.toml", &text, &m).unwrap();
     assert_eq!(back.source, "t.toml");
     let mut t2 = t.clone();
     t2.source = back.source.clone();

@@ -1,24 +1,22 @@
 //! The validation of a truth file: every entry checked against the machine, every problem
 //! located by line and column.
 
-use super::{MAX_NOISE_PHI, MAX_NOISE_UM, MAX_SEED, MAX_VALUE, Truth, TruthError, places};
-use crate::model::{Basis, Carrier, Effect, Term};
+use super::TruthError;
+use crate::located::{Key, TomlText, Val, in_order};
 use model_spec::Machine;
 use model_spec::units::parse_scaled;
+use simulation::model::{Basis, Carrier, Effect, Term};
+use simulation::truth::{MAX_NOISE_PHI, MAX_NOISE_UM, MAX_SEED, MAX_VALUE, Truth, places};
 use std::ops::Range;
-use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
 /// The validator: the source, for locating errors, and the machine.
 pub(super) struct Parser<'a> {
-    pub(super) file: &'a str,
-    pub(super) text: &'a str,
+    pub(super) t: TomlText<'a>,
     pub(super) m: &'a Machine,
 }
 
 type Res<T> = Result<T, TruthError>;
-type Key<'i> = Spanned<std::borrow::Cow<'i, str>>;
-type Val<'i> = Spanned<DeValue<'i>>;
 
 const TOP_KEYS: &str =
     "machine, description, noise_um, noise_phi, seed, zeroed, [parameters], [errors]";
@@ -26,32 +24,25 @@ const TOP_KEYS: &str =
 impl Parser<'_> {
     /// The truth of the text, validated.
     pub(super) fn parse(&self) -> Res<Truth> {
-        let root = DeTable::parse(self.text)
-            .map_err(|e| self.err(e.span().unwrap_or(0..0), e.message()))?;
+        let root = self.t.root()?;
         self.truth(root.get_ref())
     }
 
     fn err(&self, span: Range<usize>, message: impl Into<String>) -> TruthError {
-        let (line, column) = model_spec::locate::line_col(self.text, span.start);
-        TruthError::Invalid {
-            file: self.file.to_string(),
-            line,
-            column,
-            message: message.into(),
-        }
+        self.t.at(span, message).into()
     }
 
     fn line(&self, span: &Range<usize>) -> usize {
-        model_spec::locate::line_col(self.text, span.start).0
+        self.t.line(span)
     }
 
     fn truth(&self, root: &DeTable<'_>) -> Res<Truth> {
         let m = self.m;
         let mut t = Truth::nominal(m);
-        t.source = self.file.to_string();
+        t.source = self.t.file().to_string();
         t.description = String::new();
         let mut terms: Vec<(Term, Vec<f64>, Range<usize>)> = Vec::new();
-        for (k, v) in sorted(root) {
+        for (k, v) in in_order(root) {
             match k.get_ref().as_ref() {
                 "machine" => {
                     let name = self.string(k, v)?;
@@ -129,43 +120,12 @@ impl Parser<'_> {
     }
 
     fn string(&self, k: &Key<'_>, v: &Val<'_>) -> Res<String> {
-        match v.get_ref() {
-            DeValue::String(s) => Ok(s.to_string()),
-            other => Err(self.err(
-                v.span(),
-                format!(
-                    "`{}` must be a string, not {}",
-                    k.get_ref(),
-                    other.type_str()
-                ),
-            )),
-        }
+        Ok(self.t.string(v, &format!("`{}`", k.get_ref()))?)
     }
 
     /// A finite number and the decimal text it was written as.
     fn number(&self, v: &Val<'_>, what: &str) -> Res<(f64, String)> {
-        let text = match v.get_ref() {
-            DeValue::Float(f) => f.as_str().to_string(),
-            DeValue::Integer(i) => match i.radix() {
-                10 => i.as_str().to_string(),
-                r => i64::from_str_radix(i.as_str(), r)
-                    .map(|x| x.to_string())
-                    .map_err(|_| self.err(v.span(), format!("{what}: integer out of range")))?,
-            },
-            other => {
-                return Err(self.err(
-                    v.span(),
-                    format!("{what} must be a number, not {}", other.type_str()),
-                ));
-            }
-        };
-        match text.parse::<f64>() {
-            Ok(x) if x.is_finite() => Ok((x, text)),
-            _ => Err(self.err(
-                v.span(),
-                format!("{what} must be a finite number, not `{text}`"),
-            )),
-        }
+        Ok(self.t.number(v, what)?)
     }
 
     /// `x` (read at `v`, written `text`) if its magnitude is at most `max` (in `unit`).
@@ -210,7 +170,7 @@ impl Parser<'_> {
 
     fn parameters(&self, v: &Val<'_>, params: &mut [f64]) -> Res<()> {
         let m = self.m;
-        for (k, v) in sorted(self.table(v, "`[parameters]`")?) {
+        for (k, v) in in_order(self.table(v, "`[parameters]`")?) {
             let name = k.get_ref().as_ref();
             let Some(i) = m.symbol_by_name(name) else {
                 let known: Vec<&str> = m.symbols.iter().map(|s| s.name.as_str()).collect();
@@ -242,7 +202,7 @@ impl Parser<'_> {
 
     fn errors(&self, v: &Val<'_>, terms: &mut Vec<(Term, Vec<f64>, Range<usize>)>) -> Res<()> {
         let m = self.m;
-        for (k, v) in sorted(self.table(v, "`[errors]`")?) {
+        for (k, v) in in_order(self.table(v, "`[errors]`")?) {
             let name = k.get_ref().as_ref();
             let Some(effect) = Effect::parse(m, name) else {
                 return Err(self.err(
@@ -263,7 +223,7 @@ impl Parser<'_> {
                             format!("`{name}` has no terms: give e.g. {{ const = 1.0 }} ({unit})"),
                         ));
                     }
-                    for (bk, bv) in sorted(table) {
+                    for (bk, bv) in in_order(table) {
                         let basis = Basis::parse(bk.get_ref())
                             .map_err(|e| self.err(bk.span(), format!("{name}: {}", e.0)))?;
                         self.term(effect, basis, &bk.span(), bv, terms)?;
@@ -365,11 +325,4 @@ impl Parser<'_> {
         terms.push((term, values, at.clone()));
         Ok(())
     }
-}
-
-/// The entries of a table in the order of the file.
-fn sorted<'t, 'i>(t: &'t DeTable<'i>) -> Vec<(&'t Key<'i>, &'t Val<'i>)> {
-    let mut v: Vec<_> = t.iter().collect();
-    v.sort_by_key(|(k, _)| k.span().start);
-    v
 }

@@ -9,16 +9,16 @@
 //! s_i = g₀·(1 + δg)·t(R(ω)ᵀ·e_i) + z
 //! ```
 //!
-//! with `t` the exact travel of the described geometry ([`simulation::instrument::contact`]), `g₀` its described
-//! gain, and four parameters: the **gain error** `δg` (relative), the **zero** `z` (mm) and the
-//! **direction error** `ω = α·p₁ + β·p₂` (rad): a small rotation of the whole sensor (its
-//! direction and tip position) about the nest centre, about two axes `p₁`, `p₂` perpendicular
+//! with `t` the exact travel of the described geometry ([`simulation::instrument::contact`]), `g₀`
+//! its described gain, and four parameters: the **gain error** `δg` (relative), the **zero** `z`
+//! (mm) and the **direction error** `ω = α·p₁ + β·p₂` (rad): a small rotation of the whole sensor
+//! (its direction and tip position) about the nest centre, about two axes `p₁`, `p₂` perpendicular
 //! to its measuring direction (`p₁ = m × z`, or `m × x` when `m` is along z, normalised;
-//! `p₂ = m × p₁`). Gauss–Newton with the exact geometry; each correction is the least-squares
-//! fit of [`crate::least_squares()`] (column scaling, numerical rank), so a quantity the
-//! record does not determine (displacements that never move across the sensor leave its tilt
-//! about that axis free) gets no number and stays as described. Uncertainties are the fit's,
-//! from the residual's σ̂ (which also measures the sensor's noise plus the reference's error).
+//! `p₂ = m × p₁`). Gauss–Newton with the exact geometry; each correction is the least-squares fit of
+//! [`crate::least_squares()`] (column scaling, numerical rank), so a quantity the record does not
+//! determine (displacements that never move across the sensor leave its tilt about that axis free)
+//! gets no number and stays as described. Uncertainties are the fit's, from the residual's σ̂
+//! (which also measures the sensor's noise plus the reference's error).
 //!
 //! **Instrument terms.** Read with the described head, sensors whose gains are off by
 //! `δg_k` give, to first order, the error vector `(I + S)·e` with

@@ -56,7 +56,8 @@
 //! assert!((ident.fit.values[xoc].unwrap() - truth_xoc).abs() < 1e-5); // mm
 //!
 //! // The identified values predict K1, a path they were not fitted on, to well below 0.01 µm.
-//! let v = validate(&m, &ident.model, &ident.fit.values, &k1, &ValidateOptions::default()).unwrap();
+//! let opts = ValidateOptions::default();
+//! let v = validate(&m, &ident.model, &ident.fit.values, &k1, &opts).unwrap();
 //! assert!(v.overall.residual_rms < 1e-5); // mm
 //! ```
 

@@ -40,9 +40,9 @@ pub struct ValidateOptions {
     pub unidentified: Unidentified,
     /// Kinematic parameters (mm, symbol order); `None`: the machine's defaults.
     pub params: Option<Vec<f64>>,
-    /// Predict with the exact machine at the identified values ([`crate::refine::exact_prediction`])
-    /// instead of the first-order `H·v`: the difference is the second-order terms (about
-    /// 1e-3 µm for errors of tens of µm and µrad).
+    /// Predict with the exact machine at the identified values
+    /// ([`crate::refine::exact_prediction`]) instead of the first-order `H·v`: the difference is
+    /// the second-order terms (about 1e-3 µm for errors of tens of µm and µrad).
     pub exact: bool,
 }
 

@@ -2,9 +2,8 @@
 //! instrument that reads it, and the exact virtual machine that produces both.
 //!
 //! The bottom of rtest's numeric layers: it depends only on the machine description
-//! ([`model_spec`]) and the emitted and generated gains ([`codegen`], [`generated`]); the
-//! crates of files (`formats`), fitting, diagnosis and compensation build on it
-//! (`docs/architecture.md`).
+//! ([`model_spec`]); the crates of files (`formats`), fitting, diagnosis and compensation
+//! build on it (`docs/architecture.md`).
 //!
 //! - [`model`]: the terms a fit has (errors, their bases, the R-test's offsets);
 //! - [`record`]: samples along a path (commands, times, directions of motion) with readings;

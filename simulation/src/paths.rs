@@ -19,7 +19,7 @@
 //! order of the samples matters for `time:K` effects, which are normalised over the record.
 //! Directions of motion come from [`crate::record::motion_directions`].
 //!
-//! Path files (a CSV in the measurement format) are read by [`formats::paths`].
+//! Path files (a CSV in the measurement format) are read by `formats::paths`.
 
 use crate::exact::{ExactError, VirtualMachine};
 use crate::generator::{self, GeneratorError, GeneratorOptions};

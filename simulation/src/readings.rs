@@ -220,7 +220,7 @@ fn check(m: &Machine, truth: &Truth, path: &Record) -> Result<(), SimulateError>
     Ok(())
 }
 
-/// Comment lines for the CSV of a simulation ([`formats::csv::format_record`]): what produced
+/// Comment lines for the CSV of a simulation (`formats::csv::format_record`): what produced
 /// it, the machine, the path, the truth and the units.
 pub fn provenance(m: &Machine, path_name: &str, truth: &Truth, samples: usize) -> Vec<String> {
     vec![

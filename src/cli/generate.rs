@@ -1,7 +1,7 @@
 //! `rtest generate`: standalone `no_std` Rust code for a machine's gains, as one file or as a
 //! ready crate (`--crate DIR`).
 
-mod crate_files;
+use codegen::build::crate_files;
 
 use super::{CliError, CliResult, EXIT_CODES, args, check_outputs, write};
 use model_spec::Machine;

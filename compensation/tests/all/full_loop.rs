@@ -4,9 +4,9 @@
 //! at a ball position no record had (the study in `full_loop/study.rs`; docs/compensation.md
 //! §6, "The full loop on a full budget").
 //!
-//! `cargo test -p compensation --test all full_loop:: -- --nocapture` prints the figures at noise seeds 1,
-//! 2 and 3 (`FULL_LOOP_SEEDS=1,2,3,4,5` for others) and asserts the gate: with the model the
-//! diagnosis recommends (its findings and the error groups it confirms) and the new ball's
+//! `cargo test -p compensation --test all full_loop:: -- --nocapture` prints the figures at noise
+//! seeds 1, 2 and 3 (`FULL_LOOP_SEEDS=1,2,3,4,5` for others) and asserts the gate: with the model
+//! the diagnosis recommends (its findings and the error groups it confirms) and the new ball's
 //! set-up refitted, the machine's own error falls by at least 90 % (92.3–94.7 % at seeds 1–5,
 //! docs/compensation.md §6).
 

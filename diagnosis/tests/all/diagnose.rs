@@ -436,11 +436,11 @@ fn constant_yaw_of_x_is_confounded_with_coa() {
 // Tools for people (ignored): the detection-rate table of docs/diagnosis.md.
 
 /// `CASES="ECC@harmonic:2=12,9;XOW=~3" SEEDS=30 [FIT=K4R HELD=K1R] cargo test --release -p
-/// diagnosis --test all -- --ignored diagnose::rates --nocapture`: for each case (`TERM=VALUES`, `~` for
-/// an error of the reduced model that the base then lacks), over noise seeds: how often the
-/// hidden term is the first finding, among its alternatives, or neither; how often the
-/// held-out RMS halves, the median and largest ratio after/before; the signature RMS on the
-/// fitted path (noise free, before any fit).
+/// diagnosis --test all -- --ignored diagnose::rates --nocapture`: for each case (`TERM=VALUES`,
+/// `~` for an error of the reduced model that the base then lacks), over noise seeds: how often the
+/// hidden term is the first finding, among its alternatives, or neither; how often the held-out RMS
+/// halves, the median and largest ratio after/before; the signature RMS on the fitted path (noise
+/// free, before any fit).
 #[test]
 #[ignore]
 fn rates() {
@@ -570,8 +570,8 @@ fn budget_on_more_paths() {
     }
 }
 
-/// `cargo test --release -p diagnosis --test all -- --ignored diagnose::nestings --nocapture`: on K4,
-/// given the reduced model, the candidates whose directions lie (nearly) inside a wider
+/// `cargo test --release -p diagnosis --test all -- --ignored diagnose::nestings --nocapture`:
+/// on K4, given the reduced model, the candidates whose directions lie (nearly) inside a wider
 /// candidate's span: `1 − cos²` of the narrower one's direction with the wider one's span.
 #[test]
 #[ignore]

@@ -1,8 +1,8 @@
 //! The campaign clock: one time axis for every record, when every record says when it started.
 //!
-//! A record's samples carry their time since the record's start (`t`, s). With a start `s_r` on
-//! the campaign clock ([`simulation::campaign::CampaignRecord::start_s`]) sample `i` of record `r` is at
-//! `T = s_r + t_i` on the campaign clock. The campaign's span `[T₀, T₁]` runs from the first
+//! A record's samples carry their time since the record's start (`t`, s). With a start `s_r` on the
+//! campaign clock ([`simulation::campaign::CampaignRecord::start_s`]) sample `i` of record `r` is
+//! at `T = s_r + t_i` on the campaign clock. The campaign's span `[T₀, T₁]` runs from the first
 //! sample of all records to the last; the campaign's start is `T = 0`, the instant the records'
 //! starts count from. The time bases are then taken on that clock:
 //!

@@ -24,6 +24,11 @@
 //! [`validate::validate_campaign`] predicts other records, refitting the set-up errors of a
 //! set-up that was not fitted (and a record's own zero) with the machine's errors held.
 //! `docs/campaigns.md` describes the campaign file and a worked campaign.
+//!
+//! [`CampaignRecord::params`]: simulation::campaign::CampaignRecord::params
+//! [`CampaignRecord::setup`]: simulation::campaign::CampaignRecord::setup
+//! [`CampaignRecord::zeroed`]: simulation::campaign::CampaignRecord::zeroed
+//! [`CampaignRecord::start_s`]: simulation::campaign::CampaignRecord::start_s
 
 pub mod clock;
 pub mod design;

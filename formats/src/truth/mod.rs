@@ -19,11 +19,12 @@
 //! SXY = 0.03                   # instrument term (dimensionless): cross-talk
 //! ```
 //!
-//! Inside, a [`Truth`] holds the terms as a [`Model`] and one coefficient per model column in
-//! mm (translations, sensor offsets), rad (angles), ms (`velocity`) or 1 (instrument terms,
-//! [`Truth::instrument`]). The value of an effect at a sample is `Σ coefficient · basis value`
-//! over its terms ([`simulation::model::Basis::values`]). Every entry is validated against the
-//! machine, and every problem is a [`TruthError`] naming the file, the line and the column.
+//! Inside, a [`Truth`] holds the terms as a [`Model`](simulation::model::Model) and one coefficient
+//! per model column in mm (translations, sensor offsets), rad (angles), ms (`velocity`) or 1
+//! (instrument terms, [`Truth::instrument`]). The value of an effect at a sample is
+//! `Σ coefficient · basis value` over its terms ([`simulation::model::Basis::values`]). Every
+//! entry is validated against the machine, and every problem is a [`TruthError`] naming the
+//! file, the line and the column.
 //!
 //! Built-in truths for `seed-ac` ([`BUILTIN_TRUTHS`], files in `formats/truths/`): `seed-ac-demo`
 //! (the documented default of `rtest demo`) and `seed-ac-reduced` (the 11 errors of the reduced
@@ -235,7 +236,7 @@ pub fn default_truth(m: &Machine) -> Result<Truth, TruthError> {
     }
 }
 
-/// The default demo truth of `seed-ac` (`simulation/truths/seed-ac-demo.toml`, documented in
+/// The default demo truth of `seed-ac` (`formats/truths/seed-ac-demo.toml`, documented in
 /// `docs/truth.md`): location errors of A and C and ball set-up errors of 10–30 µm and µrad,
 /// an angular positioning error of C twice per revolution (`ECC@harmonic:2`, amplitude
 /// 10 µrad) that the reduced model lacks, and 0.5 µm noise, seed 1, not zeroed. Parsed against
@@ -244,7 +245,7 @@ pub fn seed_ac_demo_truth() -> Truth {
     seed_ac_builtin("seed-ac-demo")
 }
 
-/// The reduced truth of `seed-ac` (`simulation/truths/seed-ac-reduced.toml`): only the 11 errors of
+/// The reduced truth of `seed-ac` (`formats/truths/seed-ac-reduced.toml`): only the 11 errors of
 /// the reduced model, as constants of 10–40 µm and µrad, no noise, not zeroed.
 pub fn seed_ac_reduced_truth() -> Truth {
     seed_ac_builtin("seed-ac-reduced")

@@ -250,7 +250,7 @@ pub struct ConfoundedReport {
 }
 
 /// A position error of an axis and a term of time that the fitted records cannot tell apart
-/// ([`diagnosis::separable`](diagnosis::separable)).
+/// ([`diagnosis::separable`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PositionOrTimeReport {
     /// The error of the axis that depends on its position (`EBB@harmonic:1`).

@@ -14,7 +14,7 @@
 //!   instruments included;
 //! - [`simulate`](mod@simulate): the readings a head would give on the exact virtual machine;
 //! - [`CalibrationRecord`]: known displacements and the sensors' readings of them, which
-//!   [`fitting::calibrate`] fits for the sensors' gain errors, zeros and direction
+//!   `fitting::calibrate` fits for the sensors' gain errors, zeros and direction
 //!   errors.
 //!
 //! The error vector `e` is the tool point minus the workpiece point, the nest centre minus the

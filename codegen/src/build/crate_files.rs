@@ -231,7 +231,7 @@ fn lib_docs(m: &Machine, models: &[&str]) -> String {
     d += &format!("//! {model}::gains(&pose, &Params::default(), &mut gains);\n");
     d += &format!("//! // gains[i]: [gx, gy, gz, gi, gj, gk] of the error {model}::ERRORS[i].\n");
     d += "//! assert!(gains.iter().flatten().all(|g| g.is_finite()));\n//! ```\n";
-    match codegen::compensation::check_topology(m) {
+    match crate::compensation::check_topology(m) {
         Ok(()) => d += &compensation_docs(m, &lib, model, &values),
         Err(e) => {
             d += "//!\n";

@@ -62,9 +62,14 @@
 //! `machine::location::compensation::first_order_f32` and the rest (docs/codegen.md).
 //! `examples/user-machine` in the rtest repository is such a crate, with tests against the
 //! exact virtual machine.
+//!
+//! [`crate_files`] gives the other way: the files of a standalone crate holding a machine's
+//! generated code (what `rtest generate --crate DIR` writes), pure text, no file access.
 
 // The example above is a whole `build.rs`, `fn main` included.
 #![allow(clippy::needless_doctest_main)]
+
+pub mod crate_files;
 
 use crate::emit::{GenerateError, generate_machine};
 use model_spec::SpecError;

@@ -22,39 +22,27 @@ use report::text::compensate::{compensation, kinematics_and_tables};
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
-Puts identified errors back onto the machine. The values are those of an `rtest identify` JSON \
-(--params: one record or a campaign of several, position-dependent terms included); what is \
-compensated is the machine's geometric errors only, its shared values: the set-up errors of the \
-ball (one set per set-up in a campaign, XOW[k4]), the R-test's sensor offsets and instrument \
-terms, every parameter of a record, time, velocity and reversal terms are left out and listed. \
-A value the identification could not determine is refused (identify with a constraint, or with \
-another path). The records' ball positions do not matter to the correction; the machine's other \
-kinematic symbols (the tool's length) come from the description and --param, and records \
-modelled with different values of one are refused (which one the machine has is unknown).
+Puts identified errors back onto the machine. The values come from `rtest identify --json` \
+(--params: one record or a campaign; µm and µrad). Only the machine's geometric errors are \
+compensated (of a campaign, its shared values); the ball's set-up errors, the R-test's offsets \
+and instrument terms, each record's own parameters, and time, velocity and reversal terms are \
+left out and listed. A value the identification could not determine is refused.
 
 --path IN -o OUT: corrected commands. IN is a CSV of commanded poses (one column per machine \
-axis named by its letter, mm and degrees; other columns kept as they are) or, with --nc \
-iso|heidenhain, an NC program in machine coordinates (absolute G0/G1 or L blocks; every other \
-line passed through byte for byte; arcs, incremental moves, datum shifts and TCP are refused with \
-the line). OUT has the same format with the corrected axis values: at the corrected pose the \
-model's predicted tool point and tool axis are the commanded ones (nominal kinematics plus the \
-identified first-order error, iterated until the predicted position remainder is below 1 nm). \
-The linear axes correct the position, two rotary axes the tilt of the tool axis (damped near a \
-singular pose, where the report says what remains); the rotation about the tool axis cannot be \
-corrected and is reported. A corrected pose outside a stroke or range is refused with its line. \
-NC words keep their decimals (--decimals N for more); the rounding this costs is reported.
+axis, named by its letter; mm and degrees) or, with --nc iso|heidenhain, an NC program in \
+machine coordinates (absolute straight moves); OUT has the same format with the corrected axis \
+values, at which the model's predicted tool point and tool axis are the commanded ones (to \
+1 nm). The rotation about the tool axis cannot be corrected and is reported; a corrected pose \
+outside a stroke or range is refused with its line.
 
---kinematics-out FILE: the machine description with the location errors folded into its \
-kinematic offsets and the identified kinematic symbols (--terms Zt) into their defaults; what \
-cannot be folded (angular location errors, squareness, component errors, lengths of the \
-workpiece side, undetermined changes) is listed. --tables DIR: one CSV per axis of its component errors against its position \
-at --pitch mm (--pitch-deg for rotary axes), with the positioning correction in the axis's own \
-sense (docs/compensation-tables.md).
+--kinematics-out FILE: the machine description with the location errors and the identified \
+kinematic symbols folded into its offsets and defaults; what cannot be folded is listed. \
+--tables DIR: one CSV per axis of its component errors (µm, µrad) and positioning correction \
+against its position, every --pitch mm (--pitch-deg degrees on rotary axes). --param sets \
+kinematic symbols (mm; the tool length, say). --json FILE writes the summary, --report FILE the \
+HTML report (both need --path).
 
-The workpiece point of the correction is the material point under the tool tip; --param sets \
-kinematic symbols (the tool length, say) as in `gains`. --json writes the summary \
-(docs/compensation.md); --report FILE writes the HTML report of the identification of --params \
-and this compensation (docs/report.md; needs --path).";
+Details: docs/compensation.md, docs/compensation-tables.md, docs/nc-programs.md, docs/report.md.";
 
 /// Flags of `rtest compensate`.
 #[derive(Debug, clap::Args)]

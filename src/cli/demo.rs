@@ -29,41 +29,26 @@ const MACHINE_ID: &str = "demo";
     long_about = "\
 The main job of rtest on the seed's five-axis machine (seed-ac), with the documented demo truth \
 seed-ac-demo (docs/truth.md): location errors of A and C and ball set-up errors of 10-30 µm and \
-µrad, plus an angular positioning error of C twice per revolution (ECC@harmonic:2, 10 µrad) \
-that the reduced model lacks, and 0.5 µm of R-test noise.
+µrad, an angular positioning error of C twice per revolution (ECC@harmonic:2, 10 µrad) that the \
+reduced model lacks, and 0.5 µm of R-test noise.
 
-1. Simulates K4 (241 samples), K1 (361) and K2 (121) on the exact virtual machine (noise seeds 1, \
-2, 3).
-2. Identifies the reduced model (the seed's Table 2: XOW YOW ZOW YOA ZOA BOA COA XOC YOC AOC BOC) \
-on K4, refined against the exact machine, and prints the values against the truth with their \
-standard uncertainties (µm, µrad), like the seed's Table 4.
-3. Validates on K1 and K2 (and on K4 itself): residual RMS and max per direction in µm, before \
-(nominal machine) and after (identified model, exact prediction), compared with the seed's \
-±12 µm (K4) and ±15 µm (K1, K2).
-4. Says what is left unexplained and why: the truth's terms the reduced model lacks, how much \
-they move the readings and how they bias the 11 values.
-5. Diagnoses the reduced model on K4 with K1 and K2 held out (rtest diagnose): the missing term \
-found from the data alone, named as an ISO 230 error with its value ± std (µm, µrad), its \
-significance, and the residual RMS before and after on K4, K1 and K2; then checks it against the \
-truth (known here, not used by the diagnosis).
+1. Simulates K4, K1 and K2 on the exact virtual machine.
+2. Identifies the reduced model (the seed's Table 2) on K4: values ± std against the truth.
+3. Validates on K1 and K2: residual RMS and max per direction (µm), before and after, against \
+the seed's ±12 µm (K4) and ±15 µm (K1, K2).
+4. Says what the reduced model leaves unexplained, and why.
+5. Diagnoses it on K4 with K1 and K2 held out: the missing term, named as an ISO 230 error with \
+its value ± std (µm, µrad), then checked against the truth.
+6. Compensates K1 and K2 with the recommended model; measures what is left on the exact machine.
 
-Writes, in ./rtest-demo/ (created if needed; every file computed first, then all written or \
-none): k4.csv, k1.csv, k2.csv (the measurements: axes in mm and degrees, readings in µm), \
-identify.json (rtest identify --json), validate-k1.json and validate-k2.json (rtest validate \
---json), seed_ac.rs (generated no_std Rust gains of the full and reduced models), \
-gains-reduced.md (the Markdown gain table of the reduced model, mm/mm and mm/rad), \
-diagnose.json (rtest diagnose --json), seed-ac-extended.toml (the machine with the extended \
-model, rtest diagnose --model-out) and the figures of rtest diagnose --plot: k4-path.svg, \
-k1-path.svg, k2-path.svg (measured against predicted error, base and extended model) and \
-k4-spectrum.svg, k1-spectrum.svg, k2-spectrum.svg (residual components before and after), and \
-identify-recommended.json (the model the diagnosis recommends, identified on K4), \
-k1-compensated.csv and compensate-k1.json (K1 compensated with it, rtest compensate -o and \
---json), report.html (the HTML report of the check: identification, validations, diagnosis \
-with its figures; docs/report.md) and report-compensation.html (the report of the \
-compensation: the recommended model's identification, the diagnosis, K1 compensated). It \
-records the identification on K4 in the history database rtest-demo/rtest-history.sqlite \
-(machine id demo; each run adds a check: rtest history --db rtest-demo/rtest-history.sqlite). The \
-same steps one by one: rtest simulate / identify / validate / diagnose / history.",
+Writes, in ./rtest-demo/ (all or none), and lists: the measurements k4.csv, k1.csv, k2.csv (axes \
+in mm and degrees, readings in µm), the JSON reports of identify, validate, diagnose and \
+compensate, the generated code, the gain table (mm/mm, mm/rad), the extended machine, SVG \
+figures and two HTML reports (report.html, report-compensation.html). Records the \
+identification on K4 in rtest-demo/rtest-history.sqlite (machine id demo). The same steps one \
+by one: rtest simulate / identify / validate / diagnose / compensate / history.
+
+Details: README.md (the demo and its files), docs/truth.md, docs/report.md.",
     after_help = EXIT_CODES
 )]
 pub struct DemoArgs {}

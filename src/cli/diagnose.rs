@@ -18,97 +18,28 @@ use simulation::record::Record;
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
-Finds what a model lacks from a measurement CSV (--data, the fitted path, e.g. K4: axes in mm \
-and degrees, dx_um,dy_um,dz_um in µm), extends the model with it and measures the gain on the \
-fitted data and on held-out measurements (--validate, e.g. K1 and K2).
+Finds what a model lacks from a measurement CSV (--data, the fitted path, e.g. K4: axes in mm and \
+degrees, dx_um,dy_um,dz_um in µm), extends the model with it and measures the gain on the fitted \
+data and on held-out measurements (--validate, e.g. K1 and K2). Details: docs/diagnosis.md.
 
-1. Base fit: the model --model is identified on --data (least squares, refined against the \
-exact machine); its residual RMS (µm). Outliers (isolated readings beyond 6 robust scales of the \
-residual's local deviation, one or two samples in a row) are listed with file, line and \
-direction, and their samples left out of everything after.
-2. Noise model (--noise, --noise-record, else estimated from the fitted and held-out records by \
-the variogram of second differences): σ and AR(1) φ per direction x, y, z. The readings and \
-every column are whitened by it, so that every test and p-value below accounts for serially \
-correlated noise, and the fits are generalized least squares under it.
-3. Residual structure: the residual per direction against every axis that moves (harmonics \
-1..K of rotary angles, Legendre polynomials 1..P of linear positions), time (1..T) and direction \
-of motion (reversal); the largest components in µm.
-4. Candidates: every term of the machine's topology the model lacks: harmonic:1..K of rotary-axis \
-component errors, poly:1..P of linear-axis component errors (and const of their angular ones), \
-reversal of positioning errors (backlash), const location, squareness and ball set-up errors, \
-the R-test's zero offsets dx0 dy0 dz0 (const, a drift as rate in µm/s, or time:1 on a record \
-without t_s, and time:2..T); and scanned: period:P (ballscrew, scale) and step:V of positioning \
-errors, warmup:TAU (warm-up from t_s = 0) of the zero offsets and location errors, rate of \
-location errors, velocity (servo lag, records with t_s) of positioning errors, the \
-instrument terms SXX..SZY (sensor gain and cross-talk), and jump:T of the ball's set-up errors \
-XOW YOW ZOW and the zero offsets (the ball knocked or a sensor bumped at T s of a fitted \
-record: a term of that record only, which predicts nothing on another).
-5. Selection: one candidate at a time, the one that explains most of what is left; kept if its \
-F-test is significant at --alpha after a correction for the number of candidates tried, every \
-scanned value counted (Bonferroni, else a Monte-Carlo null of the selection itself). Candidates \
-the model already spans are listed as confounded (with what); candidates the data cannot tell \
-from a finding are named with it. A scanned parameter (P, V, TAU, T) is refined with a 95 % \
-interval. A finding beyond --budget is 'implausible': not a cause, not in the extended model.
-6. Gain: the extended model (model + plausible findings) is fitted on --data and predicts every \
---validate file (exact prediction, with only what the fits determine: a file whose prediction \
-needs an undetermined combination is flagged and not counted); residual RMS before and after, \
-µm. Each finding is then confirmed on its own: its held-out gain given the other findings must \
-exceed twice a spurious gain's standard deviation; a finding with alternatives has up to five \
-of them tried in its place, and one the held-out files confirm clearly better replaces it. The extended model holds the confirmed findings. With no --validate and several --data \
-files, each file is predicted by the fit on the others instead.
-7. Verdict: the residual of the extended model on every file is tested against the noise \
-(parametric bootstrap; 'down to the noise' only when it passes); where it fails, what remains is \
-described (what it follows, its shape, its RMS). The extended model is recommended only when no \
-held-out file gets worse, the held-out residual falls, a finding is confirmed and no fitted \
-record jumped; a finding is a 'cause' only when confirmed and recommended, otherwise 'not \
-confirmed', and the text says why. A jump is never a cause: its status is 'jump', it is \
-described in what remains (a step in time at its sample), and the record is to be measured \
-again.
+1. Base fit: --model identified on --data; its residual RMS (µm); outliers listed and left out.
+2. Noise model (--noise, --noise-record, else estimated): σ (µm), AR(1) φ; every test whitened.
+3. Residual structure: the residual (µm) against every axis that moves, time and reversal.
+4. Candidates: every term of the machine's topology the model lacks (harmonics, polynomials, \
+reversal, constants, zero offsets, drifts) and scanned ones (period, step, warm-up, jump).
+5. Selection: one at a time, F-test at --alpha corrected for the candidates tried (Bonferroni, \
+else a Monte-Carlo null); confounded candidates and alternatives named; beyond --budget: \
+implausible.
+6. Gain: the extended model's residual RMS (µm) on every --validate file; findings confirmed.
+7. Verdict: what remains tested against the noise; the extended model recommended or not, and why.
 
-Values of findings are in µm (translational errors, offsets) and µrad (angular errors); a \
-harmonic is printed as its cos and sin coefficients, its amplitude √(cos² + sin²) and phase φ \
-(cos·cos kθ + sin·sin kθ = amplitude·cos(kθ − φ)). Every fit is refined against the exact \
-machine and has converged when its last step moves the prediction by less than max(1e-6 µm, \
-1e-6·σ) or the rounding floor of the evaluation. A base fit whose refinement does not converge, \
-or whose values are beyond --max-error-um / --max-error-urad, is an error (exit code 3); a \
-finding whose extended fit does not converge is dropped, and the text and the JSON say so.
+Values are in µm (translational errors, offsets) and µrad (angular errors); a harmonic as cos, \
+sin, amplitude and phase (degrees). Several records: --data a.csv,b.csv or --campaign FILE \
+(docs/campaigns.md).
 
-Campaigns (docs/campaigns.md, docs/diagnosis.md): --data a.csv,b.csv or --campaign FILE fits \
-the base model on several records together (each its own ball set-up and R-test zero, the \
-machine's errors shared); one file is the campaign of that record, and everything above works \
-alike. Held-out records come from --validate (on the fitted records' set-up when they have one, \
-the ball not moved; else each on a set-up of its own, whose set-up errors are refitted with \
-the machine held) or --validate-campaign FILE; a held-out record's own zero (--zeroed) and \
-drifts are refitted on it. --instrument reads every record through an R-test head: each \
-sample is weighted by the covariance its sensors give it.
-
---report FILE writes the HTML report of the diagnosis (docs/report.md): findings, gain, what \
-remains, the residual components and the measured-against-predicted figures of every record \
-inline.
-
---json writes the report (docs/diagnosis.md): {version: 2, machine, data, data_arguments, \
-records: [{label, data, role, setup, setup_fitted, zeroed, samples, params, \
-residual_rms_before_um, residual_rms_after_um, refitted}], base_model, zeroed, alpha, base_fit, \
-structure, dictionary_size, unexcited, findings: [{error, basis, description, values, \
-stds, unit, amplitude, phase_deg, explained_fraction, f, p_value, correction, candidates_tried, \
-alternatives, size, limit, plausible, status, scan, …}], dropped, stop, confounded, \
-extended_model, gain: {fit, validation: [{…, estimable, undetermined}]}, outliers, budget, \
-recommended, recommendation, noise_model, adequacy: {records, p_value, consistent_with_noise, \
-…}, unexplained, notes}; `--json -` writes \
-it to standard output. --model-out writes the machine description (the text of --machine) with \
-the extended model appended as [models.extended] (extended2, … if that name is taken). --plot \
-DIR writes SVG figures: per record the measured error against the base and extended \
-predictions along the path (<name>-path.svg; against the position of the axis that sweeps the \
-largest share of its stroke or range, one that never reverses first: `C (deg)`, `X (mm)`; the \
-sample index only when no axis moves), the residual spectrum before and after \
-(<name>-spectrum.svg), and what remains unexplained against what it follows \
-(<name>-unexplained-<dir>.svg). Every output is computed first; they are all written or none is. \
-The text lists the unexcited candidates (their columns are zero on the fitted record).
-
-Progress: on a terminal, a bar on standard error follows the reading of the records, the stages \
-of the diagnosis and the candidates scored at each selection step, once the work has run half a \
-second (RTEST_PROGRESS_DELAY_MS sets the delay, in ms), and is cleared when it ends; never on a \
-pipe or a file, nor with `--json -`.";
+--json FILE writes the report (`-`: standard output); --model-out FILE the machine description \
+with the extended model appended as [models.extended]; --plot DIR SVG figures of every record; \
+--report FILE the HTML report (docs/report.md). All outputs are written, or none.";
 
 /// Flags of `rtest diagnose`.
 #[derive(Debug, clap::Args)]

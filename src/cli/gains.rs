@@ -21,27 +21,14 @@ translational error, mm per rad of an angular error) and ΔI ΔJ ΔK (orientatio
 per mm or per rad), written in Sa/Ca (sine/cosine of rotary axis A's command), Xm (linear \
 command of X, mm) and the kinematic symbols (mm).
 
-With --at: the numbers at that pose, the six gains of every error evaluated from the same \
-polynomials: position [gx, gy, gz] (tool frame; mm/mm for translational errors, mm/rad for angular \
-errors: 1 mm/rad = 1 µm of error vector per mrad; an error of e µm moves the tool point by g·e µm, \
-an error of e µrad by g·e nm) and orientation [gi, gj, gk] of the tool axis (1/mm, 1/rad). Axis \
-positions in mm and degrees, kinematic parameters in mm (defaults from the machine description, \
-overridden by --param). Every rotary axis must be given; linear axes left out of --at are filled \
-by the machine's nominal tool-centre-point inverse kinematics (the linear positions that put the \
-tool point on the workpiece point at the given rotary positions), and the output says which. The \
-pose must be within the machine's strokes and ranges unless --allow-off-stroke is given. A gain is \
-written 0 when its polynomial is identically zero, or when its value at the pose is within the \
-bound on the rounding error of its evaluation (a cancellation at this pose: such gains are listed, \
-never shown as -7.4e-15).
+With --at: the six gains of every error at that pose: position [gx, gy, gz] in mm/mm or mm/rad \
+(an error of e µm moves the tool point by g·e µm, of e µrad by g·e nm) and orientation [gi, gj, \
+gk] (1/mm, 1/rad). Axis positions in mm and degrees, kinematic parameters in mm (--param). \
+Every rotary axis must be given; linear axes left out are filled by the nominal \
+tool-centre-point inverse kinematics. The pose must be within the strokes and ranges unless \
+--allow-off-stroke. A gain within the rounding bound of its evaluation is written 0 and listed.
 
-JSON without --at: {\"machine\", \"model\" (null with --errors), \"units\", \"columns\", \
-\"atoms\": {name: meaning}, \"gains\": {error: [6 formulas]}}. JSON with --at: {\"machine\", \
-\"model\", \"pose\": {\"commands\": {axis: value}, \"filled_by_inverse_kinematics\": [axes], \
-\"parameters\": {symbol: mm}, \"tool_point_to_workpiece_point\"}, \"units\": {\"commands\": \
-{axis: \"mm\"|\"deg\"}, ...}, \"error_vector\", \"zeros\", \"gains\": {error: {\"kind\", \
-\"position\": [gx, gy, gz], \"position_unit\", \"orientation\": [gi, gj, gk], \
-\"orientation_unit\"}}, \"vanishing_at_this_pose\": [\"ERROR gx\", ...]}, errors in model order; \
-numbers are the shortest decimals that read back to the same double, zeros are written 0.";
+Details (the pose, the zeros, the JSON of --format json): docs/codegen.md §10.";
 
 /// `--format` of the gain tables.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -235,29 +235,27 @@ pub fn write_and_record(
 }
 
 const LONG_ABOUT: &str = "\
-The machine's history (docs/history.md): the checks `rtest identify --record` put into an \
-SQLite database (--db, default rtest-history.sqlite), and the trend of one error over them.
+The machine's history: the checks `rtest identify --record` put into an SQLite database (--db, \
+default rtest-history.sqlite), and the trend of one error over them.
 
 Without --machine-id: every machine id with its checks (id, measurement time, model, paths, \
 residual RMS in µm, rank). With --machine-id ID: that machine's checks and the errors it can \
 show. With --error NAME as well: that error's trend over the machine's comparable checks (same \
-machine description, same model, same test paths, same constraint; the others are listed as \
-left out, with why) as a table with the flags of every check:
+machine description, model, test paths and constraint; the others are listed as left out, with \
+why) as a table with the flags of every check:
 
-- tolerance: |value| > limit (µm or µrad; --tolerance NAME=LIMIT or --tolerances FILE, a TOML \
-file of NAME = limit lines; nonconformance proven when beyond the limit by more than 2σ, ISO \
-14253-1);
+- tolerance: |value| > limit (µm or µrad; --tolerance NAME=LIMIT or --tolerances FILE);
 - baseline: the value changed against the baseline check (--baseline CHECK, default the first \
-of the series): |v − v_b| > z·√(σ² + σ_b²), z the two-sided normal quantile of --alpha \
-(default 0.01: z = 2.576);
-- trend: the weighted least-squares slope (per day) from the baseline to the check, its \
-standard error scaled by the checks' scatter about the line, flagged when |t| exceeds \
-Student's two-sided quantile of --alpha with n − 2 degrees of freedom.
+of the series) by more than z·√(σ² + σ_b²), z the two-sided normal quantile of --alpha;
+- trend: the weighted least-squares slope (per day) from the baseline to the check is \
+significant (Student's t, two-sided, at --alpha).
 
-Each row's flags use that check and the ones before it only. --figure FILE.svg draws the \
-values ± σ, the tolerance band, the baseline and the trend line; --csv FILE writes the rows \
-(values in the error's unit, shortest round-trip decimals); --json FILE writes the listing or \
-the trend (`-`: standard output, the text then goes to standard error).";
+Each row's flags use that check and the ones before it only. --figure FILE.svg draws the values \
+± σ, the tolerance band, the baseline and the trend line; --csv FILE writes the rows (values in \
+the error's unit); --json FILE writes the listing or the trend (`-`: standard output, the text \
+then goes to standard error).
+
+Details: docs/history.md.";
 
 /// Flags of `rtest history`.
 #[derive(Debug, clap::Args)]

@@ -19,86 +19,29 @@ use report::text::identify::identification;
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
-Identifies the errors of a model from a measurement CSV (axis columns in mm and degrees, \
-dx_um,dy_um,dz_um in µm; docs/conventions.md): least squares on the column-scaled H matrix \
-(gains from the generated code for built-in machines, from the in-process evaluator for machine \
-files), with numerical rank, condition number, standard uncertainties from the residuals (σ̂), \
-correlations, and what the data cannot separate. Values are in µm (translational errors, sensor \
-offsets) and µrad (angular errors).
+Identifies the errors of a model from a measurement CSV (axes in mm and degrees, \
+dx_um,dy_um,dz_um in µm) by least squares on the H matrix, refined against the exact virtual \
+machine: values in µm (translational errors, sensor offsets, changes of kinematic symbols) and \
+µrad (angular errors), standard uncertainties, correlations, rank, condition number, and what \
+the data cannot separate.
 
-The model is --model NAME (the terms of a model of the machine: full, reduced, …), --terms LIST \
-(NAME or NAME@BASIS: XOC, ECC@harmonic:2, EXX@reversal, EXX@poly:2, dx0@time:1, \
-EXX@period:5, EXX@step:100, dz0@exp:20, ECC@velocity, SXY), or both (the terms are added to the \
-model). velocity (the servo lag, in ms) and exp:TAU need a `t_s` column; the instrument terms \
-SXX … SZY are dimensionless (docs/conventions.md); a kinematic symbol of the description, written exactly as under [symbols] (Zt, Xw), is identified as its change in µm (constants only; the report gives its nominal and identified length in mm, docs/identification.md). The record needs at least one reading (3 per sample) more than \
-the model has parameters.
+The model is --model NAME (full, reduced, …), --terms LIST (NAME or NAME@BASIS: XOC, \
+ECC@harmonic:2, EXX@reversal, dx0@time:1, ECC@velocity, Zt, …), or both (the terms added). A \
+parameter the data cannot determine is printed as \"not determined: confounded with …\" (null \
+in the JSON) unless --constraint min-norm or zero:NAME,... gives it a value. --zeroed: \
+readings zeroed at the first sample (dx0 dy0 dz0 join the model).
 
-A parameter the data cannot determine gets no number: it is printed as \"not determined: \
-confounded with …\" and its value is null in the JSON, unless --constraint gives it one \
-(min-norm: the minimum-norm solution, a convention; zero:NAME,NAME: those fixed to 0 before the \
-fit). With --zeroed (readings zeroed at the first sample) the R-test zero offsets dx0 dy0 dz0 \
-join the model and the report names the errors they swallow (those with a constant gain: XOC, \
-YOA, ZOA on seed-ac).
+The refinement (Gauss-Newton, two or three steps) removes the second-order terms (about 1e-3 µm \
+for errors of tens of µm and µrad); one that does not converge is exit code 3, and \
+--first-order skips it. The uncertainties assume a noise model per direction (white or AR(1), \
+by generalized least squares): --noise, --noise-record, else estimated from the residual.
 
-By default the linear estimate is refined against the exact virtual machine (Gauss-Newton with \
-H as Jacobian, two or three steps): that removes the second-order terms of a real machine \
-(products of two errors with a lever arm, about 1e-3 µm for errors of tens of µm and µrad). A \
-refinement that does not converge is an error (exit code 3); --first-order skips it.
+--data a.csv,b.csv or --campaign FILE fit several records together (docs/campaigns.md); \
+--stream reads one long record in blocks. --json FILE (`-`: standard output) writes the report \
+that validate and compensate read, --report FILE the HTML report, --record the history entry. \
+Plausibility bounds: --max-reading-um (readings), --max-error-um, --max-error-urad (values).
 
-Noise: the uncertainties assume a noise model per direction x, y, z (the marginal σ of a reading \
-and the lag-1 autocorrelation φ of an AR(1) process; equally spaced samples), and the fit is \
-generalized least squares: the rows are whitened by the model (Prais-Winsten), so correlated \
-noise (thermal drift, vibration, electronics) gets honest uncertainties. The model is, in this \
-order: --noise white:sigma=S or ar1:phi=F,sigma=S (declared; S in µm, 0 ≤ F < 0.99); \
---noise-record FILE (a record of the machine standing still: σ and φ by Yule-Walker, at least \
-100 samples); else estimated from the residual of an ordinary fit by the variogram of second \
-differences, which a smooth misfit of the model does not fool (white with the residual's σ̂ \
-when the data are noise-free). --noise white is ordinary least squares (white noise, one σ from \
-the residual). The report says which model was used (noise_model). --stream fits by ordinary \
-least squares (the estimate needs the whole record) and refuses --noise models and \
---noise-record.
-
-Plausibility: readings beyond --max-reading-um and poses outside the strokes are refused with \
-their lines; identified values beyond --max-error-um / --max-error-urad are an error (exit code \
-3), not a result.
-
-Campaigns (docs/campaigns.md): a record is a campaign of one, and --data a.csv,b.csv fits several \
-records together, each on its own ball set-up (its own XOW YOW ZOW, named XOW[a]) and with its \
-own R-test zero (dx0[a] when --zeroed), the machine's errors shared; --param NAME=VALUE,... gives \
-every record the same kinematic parameters (the ball's position). --campaign FILE reads a TOML \
-list of records with their labels, set-ups (records with the same set-up share its errors), ball \
-positions, zeroing and optional start times on one campaign clock. The report of several \
-records gives the shared values, one block per set-up and per record, and each record's \
-residual. --stream reads one long record in blocks and takes one --data file: several records \
-are fitted whole, in one design matrix held in memory.
-
---report FILE writes the HTML report of this identification (docs/report.md: the records with \
-their ball positions and set-ups, values with uncertainties, what the data cannot separate, each \
-record's measured error against its prediction along its path, the input files with their \
-SHA-256).
-
---json writes the report (docs/identification.md), version 2: {version, machine, fingerprint, \
-data, model, base_model, terms, setups: [{label, records}], records: [{label, data, setup, \
-params, zeroed, samples, residual_rms_um}], parameters: [{name, error, basis, value, std, unit, \
-determined, fixed}], residual_rms_um, rank, condition, confounded, samples, zeroed, sigma_um, \
-near_confounded, refinement: {method, iterations, converged, …}, noise_model: {source, \
-sigma_um, phi, whitened_sigma, text}, notes, …}; several records: \"kind\": \"campaign\", no \
-data nor zeroed, every parameter with its owner (shared, setup, record) and the set-up's or \
-record's label (of). `rtest validate --params` and `rtest compensate --params` read it (and what \
-earlier versions wrote). `--json -` writes it to standard output (the text then goes to \
-standard error).
-
-History (docs/history.md): --record --machine-id ID keeps the identification, once it succeeded \
-and its outputs are written, in the machine's history database (--db, default \
-rtest-history.sqlite): machine id and fingerprint, model and terms, test paths (--record-paths), \
-the measurement time (--measured-at), the SHA-256 of every input file, every value with its σ and \
-unit, rank, unidentifiable groups and residual; a campaign is one check whose paths are its \
-records' labels and whose parameters carry their owners. rtest history shows the checks and each \
-error's trend (of a campaign: its shared values).
-
-Progress: on a terminal, a bar on standard error follows the reading of the records (bytes of \
-the files, with --stream too) once it has run half a second (RTEST_PROGRESS_DELAY_MS sets the delay, \
-in ms) and is cleared when it ends; never on a pipe or a file, nor with `--json -`.";
+Details: docs/identification.md (§16: the command line).";
 
 /// Flags of `rtest identify`.
 #[derive(Debug, clap::Args)]

@@ -15,38 +15,27 @@ use simulation::generator::{
 use simulation::record::Record;
 
 const LONG_ABOUT: &str = "\
-The R-test tests of a machine, in the spirit of ISO 10791-6 (docs/paths.md): `turn-R` for every \
-rotary axis R (R turns over its range, a full turn where the range allows it, the other rotary \
-axes at 0°), `pair-R-S` for every two rotary axes (the primary turns, the secondary follows \
-base + a·(1 − cos φ), like the seed's K4), and on machines whose rotary axes are A and C the \
-seed's K1, K2, K4. Every test T also comes reversed, T-rev (the same poses from the last to the \
-first, times from 0 again), and there and back, T-back (the poses forward then reversed in one \
-record, the turning point once): an error of an axis that turns monotonically in time in T and a \
-drift in time explain the same readings on T alone, not on T with T-rev or on T-back.
+The R-test tests of a machine, in the spirit of ISO 10791-6: `turn-R` for every rotary axis R (a \
+full turn where its range allows, the other rotary axes at 0°), `pair-R-S` for every two rotary \
+axes (the primary turns, the secondary follows base + a·(1 − cos φ)), and on machines whose rotary \
+axes are A and C the seed's K1, K2, K4. Every test T also comes reversed, T-rev, and there and \
+back in one record, T-back. Details: docs/paths.md.
 
---list: the machine's tests, one line each (with --param: whether each stays within the strokes \
-at that ball position). --test NAME -o FILE: the test's path as a CSV in the measurement format \
-without readings (axis columns in mm and degrees, t_s in s; shortest decimals that read back to \
-the same values). The linear axes follow the ball by the nominal tool-centre-point inverse \
-kinematics at the kinematic parameters (the description's defaults, overridden by --param: the \
-ball position is set by the workpiece-side symbols, Xw=…,Yw=…,Zw=… on most machines).
+--list: the machine's tests, one line each (with --param: whether each stays within the strokes at \
+that ball position). --test NAME -o FILE: the test's path as a CSV in the measurement format \
+without readings (axis columns in mm and degrees, t_s in s). The linear axes follow the ball by \
+the nominal inverse kinematics at the kinematic parameters (the description's defaults, overridden \
+by --param, mm: the ball position is Xw=…,Yw=…,Zw=… on most machines).
 
-Every sample is checked: within the strokes and ranges, the nest on the ball, and the clearance \
-rule: the tool axis within --max-tilt-deg (90) of the table normal, the ball centre at least \
---min-ball-height-mm (30) above the table face. A test that breaks a check is an error naming \
-the first sample, the axis and the limit; nothing is clipped. Where a rotary axis's range (or \
-the tilt rule) is narrower than a full turn, its turn covers what is allowed.
+Every sample is checked: within the strokes and ranges, the nest on the ball, the tool axis within \
+--max-tilt-deg (90°) of the table normal, the ball centre at least --min-ball-height-mm (30 mm) \
+above the table face. A test that breaks a check is an error naming the first sample, the axis and \
+the limit; nothing is clipped.
 
---nc iso|heidenhain -o prog.nc: an NC measurement program of the test instead of the CSV \
-(docs/measurement-programs.md): static (a move, a settle time and a measuring window at each \
-pose; --settle-s, --window-s, --rapid) or --continuous (feed moves through the poses, the R-test \
-sampling at --sample-rate-hz), the assumptions stated in its header (machine coordinates, tool \
-centre point control off, mm and degrees, the kinematic parameters), and its sample-timing plan \
-(CSV, --plan FILE, default the program's name with .plan.csv) that `rtest segment` cuts a \
-streamed log with. The program reads back to the poses to its resolution (--decimals, 4).
-
-`rtest simulate --path NAME` takes the same names at the description's default parameters. \
-`-o -` writes the CSV to standard output (the summary then goes to standard error).";
+--nc iso|heidenhain -o prog.nc: an NC measurement program of the test instead of the CSV, static \
+or --continuous, and its sample-timing plan (CSV, --plan) that `rtest segment` cuts a streamed log \
+with (docs/measurement-programs.md). `rtest simulate --path NAME` takes the same test names. \
+`-o -` writes to standard output.";
 
 /// Flags of `rtest path`.
 #[derive(Debug, clap::Args)]

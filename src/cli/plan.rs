@@ -20,51 +20,27 @@ use simulation::generator::{self, Clearance, GeneratorError, GeneratorOptions, S
 
 const LONG_ABOUT: &str = "\
 Predicts, before measuring, what a campaign of R-test tests will determine: the rank and the \
-condition number of its design matrix, the groups of parameters it cannot separate (named as \
-`rtest identify` names them), and the predicted standard uncertainty (µm, µrad) of every \
-parameter it determines, for a reading noise of --noise-um per direction (white, or AR(1) with \
---noise-phi). No number is given for what the plan cannot determine. Then it suggests the single \
-added test or ball position that helps most, and ranks the candidates (docs/plan.md).
+condition number of its design matrix, the groups of parameters it cannot separate, and the \
+predicted standard uncertainty (µm, µrad; ms for servo lags) of every parameter it determines, for \
+a reading noise of --noise-um per direction (white, or AR(1) with --noise-phi); none for what it \
+cannot determine. Then it suggests the single added test or ball position that helps most, and \
+ranks the candidates. Details: docs/plan.md.
 
-The plan: --paths lists tests of the machine's generator (see `rtest path --list`): `K4,K1`, \
-`turn-C,pair-A-C`. Every test is generated with the linear axes following the ball at the \
-plan's kinematic parameters (--param: the machine's defaults overridden, the ball position \
-among them; this position is called `base`), checked against the strokes, the ranges and the \
-clearance rule at every sample. `TEST:NAME` puts a test at the ball position NAME, defined by \
---ball NAME:SYMBOL=VALUE,... (mm; the symbols not given as in `base`), e.g. --ball \
-high:Zw=260 --paths K4,K4:high.
+The plan: --paths lists tests of the machine's generator (`rtest path --list`), each generated \
+with the linear axes following the ball at the kinematic parameters of --param (mm; the ball \
+position `base`) and checked against the strokes, the ranges and the clearance rule. `TEST:NAME` \
+puts a test at the ball position NAME of --ball NAME:SYMBOL=VALUE,... (mm), e.g. --ball \
+high:Zw=260 --paths K4,K4:high. Each record has its own ball set-up (XOW YOW ZOW) unless \
+--shared-setup; with --zeroed its own R-test zero (dx0 dy0 dz0).
 
-Each record is, as in a campaign fit, its own ball set-up (its own XOW YOW ZOW) unless \
---shared-setup makes the records at one ball position share one; with --zeroed every record has \
-its own R-test zero (dx0 dy0 dz0). The parameters are named as a campaign fit names them: \
-`XOC` (the machine's, shared), `XOW[K4]` (a set-up's), `dx0[K1]` (a record's).
+The suggestion: every test at every planned ball position and at each moved by --ball-step-mm (mm) \
+along each of the ball's symbols, added on its own, ranked by the parameters of interest (the \
+machine's) newly determined, then the largest std/target (--target-um, --target-urad, \
+--target-ms), then the sum of (std/target)^2; --top sets how many are shown. Where a position term \
+and a time term correlate by 0.9 or more, it names the reversed (T-rev) or there-and-back (T-back) \
+test that separates them.
 
-The suggestion: every test of the generator at every planned ball position and at each planned \
-position moved by --ball-step-mm along each of the ball's symbols (down and up), each generated \
-and checked (the refused ones are listed with the generator's reason), is added to the plan on \
-its own. Criterion: first the most parameters of interest (the machine's, shared) newly \
-determined; then the smallest largest predicted uncertainty relative to its target \
-(--target-um, --target-urad, --target-ms); then the smallest sum of (std/target)^2. --top sets \
-how many candidates the ranking shows.
-
-Position against time: where the plan's model holds an error that depends on an axis's position \
-and a term of time (time:K, rate, exp:TAU, warmup:TAU) whose estimates correlate by 0.9 or more \
-(the axis moves monotonically in time on the planned tests), the plan says so and names the \
-reversed (T-rev) or there-and-back (T-back) version of a planned test T that separates them best. \
-The candidates include those versions of the planned tests.
-
---json writes the report: {machine, fingerprint, model, terms, noise, zeroed, shared_setup, \
-balls, records, parameters: [{name, error, basis, owner, unit, determined, std}], rank, \
-columns, condition, confounded, near_confounded, targets, largest, suggestion: {criterion, \
-interest, step_mm, positions, evaluated, ranking: [{place, test, ball, paths_item, samples, \
-ball_arg, newly_determined, rank, columns, determined, largest, sum_squares}], skipped: [{test, ball, \
-reason}]}, separation (when a position term and a time term are not separated): {threshold, \
-pairs: [{position, time, correlation}], candidates: [{test, ball, paths_item, \
-largest_correlation}]}}; `null` only where the plan does not determine a value.
-
-Progress: on a terminal, a bar on standard error follows the candidates evaluated once the work \
-has run half a second (RTEST_PROGRESS_DELAY_MS sets the delay, in ms) and is cleared when it \
-ends; never on a pipe or a file, nor with `--json -`.";
+--json FILE writes the report (`-`: standard output; `null` where the plan determines no value).";
 
 /// Flags of `rtest plan`.
 #[derive(Debug, clap::Args)]

@@ -12,44 +12,26 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
-Writes one self-contained HTML report of a check (docs/report.md), for reading on screen and \
-printing to PDF (A4): the machine and model; the data (records with their samples, input files \
-with their size and SHA-256); the identified values with their standard uncertainties (µm, \
-µrad) and the groups the data could not separate; the validations (residual RMS and maximum per \
-direction, µm, and a figure); the diagnosis (findings, gain on the fitted and held-out records, \
-what remains unexplained, the residual components figure); the compensation summary. A part \
-whose report is not given is one line saying so.
+Writes one self-contained HTML report of a check, for reading on screen and printing to PDF (A4): \
+the machine and model; the data (records with their samples, input files with their size and \
+SHA-256); the identified values with their standard uncertainties (µm, µrad) and the groups the \
+data could not separate; the validations (residual RMS and maximum per direction, µm, and a \
+figure); the diagnosis (findings, gain, what remains); the compensation summary. A part whose \
+report is not given is one line saying so. Details: docs/report.md.
 
-The inputs are the JSON files that `rtest identify --json`, `rtest validate --json`, `rtest \
-diagnose --json` and `rtest compensate --json` write, in any order; each is recognised by its \
-content. At most one identification, one diagnosis and one compensation; any number of \
-validations (each of another record). They must belong to one check: one machine (and the \
-machine of --machine, fingerprint included), the identification's model in every validation \
-and compensation, and for a diagnosis the identification's fitted record and its base or \
-extended model. An identification or validation may be of one record or of a campaign of \
-several: the report then lists the records with their ball positions (kinematic parameters that \
-differ from the machine's defaults) and set-ups, the shared values (the machine's errors), the \
-values of each set-up and record, and for each validated record its set-up (fitted, or new and \
-refitted on the record). The records and files the reports name are looked for relative to the \
-directory of the report that names them (or to --data-dir DIR): an absolute name, or one that \
-leaves that directory, is refused. Regular files are read (at most their kind's size: 256 MiB \
-for a record) and hashed; anything else (a pipe, a device, a directory) is listed as not hashed \
-and never opened.
+The inputs are the JSON files that `rtest identify --json`, `validate --json`, `diagnose --json` \
+and `compensate --json` write, of one record or of a campaign, in any order; each is recognised by \
+its content. At most one identification, one diagnosis and one compensation; any number of \
+validations. They must belong to one check: one machine (that of --machine, fingerprint included) \
+and the identification's model and records.
 
-The measured error against the identified model's prediction along each path (every record of \
-the identification and of the validations, against the axis that moves most) is drawn from the \
-records the reports name, read as above at their kinematic parameters, with \
-the identification's values on the exact virtual machine (a validated record on a new set-up \
-with its set-up errors refitted, as rtest validate did); a record that cannot be read is named \
-with why. The \
-machine is --machine, or the built-in the reports name. The diagnosis's base and extended \
-predictions along the paths are drawn by `rtest diagnose --report FILE`. `identify`, \
-`diagnose` and `compensate` take --report FILE to write this report from what they just \
-computed.
-
-The document makes no request of any kind: figures are inline SVG, their font (DejaVu Sans, \
-about 1 MB of the file) is embedded, a Content-Security-Policy forbids every other source, and \
-there is no script. -o - writes it to standard output.";
+The records the reports name are read relative to the directory of the report that names them (or \
+to --data-dir DIR; an absolute name, or one that leaves that directory, is refused), hashed, and \
+drawn: the measured error against the identified model's prediction (µm) along each path, against \
+the axis that moves most (mm or degrees). The document makes no request of any kind: figures are \
+inline SVG, their font (DejaVu Sans, about 1 MB) is embedded, a Content-Security-Policy forbids \
+every other source, and there is no script. `identify`, `diagnose` and `compensate` write the same \
+report with --report FILE. `-o -` writes it to standard output.";
 
 /// Flags of `rtest report`.
 #[derive(Debug, clap::Args)]

@@ -14,32 +14,29 @@ use programs::segment::{
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
-Cuts a time-stamped R-test log into one sample per pose of a measurement program's timing plan \
-(docs/measurement-programs.md) and writes the samples as a measurement record.
+Cuts a time-stamped R-test log into one sample per pose of a measurement program's timing plan and \
+writes the samples as a measurement record. Details: docs/measurement-programs.md.
 
 --plan is the plan written beside the program (sample, the axes in mm and degrees, arrive_s, \
 start_s, end_s, depart_s on the program clock). --log is the R-test's stream: a CSV with a time \
 column, t_s (s on any clock) or t_abs_s (Unix time, s), and reading columns named …_um (µm: \
-dx_um,dy_um,dz_um, or sensor columns s1_um,s2_um,…, carried through under their names; not \
-both); other \
-columns are not read. The log is read twice, so it must be a file.
+dx_um,dy_um,dz_um, or sensor columns s1_um,s2_um,…; not both); other columns are not read. The log \
+is read twice, so it must be a file.
 
-The log usually starts before the program. Static plans: the still periods of the readings are \
-matched with the plan's rests, each pose tracked from the one before, so a machine whose timing \
-drifts from the plan is followed; a pose is placed at the end of its still period (the \
-departure), else at its start (the arrival), else where the pose before puts it. An ambiguous \
-match (a log of two runs) or a poor one (fewer than half the poses placed at an edge) is \
-refused: give --offset-s, the program's start on the log's clock. Each window, less --margin-s \
-at each end (default a tenth of it) and within its still period, is averaged; windows whose \
-readings scatter more than four times the median, or that motion cut short, are flagged. \
-Continuous plans: the run is found between its lead-in and lead-out dwells, and the readings \
-are interpolated at each pose's instant.
+Static plans: the still periods of the readings are matched with the plan's rests, each pose \
+tracked from the one before, so a machine whose timing drifts from the plan is followed. An \
+ambiguous match (two runs) or a poor one (fewer than half the poses placed at an edge) is refused: \
+give --offset-s, the program's start on the log's clock. Each window, less --margin-s at each end \
+(default a tenth of it) and within its still period, is averaged; windows whose readings scatter \
+more than four times the median, or that motion cut short, are flagged. Continuous plans: the run \
+is found between its lead-in and lead-out dwells, the readings interpolated at each pose's \
+instant.
 
 The record (-o) has the plan's axis columns, the averaged reading columns and t_s, the window's \
 middle on the program clock as the log measured it; with dx_um,dy_um,dz_um it is read back as \
-`identify` reads it before it is written. --windows writes each window's log times, readings, \
-drift, anchor, spread per column (µm) and flags. Prints the program's start in the log, the \
-alignment, the noise and the flagged windows.";
+`identify` reads it before it is written. --windows: each window's log times, readings, drift, \
+anchor, spread per column (µm) and flags. Prints the program's start in the log, the alignment, \
+the noise and the flagged windows.";
 
 /// Flags of `rtest segment`.
 #[derive(Debug, clap::Args)]

@@ -20,34 +20,23 @@ Simulates an R-test measurement: the exact virtual machine (exact homogeneous tr
 linearisation) runs a test path with the errors of a truth, and the readings are written as a \
 measurement CSV.
 
-The path is a test of the machine (`rtest path --machine M --list`: turn-C, pair-A-C, …, \
-generated at the description's default kinematic parameters or at --param Xw=…,Zw=… (the ball \
-position: the path is planned there, the truth's ball stands there with its own deviations, and \
-the record reads back at those parameters, as `identify --param` and campaign files read it); on machines whose rotary axes are A \
-and C also K1 (C 0..360 deg in 1 deg steps, A = 0; 361 samples), K2 (A -90..30 deg, C = 0; 121 \
-samples), K4 (C = 1.5·i deg, A = -45·(1 - cos C) deg, i = 0..240; 241 samples)), or a path CSV file (rotary columns in degrees, linear columns in \
-mm optional: they are filled by the nominal tool-centre-point inverse kinematics; poses must be \
-within the strokes and keep the nest on the ball). The truth (docs/truth.md) says the real \
-machine: error values (translational in µm, angular in µrad, constants or position-dependent), \
-R-test zero offsets dx0 dy0 dz0 (µm), noise (µm) and its seed, zeroing at the first sample. \
-Default truth: the machine's built-in demo truth if it has one (seed-ac-demo for seed-ac), else \
-the nominal machine. --noise-um, --noise-phi, --seed and --zeroed override the truth's. The \
-noise is Gaussian, per direction: white, or AR(1) with lag-1 autocorrelation --noise-phi \
-(stationary from the first sample; --noise-um stays the standard deviation of one reading).
+The path is a test of the machine (`rtest path --machine M --list`: turn-C, pair-A-C, …; on \
+machines whose rotary axes are A and C also the seed's K1, K2, K4) or a path CSV file (rotary \
+columns in degrees, linear columns in mm optional: filled by the nominal inverse kinematics), \
+planned at the description's kinematic parameters or at --param Xw=…,Zw=… (mm, the ball \
+position; the truth's ball moves with it and the record reads back there).
 
-The CSV (docs/conventions.md) has a comment header saying what produced it, then the columns of \
-the machine's axes (linear mm, rotary degrees), dx_um,dy_um,dz_um (tool minus workpiece, tool \
-frame, µm) and t_s (s). It is read back before it is written: a simulation whose readings \
-`identify` would refuse (beyond --max-reading-um) is an error (exit code 3) and writes nothing. \
-`-o -` writes the CSV to standard output (the summary then goes to standard error). Prints one \
-line: the samples and the RMS of the readings (µm).
+The truth (--truth) says the real machine: error values (translational in µm, angular in \
+µrad), R-test zero offsets dx0 dy0 dz0 (µm), Gaussian noise (µm; white, or AR(1)) and its seed, \
+zeroing at the first sample; --noise-um, --noise-phi, --seed and --zeroed override it. Default: \
+the machine's demo truth if it has one (seed-ac-demo for seed-ac), else the nominal machine.
 
-To check a compensation: simulate the compensated path (`rtest compensate -o`) with \
---commanded set to the path before compensation; the record then holds the program's poses and \
-the readings the compensated machine gives there, as a controller that compensates reports them, \
-and `rtest identify` on it finds the compensated errors near zero.
+The CSV has the machine's axes (linear mm, rotary degrees), dx_um,dy_um,dz_um (tool minus \
+workpiece, tool frame, µm) and t_s (s). It is read back first: readings `identify` would refuse \
+(beyond --max-reading-um) are an error (exit code 3) and nothing is written. `-o -` writes it to \
+standard output. Prints the samples and the RMS of the readings (µm).
 
-With --instrument NAME|FILE (docs/instrument.md) the CSV holds the readings of the instrument's sensors (columns s1_um, s2_um, … in µm, positive when the plunger is pushed in) instead of dx_um,dy_um,dz_um: the exact forward geometry of the head (flat faces or ball tips, gains, zeros) applied to the exact error vector (rotated into the machine frame first when the instrument reads there), plus each sensor's noise (its noise_um) from the truth's seed. The truth's own noise (--noise-um, --noise-phi) is then the noise of the displacement itself (vibration, drift), added before the sensors read it; --zeroed zeroes the sensors' readings at the first sample. Read it back with --instrument on identify, validate or diagnose.";
+Details (paths, truths, the CSV, --commanded, --instrument): docs/truth.md.";
 
 /// Flags of `rtest simulate`.
 #[derive(Debug, clap::Args)]

@@ -18,42 +18,22 @@ JSON (--params: one record or a campaign of several) predict the readings of mea
 (--data FILE[,FILE...]: axes in mm and degrees, dx_um,dy_um,dz_um in µm; or the records of \
 --campaign FILE), each record on its set-up, and the residual (measured minus predicted) is \
 reported per record, per direction x, y, z of the tool frame and overall: RMS and maximum in µm, \
-before (the nominal machine: prediction 0) and after (the identified model). Overall RMS = \
-sqrt(Σ r² / 3N).
+before (the nominal machine: prediction 0) and after (the identified model).
 
-The values must belong to the machine: the JSON's machine name and fingerprint (topology and \
-machine-side kinematic defaults) must be this machine's, its base model must exist, every \
-parameter must be there, and every value within --max-error-um / --max-error-urad.
+The values must belong to the machine (its name and fingerprint, base model and parameters; \
+values within --max-error-um / --max-error-urad). The prediction is the exact virtual machine at \
+the identified values; --first-order predicts with H·v (about 1e-3 µm apart for errors of tens \
+of µm and µrad).
 
-The prediction is the exact virtual machine at the identified values, at each record's \
-kinematic parameters (no linearisation); with --first-order it is the first-order model H·v \
-(the difference is the second-order terms, about 1e-3 µm for errors of tens of µm and µrad).
-
-Set-ups (docs/campaigns.md): shared values (the machine's errors) come from the identification. \
-A record on a set-up the identification fitted uses that set-up's values XOW YOW ZOW; a record \
-on a new set-up has them refitted on it with everything else held, and the report says which \
-parameters were refitted and their values. Without --setup, the --data records are on the \
-identification's set-up when it fitted one set-up at their kinematic parameters (one ball \
-mounting measured along other paths: the usual check of one record on another), else each on a \
-new set-up named by its file's stem; --setup LABEL puts every --data record on set-up LABEL (a \
-fitted one, or a new one). With --zeroed (readings zeroed at the first sample) each record's \
-zero dx0 dy0 dz0 joins its model and is refitted on it, unless it is the fitted record itself. \
---instrument reads sensor readings, and a refit weights the samples by their covariances.
-
+A record on a set-up the identification fitted uses that set-up's XOW YOW ZOW; on a new set-up \
+they are refitted on the record, everything else held. The --data records are on the \
+identification's set-up when it fitted one at their kinematic parameters, else each on its own \
+(--setup LABEL chooses). With --zeroed each record's zero dx0 dy0 dz0 is refitted on it. \
 Parameters the identification could not determine (value null) are set to 0 and named; \
 --refuse-undetermined makes that an error instead.
 
---json writes (docs/campaigns.md) version 2: {version, machine, model, params, data, samples, \
-prediction, measured_rms_um, residual_rms_um, measured_max_um, residual_max_um, per_direction: \
-{x, y, z: {measured_rms_um, measured_max_um, residual_rms_um, residual_max_um}}, zeroed, \
-unidentified_set_to_zero, records: [{label, data, setup, setup_fitted, record_fitted, zeroed, \
-params, samples, refitted: [{name, value, std, unit}], measured_rms_um, …, per_direction, \
-unidentified_set_to_zero}]}; several records: \"kind\": \"campaign\", without data and zeroed. \
-`--json -` writes it to standard output.
-
-Progress: on a terminal, bars on standard error follow the reading and the validation of the \
-records once they have run half a second (RTEST_PROGRESS_DELAY_MS), cleared when they end; never \
-on a pipe or a file, nor with `--json -`.";
+--json FILE (`-`: standard output) writes the report. Details: docs/campaigns.md §6 (set-ups), \
+docs/identification.md §9, §11, §16.";
 
 /// Flags of `rtest validate`.
 #[derive(Debug, clap::Args)]

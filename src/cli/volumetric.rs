@@ -17,25 +17,25 @@ const LONG_ABOUT: &str = "\
 The three-axis volumetric compensation of the seed's three-axis paper: the kinematic-parameter \
 independent model of a machine whose three linear axes carry the tool (seed-3axis), built from \
 one 6D laser-interferometer measurement per axis taken with the reflector at the tool end, and \
-the squareness errors from their own measurement. It predicts the tool-end error du at any X, \
-Y, Z of the measured ranges and compensates with -du: the corrected command u_c solves \
-u_c = u - du(u_c), iterated until no command changes by 1e-6 µm.
+the squareness errors from their own measurement. It predicts the tool-end error du (µm) at any \
+X, Y, Z of the measured ranges and compensates with -du: the corrected command u_c solves \
+u_c = u - du(u_c).
 
 --laser names one CSV per linear axis (AXIS=FILE, comma-separated or the flag repeated): the \
 commands of every axis in mm (X_mm,Y_mm,Z_mm: the measured axis strictly increasing, the others \
 standing still) and the six errors of the measured axis at the tool end (EXX_um,EYX_um,EZX_um \
 in µm and EAX_urad,EBX_urad,ECX_urad in µrad for X). --squareness is a TOML file with every \
 squareness error of the machine in µrad (COX, AOZ, BOZ on seed-3axis) and optionally \
-[reference], the axis positions in mm where du = 0 (default 0). Straightness is taken relative \
-to its least-squares line; tables are interpolated linearly; a position outside a measured \
+[reference], the axis positions in mm where du = 0 (default 0). A position outside a measured \
 range is an error.
 
---path corrects the commanded poses of a CSV (columns X,Y,Z in mm; other columns, comments and \
-line ends kept byte for byte) into -o; a corrected command outside a stroke is refused. --grid \
-writes du on a grid over the measured ranges at --pitch mm (X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um: \
-the predicted error, actual minus nominal tool point; a controller moves by -du). Prints the \
-largest and RMS predicted error and correction per axis over the grid, the path, or (neither \
-given) an 11 x 11 x 11 lattice over the measured ranges; --json prints it as JSON.";
+--path corrects the commanded poses of a CSV (columns X,Y,Z in mm; other columns kept byte for \
+byte) into -o; a corrected command outside a stroke is refused. --grid writes du on a grid over \
+the measured ranges at --pitch mm (X_mm,Y_mm,Z_mm,dx_um,dy_um,dz_um: the predicted error; a \
+controller moves by -du). Prints the largest and RMS predicted error and correction per axis \
+over the grid, the path, or (neither given) an 11 x 11 x 11 lattice; --json prints it as JSON.
+
+Details: docs/volumetric.md.";
 
 /// Flags of `rtest volumetric`.
 #[derive(Debug, clap::Args)]

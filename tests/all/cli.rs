@@ -258,6 +258,52 @@ fn every_verb_documents_units_and_exit_codes() {
     assert!(ok(&["demo", "--help"]).contains("rtest-demo"));
 }
 
+/// `text` folded at `width` columns at spaces, as `fold -s -w width` does: the number of lines.
+fn folded_lines(text: &str, width: usize) -> usize {
+    text.lines()
+        .map(|line| {
+            let (mut lines, mut used) = (1, 0);
+            for word in line.split(' ') {
+                let w = word.chars().count();
+                if used > 0 && used + 1 + w > width {
+                    lines += 1;
+                    used = w;
+                } else {
+                    used += if used > 0 { 1 + w } else { w };
+                }
+            }
+            lines
+        })
+        .sum()
+}
+
+#[test]
+fn every_verb_says_what_it_does_in_at_most_25_lines_and_points_at_the_docs() {
+    let top = ok(&["--help"]);
+    let verbs: Vec<&str> = top
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| !l.is_empty())
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|v| *v != "help")
+        .collect();
+    assert!(verbs.len() >= 17, "{verbs:?}");
+    for verb in verbs {
+        let help = ok(&[verb, "--help"]);
+        let description = help.split("\nUsage:").next().unwrap();
+        let lines = folded_lines(description.trim_end(), 100);
+        assert!(
+            lines <= 25,
+            "{verb}: {lines} lines of description at 100 columns:\n{description}"
+        );
+        assert!(
+            description.contains("docs/") || description.contains(".md"),
+            "{verb}: no pointer to the docs:\n{description}"
+        );
+    }
+}
+
 // ---------------------------------------------------------------- bad input
 
 #[test]

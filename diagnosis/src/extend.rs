@@ -46,7 +46,8 @@ pub(super) fn fit_refined(
     opts.constraint = o.constraint.clone();
     opts.tolerances = o.tolerances;
     opts.params = None;
-    Ok(identify_campaign_refined(m, model, c, &opts, refine, noise)?.0)
+    opts.noise = noise.clone();
+    Ok(identify_campaign_refined(m, model, c, &opts, refine)?.0)
 }
 
 /// The values and standard uncertainties of `term` in `fit` (mm or rad; every owner's columns

@@ -3,7 +3,7 @@
 //! [`super::least_squares()`], and what the offsets swallow. First order; [`super::refine`]
 //! refines it against the exact machine.
 //!
-//! Under a noise model ([`identify_with_noise`]): first an ordinary fit, then the noise model
+//! Under a noise model ([`IdentifyOptions::noise`]): first an ordinary fit, then the noise model
 //! ([`choose_noise`]: declared, from a static record, or estimated from the ordinary fit's
 //! residual), then the generalized least-squares fit of the whitened rows
 //! ([`super::least_squares_whitened`]), whose uncertainties are honest under correlated noise.
@@ -81,6 +81,10 @@ pub struct IdentifyOptions {
     pub tolerances: Tolerances,
     /// Kinematic parameters (mm, symbol order); `None`: the machine's defaults.
     pub params: Option<Vec<f64>>,
+    /// The noise model the fit assumes: ordinary least squares by default; estimated from the
+    /// residual, or a given model, for a generalized least-squares fit (see the module
+    /// documentation).
+    pub noise: NoiseChoice,
 }
 
 impl IdentifyOptions {
@@ -104,6 +108,12 @@ impl IdentifyOptions {
     /// With the kinematic parameters `params` (mm, symbol order).
     pub fn params(mut self, params: Vec<f64>) -> IdentifyOptions {
         self.params = Some(params);
+        self
+    }
+
+    /// Under the noise model `noise`.
+    pub fn noise(mut self, noise: NoiseChoice) -> IdentifyOptions {
+        self.noise = noise;
         self
     }
 
@@ -203,21 +213,6 @@ pub fn gain_source(
     Ok(GainSource::new(m, &fitted.errors(), &opts.parameters(m))?)
 }
 
-/// As [`identify`], under the noise model `noise` (see the module documentation).
-///
-/// # Errors
-/// See [`identify_with_noise`].
-pub fn identify_noise(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    opts: &IdentifyOptions,
-    noise: &NoiseChoice,
-) -> Result<Identification, EstimateError> {
-    let mut source = gain_source(m, model, opts)?;
-    identify_with_noise(m, model, record, &mut source, opts, noise)
-}
-
 /// The noise model of `choice` for an ordinary fit with `residual` (mm, 3 rows per sample, one
 /// record) and σ̂ `sigma` (mm): [`NoiseChoice::Ordinary`] is white with σ̂;
 /// [`NoiseChoice::Model`] the model; [`NoiseChoice::Estimate`] the estimate from the residual
@@ -306,22 +301,27 @@ pub fn choose_noise_weighted(
     Ok(choose_noise(choice, r.as_slice(), sigma))
 }
 
-/// As [`identify_with`], under the noise model `noise`: an ordinary fit, the noise model of
+/// As [`identify`], with gains from `source` (which must cover the model's errors; its
+/// parameters are used, `opts.params` is ignored; a caller fitting many records keeps one).
+///
+/// Under the options' noise model: an ordinary fit, the noise model of
 /// [`choose_noise`] from its residual, then generalized least squares
 /// ([`super::least_squares_whitened`]) unless the choice is [`NoiseChoice::Ordinary`]. A record
 /// with covariances is whitened by them first (see the module documentation).
 ///
 /// # Errors
-/// As [`identify_with`]; [`EstimateError::Noise`] when the model or the covariances cannot
+/// A model or record that does not fit `m`, a record without (finite) measurements, fewer
+/// readings than parameters plus one ([`check_readings`]), a bad constraint, an SVD that does
+/// not converge; [`EstimateError::Noise`] when the model or the covariances cannot
 /// whiten, whitening changes the rank, or a declared model meets covariances.
-pub fn identify_with_noise(
+pub fn identify_with(
     m: &Machine,
     model: &Model,
     record: &Record,
     source: &mut GainSource,
     opts: &IdentifyOptions,
-    noise: &NoiseChoice,
 ) -> Result<Identification, EstimateError> {
+    let noise = &opts.noise;
     let fitted = opts.fitted_model(model);
     check_readings(record.samples.len(), fitted.width())?;
     let y = measurement_vector(record)?;
@@ -358,23 +358,6 @@ pub fn identify_with_noise(
     ident.noise = model_of_noise;
     ident.whitened_sigma = whitened_sigma;
     Ok(ident)
-}
-
-/// As [`identify`], with gains from `source` (which must cover the model's errors; its
-/// parameters are used, `opts.params` is ignored).
-///
-/// # Errors
-/// A model or record that does not fit `m`, a record without (finite) measurements, fewer
-/// readings than parameters plus one ([`check_readings`]), a bad constraint, an SVD that does
-/// not converge.
-pub fn identify_with(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    source: &mut GainSource,
-    opts: &IdentifyOptions,
-) -> Result<Identification, EstimateError> {
-    identify_with_noise(m, model, record, source, opts, &NoiseChoice::Ordinary)
 }
 
 impl Identification {

@@ -83,16 +83,13 @@ pub mod validate;
 pub use hmatrix::{Backend, GainSource, HMatrixError, h_matrix};
 pub use identify::{
     Identification, IdentifyOptions, check_readings, choose_noise, gain_source, identify,
-    identify_noise, identify_with, identify_with_noise, measurement_vector, with_offsets,
+    identify_with, measurement_vector, with_offsets,
 };
 pub use least_squares::{
     Constraint, EstimateError, Fit, RANK_RELATIVE_TOLERANCE, Tolerances, WhitenedFit,
     least_squares, least_squares_reduced, least_squares_whitened,
 };
 pub use noise::{NoiseChoice, NoiseModel, NoiseSource};
-pub use refine::{
-    RefineError, RefineOptions, Refinement, identify_refined, identify_refined_noise,
-    identify_refined_with, identify_refined_with_noise,
-};
+pub use refine::{RefineError, RefineOptions, Refinement, identify_refined, identify_refined_with};
 pub use sanity::{Implausible, ValueLimits, check_values};
 pub use validate::{ValidateError, ValidateOptions, Validation, validate};

@@ -43,7 +43,7 @@
 //! After convergence the fit's residual, σ̂, uncertainties and covariance are those of the exact
 //! residual; the identifiability analysis is unchanged (it depends on H only).
 //!
-//! Under a noise model ([`identify_refined_with_noise`]) the ordinary refinement comes first;
+//! Under a noise model ([`IdentifyOptions::noise`](crate::IdentifyOptions::noise)) the ordinary refinement comes first;
 //! the noise model is chosen from its exact residual ([`crate::choose_noise`]), then
 //! the iteration continues from its solution with every correction the generalized
 //! least-squares one (`Δ = (W·H)⁺·W·r`, [`crate::least_squares_whitened`]), and the
@@ -147,6 +147,36 @@ pub struct Refinement {
     pub converged: bool,
     /// Residual RMS of the linear fit and of the refined one (mm, over 3N rows).
     pub rms_mm: (f64, f64),
+}
+
+impl Refinement {
+    /// Nothing when the refinement converged, else [`RefineError::NotConverged`] with its
+    /// last step: its values are no identification.
+    pub(crate) fn converged(&self) -> Result<(), RefineError> {
+        if self.converged {
+            return Ok(());
+        }
+        Err(RefineError::NotConverged {
+            iterations: self.iterations,
+            last_step_mm: self.steps_mm.last().copied().unwrap_or(0.0),
+            tolerance_mm: self.tolerance_mm,
+        })
+    }
+
+    /// This ordinary refinement followed by the converged generalized one `whitened`: the
+    /// steps of both, the first-order RMS of the ordinary linear fit, the refined RMS of the
+    /// last.
+    pub(crate) fn followed_by(self, whitened: &Refinement) -> Refinement {
+        let mut steps_mm = self.steps_mm;
+        steps_mm.extend(&whitened.steps_mm);
+        Refinement {
+            iterations: steps_mm.len(),
+            steps_mm,
+            tolerance_mm: whitened.tolerance_mm,
+            converged: true,
+            rms_mm: (self.rms_mm.0, whitened.rms_mm.1),
+        }
+    }
 }
 
 /// Why a refinement failed.
@@ -436,7 +466,7 @@ pub(crate) fn gauss_newton(
 
 /// Identifies `model` on `record` ([`crate::identify()`], with the gain source it
 /// needs built here) and refines the result against the exact machine ([`refine`], with the
-/// identification's tolerances).
+/// identification's tolerances), under the options' noise model ([`identify_refined_with`]).
 ///
 /// # Errors
 /// As [`crate::identify_with`] and [`refine`]; [`RefineError::NotConverged`] when
@@ -455,8 +485,14 @@ pub fn identify_refined(
 /// [`identify_refined`] with gains from `source` (covering the fitted model's errors), for
 /// callers that fit several models of one machine with one source.
 ///
+/// Under a noise model other than ordinary least squares ([`IdentifyOptions::noise`], see the
+/// module documentation): the ordinary refinement, the noise model from its exact residual,
+/// then the refinement by generalized least squares from its solution. The [`Refinement`]
+/// counts the steps of both; its first-order RMS is the ordinary linear fit's.
+///
 /// # Errors
-/// As [`identify_refined`].
+/// As [`identify_refined`]; [`RefineError::NotConverged`] when a refinement does not
+/// converge (its values are no identification).
 pub fn identify_refined_with(
     m: &Machine,
     model: &Model,
@@ -465,55 +501,12 @@ pub fn identify_refined_with(
     opts: &IdentifyOptions,
     refine_opts: &RefineOptions,
 ) -> Result<(Identification, Refinement), RefineError> {
-    let mut ident = identify_with(m, model, record, source, opts)?;
-    let r = refine(m, record, &mut ident, source, &opts.tolerances, refine_opts)?;
-    if !r.converged {
-        return Err(RefineError::NotConverged {
-            iterations: r.iterations,
-            last_step_mm: r.steps_mm.last().copied().unwrap_or(0.0),
-            tolerance_mm: r.tolerance_mm,
-        });
-    }
-    Ok((ident, r))
-}
-
-/// [`identify_refined`] under the noise model `noise`, with the gain source it needs built
-/// here.
-///
-/// # Errors
-/// As [`identify_refined_with_noise`].
-pub fn identify_refined_noise(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    opts: &IdentifyOptions,
-    refine_opts: &RefineOptions,
-    noise: &NoiseChoice,
-) -> Result<(Identification, Refinement), RefineError> {
-    let mut source = gain_source(m, model, opts)?;
-    identify_refined_with_noise(m, model, record, &mut source, opts, refine_opts, noise)
-}
-
-/// [`identify_refined_with`] under the noise model `noise` (see the module documentation):
-/// the ordinary refinement, the noise model from its exact residual, then the refinement by
-/// generalized least squares from its solution. The [`Refinement`] counts the steps of both;
-/// its first-order RMS is the ordinary linear fit's. [`NoiseChoice::Ordinary`] is
-/// [`identify_refined_with`].
-///
-/// # Errors
-/// As [`identify_refined`]; [`RefineError::NotConverged`] when either refinement does not
-/// converge.
-pub fn identify_refined_with_noise(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    source: &mut GainSource,
-    opts: &IdentifyOptions,
-    refine_opts: &RefineOptions,
-    noise: &NoiseChoice,
-) -> Result<(Identification, Refinement), RefineError> {
+    let noise = &opts.noise;
     let weights = sample_whitening(record, noise)?;
-    let (mut ident, ordinary) = identify_refined_with(m, model, record, source, opts, refine_opts)?;
+    let ordinary_opts = opts.clone().noise(NoiseChoice::Ordinary);
+    let mut ident = identify_with(m, model, record, source, &ordinary_opts)?;
+    let ordinary = refine(m, record, &mut ident, source, &opts.tolerances, refine_opts)?;
+    ordinary.converged()?;
     if *noise == NoiseChoice::Ordinary {
         return Ok((ident, ordinary));
     }
@@ -528,25 +521,8 @@ pub fn identify_refined_with_noise(
         &chosen,
     )?;
     ident.noise = chosen;
-    if !r.converged {
-        return Err(RefineError::NotConverged {
-            iterations: r.iterations,
-            last_step_mm: r.steps_mm.last().copied().unwrap_or(0.0),
-            tolerance_mm: r.tolerance_mm,
-        });
-    }
-    let mut steps_mm = ordinary.steps_mm;
-    steps_mm.extend(&r.steps_mm);
-    Ok((
-        ident,
-        Refinement {
-            iterations: steps_mm.len(),
-            steps_mm,
-            tolerance_mm: r.tolerance_mm,
-            converged: true,
-            rms_mm: (ordinary.rms_mm.0, r.rms_mm.1),
-        },
-    ))
+    r.converged()?;
+    Ok((ident, ordinary.followed_by(&r)))
 }
 
 #[cfg(test)]

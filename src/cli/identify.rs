@@ -232,12 +232,14 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         };
         loaded.check_times(flag, &m, &model)?;
         let c = &loaded.campaign;
-        let opts = IdentifyOptions::new().constraint(campaign::constraint_for(
-            &m,
-            &model,
-            c,
-            opts.constraint.clone(),
-        ));
+        let opts = IdentifyOptions::new()
+            .constraint(campaign::constraint_for(
+                &m,
+                &model,
+                c,
+                opts.constraint.clone(),
+            ))
+            .noise(noise);
         // Records modelled with different values of a machine length cannot share its change:
         // a bad input, said before any fitting.
         let labelled: Vec<(&str, &[f64])> = c
@@ -248,11 +250,11 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         fitting::offsets::check_shared_symbols(&m, &model, &labelled)
             .map_err(|e| CliError::input(format!("{flag}: {e}")))?;
         let (ident, refinement) = if args.first_order {
-            let ident = identify_campaign(&m, &model, c, &opts, &noise).map_err(estimate_error)?;
+            let ident = identify_campaign(&m, &model, c, &opts).map_err(estimate_error)?;
             (ident, None)
         } else {
             let (ident, r) =
-                identify_campaign_refined(&m, &model, c, &opts, &RefineOptions::default(), &noise)
+                identify_campaign_refined(&m, &model, c, &opts, &RefineOptions::default())
                     .map_err(refine_error)?;
             (ident, Some(r))
         };

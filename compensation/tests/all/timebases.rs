@@ -291,9 +291,8 @@ fn a_rate_and_a_warm_up_are_identified_on_records_of_60_s_and_600_s() {
             &m,
             model,
             c,
-            &IdentifyOptions::new(),
+            &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
             &RefineOptions::default(),
-            &NoiseChoice::Ordinary,
         )
         .unwrap()
         .0
@@ -356,9 +355,8 @@ fn on_a_campaign_clock_one_warm_up_is_shared_and_the_drifts_stay_each_record_s()
         &m,
         &reduced_with(&m, &["dx0@rate", "EXZ@warmup:40"]),
         &c,
-        &IdentifyOptions::new(),
+        &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     eprintln!("refinement: {refinement:?}");

@@ -223,11 +223,10 @@ pub fn identify_campaign(
     model: &Model,
     campaign: &Campaign,
     opts: &IdentifyOptions,
-    noise: &NoiseChoice,
 ) -> Result<CampaignIdentification, EstimateError> {
     check_options(opts)?;
     let design = design_matrix(m, model, campaign)?;
-    identify_campaign_with(m, model, campaign, &design, opts, noise)
+    identify_campaign_with(m, model, campaign, &design, opts)
 }
 
 /// Refuses options that belong to the records in a campaign.
@@ -241,8 +240,8 @@ pub(crate) fn check_options(opts: &IdentifyOptions) -> Result<(), EstimateError>
 }
 
 /// Identifies `model` on `campaign` with its `design` matrix (first order): the ordinary fit
-/// (`opts`: constraint and tolerances; the records carry zeroing and parameters), then, unless
-/// `noise` is [`NoiseChoice::Ordinary`], the noise model from its residual (pooled over the
+/// (`opts`: constraint and tolerances; the records carry zeroing and parameters), then, unless the
+/// options' noise is [`NoiseChoice::Ordinary`], the noise model from its residual (pooled over the
 /// records) and the generalized least-squares fit, each record's rows whitened on their own.
 ///
 /// # Errors
@@ -254,8 +253,8 @@ pub fn identify_campaign_with(
     campaign: &Campaign,
     design: &Design,
     opts: &IdentifyOptions,
-    noise: &NoiseChoice,
 ) -> Result<CampaignIdentification, EstimateError> {
+    let noise = &opts.noise;
     check_options(opts)?;
     let samples = campaign.samples();
     check_readings(samples, design.names.len())?;

@@ -179,12 +179,11 @@ impl Run<'_> {
     }
 }
 
-/// Identifies `model` on `campaign` and refines the fit against the exact machine: the
-/// ordinary refinement, then, unless `noise` is [`NoiseChoice::Ordinary`], the noise model
-/// from its exact residual (pooled over the records) and the refinement by generalized least
-/// squares from its solution (as [`crate::identify_refined_with_noise`]). The
-/// ordinary system is factorised once for the first-order fit and both refinements (the
-/// generalized one adds the whitened system's).
+/// Identifies `model` on `campaign` and refines the fit against the exact machine: the ordinary
+/// refinement, then, unless the options' noise is [`NoiseChoice::Ordinary`], the noise model from
+/// its exact residual (pooled over the records) and the refinement by generalized least squares
+/// from its solution (as [`crate::identify_refined_with`]). The ordinary system is factorised once
+/// for the first-order fit and both refinements (the generalized one adds the whitened system's).
 ///
 /// # Errors
 /// As [`super::identify_campaign`]; [`RefineError::NotConverged`] when a refinement does not
@@ -195,8 +194,8 @@ pub fn identify_campaign_refined(
     campaign: &Campaign,
     opts: &IdentifyOptions,
     refine_opts: &RefineOptions,
-    noise: &NoiseChoice,
 ) -> Result<(CampaignIdentification, Refinement), RefineError> {
+    let noise = &opts.noise;
     check_options(opts)?;
     let design = design_matrix(m, model, campaign)?;
     check_readings(campaign.samples(), design.names.len())?;
@@ -217,7 +216,7 @@ pub fn identify_campaign_refined(
         opts: refine_opts,
     };
     let ordinary = run.refine(&mut ident, None, Some(&factored))?;
-    not_converged(&ordinary)?;
+    ordinary.converged()?;
     if *noise == NoiseChoice::Ordinary {
         return Ok((ident, ordinary));
     }
@@ -226,28 +225,6 @@ pub fn identify_campaign_refined(
     let under = factored.under(h, names, c, t, &chosen)?;
     let r = run.refine(&mut ident, Some(&chosen), Some(&under))?;
     ident.noise = chosen;
-    not_converged(&r)?;
-    let mut steps_mm = ordinary.steps_mm;
-    steps_mm.extend(&r.steps_mm);
-    Ok((
-        ident,
-        Refinement {
-            iterations: steps_mm.len(),
-            steps_mm,
-            tolerance_mm: r.tolerance_mm,
-            converged: true,
-            rms_mm: (ordinary.rms_mm.0, r.rms_mm.1),
-        },
-    ))
-}
-
-fn not_converged(r: &Refinement) -> Result<(), RefineError> {
-    if r.converged {
-        return Ok(());
-    }
-    Err(RefineError::NotConverged {
-        iterations: r.iterations,
-        last_step_mm: r.steps_mm.last().copied().unwrap_or(0.0),
-        tolerance_mm: r.tolerance_mm,
-    })
+    r.converged()?;
+    Ok((ident, ordinary.followed_by(&r)))
 }

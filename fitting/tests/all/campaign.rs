@@ -4,8 +4,8 @@
 
 use fitting::campaign::{Owner, design_matrix, identify_campaign, identify_campaign_refined};
 use fitting::noise::NoiseChoice;
-use fitting::refine::{RefineOptions, identify_refined_noise};
-use fitting::{Fit, IdentifyOptions, identify_noise};
+use fitting::refine::{RefineOptions, identify_refined};
+use fitting::{Fit, IdentifyOptions, identify};
 use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use simulation::campaign::{Campaign, CampaignError, CampaignRecord};
@@ -111,9 +111,10 @@ fn one_record_equals_the_single_identification_bit_for_bit() {
         let t = truth(&m, "seed-ac-demo", 0.5e-3, 7, zeroed);
         let k4 = simulate(&m, &t, &path(&m, "K4")).unwrap();
         let opts = IdentifyOptions::new().zeroed(zeroed);
-        let single = identify_noise(&m, &model, &k4, &opts, &noise).unwrap();
+        let single = identify(&m, &model, &k4, &opts.clone().noise(noise.clone())).unwrap();
         let c = one_record(&m, "k4", k4.clone(), zeroed);
-        let camp = identify_campaign(&m, &model, &c, &IdentifyOptions::new(), &noise).unwrap();
+        let camp = identify_campaign(&m, &model, &c, &IdentifyOptions::new().noise(noise.clone()))
+            .unwrap();
         assert_same(&single.fit, &camp.fit);
         assert_eq!(single.noise, camp.noise);
         assert_eq!(single.whitened_sigma, camp.whitened_sigma);
@@ -127,16 +128,20 @@ fn one_record_equals_the_single_identification_bit_for_bit() {
             );
         }
 
-        let (single_r, rs) =
-            identify_refined_noise(&m, &model, &k4, &opts, &RefineOptions::default(), &noise)
-                .unwrap();
+        let (single_r, rs) = identify_refined(
+            &m,
+            &model,
+            &k4,
+            &opts.clone().noise(noise.clone()),
+            &RefineOptions::default(),
+        )
+        .unwrap();
         let (camp_r, rc) = identify_campaign_refined(
             &m,
             &model,
             &c,
-            &IdentifyOptions::new(),
+            &IdentifyOptions::new().noise(noise.clone()),
             &RefineOptions::default(),
-            &noise,
         )
         .unwrap();
         assert_eq!(rs, rc);
@@ -218,7 +223,7 @@ fn two_paths_on_one_set_up_share_it_and_determine_what_one_path_cannot() {
     let k2 = simulate(&m, &t, &path(&m, "K2")).unwrap();
     let p = m.default_parameters();
     let opts = IdentifyOptions::new();
-    let alone = identify_noise(&m, &model, &k1, &opts, &NoiseChoice::Ordinary).unwrap();
+    let alone = identify(&m, &model, &k1, &opts.clone().noise(NoiseChoice::Ordinary)).unwrap();
     assert!(
         alone.fit.rank < 11,
         "K1 alone cannot determine the reduced model"
@@ -232,9 +237,8 @@ fn two_paths_on_one_set_up_share_it_and_determine_what_one_path_cannot() {
         &m,
         &model,
         &c,
-        &opts,
+        &opts.clone().noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     assert_eq!(ident.fit.rank, 11, "K1 and K2 on one ball determine all 11");
@@ -293,8 +297,7 @@ fn bad_campaigns_are_refused_naming_the_record() {
         &m,
         &reduced(&m),
         &c,
-        &IdentifyOptions::new(),
-        &NoiseChoice::Ordinary,
+        &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
     )
     .unwrap_err()
     .to_string();
@@ -333,9 +336,8 @@ fn validation_uses_a_fitted_set_up_and_refits_a_new_one() {
         &m,
         &model,
         &fitted,
-        &IdentifyOptions::new(),
+        &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     let values = CampaignValues::of(&ident);
@@ -425,9 +427,8 @@ fn a_drift_on_the_campaign_clock_is_one_drift_over_the_records() {
         &m,
         &model,
         &c,
-        &IdentifyOptions::new(),
+        &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     assert_eq!(ident.layout.clock, Some(span));

@@ -19,7 +19,7 @@
 use fitting::campaign::identify_campaign_refined;
 use fitting::noise::NoiseChoice;
 use fitting::refine::RefineOptions;
-use fitting::{IdentifyOptions, identify_noise};
+use fitting::{IdentifyOptions, identify};
 use model_spec::Machine;
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::{Basis, Effect, Model, Term};
@@ -175,9 +175,8 @@ fn two_ball_heights_determine_the_variation_of_z_tilts_that_one_height_cannot() 
         &m,
         &model,
         &one,
-        &opts,
+        &opts.clone().noise(ordinary.clone()),
         &RefineOptions::default(),
-        &ordinary,
     )
     .unwrap();
     assert_eq!((a.fit.names.len(), a.fit.rank), (17, 9));
@@ -201,7 +200,13 @@ fn two_ball_heights_determine_the_variation_of_z_tilts_that_one_height_cannot() 
         );
     }
     // The same without a campaign: one record at one height is no better.
-    let single = identify_noise(&m, &model, &one.records[0].record, &opts, &ordinary).unwrap();
+    let single = identify(
+        &m,
+        &model,
+        &one.records[0].record,
+        &opts.clone().noise(ordinary.clone()),
+    )
+    .unwrap();
     assert!(single.fit.rank <= 9);
 
     // Two heights, each its own ball set-up.
@@ -212,9 +217,8 @@ fn two_ball_heights_determine_the_variation_of_z_tilts_that_one_height_cannot() 
         &m,
         &model,
         &two,
-        &opts,
+        &opts.clone().noise(ordinary.clone()),
         &RefineOptions::default(),
-        &ordinary,
     )
     .unwrap();
     assert!(refinement.converged);

@@ -6,7 +6,7 @@
 //! "Noise model"); the ordinary fit fails it under AR(1) noise.
 
 use fitting::noise::{NoiseChoice, NoiseModel, NoiseSource};
-use fitting::{IdentifyOptions, RefineOptions, identify_noise, identify_refined_noise};
+use fitting::{IdentifyOptions, RefineOptions, identify, identify_refined};
 use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use simulation::model::Model;
@@ -59,13 +59,12 @@ fn z_scores(
     for seed in 1..=SEEDS {
         let t = truth(m, sigma_mm, phi, seed);
         let data = simulate(m, &t, &k4).unwrap();
-        let (ident, r) = identify_refined_noise(
+        let (ident, r) = identify_refined(
             m,
             &model,
             &data,
-            &IdentifyOptions::new(),
+            &IdentifyOptions::new().noise(choice(seed).clone()),
             &RefineOptions::default(),
-            &choice(seed),
         )
         .unwrap();
         assert!(r.converged);
@@ -169,8 +168,20 @@ fn white_noise_gls_values_stay_within_noise_of_the_ordinary_ones() {
     let k4 = builtin_path(&m, "K4").unwrap().unwrap();
     let data = simulate(&m, &truth(&m, 0.5e-3, 0.0, 3), &k4).unwrap();
     let opts = IdentifyOptions::new();
-    let ordinary = identify_noise(&m, &model, &data, &opts, &NoiseChoice::Ordinary).unwrap();
-    let gls = identify_noise(&m, &model, &data, &opts, &NoiseChoice::Estimate).unwrap();
+    let ordinary = identify(
+        &m,
+        &model,
+        &data,
+        &opts.clone().noise(NoiseChoice::Ordinary),
+    )
+    .unwrap();
+    let gls = identify(
+        &m,
+        &model,
+        &data,
+        &opts.clone().noise(NoiseChoice::Estimate),
+    )
+    .unwrap();
     assert_eq!(gls.fit.rank, ordinary.fit.rank);
     assert_eq!(gls.fit.condition, ordinary.fit.condition);
     for j in 0..model.terms.len() {
@@ -196,13 +207,12 @@ fn noise_free_data_fall_back_to_white_and_stay_exact() {
     let k4 = builtin_path(&m, "K4").unwrap().unwrap();
     let t = truth(&m, 0.0, 0.0, 1);
     let data = simulate(&m, &t, &k4).unwrap();
-    let (ident, _) = identify_refined_noise(
+    let (ident, _) = identify_refined(
         &m,
         &model,
         &data,
-        &IdentifyOptions::new(),
+        &IdentifyOptions::new().noise(NoiseChoice::Estimate),
         &RefineOptions::default(),
-        &NoiseChoice::Estimate,
     )
     .unwrap();
     match &ident.noise.source {

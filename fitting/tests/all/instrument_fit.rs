@@ -6,8 +6,8 @@
 use fitting::calibrate::instrument_terms;
 use fitting::noise::{NoiseChoice, NoiseError, NoiseModel, NoiseSource};
 use fitting::{
-    EstimateError, IdentifyOptions, RefineOptions, gain_source, identify_noise,
-    identify_refined_noise, identify_with,
+    EstimateError, IdentifyOptions, RefineOptions, gain_source, identify, identify_refined,
+    identify_with,
 };
 use formats::truth::builtin_truth;
 use model_spec::instrument::{Instrument, ReadingsFrame, preset};
@@ -172,10 +172,22 @@ fn a_sensor_record_identifies_what_the_ball_centre_record_of_the_same_run_does()
     let ball = simulate(&m, &truth, &path).unwrap();
     let sensors = simulate_sensors(&m, &truth, &path, &quiet, ReadingsFrame::Tool).unwrap();
     let read = to_record(&SensorHead::new(&quiet), &m, ReadingsFrame::Tool, &sensors).unwrap();
-    let (a, _) =
-        identify_refined_noise(&m, &model, &ball, &opts, &refine, &NoiseChoice::Ordinary).unwrap();
-    let (b, _) =
-        identify_refined_noise(&m, &model, &read, &opts, &refine, &NoiseChoice::Ordinary).unwrap();
+    let (a, _) = identify_refined(
+        &m,
+        &model,
+        &ball,
+        &opts.clone().noise(NoiseChoice::Ordinary),
+        &refine,
+    )
+    .unwrap();
+    let (b, _) = identify_refined(
+        &m,
+        &model,
+        &read,
+        &opts.clone().noise(NoiseChoice::Ordinary),
+        &refine,
+    )
+    .unwrap();
     for (j, name) in a.fit.names.iter().enumerate() {
         let (x, y) = (a.fit.values[j].unwrap(), b.fit.values[j].unwrap());
         assert!((x - y).abs() < 1e-8, "{name}: {x} vs {y}");
@@ -187,10 +199,22 @@ fn a_sensor_record_identifies_what_the_ball_centre_record_of_the_same_run_does()
     let ball = simulate(&m, &truth, &path).unwrap();
     let sensors = simulate_sensors(&m, &truth, &path, &i, ReadingsFrame::Tool).unwrap();
     let read = to_record(&SensorHead::new(&i), &m, ReadingsFrame::Tool, &sensors).unwrap();
-    let (a, _) =
-        identify_refined_noise(&m, &model, &ball, &opts, &refine, &NoiseChoice::Estimate).unwrap();
-    let (b, _) =
-        identify_refined_noise(&m, &model, &read, &opts, &refine, &NoiseChoice::Estimate).unwrap();
+    let (a, _) = identify_refined(
+        &m,
+        &model,
+        &ball,
+        &opts.clone().noise(NoiseChoice::Estimate),
+        &refine,
+    )
+    .unwrap();
+    let (b, _) = identify_refined(
+        &m,
+        &model,
+        &read,
+        &opts.clone().noise(NoiseChoice::Estimate),
+        &refine,
+    )
+    .unwrap();
     for (j, name) in a.fit.names.iter().enumerate() {
         let (x, y) = (a.fit.values[j].unwrap(), b.fit.values[j].unwrap());
         // The difference is the sensors' noise alone, about a third of the total: well
@@ -214,18 +238,23 @@ fn a_declared_noise_model_is_refused_for_readings_with_covariances() {
     let sensors = simulate_sensors(&m, &truth, &path, &i, ReadingsFrame::Tool).unwrap();
     let read = to_record(&SensorHead::new(&i), &m, ReadingsFrame::Tool, &sensors).unwrap();
     let declared = NoiseChoice::Model(NoiseModel::white(1e-4, NoiseSource::Declared));
-    let e = identify_noise(&m, &model, &read, &IdentifyOptions::default(), &declared).unwrap_err();
+    let e = identify(
+        &m,
+        &model,
+        &read,
+        &IdentifyOptions::default().noise(declared.clone()),
+    )
+    .unwrap_err();
     assert!(
         matches!(e, EstimateError::Noise(NoiseError::DeclaredTwice)),
         "{e}"
     );
-    let e = identify_refined_noise(
+    let e = identify_refined(
         &m,
         &model,
         &read,
-        &IdentifyOptions::default(),
+        &IdentifyOptions::default().noise(declared.clone()),
         &RefineOptions::default(),
-        &declared,
     )
     .unwrap_err();
     assert!(
@@ -235,7 +264,13 @@ fn a_declared_noise_model_is_refused_for_readings_with_covariances() {
     );
     // Estimated (over time, from the whitened rows) and ordinary are fine.
     for choice in [NoiseChoice::Estimate, NoiseChoice::Ordinary] {
-        identify_noise(&m, &model, &read, &IdentifyOptions::default(), &choice).unwrap();
+        identify(
+            &m,
+            &model,
+            &read,
+            &IdentifyOptions::default().noise(choice.clone()),
+        )
+        .unwrap();
     }
 }
 
@@ -333,13 +368,12 @@ fn identifying_s_with_the_machine_identifies_the_gain_errors_but_their_scale() {
         &sensors,
     )
     .unwrap();
-    let (id, _) = identify_refined_noise(
+    let (id, _) = identify_refined(
         &m,
         &model,
         &read,
-        &IdentifyOptions::default(),
+        &IdentifyOptions::default().noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     let s = instrument_terms(&SensorHead::new(&described), &dg).unwrap();

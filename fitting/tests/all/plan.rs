@@ -214,8 +214,7 @@ fn monte_carlo(
             model,
             &campaign,
             &design,
-            &IdentifyOptions::new(),
-            choice,
+            &IdentifyOptions::new().noise(choice.clone()),
         )
         .unwrap()
         .fit;
@@ -687,8 +686,7 @@ fn the_prediction_is_what_a_fit_reports_scaled_to_the_stated_noise() {
         &m,
         &model,
         &Campaign::new(records).unwrap(),
-        &IdentifyOptions::new(),
-        &NoiseChoice::Ordinary,
+        &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
     )
     .unwrap();
     let fit = &ident.fit;

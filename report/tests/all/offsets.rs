@@ -10,7 +10,7 @@ use fitting::campaign::{CampaignValues, Owner, identify_campaign_refined, valida
 use fitting::hmatrix::h_matrix_auto;
 use fitting::noise::NoiseChoice;
 use fitting::offsets::{OffsetGains, is_setup_symbol};
-use fitting::refine::{RefineOptions, identify_refined_noise};
+use fitting::refine::{RefineOptions, identify_refined};
 use fitting::{Identification, IdentifyOptions, ValidateOptions, identify, validate};
 use model_spec::{Machine, builtin, parse_machine};
 use report::json::read::parse_identification;
@@ -282,13 +282,12 @@ fn a_pivot_length_off_its_nominal_is_recovered_within_four_standard_uncertaintie
     // Noise-free, every parameter determined: the change is found exactly once refined
     // against the exact machine.
     let clean = simulate(&m, &head_table_truth(&m, 0.0, 0, false), &rec).unwrap();
-    let (id, _) = identify_refined_noise(
+    let (id, _) = identify_refined(
         &m,
         &determined(&m),
         &clean,
-        &opts,
+        &opts.clone().noise(NoiseChoice::Ordinary),
         &refine,
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     assert_eq!(id.fit.rank, id.fit.names.len());
@@ -308,13 +307,12 @@ fn a_pivot_length_off_its_nominal_is_recovered_within_four_standard_uncertaintie
     let seeds = 20;
     for seed in 1..=seeds {
         let noisy = simulate(&m, &head_table_truth(&m, 0.3, seed, true), &rec).unwrap();
-        let (id, _) = identify_refined_noise(
+        let (id, _) = identify_refined(
             &m,
             &location_zt,
             &noisy,
-            &opts,
+            &opts.clone().noise(NoiseChoice::Ordinary),
             &refine,
-            &NoiseChoice::Ordinary,
         )
         .unwrap();
         let (v, s) = value(&id, "Zt");
@@ -468,13 +466,12 @@ BOC = -12.0
     let mut zp_model = model(&m, Some("reduced"), "Zp");
     let zoa = m.error_by_name("ZOA").unwrap();
     zp_model.terms.retain(|t| t.effect != Effect::Error(zoa));
-    let (id, _) = identify_refined_noise(
+    let (id, _) = identify_refined(
         &m,
         &zp_model,
         &rec,
-        &IdentifyOptions::new(),
+        &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     let (v, s) = value(&id, "Zp");
@@ -506,9 +503,8 @@ fn a_campaign_shares_a_machine_length_and_gives_each_set_up_its_ball_position() 
         &m,
         &model_zt,
         &campaign,
-        &IdentifyOptions::new(),
+        &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     let owner = |name: &str| {
@@ -563,9 +559,8 @@ fn a_campaign_shares_a_machine_length_and_gives_each_set_up_its_ball_position() 
         &m,
         &model_zt,
         &Campaign::new(other).unwrap(),
-        &IdentifyOptions::new(),
+        &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap_err()
     .to_string();
@@ -584,13 +579,12 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
     let location_zt = determined(&m);
     let truth = head_table_truth(&m, 0.3, 21, false);
     let rec = simulate(&m, &truth, &builtin_path(&m, "pair-B-C").unwrap().unwrap()).unwrap();
-    let (id, r) = identify_refined_noise(
+    let (id, r) = identify_refined(
         &m,
         &location_zt,
         &rec,
-        &IdentifyOptions::new(),
+        &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     let source = IdentificationSource {
@@ -671,8 +665,7 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
                 false,
             )])
             .unwrap(),
-            &IdentifyOptions::new(),
-            &NoiseChoice::Ordinary,
+            &IdentifyOptions::new().noise(NoiseChoice::Ordinary),
         )
         .unwrap(),
     );
@@ -703,13 +696,13 @@ fn a_change_identified_at_another_value_is_read_back_against_the_default() {
         &path_at(&m, "pair-B-C", &params),
     )
     .unwrap();
-    let (id, r) = identify_refined_noise(
+    let (id, r) = identify_refined(
         &m,
         &determined(&m),
         &rec,
-        &IdentifyOptions::new().params(params),
+        &IdentifyOptions::clone(&IdentifyOptions::new().params(params))
+            .noise(NoiseChoice::Ordinary),
         &RefineOptions::default(),
-        &NoiseChoice::Ordinary,
     )
     .unwrap();
     let (v, _) = value(&id, "Zt");

@@ -207,9 +207,9 @@ fn identify(
         m,
         model,
         campaign,
-        &IdentifyOptions::new().constraint(constraint),
+        &IdentifyOptions::clone(&IdentifyOptions::new().constraint(constraint))
+            .noise(NoiseChoice::Estimate),
         &RefineOptions::default(),
-        &NoiseChoice::Estimate,
     )
     .unwrap()
     .0

@@ -3,6 +3,7 @@
 //! with the terms they are a combination of.
 
 use super::Confounded;
+use super::columns::Columns;
 use super::projected::{orthonormalise, project_out, unit_columns};
 use super::select::{SPAN_TOLERANCE, Scored, Span, gram};
 use nalgebra::{DMatrix, DVector};
@@ -140,8 +141,9 @@ pub(super) fn scaled_size(projected: &DMatrix<f64>, r: &DVector<f64>) -> f64 {
     svd.solve(r, eps).map_or(f64::INFINITY, |c| c.norm())
 }
 
-/// The candidates the final model spans, each with the model terms it is a combination of.
-#[allow(clippy::too_many_arguments)]
+/// The candidates the final model spans, each with the model terms it is a combination of:
+/// `extended` is the base model with the `chosen` candidates, whose whitened columns are those
+/// of `columns`.
 pub(super) fn confounded_with(
     extended: &Model,
     candidates: &[Term],
@@ -149,11 +151,10 @@ pub(super) fn confounded_with(
     unexcited: &[Term],
     q: &Span,
     group: &dyn Fn(usize) -> DMatrix<f64>,
-    nb: usize,
-    h_all: &DMatrix<f64>,
-    starts: &[usize],
-    widths: &[usize],
+    columns: &Columns,
 ) -> Vec<Confounded> {
+    let (nb, h_all, starts, widths) =
+        (columns.nb, &columns.h_all, &columns.starts, &columns.widths);
     // The extended model's columns, scaled to unit norm, with their term indices in `extended`.
     let mut cols: Vec<DVector<f64>> = Vec::new();
     let mut owner: Vec<usize> = Vec::new();

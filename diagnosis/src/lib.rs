@@ -521,10 +521,7 @@ pub fn diagnose(
         &unexcited,
         &Span::of_groups(n, (0..nb).chain(kept.iter().map(|&c| nb + c)), &group),
         &|t| group(t),
-        nb,
-        &cols.h_all,
-        &cols.starts,
-        &cols.widths,
+        &cols,
     );
 
     stage(5);

@@ -223,7 +223,7 @@ fn two_paths_on_one_set_up_share_it_and_determine_what_one_path_cannot() {
     let k2 = simulate(&m, &t, &path(&m, "K2")).unwrap();
     let p = m.default_parameters();
     let opts = IdentifyOptions::new();
-    let alone = identify(&m, &model, &k1, &opts.clone().noise(NoiseChoice::Ordinary)).unwrap();
+    let alone = identify(&m, &model, &k1, &opts).unwrap();
     assert!(
         alone.fit.rank < 11,
         "K1 alone cannot determine the reduced model"
@@ -233,14 +233,8 @@ fn two_paths_on_one_set_up_share_it_and_determine_what_one_path_cannot() {
         CampaignRecord::new("k2", k2, p, "ball", false),
     ])
     .unwrap();
-    let (ident, _) = identify_campaign_refined(
-        &m,
-        &model,
-        &c,
-        &opts.clone().noise(NoiseChoice::Ordinary),
-        &RefineOptions::default(),
-    )
-    .unwrap();
+    let (ident, _) =
+        identify_campaign_refined(&m, &model, &c, &opts, &RefineOptions::default()).unwrap();
     assert_eq!(ident.fit.rank, 11, "K1 and K2 on one ball determine all 11");
     for (j, name) in ident.fit.names.iter().enumerate() {
         let error = name.split('[').next().unwrap();

@@ -172,22 +172,8 @@ fn a_sensor_record_identifies_what_the_ball_centre_record_of_the_same_run_does()
     let ball = simulate(&m, &truth, &path).unwrap();
     let sensors = simulate_sensors(&m, &truth, &path, &quiet, ReadingsFrame::Tool).unwrap();
     let read = to_record(&SensorHead::new(&quiet), &m, ReadingsFrame::Tool, &sensors).unwrap();
-    let (a, _) = identify_refined(
-        &m,
-        &model,
-        &ball,
-        &opts.clone().noise(NoiseChoice::Ordinary),
-        &refine,
-    )
-    .unwrap();
-    let (b, _) = identify_refined(
-        &m,
-        &model,
-        &read,
-        &opts.clone().noise(NoiseChoice::Ordinary),
-        &refine,
-    )
-    .unwrap();
+    let (a, _) = identify_refined(&m, &model, &ball, &opts, &refine).unwrap();
+    let (b, _) = identify_refined(&m, &model, &read, &opts, &refine).unwrap();
     for (j, name) in a.fit.names.iter().enumerate() {
         let (x, y) = (a.fit.values[j].unwrap(), b.fit.values[j].unwrap());
         assert!((x - y).abs() < 1e-8, "{name}: {x} vs {y}");

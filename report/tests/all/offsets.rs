@@ -282,14 +282,7 @@ fn a_pivot_length_off_its_nominal_is_recovered_within_four_standard_uncertaintie
     // Noise-free, every parameter determined: the change is found exactly once refined
     // against the exact machine.
     let clean = simulate(&m, &head_table_truth(&m, 0.0, 0, false), &rec).unwrap();
-    let (id, _) = identify_refined(
-        &m,
-        &determined(&m),
-        &clean,
-        &opts.clone().noise(NoiseChoice::Ordinary),
-        &refine,
-    )
-    .unwrap();
+    let (id, _) = identify_refined(&m, &determined(&m), &clean, &opts, &refine).unwrap();
     assert_eq!(id.fit.rank, id.fit.names.len());
     let (v, _) = value(&id, "Zt");
     let v = v.expect("Zt is determined on pair-B-C");
@@ -307,14 +300,7 @@ fn a_pivot_length_off_its_nominal_is_recovered_within_four_standard_uncertaintie
     let seeds = 20;
     for seed in 1..=seeds {
         let noisy = simulate(&m, &head_table_truth(&m, 0.3, seed, true), &rec).unwrap();
-        let (id, _) = identify_refined(
-            &m,
-            &location_zt,
-            &noisy,
-            &opts.clone().noise(NoiseChoice::Ordinary),
-            &refine,
-        )
-        .unwrap();
+        let (id, _) = identify_refined(&m, &location_zt, &noisy, &opts, &refine).unwrap();
         let (v, s) = value(&id, "Zt");
         let (v, s) = (v.unwrap(), s.unwrap());
         let z = (v + 0.040) / s;

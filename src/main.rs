@@ -1,13 +1,12 @@
 //! `rtest`: geometric error models of machine tools from R-test measurements.
 //!
-//! A thin command line: every verb parses its flags, calls the libraries (`model-spec`,
-//! `codegen`, the numeric crates, `plots`, `output`, `perf`) and prints. Verbs live in [`cli`], one
-//! module each.
+//! A thin command line: clap parses the flags into a verb's options, the verb's function in
+//! the `app` crate does the work, and this file prints its text or its one-line error and
+//! exits with the code of the error's class.
 
-mod cli;
-
+use app::error::{EXIT_CODES, EXIT_USAGE};
+use app::verbs as cli;
 use clap::{Parser, Subcommand};
-use cli::{CliError, EXIT_CODES, EXIT_USAGE};
 use std::io::Write as _;
 use std::process::ExitCode;
 
@@ -109,10 +108,10 @@ fn main() -> ExitCode {
                 }
                 _ => "rtest --help".into(),
             };
-            report(&CliError {
-                code: EXIT_USAGE,
-                message: format!("{} (see `{help}`)", one_line(&e)),
-            });
+            report(&app::Error::usage(format!(
+                "{} (see `{help}`)",
+                one_line(&e)
+            )));
             return ExitCode::from(EXIT_USAGE);
         }
     };
@@ -135,16 +134,37 @@ fn main() -> ExitCode {
         Verb::History(a) => cli::history::run(a),
         Verb::Report(a) => cli::report::run(a),
     };
-    match result {
+    match result
+        .and_then(app::Done::finish)
+        .and_then(|shown| print(&shown))
+    {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             report(&e);
-            ExitCode::from(e.code)
+            ExitCode::from(e.exit_code())
         }
     }
 }
 
-fn report(e: &CliError) {
+fn report(e: &app::Error) {
     let message = e.message.lines().collect::<Vec<_>>().join(" ");
     let _ = writeln!(std::io::stderr(), "rtest: error: {message}");
+}
+
+/// Prints what a verb has done: its notes on standard error, its text on standard output. A
+/// stream that cannot be written (a closed pipe) is an output that cannot be written: exit
+/// code 1, never a panic.
+fn print(shown: &app::Shown) -> Result<(), app::Error> {
+    let failed =
+        |name: &str, e: std::io::Error| app::Error::input(format!("cannot write to {name}: {e}"));
+    if !shown.stderr.is_empty() {
+        std::io::stderr()
+            .lock()
+            .write_all(shown.stderr.as_bytes())
+            .map_err(|e| failed("standard error", e))?;
+    }
+    let mut out = std::io::stdout().lock();
+    out.write_all(shown.stdout.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| failed("standard output", e))
 }

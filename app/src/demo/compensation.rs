@@ -12,6 +12,7 @@ use fitting::{IdentifyOptions, RefineOptions, identify_refined};
 use formats::poses::to_file_units;
 use model_spec::Machine;
 use model_spec::units::format_scaled;
+use report::inputs::Document;
 use report::json::compensate::{CompensationReport, CompensationSource};
 use report::json::{IdentificationReport, IdentificationSource, to_json};
 use simulation::model::Model;
@@ -106,6 +107,7 @@ pub(crate) fn compensate_held_out(
         name: "identify-recommended.json".into(),
         contents: json,
         what: format!("the model the diagnosis recommends ({label}) identified on K4, as rtest identify --json writes it"),
+        document: Some(Document::Identification(Box::new(report.clone()))),
     });
     let params = m.default_parameters();
     let values_at = |q: &[f64], out: &mut [f64]| errors.values_at(m, q, out);
@@ -161,10 +163,12 @@ pub(crate) fn compensate_held_out(
                 name: "k1-compensated.csv".into(),
                 contents: csv,
                 what: "K1's poses compensated with the recommended model, as rtest compensate -o writes them (mm, degrees)".into(),
+                document: None,
             });
             files.push(DemoFile {
                 name: "compensate-k1.json".into(),
                 contents: to_json(&summary).map_err(failed("compensation"))?,
+                document: Some(Document::Compensation(Box::new(summary.clone()))),
                 what: "the summary of K1's compensation, as rtest compensate --json writes it"
                     .into(),
             });

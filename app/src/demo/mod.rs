@@ -21,6 +21,7 @@ use formats::csv::format_record;
 use formats::progress::Unwatched;
 use formats::truth::builtin_truth;
 use model_spec::FULL_MODEL;
+use report::inputs::Document;
 use report::json::{
     DiagnosisReport, DiagnosisSource, IdentificationReport, IdentificationSource, ValidationReport,
     ValidationSource, to_json,
@@ -53,6 +54,9 @@ pub struct DemoFile {
     pub contents: String,
     /// What it is, for people.
     pub what: String,
+    /// The result it holds, for a JSON report (what the HTML reports and the history take,
+    /// never read back from the JSON).
+    pub document: Option<Document>,
 }
 
 /// The demo's results.
@@ -140,6 +144,7 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
                 "{name} measurement: {} samples; axes mm and degrees, readings µm",
                 record.samples.len()
             ),
+            document: None,
         });
         runs.push(Run {
             name,
@@ -176,6 +181,7 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
         name: "identify.json".into(),
         contents: to_json(&identification).map_err(failed("identification"))?,
         what: "the reduced model identified on K4, as rtest identify --json writes it".into(),
+        document: Some(Document::Identification(Box::new(identification.clone()))),
     });
 
     // 3. Validation on every path (K4: the fit itself), exact prediction.
@@ -215,6 +221,7 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
             files.push(DemoFile {
                 name: format!("validate-{}.json", r.name.to_ascii_lowercase()),
                 contents: to_json(&report).map_err(failed("validation"))?,
+                document: Some(Document::Validation(Box::new(report.clone()))),
                 what: format!(
                     "validation on {}, as rtest validate --json writes it",
                     r.name
@@ -292,21 +299,25 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
         name: "seed_ac.rs".into(),
         contents: code,
         what: "generated no_std Rust gains of the full and reduced models".into(),
+        document: None,
     });
     files.push(DemoFile {
         name: "gains-reduced.md".into(),
         contents: markdown,
         what: "gain table of the reduced model, the seed's Table 2, Markdown".into(),
+        document: None,
     });
     files.push(DemoFile {
         name: "diagnose.json".into(),
         contents: to_json(&diagnosis_report).map_err(failed("diagnosis"))?,
         what: "the diagnosis of the reduced model on K4, as rtest diagnose --json writes it".into(),
+        document: Some(Document::Diagnosis(Box::new(diagnosis_report.clone()))),
     });
     files.push(DemoFile {
         name: EXTENDED_FILE.into(),
         contents: ext_text,
         what: "seed-ac with the extended model appended ([models.extended]), as rtest diagnose --model-out writes it".into(),
+        document: None,
     });
 
     let ops: Vec<(&str, usize, String)> = [(FULL_MODEL, &full), (REDUCED, &reduced)]

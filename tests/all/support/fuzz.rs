@@ -1,4 +1,4 @@
-//! The runner of the fuzzing tests (`tests/all/readers_fuzz.rs`, `src/cli/plan_fuzz.rs`): how many
+//! The runner of the fuzzing tests (`tests/all/readers_fuzz.rs`, `app/src/verbs/plan_fuzz.rs`): how many
 //! cases a property takes, and the count of inputs read and refused.
 
 use proptest::strategy::Strategy;

@@ -2,7 +2,7 @@
 //! file lists, `NAME=VALUE` lists, and the plausibility bounds. Every error names its flag and
 //! is a usage error (exit code 2).
 
-use super::{CliError, CliResult};
+use super::{Error, VerbResult};
 use fitting::noise::{NoiseChoice, NoiseModel};
 use fitting::{Constraint, ValueLimits};
 use formats::csv::ReadOptions;
@@ -34,10 +34,10 @@ impl NoiseArgs {
     }
 
     /// `--noise` as parsed (the static record is read by [`NoiseArgs::choice`]).
-    pub fn declared(&self) -> CliResult<NoiseChoice> {
+    pub fn declared(&self) -> VerbResult<NoiseChoice> {
         match self.noise.as_deref() {
             Some(spec) => {
-                NoiseChoice::parse(spec).map_err(|e| CliError::usage(format!("--noise: {e}")))
+                NoiseChoice::parse(spec).map_err(|e| Error::usage(format!("--noise: {e}")))
             }
             None => Ok(NoiseChoice::Estimate),
         }
@@ -52,11 +52,11 @@ impl NoiseArgs {
         m: &Machine,
         read: &ReadOptions,
         instrument: super::campaign::Through,
-    ) -> CliResult<(NoiseChoice, Option<super::ReadFile>)> {
+    ) -> VerbResult<(NoiseChoice, Option<super::ReadFile>)> {
         let Some(path) = &self.noise_record else {
             let declared = self.declared()?;
             if instrument.is_some() && matches!(declared, NoiseChoice::Model(_)) {
-                return Err(CliError::usage(
+                return Err(Error::usage(
                     "--noise: the records are read through --instrument, whose sensors' σ give each reading's covariance: a declared noise model would declare the noise a second time; leave --noise out (estimated over time from the rows whitened by the covariances) or give --noise white (the covariances' shape, the residual's scale)",
                 ));
             }
@@ -71,7 +71,7 @@ impl NoiseArgs {
             &m.default_parameters(),
         )?;
         let model = NoiseModel::from_static_record(&still)
-            .map_err(|e| CliError::input(format!("--noise-record: {}: {e}", path.display())))?;
+            .map_err(|e| Error::input(format!("--noise-record: {}: {e}", path.display())))?;
         Ok((
             NoiseChoice::Model(model),
             Some(super::ReadFile::new("--noise-record", path, digest)),
@@ -112,25 +112,25 @@ impl InstrumentArgs {
     }
 
     /// The instrument and the frame of its displacements, when `--instrument` is given.
-    pub fn load(&self) -> CliResult<Option<(Instrument, ReadingsFrame)>> {
+    pub fn load(&self) -> VerbResult<Option<(Instrument, ReadingsFrame)>> {
         self.load_read().map(|(i, _)| i)
     }
 
     /// [`InstrumentArgs::load`], with the file as read when `--instrument` names one (read
     /// once).
-    pub fn load_read(&self) -> CliResult<(Option<Loaded>, Option<super::ReadFile>)> {
+    pub fn load_read(&self) -> VerbResult<(Option<Loaded>, Option<super::ReadFile>)> {
         let Some(name) = &self.instrument else {
             return Ok((None, None));
         };
         let (i, digest) =
             model_spec::instrument::load_instrument_hashed(name).map_err(|e| match e {
-                InstrumentLoadError::NotFound(_) => CliError::usage(format!("--instrument: {e}")),
-                other => CliError::input(format!("--instrument: {other}")),
+                InstrumentLoadError::NotFound(_) => Error::usage(format!("--instrument: {e}")),
+                other => Error::input(format!("--instrument: {other}")),
             })?;
         let read = digest.map(|d| super::ReadFile::new("--instrument", Path::new(name), d));
         let frame = match self.readings_frame.as_deref() {
             Some(f) => ReadingsFrame::parse(f).ok_or_else(|| {
-                CliError::usage(format!("--readings-frame: `{f}` is not tool or machine"))
+                Error::usage(format!("--readings-frame: `{f}` is not tool or machine"))
             })?,
             None => i.frame,
         };
@@ -140,10 +140,10 @@ impl InstrumentArgs {
 
 /// The instrument `name` (a preset or a TOML file) given by `flag`: an unknown name is a usage
 /// error, a file that cannot be read or does not validate a bad input.
-pub fn instrument(name: &str, flag: &str) -> CliResult<Instrument> {
+pub fn instrument(name: &str, flag: &str) -> VerbResult<Instrument> {
     load_instrument(name).map_err(|e| match e {
-        InstrumentLoadError::NotFound(_) => CliError::usage(format!("{flag}: {e}")),
-        other => CliError::input(format!("{flag}: {other}")),
+        InstrumentLoadError::NotFound(_) => Error::usage(format!("{flag}: {e}")),
+        other => Error::input(format!("{flag}: {other}")),
     })
 }
 
@@ -208,10 +208,10 @@ pub fn between(lo: f64, hi: f64) -> impl Fn(&str) -> Result<f64, String> + Clone
 ///
 /// # Errors
 /// A usage error naming `--decimals` and the limit.
-pub fn nc_decimals(d: Option<usize>) -> CliResult<Option<usize>> {
+pub fn nc_decimals(d: Option<usize>) -> VerbResult<Option<usize>> {
     let max = formats::nc::MAX_DECIMALS;
     match d {
-        Some(d) if d > max => Err(CliError::usage(format!(
+        Some(d) if d > max => Err(Error::usage(format!(
             "--decimals: {d} decimals asked for, at most {max}"
         ))),
         d => Ok(d),
@@ -228,12 +228,12 @@ pub fn positive(s: &str) -> Result<f64, String> {
 
 /// A model chosen by `--model` and `--terms`, with a label for reports
 /// (`reduced`, `reduced + ECC@harmonic:2`, `XOC + ECC@harmonic:2`).
-pub fn model(m: &Machine, name: Option<&str>, terms: Option<&str>) -> CliResult<(String, Model)> {
+pub fn model(m: &Machine, name: Option<&str>, terms: Option<&str>) -> VerbResult<(String, Model)> {
     let mut label = Vec::new();
     let mut model = Model::default();
     if let Some(name) = name {
         model = Model::of(m, name).ok_or_else(|| {
-            CliError::usage(format!(
+            Error::usage(format!(
                 "--model: machine {} has no model `{name}` (models: {})",
                 m.name,
                 m.model_names().join(", ")
@@ -245,7 +245,7 @@ pub fn model(m: &Machine, name: Option<&str>, terms: Option<&str>) -> CliResult<
     if let Some(list) = terms {
         for (text, term) in parse_terms(m, list)? {
             if let Some(i) = model.terms.iter().position(|t| *t == term) {
-                return Err(CliError::usage(if i < from_model {
+                return Err(Error::usage(if i < from_model {
                     format!("--terms: `{text}` is already in model {}", label[0])
                 } else {
                     format!("--terms: `{text}` is given twice")
@@ -256,7 +256,7 @@ pub fn model(m: &Machine, name: Option<&str>, terms: Option<&str>) -> CliResult<
         }
     }
     if model.terms.is_empty() {
-        return Err(CliError::usage(match name {
+        return Err(Error::usage(match name {
             Some(n) => format!(
                 "--model: model `{n}` of machine {} has no terms (its `errors` list is empty): add terms with --terms (e.g. --terms XOC,ECC@harmonic:2)",
                 m.name
@@ -273,7 +273,7 @@ pub fn model(m: &Machine, name: Option<&str>, terms: Option<&str>) -> CliResult<
 /// Parses `--terms`: a comma list of `NAME` (constant) or `NAME@BASIS` terms
 /// (`ECC@harmonic:2,dx0@time:1`; `NAME` may be a kinematic symbol of the machine, `Zt`, whose
 /// change is identified in µm); each with its text as written (trimmed).
-pub fn parse_terms(m: &Machine, list: &str) -> CliResult<Vec<(String, Term)>> {
+pub fn parse_terms(m: &Machine, list: &str) -> VerbResult<Vec<(String, Term)>> {
     let example = "expected a comma list of NAME or NAME@BASIS, e.g. ECC@harmonic:2,dx0@time:1";
     let mut out = Vec::new();
     for item in items("--terms", list, example)? {
@@ -300,7 +300,7 @@ pub fn parse_terms(m: &Machine, list: &str) -> CliResult<Vec<(String, Term)>> {
             } else {
                 String::new()
             };
-            CliError::usage(format!("--terms: `{item}`: {e}{hint}"))
+            Error::usage(format!("--terms: `{item}`: {e}{hint}"))
         })?;
         out.push((item.to_string(), term));
     }
@@ -308,15 +308,15 @@ pub fn parse_terms(m: &Machine, list: &str) -> CliResult<Vec<(String, Term)>> {
 }
 
 /// The trimmed items of a comma list for `flag`, none empty (`example` shows the form).
-pub fn items<'a>(flag: &str, list: &'a str, example: &str) -> CliResult<Vec<&'a str>> {
+pub fn items<'a>(flag: &str, list: &'a str, example: &str) -> VerbResult<Vec<&'a str>> {
     if list.trim().is_empty() {
-        return Err(CliError::usage(format!("{flag}: empty list ({example})")));
+        return Err(Error::usage(format!("{flag}: empty list ({example})")));
     }
     list.split(',')
         .map(|item| {
             let item = item.trim();
             if item.is_empty() {
-                Err(CliError::usage(format!(
+                Err(Error::usage(format!(
                     "{flag}: empty item in `{}` ({example})",
                     model_spec::text::quoted_start(list)
                 )))
@@ -328,7 +328,7 @@ pub fn items<'a>(flag: &str, list: &'a str, example: &str) -> CliResult<Vec<&'a 
 }
 
 /// Parses `--constraint`: `none`, `min-norm` (or `minimum-norm`), or `zero:NAME,NAME`.
-pub fn constraint(text: Option<&str>) -> CliResult<Constraint> {
+pub fn constraint(text: Option<&str>) -> VerbResult<Constraint> {
     let Some(text) = text else {
         return Ok(Constraint::None);
     };
@@ -338,7 +338,7 @@ pub fn constraint(text: Option<&str>) -> CliResult<Constraint> {
         _ => {}
     }
     let Some(list) = text.trim().strip_prefix("zero:") else {
-        return Err(CliError::usage(format!(
+        return Err(Error::usage(format!(
             "--constraint: `{text}` is not one of none, min-norm, zero:NAME,NAME (e.g. zero:XOC,YOA,ZOA)"
         )));
     };
@@ -349,7 +349,7 @@ pub fn constraint(text: Option<&str>) -> CliResult<Constraint> {
         "expected zero:NAME,NAME, e.g. zero:XOC,YOA,ZOA",
     )? {
         if names.iter().any(|n| n == item) {
-            return Err(CliError::usage(format!(
+            return Err(Error::usage(format!(
                 "--constraint: `{item}` is given twice"
             )));
         }
@@ -359,13 +359,13 @@ pub fn constraint(text: Option<&str>) -> CliResult<Constraint> {
 }
 
 /// Parses a comma list of files (`--validate`), none empty, none twice.
-pub fn files(flag: &str, list: &str) -> CliResult<Vec<PathBuf>> {
+pub fn files(flag: &str, list: &str) -> VerbResult<Vec<PathBuf>> {
     let example = "expected a comma list of measurement CSV files, e.g. k1.csv,k2.csv";
     let mut out: Vec<PathBuf> = Vec::new();
     for item in items(flag, list, example)? {
         let p = PathBuf::from(item);
         if out.contains(&p) {
-            return Err(CliError::usage(format!("{flag}: `{item}` is given twice")));
+            return Err(Error::usage(format!("{flag}: `{item}` is given twice")));
         }
         out.push(p);
     }
@@ -378,7 +378,7 @@ pub fn select_errors(
     m: &Machine,
     model: Option<&str>,
     errors: Option<&str>,
-) -> CliResult<(Option<String>, Vec<ErrorId>)> {
+) -> VerbResult<(Option<String>, Vec<ErrorId>)> {
     if let Some(list) = errors {
         return parse_error_list(m, list).map(|ids| (None, ids));
     }
@@ -387,11 +387,11 @@ pub fn select_errors(
 }
 
 /// The errors of the model `name` of `m`, or a usage error listing its models.
-pub fn model_errors(m: &Machine, name: &str) -> CliResult<Vec<ErrorId>> {
+pub fn model_errors(m: &Machine, name: &str) -> VerbResult<Vec<ErrorId>> {
     m.model_errors(name)
         .map(<[ErrorId]>::to_vec)
         .ok_or_else(|| {
-            CliError::usage(format!(
+            Error::usage(format!(
                 "--model: machine {} has no model `{name}` (models: {})",
                 m.name,
                 m.model_names().join(", ")
@@ -401,20 +401,20 @@ pub fn model_errors(m: &Machine, name: &str) -> CliResult<Vec<ErrorId>> {
 
 /// Parses `--errors`: a comma list of catalogue names (digit-zero spelling accepted), kept in
 /// the given order.
-pub fn parse_error_list(m: &Machine, list: &str) -> CliResult<Vec<ErrorId>> {
+pub fn parse_error_list(m: &Machine, list: &str) -> VerbResult<Vec<ErrorId>> {
     let example = "expected a comma list of error names, e.g. XOC,YOC,BOA";
     let mut ids = Vec::new();
     for item in items("--errors", list, example)? {
         let Some(id) = m.error_by_name(item) else {
             let names: Vec<&str> = m.catalogue.iter().map(|e| e.name.as_str()).collect();
-            return Err(CliError::usage(format!(
+            return Err(Error::usage(format!(
                 "--errors: machine {} has no error `{item}` (its errors: {})",
                 m.name,
                 names.join(" ")
             )));
         };
         if ids.contains(&id) {
-            return Err(CliError::usage(format!(
+            return Err(Error::usage(format!(
                 "--errors: error {} given twice",
                 m.catalogue[id].name
             )));

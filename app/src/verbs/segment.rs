@@ -2,7 +2,8 @@
 //! program's timing plan, written as a measurement record.
 
 use super::args::RecordLimits;
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use super::{EXIT_CODES, Error, VerbResult, check_outputs};
+use crate::Done;
 use formats::csv::{CsvError, parse_measurement};
 use model_spec::units::{UM_PER_MM, short};
 use output::{Outputs, Target};
@@ -101,7 +102,7 @@ fn at_least_zero(s: &str) -> Result<f64, String> {
 }
 
 /// Runs `rtest segment`.
-pub fn run(args: &SegmentArgs) -> CliResult {
+pub fn run(args: &SegmentArgs) -> VerbResult<Done> {
     let m = super::load_machine(&args.machine)?;
     let mut inputs: Vec<(&str, &Path)> = vec![("--plan", &args.plan), ("--log", &args.log)];
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
@@ -110,7 +111,7 @@ pub fn run(args: &SegmentArgs) -> CliResult {
         outputs.push(("--windows", w));
     }
     check_outputs(&inputs, &outputs, &[])?;
-    let plan = read_plan(&args.plan, &m).map_err(|e| CliError::input(format!("--plan: {e}")))?;
+    let plan = read_plan(&args.plan, &m).map_err(|e| Error::input(format!("--plan: {e}")))?;
     let opts = SegmentOptions {
         offset_s: args.offset_s,
         margin_s: args.margin_s,
@@ -119,9 +120,9 @@ pub fn run(args: &SegmentArgs) -> CliResult {
         min_readings: args.min_readings as usize,
     };
     let seg = segment_file(&args.log, &plan, &opts).map_err(|e| match e {
-        SegmentError::Options(m) => CliError::usage(m),
-        SegmentError::Csv(e) => CliError::input(format!("--log: {e}")),
-        e => CliError::input(format!("--log: {e}")),
+        SegmentError::Options(m) => Error::usage(m),
+        SegmentError::Csv(e) => Error::input(format!("--log: {e}")),
+        e => Error::input(format!("--log: {e}")),
     })?;
     let comments = vec![
         format!(
@@ -139,7 +140,7 @@ pub fn run(args: &SegmentArgs) -> CliResult {
         "readings in µm: the mean of each measuring window (static) or interpolated at the pose's instant (continuous)".into(),
     ];
     let csv = format_segmented(&m, &plan, &seg, &comments)
-        .map_err(|e| CliError::computation(format!("-o: {e}")))?;
+        .map_err(|e| Error::computation(format!("-o: {e}")))?;
     let error_vector = seg.columns.len() == 3
         && ["dx_um", "dy_um", "dz_um"]
             .iter()
@@ -152,7 +153,7 @@ pub fn run(args: &SegmentArgs) -> CliResult {
             &args.records.read_options(),
         )
         .map_err(|e: CsvError| {
-            CliError::input(format!(
+            Error::input(format!(
                 "--log: the segmented record would not be accepted by identify, so it is not written: {e}"
             ))
         })?;
@@ -162,10 +163,9 @@ pub fn run(args: &SegmentArgs) -> CliResult {
     if let Some(w) = &args.windows {
         files.add("--windows", w.clone(), format_windows(&seg));
     }
-    let written = write(files)?;
     let stdout_taken =
         matches!(args.output, Target::Stdout) || matches!(args.windows, Some(Target::Stdout));
-    print_text(&(summary(&seg, &args.log) + &wrote(&written)), stdout_taken)
+    Ok(Done::new(summary(&seg, &args.log), files, stdout_taken))
 }
 
 /// The summary for people.

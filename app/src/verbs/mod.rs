@@ -1,6 +1,7 @@
-//! The verbs of the `rtest` command line and what they share: the error type and its exit
-//! codes, loading a machine, and writing the outputs of a verb through the one writer (the
-//! `output` crate). Each verb parses its flags, calls the libraries and prints.
+//! The verbs of `rtest`, one module each: its options (clap `Args`, with its help) and its
+//! `run`, which takes them and returns what it has done ([`crate::Done`]: its text and its
+//! outputs, not yet written). What they share: loading a machine, reading a record, checking
+//! the outputs before any work.
 
 pub mod args;
 pub mod bench;
@@ -29,93 +30,29 @@ pub mod volumetric;
 use formats::csv::ReadOptions;
 use model_spec::sha256::Digest;
 use model_spec::{LoadError, Machine};
-use output::{Outputs, Target, WriteError, Written};
+use output::{Target, WriteError, Written};
 use simulation::record::Record;
-use std::fmt;
-use std::io::Write as _;
 use std::path::Path;
 
-/// Exit code of a bad input: a file that cannot be read, is malformed, implausible, or does
-/// not belong to the machine.
-pub const EXIT_INPUT: u8 = 1;
-/// Exit code of a usage error: the command line itself is wrong.
-pub const EXIT_USAGE: u8 = 2;
-/// Exit code of a computation that failed: a refinement that does not converge, a non-finite
-/// or implausible result. No result file is written.
-pub const EXIT_COMPUTATION: u8 = 3;
-
-/// The exit-code rule, shown after every verb's help.
-pub const EXIT_CODES: &str = "\
-Exit codes: 0 success; 1 bad input (a machine, truth, measurement CSV or JSON file that cannot \
-be read, is malformed, holds implausible readings, poses or values, or belongs to another \
-machine; an output that cannot be written); 2 the command line is wrong (missing or unknown flag; unknown \
-machine, model, path, truth, axis, symbol, error or term name; a malformed or out-of-range \
-value; an output that names an input); 3 a computation failed (a refinement that does not \
-converge, a non-finite result, identified values beyond the plausibility bounds). Errors are \
-one line on stderr naming the flag at fault (a malformed file is named with its line and \
-column). Outputs are all written or none; on exit code 3 none is written.";
-
-/// A failure of a verb: a one-line message and its exit code.
-#[derive(Debug)]
-pub struct CliError {
-    /// [`EXIT_INPUT`], [`EXIT_USAGE`] or [`EXIT_COMPUTATION`].
-    pub code: u8,
-    /// One line, naming the flag and the offending item.
-    pub message: String,
-}
-
-impl CliError {
-    /// A usage error (exit code 2).
-    pub fn usage(message: impl Into<String>) -> CliError {
-        CliError {
-            code: EXIT_USAGE,
-            message: message.into(),
-        }
-    }
-
-    /// A bad input (exit code 1).
-    pub fn input(message: impl Into<String>) -> CliError {
-        CliError {
-            code: EXIT_INPUT,
-            message: message.into(),
-        }
-    }
-
-    /// A failed computation (exit code 3).
-    pub fn computation(message: impl Into<String>) -> CliError {
-        CliError {
-            code: EXIT_COMPUTATION,
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for CliError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.message)
-    }
-}
-
-/// The result of a verb.
-pub type CliResult<T = ()> = Result<T, CliError>;
+pub use crate::error::{EXIT_CODES, EXIT_COMPUTATION, EXIT_INPUT, EXIT_USAGE, Error, VerbResult};
 
 /// Loads the machine of `--machine` (a built-in name or a TOML file). An unknown name is a
 /// usage error; a file that cannot be read or does not validate is a bad input.
-pub fn load_machine(name_or_path: &str) -> CliResult<Machine> {
+pub fn load_machine(name_or_path: &str) -> VerbResult<Machine> {
     load_machine_read(name_or_path).map(|l| l.machine)
 }
 
 /// [`load_machine`], with the text it was read from (read once).
-pub fn load_machine_and_text(name_or_path: &str) -> CliResult<(Machine, String)> {
+pub fn load_machine_and_text(name_or_path: &str) -> VerbResult<(Machine, String)> {
     load_machine_read(name_or_path).map(|l| (l.machine, l.text))
 }
 
 /// [`load_machine`], with the text it was read from and, for a file, the digest of the bytes
 /// read (read once).
-pub fn load_machine_read(name_or_path: &str) -> CliResult<model_spec::LoadedMachine> {
+pub fn load_machine_read(name_or_path: &str) -> VerbResult<model_spec::LoadedMachine> {
     model_spec::load_machine_read(name_or_path).map_err(|e| match e {
-        LoadError::NotFound(_) => CliError::usage(format!("--machine: {e}")),
-        _ => CliError::input(format!("--machine: {e}")),
+        LoadError::NotFound(_) => Error::usage(format!("--machine: {e}")),
+        _ => Error::input(format!("--machine: {e}")),
     })
 }
 
@@ -162,9 +99,9 @@ pub fn read_record(
     options: &ReadOptions,
     instrument: campaign::Through,
     params: &[f64],
-) -> CliResult<(Record, Digest)> {
+) -> VerbResult<(Record, Digest)> {
     formats::campaign::read_record_at(path, m, params, options, instrument).map_err(|e| {
-        CliError::input(format!(
+        Error::input(format!(
             "{flag}: {e}{}",
             formats::campaign::parameters_note(m, params)
         ))
@@ -180,14 +117,14 @@ pub fn check_times(
     m: &Machine,
     model: &simulation::model::Model,
     record: &Record,
-) -> CliResult<()> {
+) -> VerbResult<()> {
     if let Some(t) = model.terms.iter().find(|t| t.basis.starts_at_zero()) {
         record
             .check_started(&t.spelling(m))
-            .map_err(|e| CliError::input(format!("{flag} {}: {e}", path.display())))?;
+            .map_err(|e| Error::input(format!("{flag} {}: {e}", path.display())))?;
     }
     match model.terms.iter().find(|t| t.basis.needs_times()) {
-        Some(t) if !record.has_times() => Err(CliError::input(format!(
+        Some(t) if !record.has_times() => Err(Error::input(format!(
             "{flag} {}: term `{}` needs the real sample times, but the file has no `t_s` column (its samples are only numbered): add the times in s",
             path.display(),
             t.spelling(m)
@@ -204,11 +141,11 @@ pub fn machine_file(name_or_path: &str) -> Option<&Path> {
 
 /// A writer error as a verb's error: a wrong command line (an output that names an input, two
 /// outputs on one file) is a usage error, anything else a bad input.
-pub fn write_error(e: WriteError) -> CliError {
+pub fn write_error(e: WriteError) -> Error {
     if e.is_usage() {
-        CliError::usage(e.to_string())
+        Error::usage(e.to_string())
     } else {
-        CliError::input(e.to_string())
+        Error::input(e.to_string())
     }
 }
 
@@ -218,7 +155,7 @@ pub fn check_outputs(
     inputs: &[(&str, &Path)],
     outputs: &[(&str, &Target)],
     dirs: &[(&str, &Path)],
-) -> CliResult {
+) -> VerbResult {
     output::refuse_overwriting_inputs(inputs, outputs).map_err(write_error)?;
     output::check_targets(outputs).map_err(write_error)?;
     for (flag, dir) in dirs {
@@ -234,37 +171,8 @@ pub fn check_dir_inputs(
     flag: &str,
     dir: &Path,
     writes: &dyn Fn(&str) -> bool,
-) -> CliResult {
+) -> VerbResult {
     output::refuse_inputs_in_dir(inputs, flag, dir, writes).map_err(write_error)
-}
-
-/// Writes every output (all or none).
-pub fn write(outputs: Outputs) -> CliResult<Vec<Written>> {
-    outputs.write_all().map_err(write_error)
-}
-
-/// Prints the text for people: on standard output, or on standard error when an output goes to
-/// standard output (`-o -`), so that the two never mix. A stream that cannot be written (a
-/// closed pipe) is an output that cannot be written: exit code 1, never a panic.
-pub fn print_text(text: &str, stdout_taken: bool) -> CliResult {
-    let (result, name) = if stdout_taken {
-        (
-            std::io::stderr().lock().write_all(text.as_bytes()),
-            "standard error",
-        )
-    } else {
-        let mut out = std::io::stdout().lock();
-        (
-            out.write_all(text.as_bytes()).and_then(|()| out.flush()),
-            "standard output",
-        )
-    };
-    result.map_err(|e| CliError::input(format!("cannot write to {name}: {e}")))
-}
-
-/// Prints `text` on standard output (see [`print_text`]).
-pub fn print(text: &str) -> CliResult {
-    print_text(text, false)
 }
 
 /// One `Wrote FILE` line per file written (standard output is not listed).

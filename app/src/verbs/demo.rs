@@ -1,8 +1,9 @@
 //! `rtest demo`: the seed's experiment on the virtual seed machine (`app::demo`), written to
 //! `./rtest-demo/`.
 
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, write};
-use app::demo;
+use super::{EXIT_CODES, Error, VerbResult, check_outputs};
+use crate::Done;
+use crate::demo;
 use output::Outputs;
 use std::path::Path;
 use std::time::Instant;
@@ -54,14 +55,15 @@ Details: README.md (the demo and its files), docs/truth.md, docs/report.md.",
 pub struct DemoArgs {}
 
 /// Runs `rtest demo`.
-pub fn run(_args: &DemoArgs) -> CliResult {
+pub fn run(_args: &DemoArgs) -> VerbResult<Done> {
     let start = Instant::now();
     let dir = Path::new(OUT_DIR);
     check_outputs(&[], &[], &[("demo", dir)])?;
     // A history left by an earlier run is checked before any work.
     let db = dir.join(HISTORY);
-    let mut recorder = super::history::Recorder::open("demo:", &db, MACHINE_ID, &["K4"])?;
-    let result = demo::run(OUT_DIR).map_err(|e| CliError::computation(e.to_string()))?;
+    let mut recorder =
+        super::history::Recorder::open("demo:", &db, MACHINE_ID, &["K4"])?.saying(recorded);
+    let result = demo::run(OUT_DIR).map_err(|e| Error::computation(e.to_string()))?;
     let mut files = Outputs::new();
     let mut listed = Vec::new();
     for f in &result.files {
@@ -87,20 +89,25 @@ pub fn run(_args: &DemoArgs) -> CliResult {
         REPORT_COMPENSATION.to_string(),
         "the HTML report of the compensation: the recommended model identified on K4, the diagnosis, K1 compensated".to_string(),
     ));
-    write(files)?;
-    let recorded = record(&mut recorder, &result.files)?;
+    let check = check_of(&mut recorder, &result.files)?;
     let seconds = start.elapsed().as_secs_f64();
-    super::print(&(result.text + &demo::written(OUT_DIR, &listed, seconds) + &recorded))
+    let text = result.text + &demo::written(OUT_DIR, &listed, seconds);
+    Ok(Done::new(text, files, false)
+        .unlisted()
+        .recording_last(recorder, check))
 }
 
-/// Records the demo's identification on K4 (its `identify.json`, from `k4.csv`) in the
-/// history; returns the line that says so.
-fn record(recorder: &mut super::history::Recorder, files: &[demo::DemoFile]) -> CliResult<String> {
+/// The check of the demo's identification on K4 (its `identify.json`, from `k4.csv`), for the
+/// history, with `k4.csv` among the recorder's inputs.
+fn check_of(
+    recorder: &mut super::history::Recorder,
+    files: &[demo::DemoFile],
+) -> VerbResult<history::Check> {
     let file = |name: &str| {
         files
             .iter()
             .find(|f| f.name == name)
-            .ok_or_else(|| CliError::computation(format!("demo: no {name} to record")))
+            .ok_or_else(|| Error::computation(format!("demo: no {name} to record")))
     };
     let k4 = file("k4.csv")?;
     recorder.add_input(
@@ -108,17 +115,21 @@ fn record(recorder: &mut super::history::Recorder, files: &[demo::DemoFile]) -> 
         &format!("{OUT_DIR}/k4.csv"),
         k4.contents.as_bytes(),
     );
-    let report: report::json::IdentificationReport =
-        serde_json::from_str(&file("identify.json")?.contents)
-            .map_err(|e| CliError::computation(format!("demo: identify.json: {e}")))?;
-    let check = history::Check::from_identification(&report, recorder.provenance());
-    let id = recorder
-        .stage(&check)?
-        .commit()
-        .map_err(|e| CliError::input(format!("demo: {e}")))?;
-    Ok(format!(
+    match &file("identify.json")?.document {
+        Some(::report::Document::Identification(report)) => Ok(
+            history::Check::from_identification(report, recorder.provenance()),
+        ),
+        _ => Err(Error::computation(
+            "demo: identify.json holds no identification to record",
+        )),
+    }
+}
+
+/// The line that says where the demo's check `id` went.
+fn recorded(id: i64) -> String {
+    format!(
         "Recorded the identification on K4 as check {id} of machine `{MACHINE_ID}` in {OUT_DIR}/{HISTORY}; its trend: rtest history --db {OUT_DIR}/{HISTORY} --machine-id {MACHINE_ID} --error XOC\n"
-    ))
+    )
 }
 
 /// The two checks the demo's HTML reports show.
@@ -132,10 +143,10 @@ enum Check {
 
 /// The HTML report of one of the demo's checks, with the diagnosis's path figures and the
 /// measurement files hashed as written.
-fn html_report(result: &demo::Demo, check: Check) -> CliResult<String> {
+fn html_report(result: &demo::Demo, check: Check) -> VerbResult<String> {
     let m = super::load_machine("seed-ac")?;
     let mut i = super::report::inputs_for(&m, &[]);
-    let fail = |e: ::report::InputError| CliError::computation(format!("demo: {e}"));
+    let fail = |e: ::report::InputError| Error::computation(format!("demo: {e}"));
     for f in &result.files {
         let path = format!("{OUT_DIR}/{}", f.name);
         if ["k4.csv", "k1.csv", "k2.csv"].contains(&f.name.as_str()) {
@@ -152,9 +163,8 @@ fn html_report(result: &demo::Demo, check: Check) -> CliResult<String> {
                 Check::Reduced => f.name == "identify.json" || json("validate-"),
                 Check::Compensation => f.name == "identify-recommended.json" || json("compensate-"),
             };
-        if wanted {
-            let doc = ::report::inputs::classify(&path, &f.contents).map_err(fail)?;
-            i.add(&path, doc).map_err(fail)?;
+        if let (true, Some(doc)) = (wanted, &f.document) {
+            i.add(&path, doc.clone()).map_err(fail)?;
         }
     }
     if check == Check::Reduced {
@@ -163,6 +173,6 @@ fn html_report(result: &demo::Demo, check: Check) -> CliResult<String> {
         ));
     }
     i.path_figures = ::report::figures::path_figures(&result.figures)
-        .map_err(|e| CliError::computation(format!("demo: {e}")))?;
+        .map_err(|e| Error::computation(format!("demo: {e}")))?;
     super::report::render("demo", &i)
 }

@@ -2,7 +2,8 @@
 //! with its flags (table, figure, CSV, JSON); and the `--record` flags of `rtest identify`
 //! that put a check into it (docs/history.md).
 
-use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text, write, wrote};
+use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
+use crate::Done;
 use history::report::{TrendReport, known_parameters, listing, listing_json};
 use history::tolerance::{self, MAX_TOLERANCE_BYTES, Tolerances};
 use history::trend::{self, Options, TrendError};
@@ -46,11 +47,13 @@ pub struct Recorder {
     db: PathBuf,
     store: Option<Store>,
     provenance: Provenance,
+    /// The line that says where the check went, when not [`Recorder::recorded`]'s own.
+    line: Option<fn(i64) -> String>,
 }
 
 /// A history error as a verb's error, `flag` naming the database's flag.
-fn history_error(flag: &str, e: HistoryError) -> CliError {
-    CliError::input(format!("{flag} {e}"))
+pub(crate) fn history_error(flag: &str, e: HistoryError) -> Error {
+    Error::input(format!("{flag} {e}"))
 }
 
 impl RecordArgs {
@@ -73,26 +76,26 @@ impl RecordArgs {
     /// # Errors
     /// A usage error for missing or malformed flags; a bad input for a database that cannot
     /// be used.
-    pub fn recorder(&self) -> CliResult<Option<Recorder>> {
+    pub fn recorder(&self) -> VerbResult<Option<Recorder>> {
         if !self.record {
             return Ok(None);
         }
         let Some(machine_id) = self.machine_id.clone() else {
-            return Err(CliError::usage(
+            return Err(Error::usage(
                 "--record needs --machine-id ID: the machine's own id (e.g. its serial number); two machines of one description are two histories",
             ));
         };
         history::check::label("machine id", &machine_id, false)
-            .map_err(|e| CliError::usage(format!("--machine-id: {e}")))?;
+            .map_err(|e| Error::usage(format!("--machine-id: {e}")))?;
         let paths = match &self.record_paths {
             None => Vec::new(),
             Some(list) => {
                 let paths: Vec<String> = list.split(',').map(|p| p.trim().to_string()).collect();
                 for (i, p) in paths.iter().enumerate() {
                     history::check::label("test path", p, true)
-                        .map_err(|e| CliError::usage(format!("--record-paths: {e}")))?;
+                        .map_err(|e| Error::usage(format!("--record-paths: {e}")))?;
                     if paths[..i].iter().any(|q| q.eq_ignore_ascii_case(p)) {
-                        return Err(CliError::usage(format!(
+                        return Err(Error::usage(format!(
                             "--record-paths: test path `{p}` is given twice"
                         )));
                     }
@@ -100,11 +103,11 @@ impl RecordArgs {
                 paths
             }
         };
-        let now = Timestamp::now().map_err(|e| CliError::input(format!("--record: {e}")))?;
+        let now = Timestamp::now().map_err(|e| Error::input(format!("--record: {e}")))?;
         let measured_at = match &self.measured_at {
             None => now,
             Some(t) => {
-                Timestamp::parse(t).map_err(|e| CliError::usage(format!("--measured-at: {e}")))?
+                Timestamp::parse(t).map_err(|e| Error::usage(format!("--measured-at: {e}")))?
             }
         };
         let db = self.db();
@@ -114,6 +117,7 @@ impl RecordArgs {
             Err(e) => return Err(history_error("--db", e)),
         };
         Ok(Some(Recorder {
+            line: None,
             db,
             store,
             provenance: Provenance {
@@ -134,13 +138,13 @@ impl Recorder {
     ///
     /// # Errors
     /// A bad input for a database that cannot be used (`flag` names it).
-    pub fn open(flag: &str, db: &Path, machine_id: &str, paths: &[&str]) -> CliResult<Recorder> {
+    pub fn open(flag: &str, db: &Path, machine_id: &str, paths: &[&str]) -> VerbResult<Recorder> {
         let store = match Store::open(db) {
             Ok(s) => Some(s),
             Err(HistoryError::NotFound { .. }) => None,
             Err(e) => return Err(history_error(flag, e)),
         };
-        let now = Timestamp::now().map_err(|e| CliError::input(format!("{flag} {e}")))?;
+        let now = Timestamp::now().map_err(|e| Error::input(format!("{flag} {e}")))?;
         Ok(Recorder {
             db: db.to_path_buf(),
             store,
@@ -152,7 +156,14 @@ impl Recorder {
                 rtest_version: env!("CARGO_PKG_VERSION").to_string(),
                 inputs: Vec::new(),
             },
+            line: None,
         })
+    }
+
+    /// With `line` saying where check `id` went, instead of the default line.
+    pub fn saying(mut self, line: fn(i64) -> String) -> Recorder {
+        self.line = Some(line);
+        self
     }
 
     /// Adds an input file given by its bytes (`role`: what it was, `path`: its name).
@@ -187,10 +198,10 @@ impl Recorder {
     ///
     /// # Errors
     /// A bad input for a database that cannot be made or written, or a check it refuses.
-    pub fn stage(&mut self, check: &Check) -> CliResult<Staged<'_>> {
+    pub fn stage(&mut self, check: &Check) -> VerbResult<Staged<'_>> {
         // A check the database would refuse makes no database.
         check.validate().map_err(|e| {
-            CliError::input(format!(
+            Error::input(format!(
                 "--db {}: cannot record the check: {e}",
                 self.db.display()
             ))
@@ -205,6 +216,9 @@ impl Recorder {
 
     /// The line that says where the check went.
     pub fn recorded(&self, id: i64) -> String {
+        if let Some(line) = self.line {
+            return line(id);
+        }
         let m = &self.provenance.machine_id;
         format!(
             "Recorded as check {id} of machine {m} in {} (rtest history --db {} --machine-id {})\n",
@@ -212,25 +226,6 @@ impl Recorder {
             shell(&self.db.display().to_string()),
             shell(m)
         )
-    }
-}
-
-/// Writes `files`, then commits the check staged by `recorder` (when recording): a check is
-/// recorded only when every output was written. Returns the text that lists what was
-/// written and recorded.
-pub fn write_and_record(
-    files: Outputs,
-    recorder: Option<&mut Recorder>,
-    check: Option<Check>,
-) -> CliResult<String> {
-    match (recorder, check) {
-        (Some(r), Some(check)) => {
-            let staged = r.stage(&check)?;
-            let written = write(files)?;
-            let id = staged.commit().map_err(|e| history_error("--db", e))?;
-            Ok(wrote(&written) + &r.recorded(id))
-        }
-        _ => Ok(wrote(&write(files)?)),
     }
 }
 
@@ -303,7 +298,7 @@ pub struct HistoryArgs {
 }
 
 /// Runs `rtest history`.
-pub fn run(args: &HistoryArgs) -> CliResult {
+pub fn run(args: &HistoryArgs) -> VerbResult<Done> {
     let db = args
         .db
         .clone()
@@ -325,13 +320,13 @@ pub fn run(args: &HistoryArgs) -> CliResult {
     let all = store.checks(None).map_err(|e| history_error("--db", e))?;
     let name = db.display().to_string();
     if all.is_empty() {
-        return Err(CliError::input(format!(
+        return Err(Error::input(format!(
             "--db {name}: the history is empty: no check recorded"
         )));
     }
     let stdout_taken = outputs.iter().any(|(_, t)| matches!(t, Target::Stdout));
     let mut files = Outputs::new();
-    let mut text = match (&args.machine_id, &args.error) {
+    let text = match (&args.machine_id, &args.error) {
         (id, None) => {
             let mut machines = store.machines().map_err(|e| history_error("--db", e))?;
             let checks: Vec<_> = match id {
@@ -348,39 +343,38 @@ pub fn run(args: &HistoryArgs) -> CliResult {
             };
             if let Some(t) = &args.json {
                 let json = listing_json(&name, &machines, &checks)
-                    .map_err(|e| CliError::computation(format!("--json: {e}")))?;
+                    .map_err(|e| Error::computation(format!("--json: {e}")))?;
                 files.add("--json", t.clone(), json);
             }
             listing(&name, &machines, &checks)
         }
         (Some(id), Some(error)) => trend_outputs(args, &name, &all, id, error, &mut files)?,
-        (None, Some(_)) => return Err(CliError::usage("--error needs --machine-id ID")),
+        (None, Some(_)) => return Err(Error::usage("--error needs --machine-id ID")),
     };
-    text.push_str(&wrote(&write(files)?));
-    print_text(&text, stdout_taken)
+    Ok(Done::new(text, files, stdout_taken))
 }
 
-fn unknown_machine(id: &str, all: &[history::RecordedCheck]) -> CliError {
+fn unknown_machine(id: &str, all: &[history::RecordedCheck]) -> Error {
     let mut known: Vec<&str> = all.iter().map(|c| c.check.machine_id.as_str()).collect();
     known.sort_unstable();
     known.dedup();
-    CliError::usage(format!(
+    Error::usage(format!(
         "--machine-id: no check of machine `{id}` in the history (machines: {})",
         known.join(", ")
     ))
 }
 
 /// A trend error as a verb's error.
-fn trend_error(e: TrendError) -> CliError {
+fn trend_error(e: TrendError) -> Error {
     match e {
         TrendError::UnknownParameter { .. } | TrendError::NeverDetermined { .. } => {
-            CliError::usage(format!("--error: {e}"))
+            Error::usage(format!("--error: {e}"))
         }
-        TrendError::Reference { .. } => CliError::usage(format!("--baseline: {e}")),
-        TrendError::Alpha(m) => CliError::usage(format!("--alpha: {m}")),
-        TrendError::Tolerance(m) => CliError::usage(format!("--tolerance: {m}")),
-        TrendError::UnknownMachine { .. } => CliError::usage(format!("--machine-id: {e}")),
-        TrendError::EmptyHistory => CliError::input(format!("--db: {e}")),
+        TrendError::Reference { .. } => Error::usage(format!("--baseline: {e}")),
+        TrendError::Alpha(m) => Error::usage(format!("--alpha: {m}")),
+        TrendError::Tolerance(m) => Error::usage(format!("--tolerance: {m}")),
+        TrendError::UnknownMachine { .. } => Error::usage(format!("--machine-id: {e}")),
+        TrendError::EmptyHistory => Error::input(format!("--db: {e}")),
     }
 }
 
@@ -393,22 +387,22 @@ fn trend_outputs(
     id: &str,
     error: &str,
     files: &mut Outputs,
-) -> CliResult<String> {
+) -> VerbResult<String> {
     if !all.iter().any(|c| c.check.machine_id == id) {
         return Err(unknown_machine(id, all));
     }
     let tolerances = match &args.tolerances {
         Some(path) => {
             let text = model_spec::text::read_text(path, MAX_TOLERANCE_BYTES)
-                .map_err(|e| CliError::input(format!("--tolerances: {e}")))?;
+                .map_err(|e| Error::input(format!("--tolerances: {e}")))?;
             let t = tolerance::parse_file(&path.display().to_string(), &text)
-                .map_err(|e| CliError::input(format!("--tolerances {e}")))?;
+                .map_err(|e| Error::input(format!("--tolerances {e}")))?;
             Some(("--tolerances", t))
         }
         None if !args.tolerance.is_empty() => Some((
             "--tolerance",
             tolerance::parse_args(&args.tolerance)
-                .map_err(|e| CliError::usage(format!("--tolerance: {}", e.message)))?,
+                .map_err(|e| Error::usage(format!("--tolerance: {}", e.message)))?,
         )),
         None => None,
     };
@@ -416,9 +410,9 @@ fn trend_outputs(
     if let Some((flag, t)) = &tolerances {
         t.check(id, &known).map_err(|e| {
             if *flag == "--tolerance" {
-                CliError::usage(format!("--tolerance: {}", e.message))
+                Error::usage(format!("--tolerance: {}", e.message))
             } else {
-                CliError::input(format!("--tolerances {e}"))
+                Error::input(format!("--tolerances {e}"))
             }
         })?;
     }
@@ -443,7 +437,7 @@ fn trend_outputs(
     if let Some(t) = &args.json {
         let json = report
             .json()
-            .map_err(|e| CliError::computation(format!("--json: {e}")))?;
+            .map_err(|e| Error::computation(format!("--json: {e}")))?;
         files.add("--json", t.clone(), json);
     }
     Ok(report.text())
@@ -466,7 +460,7 @@ fn tolerance_of(t: &Tolerances, parameter: &str) -> (Option<f64>, Option<String>
 }
 
 /// The trend figure: days since the first check of the series.
-fn figure(report: &TrendReport) -> CliResult<String> {
+fn figure(report: &TrendReport) -> VerbResult<String> {
     let a = &report.assessment;
     let s = &report.series;
     let unit = model_spec::units::symbol(&s.unit).to_string();
@@ -523,5 +517,5 @@ fn figure(report: &TrendReport) -> CliResult<String> {
         baseline: base.map(|b| (b, format!("baseline (check {})", a.baseline))),
         line,
     })
-    .map_err(|e| CliError::computation(format!("--figure: {e}")))
+    .map_err(|e| Error::computation(format!("--figure: {e}")))
 }

@@ -4,7 +4,8 @@
 
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
-use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text, write, wrote};
+use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
+use crate::Done;
 use diagnosis::dictionary::DictionaryOptions;
 use diagnosis::figures::figures;
 use diagnosis::{DiagnoseError, DiagnoseOptions, diagnose};
@@ -146,7 +147,7 @@ fn parse_alpha(s: &str) -> Result<f64, String> {
 /// Runs `rtest diagnose`: the fitted records (`--data`, or `--campaign`) and the held-out
 /// records (`--validate`, or `--validate-campaign`) read as two campaigns, one record being the
 /// campaign of that record, and diagnosed by [`diagnose`].
-pub fn run(args: &DiagnoseArgs) -> CliResult {
+pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
     let machine = super::load_machine_read(&args.machine)?;
     let (m, machine_text) = (machine.machine, machine.text);
     let (label, model) = args::model(&m, Some(&args.model), None)?;
@@ -159,7 +160,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         None => Vec::new(),
     };
     if args.validate.is_some() && args.validate_campaign.is_some() {
-        return Err(CliError::usage(
+        return Err(Error::usage(
             "--validate and --validate-campaign both give held-out records: give one",
         ));
     }
@@ -283,12 +284,12 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         DiagnoseError::Estimate(e) | DiagnoseError::Refine(fitting::RefineError::Estimate(e)) => {
             super::identify::estimate_error(e)
         }
-        DiagnoseError::Campaign(e) => CliError::usage(format!("{flag}: {e}")),
-        other => CliError::computation(format!("{flag}: cannot diagnose: {other}")),
+        DiagnoseError::Campaign(e) => Error::usage(format!("{flag}: {e}")),
+        other => Error::computation(format!("{flag}: cannot diagnose: {other}")),
     })?;
     for fit in [&d.base_fit, &d.extended_fit] {
         check_values(&m, &fit.as_identification(), &args.bounds.values()).map_err(|e| {
-            CliError::computation(format!(
+            Error::computation(format!(
                 "{flag}: implausible result: {e}; the fit does not describe this machine (--max-error-um, --max-error-urad change the bounds)"
             ))
         })?;
@@ -307,7 +308,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
                 &label,
                 &format!("rtest diagnose on {data}"),
             )
-            .map_err(|e| CliError::computation(format!("--model-out: {e}")))?;
+            .map_err(|e| Error::computation(format!("--model-out: {e}")))?;
         out.add("--model-out", target.clone(), contents);
         model_out = Some((name, target.to_string()));
     }
@@ -321,9 +322,9 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         model_out,
     };
     let report = DiagnosisReport::new(&m, &source, &d)
-        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
+        .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
     if let Some(target) = &args.json {
-        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        let json = to_json(&report).map_err(|e| Error::computation(format!("--json: {e}")))?;
         out.add("--json", target.clone(), json);
     }
     let figs = if args.plot.is_some() || args.report.is_some() {
@@ -344,7 +345,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
                 &held.campaign,
                 &names,
             )
-            .map_err(|e| CliError::computation(format!("{what}: {e}")))?,
+            .map_err(|e| Error::computation(format!("{what}: {e}")))?,
         )
     } else {
         None
@@ -358,7 +359,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         let mut i = super::report::inputs_for(&m, &read_files);
         if let Some(figs) = &figs {
             i.path_figures = ::report::figures::path_figures(figs)
-                .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+                .map_err(|e| Error::computation(format!("--report: {e}")))?;
         }
         add_diagnosis(&mut i, &report)?;
         out.add(
@@ -374,8 +375,7 @@ pub fn run(args: &DiagnoseArgs) -> CliResult {
         "give --zeroed"
     }));
     let stdout_taken = outputs.iter().any(|(_, t)| matches!(t, Target::Stdout));
-    text.push_str(&wrote(&write(out)?));
-    print_text(&text, stdout_taken)
+    Ok(Done::new(text, out, stdout_taken))
 }
 
 /// The records of `files` (given by `flag`) at kinematic parameters `params` (mm), read through
@@ -389,7 +389,7 @@ fn read_records(
     args: &DiagnoseArgs,
     instrument: campaign::Through,
     shown: bool,
-) -> CliResult<(Vec<Record>, Vec<ReadFile>)> {
+) -> VerbResult<(Vec<Record>, Vec<ReadFile>)> {
     campaign::record_count(flag, files)?;
     let read = args.records.read_options();
     let mut records = Vec::with_capacity(files.len());
@@ -409,13 +409,13 @@ fn loaded(
     records: Vec<CampaignRecord>,
     files: &[PathBuf],
     read: Vec<ReadFile>,
-) -> CliResult<campaign::Loaded> {
+) -> VerbResult<campaign::Loaded> {
     let campaign = if records.is_empty() {
         Campaign {
             records: Vec::new(),
         }
     } else {
-        Campaign::new(records).map_err(|e| CliError::usage(e.0))?
+        Campaign::new(records).map_err(|e| Error::usage(e.0))?
     };
     Ok(campaign::Loaded {
         campaign,
@@ -453,7 +453,7 @@ fn options(
     m: &model_spec::Machine,
     read: &formats::csv::ReadOptions,
     instrument: campaign::Through,
-) -> CliResult<(DiagnoseOptions, Option<ReadFile>)> {
+) -> VerbResult<(DiagnoseOptions, Option<ReadFile>)> {
     let mut opts = DiagnoseOptions::default();
     opts.dictionary = DictionaryOptions::new(args.harmonics, args.poly, args.time);
     opts.alpha = args.alpha;
@@ -462,16 +462,16 @@ fn options(
     opts.noise = noise;
     if let Some(b) = &args.budget {
         opts.budget = diagnosis::plausible::Budget::parse(b)
-            .map_err(|e| CliError::usage(format!("--budget: {e}")))?;
+            .map_err(|e| Error::usage(format!("--budget: {e}")))?;
     }
     Ok((opts, noise_read))
 }
 
 /// Adds the diagnosis just computed to the inputs of its HTML report (`--report`).
-fn add_diagnosis(i: &mut ::report::Inputs, r: &DiagnosisReport) -> CliResult {
+fn add_diagnosis(i: &mut ::report::Inputs, r: &DiagnosisReport) -> VerbResult {
     i.add(
         "this run of rtest diagnose",
         ::report::Document::Diagnosis(Box::new(r.clone())),
     )
-    .map_err(|e| CliError::computation(format!("--report: {e}")))
+    .map_err(|e| Error::computation(format!("--report: {e}")))
 }

@@ -2,7 +2,8 @@
 //! a measurement CSV that `identify` reads back.
 
 use super::args::RecordLimits;
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write};
+use super::{EXIT_CODES, Error, VerbResult, check_outputs};
+use crate::Done;
 use formats::csv::{format_record, parse_measurement};
 use formats::paths::{PathFileError, load_path};
 use formats::truth::TruthError;
@@ -92,8 +93,8 @@ pub struct SimulateArgs {
 }
 
 /// Parses `--noise-um` (µm, finite, 0 to [`MAX_NOISE_UM`]) into mm, without double rounding.
-fn noise_mm(text: &str) -> CliResult<f64> {
-    let bad = |why: &str| CliError::usage(format!("--noise-um: `{text}` {why}"));
+fn noise_mm(text: &str) -> VerbResult<f64> {
+    let bad = |why: &str| Error::usage(format!("--noise-um: `{text}` {why}"));
     let x: f64 = text
         .trim()
         .parse()
@@ -107,14 +108,14 @@ fn noise_mm(text: &str) -> CliResult<f64> {
 }
 
 /// Parses `--noise-phi` (finite, 0 ≤ φ < [`MAX_NOISE_PHI`]).
-fn noise_phi(text: &str) -> CliResult<f64> {
+fn noise_phi(text: &str) -> VerbResult<f64> {
     let x: f64 = text.trim().parse().map_err(|_| {
-        CliError::usage(format!(
+        Error::usage(format!(
             "--noise-phi: `{text}` is not a number (the lag-1 autocorrelation)"
         ))
     })?;
     if !(x.is_finite() && (0.0..MAX_NOISE_PHI).contains(&x)) {
-        return Err(CliError::usage(format!(
+        return Err(Error::usage(format!(
             "--noise-phi: `{text}` must be at least 0 and below {MAX_NOISE_PHI}"
         )));
     }
@@ -122,14 +123,14 @@ fn noise_phi(text: &str) -> CliResult<f64> {
 }
 
 /// The truth of `--truth`, else the machine's demo truth, else the nominal machine.
-fn truth(m: &model_spec::Machine, name: Option<&str>) -> CliResult<Truth> {
+fn truth(m: &model_spec::Machine, name: Option<&str>) -> VerbResult<Truth> {
     let found = match name {
         Some(n) => formats::truth::load_truth(n, m),
         None => formats::truth::default_truth(m),
     };
     found.map_err(|e| match e {
-        TruthError::NotFound(_) => CliError::usage(format!("--truth: {e}")),
-        _ => CliError::input(format!("--truth: {e}")),
+        TruthError::NotFound(_) => Error::usage(format!("--truth: {e}")),
+        _ => Error::input(format!("--truth: {e}")),
     })
 }
 
@@ -139,12 +140,12 @@ fn relabel(
     m: &model_spec::Machine,
     record: &mut simulation::record::Record,
     file: &Path,
-) -> CliResult {
+) -> VerbResult {
     let table = formats::poses::read_pose_file(file, &formats::poses::axis_words(m))
-        .map_err(|e| CliError::input(format!("--commanded: {e}")))?;
+        .map_err(|e| Error::input(format!("--commanded: {e}")))?;
     let poses = table.poses();
     if poses.len() != record.samples.len() {
-        return Err(CliError::input(format!(
+        return Err(Error::input(format!(
             "--commanded: {} holds {} poses, the path {} samples: they must be the same poses, before and after compensation",
             file.display(),
             poses.len(),
@@ -158,7 +159,7 @@ fn relabel(
 }
 
 /// Runs `rtest simulate`.
-pub fn run(args: &SimulateArgs) -> CliResult {
+pub fn run(args: &SimulateArgs) -> VerbResult<Done> {
     let m = super::load_machine(&args.machine)?;
     let noise = args.noise_um.as_deref().map(noise_mm).transpose()?;
     let phi = args.noise_phi.as_deref().map(noise_phi).transpose()?;
@@ -188,9 +189,9 @@ pub fn run(args: &SimulateArgs) -> CliResult {
     let read = args.records.read_options();
     let path = load_path(&m, &args.path, &read).map_err(|e| match e {
         PathFileError::NotFound { .. } | PathFileError::Builtin(PathError::NotAC { .. }) => {
-            CliError::usage(format!("--path: {e}"))
+            Error::usage(format!("--path: {e}"))
         }
-        other => CliError::input(format!("--path: {other}")),
+        other => Error::input(format!("--path: {other}")),
     })?;
     if let Some(n) = noise {
         truth.noise_mm = n;
@@ -206,27 +207,26 @@ pub fn run(args: &SimulateArgs) -> CliResult {
         return run_instrument(args, &m, &truth, &path, &instrument, frame);
     }
     let mut record = simulate(&m, &truth, &path).map_err(|e| match e {
-        e @ SimulateError::Times { .. } => CliError::input(format!("--path {}: {e}", args.path)),
-        e => CliError::computation(format!("--truth: {e}")),
+        e @ SimulateError::Times { .. } => Error::input(format!("--path {}: {e}", args.path)),
+        e => Error::computation(format!("--truth: {e}")),
     })?;
     if let Some(file) = &args.commanded {
         relabel(&m, &mut record, file)?;
     }
     let comments = provenance(&m, &args.path, &truth, record.samples.len());
     let csv = format_record(&m, &record, &comments)
-        .map_err(|e| CliError::computation(format!("-o: {e}")))?;
+        .map_err(|e| Error::computation(format!("-o: {e}")))?;
     // What is written is what identify reads: read it back with the same rules.
     parse_measurement(&args.output.to_string(), &csv, &m, &read).map_err(|e| {
-        CliError::computation(format!(
+        Error::computation(format!(
             "-o: the simulated record would not be accepted by identify, so it is not written: {e}"
         ))
     })?;
     let mut files = Outputs::new();
     files.add("-o", args.output.clone(), csv);
-    write(files)?;
     let written = args.output.path().map(|p| p.display().to_string());
     let text = simulation(&m, &args.path, &truth, &record, written.as_deref());
-    print_text(&text, matches!(args.output, Target::Stdout))
+    Ok(Done::new(text, files, matches!(args.output, Target::Stdout)).unlisted())
 }
 
 /// `rtest simulate --instrument`: the sensors' readings instead of the error vectors.
@@ -237,18 +237,18 @@ fn run_instrument(
     path: &simulation::record::Record,
     instrument: &model_spec::instrument::Instrument,
     frame: model_spec::instrument::ReadingsFrame,
-) -> CliResult {
+) -> VerbResult<Done> {
     use formats::sensors::{format_sensor_record, parse_sensor_measurement};
     use simulation::instrument::simulate::{SensorSimulationError, simulate_sensors};
     let mut sensors = simulate_sensors(m, truth, path, instrument, frame).map_err(|e| match e {
         SensorSimulationError::Simulate(e @ SimulateError::Times { .. }) => {
-            CliError::input(format!("--path {}: {e}", args.path))
+            Error::input(format!("--path {}: {e}", args.path))
         }
-        SensorSimulationError::Contact { .. } => CliError::computation(format!(
+        SensorSimulationError::Contact { .. } => Error::computation(format!(
             "--instrument {}: {e}: the error vector takes the ball off a sensor",
             instrument.name
         )),
-        e => CliError::computation(format!("--truth: {e}")),
+        e => Error::computation(format!("--truth: {e}")),
     })?;
     if let Some(file) = &args.commanded {
         relabel(m, &mut sensors.record, file)?;
@@ -273,18 +273,17 @@ fn run_instrument(
         instrument.columns().join(" ")
     ));
     let csv = format_sensor_record(m, instrument, &sensors, &comments)
-        .map_err(|e| CliError::computation(format!("-o: {e}")))?;
+        .map_err(|e| Error::computation(format!("-o: {e}")))?;
     let read = args.records.read_options();
     let record =
         parse_sensor_measurement(&args.output.to_string(), &csv, m, instrument, frame, &read)
             .map_err(|e| {
-                CliError::computation(format!(
+                Error::computation(format!(
                     "-o: the simulated record would not be accepted by identify --instrument, so it is not written: {e}"
                 ))
             })?;
     let mut files = Outputs::new();
     files.add("-o", args.output.clone(), csv);
-    write(files)?;
     let written = args.output.path().map(|p| p.display().to_string());
     let mut text = simulation(m, &args.path, truth, &record, written.as_deref());
     if let Some(at) = text.find("): ") {
@@ -294,5 +293,5 @@ fn run_instrument(
         "RMS of the readings",
         "RMS of the error vectors the sensors read",
     );
-    print_text(&text, matches!(args.output, Target::Stdout))
+    Ok(Done::new(text, files, matches!(args.output, Target::Stdout)).unlisted())
 }

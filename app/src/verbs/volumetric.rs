@@ -1,7 +1,8 @@
 //! `rtest volumetric`: the three-axis volumetric compensation from 6D laser-interferometer
 //! measurements taken at the tool end (docs/volumetric.md).
 
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use super::{EXIT_CODES, Error, VerbResult, check_outputs};
+use crate::Done;
 use compensation::volumetric::path::correct_poses;
 use compensation::volumetric::summary::{SetSummary, VolumetricReport};
 use compensation::volumetric::{
@@ -82,11 +83,11 @@ pub struct VolumetricArgs {
 const LATTICE_POINTS: usize = 11;
 
 /// `--laser` as (axis, file) pairs, each linear axis of `m` once.
-fn laser_files(m: &Machine, values: &[String]) -> CliResult<Vec<(usize, PathBuf)>> {
+fn laser_files(m: &Machine, values: &[String]) -> VerbResult<Vec<(usize, PathBuf)>> {
     let mut out: Vec<(usize, PathBuf)> = Vec::new();
     for item in values.iter().flat_map(|v| v.split(',')) {
         let Some((axis, file)) = item.split_once('=') else {
-            return Err(CliError::usage(format!(
+            return Err(Error::usage(format!(
                 "--laser: `{item}` is not AXIS=FILE (e.g. X=x.csv)"
             )));
         };
@@ -96,17 +97,17 @@ fn laser_files(m: &Machine, values: &[String]) -> CliResult<Vec<(usize, PathBuf)
             .filter(|&a| m.axes[a].kind == AxisKind::Linear)
             .ok_or_else(|| {
                 let linear: Vec<&str> = m.linear_axes().map(|a| m.axes[a].name.as_str()).collect();
-                CliError::usage(format!(
+                Error::usage(format!(
                     "--laser: `{axis}` is not a linear axis of {} ({})",
                     m.name,
                     linear.join(", ")
                 ))
             })?;
         if file.is_empty() {
-            return Err(CliError::usage(format!("--laser: `{item}` names no file")));
+            return Err(Error::usage(format!("--laser: `{item}` names no file")));
         }
         if out.iter().any(|(b, _)| *b == a) {
-            return Err(CliError::usage(format!(
+            return Err(Error::usage(format!(
                 "--laser: axis {} is given twice",
                 m.axes[a].name
             )));
@@ -118,25 +119,25 @@ fn laser_files(m: &Machine, values: &[String]) -> CliResult<Vec<(usize, PathBuf)
 
 /// A library error as the verb's error: the files and the poses are bad input, a failed
 /// computation is exit code 3.
-fn failure(flag: &str, e: VolumetricError) -> CliError {
+fn failure(flag: &str, e: VolumetricError) -> Error {
     match e {
-        VolumetricError::Computation(_) => CliError::computation(format!("{flag}: {e}")),
-        _ => CliError::input(format!("{flag}: {e}")),
+        VolumetricError::Computation(_) => Error::computation(format!("{flag}: {e}")),
+        _ => Error::input(format!("{flag}: {e}")),
     }
 }
 
 /// Parses `--pitch` (mm, finite, positive).
-fn pitch_mm(text: &str) -> CliResult<f64> {
+fn pitch_mm(text: &str) -> VerbResult<f64> {
     match text.trim().parse::<f64>() {
         Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
-        _ => Err(CliError::usage(format!(
+        _ => Err(Error::usage(format!(
             "--pitch: `{text}` is not a positive number of mm"
         ))),
     }
 }
 
 /// Runs `rtest volumetric`.
-pub fn run(args: &VolumetricArgs) -> CliResult {
+pub fn run(args: &VolumetricArgs) -> VerbResult<Done> {
     let m = super::load_machine(&args.machine)?;
     let lasers = laser_files(&m, &args.laser)?;
     let pitch = args.pitch.as_deref().map(pitch_mm).transpose()?;
@@ -158,7 +159,7 @@ pub fn run(args: &VolumetricArgs) -> CliResult {
     let measurements: Vec<AxisMeasurement> = lasers
         .iter()
         .map(|(a, p)| read_laser(p, &m, *a).map_err(|e| failure("--laser", e)))
-        .collect::<CliResult<_>>()?;
+        .collect::<VerbResult<_>>()?;
     let squareness =
         read_squareness(&args.squareness, &m).map_err(|e| failure("--squareness", e))?;
     let model =
@@ -168,7 +169,7 @@ pub fn run(args: &VolumetricArgs) -> CliResult {
     let mut sets = Vec::new();
     if let (Some(target), Some(p)) = (&args.grid, pitch) {
         let grid =
-            GridSpec::new(&m, &model, p).map_err(|e| CliError::usage(format!("--pitch: {e}")))?;
+            GridSpec::new(&m, &model, p).map_err(|e| Error::usage(format!("--pitch: {e}")))?;
         let poses = grid.poses(m.axes.len());
         let (summary, du) = SetSummary::over_poses(&m, &model, "grid", Some(p), &poses)
             .map_err(|e| failure("--grid", e))?;
@@ -197,7 +198,7 @@ pub fn run(args: &VolumetricArgs) -> CliResult {
     }
     if let (Some(path), Some(target)) = (&args.path, &args.output) {
         let table = read_pose_file(path, &axis_words(&m))
-            .map_err(|e| CliError::input(format!("--path: {e}")))?;
+            .map_err(|e| Error::input(format!("--path: {e}")))?;
         let poses: Vec<(usize, Vec<f64>)> = table
             .poses()
             .iter()
@@ -208,11 +209,11 @@ pub fn run(args: &VolumetricArgs) -> CliResult {
         let commands: Vec<Vec<f64>> = corrected.iter().map(|c| c.commands.clone()).collect();
         let text = table
             .write(&commands)
-            .map_err(|e| CliError::input(format!("-o: {e}")))?;
+            .map_err(|e| Error::input(format!("-o: {e}")))?;
         let du = corrected
             .iter()
             .map(|c| model.du(&c.commanded).map_err(|e| failure("--path", e)))
-            .collect::<CliResult<Vec<_>>>()?;
+            .collect::<VerbResult<Vec<_>>>()?;
         sets.push(SetSummary::new(&m, "path", None, &du, &corrected));
         files.add("-o", target.clone(), text);
     }
@@ -232,16 +233,12 @@ pub fn run(args: &VolumetricArgs) -> CliResult {
             .grid
             .as_ref()
             .is_some_and(|t| matches!(t, Target::Stdout));
-    let written = write(files)?;
-    let text = if args.json {
+    if args.json {
         let mut j = serde_json::to_string_pretty(&report)
-            .map_err(|e| CliError::computation(format!("--json: {e}")))?;
+            .map_err(|e| Error::computation(format!("--json: {e}")))?;
         j.push('\n');
-        j
+        Ok(Done::new(j, files, stdout_taken).unlisted())
     } else {
-        let mut t = report.text();
-        t.push_str(&wrote(&written));
-        t
-    };
-    print_text(&text, stdout_taken)
+        Ok(Done::new(report.text(), files, stdout_taken))
+    }
 }

@@ -1,7 +1,7 @@
 //! The NC measurement program of `rtest path --nc`: the flags and the program with its timing
 //! plan, from the record of poses `rtest path` computed (docs/measurement-programs.md).
 
-use super::{CliError, CliResult};
+use super::{Error, VerbResult};
 use formats::nc::Dialect;
 use model_spec::Machine;
 use output::Target;
@@ -50,19 +50,19 @@ pub struct NcArgs {
 
 impl NcArgs {
     /// The dialect of `--nc`, if given.
-    pub fn dialect(&self) -> CliResult<Option<Dialect>> {
+    pub fn dialect(&self) -> VerbResult<Option<Dialect>> {
         self.nc
             .as_deref()
             .map(|n| {
                 Dialect::from_name(n).ok_or_else(|| {
-                    CliError::usage(format!("--nc: `{n}` is not a dialect (iso or heidenhain)"))
+                    Error::usage(format!("--nc: `{n}` is not a dialect (iso or heidenhain)"))
                 })
             })
             .transpose()
     }
 
     /// The plan's target: --plan, else the program's file with `.plan.csv`.
-    pub fn plan_target(&self, program: &Target) -> CliResult<Target> {
+    pub fn plan_target(&self, program: &Target) -> VerbResult<Target> {
         if let Some(p) = &self.plan {
             return Ok(p.clone());
         }
@@ -72,7 +72,7 @@ impl NcArgs {
                 plan.set_extension("plan.csv");
                 Ok(Target::Path(plan))
             }
-            Target::Stdout => Err(CliError::usage(
+            Target::Stdout => Err(Error::usage(
                 "--nc with -o -: give the timing plan's file with --plan FILE",
             )),
         }
@@ -85,7 +85,7 @@ impl NcArgs {
         dialect: Dialect,
         test: &str,
         params: &[f64],
-    ) -> CliResult<MeasureOptions> {
+    ) -> VerbResult<MeasureOptions> {
         let mode = if self.continuous {
             let mut t = ContinuousTiming::default();
             if let Some(r) = self.sample_rate_hz {
@@ -127,14 +127,14 @@ pub fn program(
     test: &str,
     record: &Record,
     params: &[f64],
-) -> CliResult<(String, String, String)> {
+) -> VerbResult<(String, String, String)> {
     let o = args.options(m, dialect, test, params)?;
     let p = measurement_program(m, record, &o).map_err(|e| match e {
-        programs::measure::MeasureError::Options(why) => CliError::usage(format!("--nc: {why}")),
-        other => CliError::computation(format!("--nc: {other}")),
+        programs::measure::MeasureError::Options(why) => Error::usage(format!("--nc: {why}")),
+        other => Error::computation(format!("--nc: {other}")),
     })?;
     let plan = format_plan(m, &p.plan, &plan_comments(m, &o, &p))
-        .map_err(|e| CliError::computation(format!("--plan: {e}")))?;
+        .map_err(|e| Error::computation(format!("--plan: {e}")))?;
     let note = format!(
         "Measurement program ({}, {}): {} poses, planned duration {} s; largest nest-ball gap along a move {} mm (nominal).\n",
         dialect.name(),

@@ -4,7 +4,8 @@
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
 use super::history;
-use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text};
+use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
+use crate::Done;
 use fitting::campaign::{
     CampaignIdentification, CampaignValues, identify_campaign, identify_campaign_refined,
 };
@@ -124,7 +125,7 @@ pub struct IdentifyArgs {
 
 /// Runs `rtest identify`: one record or several, read as a campaign (a record is a campaign
 /// of one), fitted together, reported once; `--stream` reads one long record in blocks.
-pub fn run(args: &IdentifyArgs) -> CliResult {
+pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
     let machine = super::load_machine_read(&args.machine)?;
     let m = machine.machine;
     let (label, model) = args::model(&m, args.model.as_deref(), args.terms.as_deref())?;
@@ -140,17 +141,17 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     let declared = args.noise.declared()?;
     if args.stream {
         if files.len() > 1 {
-            return Err(CliError::usage(
+            return Err(Error::usage(
                 "--stream reads one long record in blocks into an incremental QR; several records are fitted whole (each with its own set-up and zero, in one design matrix held in memory): give one --data file, or drop --stream",
             ));
         }
         if args.noise.noise_record.is_some() || matches!(declared, NoiseChoice::Model(_)) {
-            return Err(CliError::usage(
+            return Err(Error::usage(
                 "--stream fits by ordinary least squares in one pass; --noise models and --noise-record need the whole record (drop --stream, or use --noise white)",
             ));
         }
         if args.param.is_some() {
-            return Err(CliError::usage(
+            return Err(Error::usage(
                 "--stream reads the file at the machine's default kinematic parameters; drop --param, or --stream",
             ));
         }
@@ -248,7 +249,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
             .map(|r| (r.label.as_str(), r.params.as_slice()))
             .collect();
         fitting::offsets::check_shared_symbols(&m, &model, &labelled)
-            .map_err(|e| CliError::input(format!("{flag}: {e}")))?;
+            .map_err(|e| Error::input(format!("{flag}: {e}")))?;
         let (ident, refinement) = if args.first_order {
             let ident = identify_campaign(&m, &model, c, &opts).map_err(estimate_error)?;
             (ident, None)
@@ -276,7 +277,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
         data: &data,
     };
     let mut report = IdentificationReport::of_campaign(&m, source, &ident, refinement.as_ref())
-        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
+        .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
     report.streaming = streaming;
     if args.param.is_some() {
         report.notes.push(format!(
@@ -300,7 +301,7 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     }
     let mut out = Outputs::new();
     if let Some(target) = &args.json {
-        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        let json = to_json(&report).map_err(|e| Error::computation(format!("--json: {e}")))?;
         out.add("--json", target.clone(), json);
     }
     if let Some(target) = &args.report {
@@ -313,11 +314,14 @@ pub fn run(args: &IdentifyArgs) -> CliResult {
     if let Some(r) = recorder.as_mut() {
         r.add_read(&read_files);
     }
-    let check = recorder
-        .as_ref()
-        .map(|r| ::history::Check::from_identification(&report, r.provenance()));
-    text.push_str(&history::write_and_record(out, recorder.as_mut(), check)?);
-    print_text(&text, stdout_taken)
+    let done = Done::new(text, out, stdout_taken);
+    Ok(match recorder {
+        Some(r) => {
+            let check = ::history::Check::from_identification(&report, r.provenance());
+            done.recording(r, check)
+        }
+        None => done,
+    })
 }
 
 /// The HTML report (`--report`) of this identification: its records, set-ups and values, and
@@ -330,13 +334,13 @@ fn html_report(
     ident: &CampaignIdentification,
     loaded: Option<&campaign::Loaded>,
     label: &str,
-) -> CliResult<String> {
+) -> VerbResult<String> {
     let mut i = super::report::inputs_for(m, inputs);
     i.add(
         "this run of rtest identify",
         ::report::Document::Identification(Box::new(report.clone())),
     )
-    .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+    .map_err(|e| Error::computation(format!("--report: {e}")))?;
     match loaded {
         None => i.prediction_not_drawn.push(format!(
             "{} is not drawn: a streamed record is read block by block, and its figure would read it all",
@@ -363,18 +367,15 @@ fn html_report(
 }
 
 /// A streaming error as a verb's error.
-fn stream_error(
-    e: StreamingError<formats::csv::CsvError>,
-    data_path: &std::path::Path,
-) -> CliError {
+fn stream_error(e: StreamingError<formats::csv::CsvError>, data_path: &std::path::Path) -> Error {
     match e {
-        StreamingError::Read(e) => CliError::input(format!("--data: {e}")),
-        e @ StreamingError::ReadTwice(_) => CliError::input(format!("--data: {e}")),
+        StreamingError::Read(e) => Error::input(format!("--data: {e}")),
+        e @ StreamingError::ReadTwice(_) => Error::input(format!("--data: {e}")),
         StreamingError::HMatrix(e @ HMatrixError::Times { .. }) => {
-            CliError::input(format!("--data {}: {e}", data_path.display()))
+            Error::input(format!("--data {}: {e}", data_path.display()))
         }
         StreamingError::Estimate(e) => estimate_error(e),
-        other => CliError::computation(format!("--data: cannot identify: {other}")),
+        other => Error::computation(format!("--data: cannot identify: {other}")),
     }
 }
 
@@ -389,20 +390,20 @@ fn parameters_text(m: &model_spec::Machine, params: &[f64]) -> String {
 }
 
 /// An implausible result as a verb's error.
-fn implausible(e: &fitting::Implausible) -> CliError {
-    CliError::computation(format!(
+fn implausible(e: &fitting::Implausible) -> Error {
+    Error::computation(format!(
         "--data: implausible result: {e}; the fit does not describe this machine (too few or unsuitable data, or a model the data cannot determine; --max-error-um, --max-error-urad change the bounds)"
     ))
 }
 
 /// A refinement error as a verb's error.
-fn refine_error(e: RefineError) -> CliError {
+fn refine_error(e: RefineError) -> Error {
     match e {
         RefineError::Estimate(e) => estimate_error(e),
-        e @ RefineError::NotConverged { .. } => CliError::computation(format!(
+        e @ RefineError::NotConverged { .. } => Error::computation(format!(
             "--data: {e}: the data do not determine the model well enough for the exact machine (--first-order gives the first-order values)"
         )),
-        other => CliError::computation(format!(
+        other => Error::computation(format!(
             "--data: the refinement against the exact machine failed: {other} (--first-order skips it)"
         )),
     }
@@ -410,12 +411,12 @@ fn refine_error(e: RefineError) -> CliError {
 
 /// An estimation error as a verb's error: an unknown constraint name is a usage error, too few
 /// samples a bad input, anything else a failed computation.
-pub(super) fn estimate_error(e: EstimateError) -> CliError {
+pub(super) fn estimate_error(e: EstimateError) -> Error {
     match e {
-        EstimateError::UnknownParameter(name, names) => CliError::usage(format!(
+        EstimateError::UnknownParameter(name, names) => Error::usage(format!(
             "--constraint: `{name}` is not a parameter of the model (parameters: {names})"
         )),
-        e @ EstimateError::TooFewReadings { .. } => CliError::input(format!("--data: {e}")),
-        other => CliError::computation(format!("--data: cannot identify: {other}")),
+        e @ EstimateError::TooFewReadings { .. } => Error::input(format!("--data: {e}")),
+        other => Error::computation(format!("--data: cannot identify: {other}")),
     }
 }

@@ -1,6 +1,7 @@
 //! `rtest bench`: what the generated code buys, measured on this computer (the `perf` crate).
 
-use super::{CliError, CliResult, EXIT_CODES};
+use super::{EXIT_CODES, Error, VerbResult};
+use crate::Done;
 
 const LONG_ABOUT: &str = "\
 Measures, on this computer and in this process, what the generated code buys (medians of \
@@ -35,19 +36,18 @@ pub struct BenchArgs {
 }
 
 /// Runs `rtest bench`.
-pub fn run(args: &BenchArgs) -> CliResult {
+pub fn run(args: &BenchArgs) -> VerbResult<Done> {
     let report = perf::report::run(args.quick);
     if let Some(what) = perf::report::non_finite(&report) {
-        return Err(CliError::computation(format!(
+        return Err(Error::computation(format!(
             "bench: a measurement failed: {what}"
         )));
     }
     if args.json {
         let json = serde_json::to_string_pretty(&report)
-            .map_err(|e| CliError::computation(format!("--json: {e}")))?;
-        super::print(&(json + "\n"))?;
+            .map_err(|e| Error::computation(format!("--json: {e}")))?;
+        Ok(Done::text(json + "\n"))
     } else {
-        super::print(&perf::report::text(&report))?;
+        Ok(Done::text(perf::report::text(&report)))
     }
-    Ok(())
 }

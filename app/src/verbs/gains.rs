@@ -1,7 +1,8 @@
 //! `rtest gains`: the error-gain functions of a machine's model, as a symbolic table or as
 //! numbers at one pose.
 
-use super::{CliError, CliResult, EXIT_CODES, args, pose_args};
+use super::{EXIT_CODES, Error, VerbResult, args, pose_args};
+use crate::Done;
 use codegen::GainModel;
 use codegen::atoms::AtomKind;
 use codegen::poly::Poly;
@@ -80,7 +81,7 @@ pub struct GainsArgs {
 }
 
 /// Runs `rtest gains`.
-pub fn run(args: &GainsArgs) -> CliResult {
+pub fn run(args: &GainsArgs) -> VerbResult<Done> {
     let m = super::load_machine(&args.machine)?;
     let (model_name, errors) =
         args::select_errors(&m, args.model.as_deref(), args.errors.as_deref())?;
@@ -96,18 +97,18 @@ pub fn run(args: &GainsArgs) -> CliResult {
         let out = match table_format {
             Some(f) => render(&m, &model, &title, f),
             None => to_json(&GainTableReport::new(&m, model_name.as_deref(), &model))
-                .map_err(|e| CliError::computation(format!("--format: {e}")))?,
+                .map_err(|e| Error::computation(format!("--format: {e}")))?,
         };
-        return super::print(&out);
+        return Ok(Done::text(out));
     };
     let params = pose_args::params(&m, args.param.as_deref())?;
     let pose = complete(&m, &pose_args::at(&m, at)?, params, args.allow_off_stroke).map_err(
         |e| match e {
-            PoseError::Ik(_) => CliError::input(format!("--at: {e}")),
+            PoseError::Ik(_) => Error::input(format!("--at: {e}")),
             PoseError::OffStroke(_) => {
-                CliError::usage(format!("--at: {e} (--allow-off-stroke accepts it)"))
+                Error::usage(format!("--at: {e} (--allow-off-stroke accepts it)"))
             }
-            PoseError::MissingRotary(_) => CliError::usage(format!("--at: {e}")),
+            PoseError::MissingRotary(_) => Error::usage(format!("--at: {e}")),
         },
     )?;
     let model = GainModel::derive(&m, &errors);
@@ -126,7 +127,7 @@ pub fn run(args: &GainsArgs) -> CliResult {
         for (k, p) in polys.iter().enumerate() {
             let (value, bound) = evaluate_with_bound(p, &atoms, &atom_errors);
             if !value.is_finite() {
-                return Err(CliError::computation(format!(
+                return Err(Error::computation(format!(
                     "--at: gain {} of {} is not finite at this pose ({value})",
                     COLUMNS[k], model.error_names[i]
                 )));
@@ -141,9 +142,10 @@ pub fn run(args: &GainsArgs) -> CliResult {
             };
         }
     }
+    let mut notes = String::new();
     if let (None, Some(note)) = (table_format, pose.off_ball_note()) {
         // The JSON stays what tools read; the note goes to standard error.
-        super::print_text(&format!("{note}\n"), true)?;
+        notes = format!("{note}\n");
     }
     // The distance from the tool point to the workpiece point is 0 to rounding after the
     // inverse kinematics: within the bound of its own rounding it is written 0.
@@ -162,11 +164,11 @@ pub fn run(args: &GainsArgs) -> CliResult {
         Some(f) => pose_gains(&m, &title, &pose, &report, f),
         None => to_json(
             &PoseGainsReport::new(&m, model_name.as_deref(), &pose, &report)
-                .map_err(|e| CliError::computation(format!("--at: {e}")))?,
+                .map_err(|e| Error::computation(format!("--at: {e}")))?,
         )
-        .map_err(|e| CliError::computation(format!("--format: {e}")))?,
+        .map_err(|e| Error::computation(format!("--format: {e}")))?,
     };
-    super::print(&out)
+    Ok(Done::text(out).noting(notes))
 }
 
 /// How `rtest gains --at` decides that a gain is zero (said in its outputs).

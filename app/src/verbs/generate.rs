@@ -3,7 +3,8 @@
 
 use codegen::build::crate_files;
 
-use super::{CliError, CliResult, EXIT_CODES, args, check_outputs, write};
+use super::{EXIT_CODES, Error, VerbResult, args, check_outputs};
+use crate::Done;
 use model_spec::Machine;
 use output::{Outputs, Target};
 use std::path::{Path, PathBuf};
@@ -48,12 +49,12 @@ pub struct GenerateArgs {
 }
 
 /// Runs `rtest generate`.
-pub fn run(args: &GenerateArgs) -> CliResult {
+pub fn run(args: &GenerateArgs) -> VerbResult<Done> {
     let (m, text) = super::load_machine_and_text(&args.machine)?;
     for (i, name) in args.model.iter().enumerate() {
         args::model_errors(&m, name)?;
         if args.model[..i].contains(name) {
-            return Err(CliError::usage(format!("--model: `{name}` is given twice")));
+            return Err(Error::usage(format!("--model: `{name}` is given twice")));
         }
     }
     let inputs: Vec<_> = super::machine_file(&args.machine)
@@ -83,15 +84,13 @@ pub fn run(args: &GenerateArgs) -> CliResult {
                 };
                 outputs.add_in_dir("--crate", place, name, contents);
             }
-            let written = write(outputs)?;
             let built = crate_files::package_name(&m.name);
-            super::print(&format!(
-                "{}Crate `{built}` of machine `{}` in `{}`: `cargo build --release` there, or a \
+            Ok(Done::new("", outputs, false).then(format!(
+                "Crate `{built}` of machine `{}` in `{}`: `cargo build --release` there, or a \
                  path dependency of your crate.\n",
-                super::wrote(&written),
                 m.name,
                 dir.display()
-            ))
+            )))
         }
         None => {
             let target = args.output.clone().unwrap_or(Target::Stdout);
@@ -100,42 +99,40 @@ pub fn run(args: &GenerateArgs) -> CliResult {
             let mut files = Outputs::new();
             files.add("-o", target.clone(), code);
             // The code may be on standard output: what was written is said on standard error.
-            super::print_text(&super::wrote(&write(files)?), true)
+            Ok(Done::new("", files, true))
         }
     }
 }
 
 /// The code of the models `models` of `m` (every model when empty).
-fn generate(m: &Machine, models: &[&str]) -> CliResult<String> {
+fn generate(m: &Machine, models: &[&str]) -> VerbResult<String> {
     codegen::emit::generate_machine(m, models)
-        .map_err(|e| CliError::computation(format!("generate: machine {}: {e}", m.name)))
+        .map_err(|e| Error::computation(format!("generate: machine {}: {e}", m.name)))
 }
 
 /// Refuses a crate directory that exists and is not an empty directory: a crate is written
 /// whole into a place of its own, never over or among other files.
-fn refuse_non_empty(dir: &Path) -> CliResult {
+fn refuse_non_empty(dir: &Path) -> VerbResult {
     let shown = dir.display();
     match std::fs::metadata(dir) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotADirectory => Err(CliError::input(format!(
+        Err(e) if e.kind() == std::io::ErrorKind::NotADirectory => Err(Error::input(format!(
             "--crate: `{shown}`: a directory above it is a file"
         ))),
-        Err(e) => Err(CliError::input(format!(
-            "--crate: cannot read `{shown}`: {e}"
-        ))),
-        Ok(meta) if !meta.is_dir() => Err(CliError::input(format!(
+        Err(e) => Err(Error::input(format!("--crate: cannot read `{shown}`: {e}"))),
+        Ok(meta) if !meta.is_dir() => Err(Error::input(format!(
             "--crate: `{shown}` exists and is not a directory"
         ))),
         Ok(_) => {
             let mut entries = std::fs::read_dir(dir)
-                .map_err(|e| CliError::input(format!("--crate: cannot read `{shown}`: {e}")))?;
+                .map_err(|e| Error::input(format!("--crate: cannot read `{shown}`: {e}")))?;
             match entries.next() {
                 None => Ok(()),
                 Some(entry) => {
                     let first = entry
                         .map(|e| format!(" (it holds `{}`)", e.file_name().to_string_lossy()))
                         .unwrap_or_default();
-                    Err(CliError::input(format!(
+                    Err(Error::input(format!(
                         "--crate: `{shown}` exists and is not empty{first}: give a new or empty \
                          directory"
                     )))

@@ -2,7 +2,8 @@
 //! first one line per machine (its family, its axes and its description), then each machine in
 //! full.
 
-use super::{CliResult, EXIT_CODES};
+use super::{EXIT_CODES, VerbResult};
+use crate::Done;
 use model_spec::{AxisKind, Machine, Side};
 
 /// Flags of `rtest machines`.
@@ -28,7 +29,7 @@ pub struct MachinesArgs {
 }
 
 /// Runs `rtest machines`.
-pub fn run(args: &MachinesArgs) -> CliResult {
+pub fn run(args: &MachinesArgs) -> VerbResult<Done> {
     let machines = match &args.machine {
         Some(name) => vec![super::load_machine(name)?],
         None => model_spec::all_builtin(),
@@ -40,7 +41,7 @@ pub fn run(args: &MachinesArgs) -> CliResult {
         .map(model_spec::describe::describe)
         .collect();
     text.push_str(&details.join("\n"));
-    super::print(&text)
+    Ok(Done::text(text))
 }
 
 /// One line per machine, aligned: name, family, axes, description.

@@ -3,7 +3,8 @@
 //! tables.
 
 use super::args::ValueBounds;
-use super::{CliError, CliResult, EXIT_CODES, ReadFile, check_outputs, print_text, write, wrote};
+use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
+use crate::Done;
 use compensation::kinematics::corrected_description;
 use compensation::run::{PoseSource, RunError, Stopped, Summary, compensate_each};
 use compensation::tables::{Pitch, axis_tables};
@@ -98,24 +99,24 @@ pub struct CompensateArgs {
 }
 
 /// Runs `rtest compensate`.
-pub fn run(args: &CompensateArgs) -> CliResult {
+pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
     if args.path.is_none() && args.kinematics_out.is_none() && args.tables.is_none() {
-        return Err(CliError::usage(
+        return Err(Error::usage(
             "nothing to write: give --path IN -o OUT, --kinematics-out FILE or --tables DIR",
         ));
     }
     if args.json.is_some() && args.path.is_none() {
-        return Err(CliError::usage(
+        return Err(Error::usage(
             "--json summarises corrected poses: give --path",
         ));
     }
     if args.report.is_some() && args.path.is_none() {
-        return Err(CliError::usage(
+        return Err(Error::usage(
             "--report summarises corrected poses: give --path",
         ));
     }
     if args.nc.is_none() && args.decimals.is_some() {
-        return Err(CliError::usage("--decimals applies to NC programs (--nc)"));
+        return Err(Error::usage("--decimals applies to NC programs (--nc)"));
     }
     super::args::nc_decimals(args.decimals)?;
     let machine = super::load_machine_read(&args.machine)?;
@@ -147,20 +148,20 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     let params_file = args.params.display().to_string();
     let (params_text, params_digest) =
         model_spec::text::read_text_hashed(&args.params, report::json::read::MAX_REPORT_BYTES)
-            .map_err(|e| CliError::input(format!("--params: {e}")))?;
+            .map_err(|e| Error::input(format!("--params: {e}")))?;
     let id = parse_identification(&params_file, &params_text, &m)
-        .map_err(|e| CliError::input(format!("--params: {e}")))?;
+        .map_err(|e| Error::input(format!("--params: {e}")))?;
     let mut read_files = vec![ReadFile::new("--params", &args.params, params_digest)];
     let v = &id.values;
     super::campaign::check_campaign_values(&m, &v.layout, &v.values, &args.bounds.values())
         .map_err(|e| {
-            CliError::input(format!(
+            Error::input(format!(
                 "--params: {}: {e}: these cannot be the errors of a machine tool (--max-error-um, --max-error-urad change the bounds)",
                 args.params.display()
             ))
         })?;
     let (errors, left_out) = MachineErrors::from_values(&m, v, &id.file)
-        .map_err(|e| CliError::input(format!("--params: {e}")))?;
+        .map_err(|e| Error::input(format!("--params: {e}")))?;
     let symbols_note = symbols_note(&m, &params, errors.record_params(), args.param.is_some());
     let mut files = Outputs::new();
     files.protect(&inputs);
@@ -178,32 +179,32 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             values_at: &values_at,
         };
         let (path_text, digest) =
-            read_keeping_bom(path).map_err(|e| CliError::input(format!("--path: {e}")))?;
+            read_keeping_bom(path).map_err(|e| Error::input(format!("--path: {e}")))?;
         read_files.push(ReadFile::new("--path", path, digest));
         let (text, rounding, format, s) = match &args.nc {
             Some(name) => {
                 let dialect = Dialect::from_name(name).expect("clap checks the dialect");
                 let program = parse_program(&file, &path_text, dialect, &words)
-                    .map_err(|e| CliError::input(format!("--path: {e}")))?;
+                    .map_err(|e| Error::input(format!("--path: {e}")))?;
                 let options = WriteOptions::with_min_decimals(args.decimals.unwrap_or(0));
                 let mut writer = program
                     .writer(&options)
-                    .map_err(|e| CliError::input(format!("-o: {e}")))?;
+                    .map_err(|e| Error::input(format!("-o: {e}")))?;
                 let s = correct.run(program.pose_list(), |q| writer.pose(q))?;
                 let written = writer
                     .finish()
-                    .map_err(|e| CliError::input(format!("-o: {e}")))?;
+                    .map_err(|e| Error::input(format!("-o: {e}")))?;
                 let rounding = from_file_units(&m, &written.rounding);
                 (written.text, Some(rounding), name.clone(), s)
             }
             None => {
                 let table = read_pose_csv(&file, &path_text, &words)
-                    .map_err(|e| CliError::input(format!("--path: {e}")))?;
+                    .map_err(|e| Error::input(format!("--path: {e}")))?;
                 let mut writer = table.writer();
                 let s = correct.run(table.pose_list(), |q| writer.pose(q))?;
                 let text = writer
                     .finish()
-                    .map_err(|e| CliError::input(format!("-o: {e}")))?;
+                    .map_err(|e| Error::input(format!("-o: {e}")))?;
                 (text, None, "csv".to_string(), s)
             }
         };
@@ -216,7 +217,7 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     }
     if let Some(target) = &args.kinematics_out {
         let corrected = corrected_description(&m, &machine_text, &errors)
-            .map_err(|e| CliError::input(format!("--kinematics-out: {e}")))?;
+            .map_err(|e| Error::input(format!("--kinematics-out: {e}")))?;
         source.kinematics = Some(KinematicsReport {
             file: target.to_string(),
             folded: corrected
@@ -256,8 +257,8 @@ pub fn run(args: &CompensateArgs) -> CliResult {
             rotary_deg: args.pitch_deg,
         };
         let tables = axis_tables(&m, &errors, pitch).map_err(|e| match e {
-            CompensationError::Pitch { .. } => CliError::usage(format!("--tables: {e}")),
-            other => CliError::computation(format!("--tables: {other}")),
+            CompensationError::Pitch { .. } => Error::usage(format!("--tables: {e}")),
+            other => Error::computation(format!("--tables: {other}")),
         })?;
         for t in &tables {
             let name = t.file_name();
@@ -268,10 +269,10 @@ pub fn run(args: &CompensateArgs) -> CliResult {
     let mut text = match &summary {
         Some(s) => {
             let report = CompensationReport::new(source, s)
-                .map_err(|e| CliError::computation(format!("--path: {e}")))?;
+                .map_err(|e| Error::computation(format!("--path: {e}")))?;
             if let Some(target) = &args.json {
                 let json =
-                    to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+                    to_json(&report).map_err(|e| Error::computation(format!("--json: {e}")))?;
                 files.add("--json", target.clone(), json);
             }
             if let Some(target) = &args.report {
@@ -290,11 +291,10 @@ pub fn run(args: &CompensateArgs) -> CliResult {
         ),
     };
     text.push_str(&symbols_note);
-    text.push_str(&wrote(&write(files)?));
     let stdout_taken = [&args.output, &args.kinematics_out, &args.json, &args.report]
         .iter()
         .any(|t| matches!(t, Some(Target::Stdout)));
-    print_text(&text, stdout_taken)
+    Ok(Done::new(text, files, stdout_taken))
 }
 
 /// The correction of the poses of `--path`: what [`compensate_each`] takes besides the poses.
@@ -313,7 +313,7 @@ impl Correction<'_> {
         &self,
         poses: &PoseList,
         mut write: impl FnMut(&[f64]) -> Result<(), E>,
-    ) -> CliResult<Summary> {
+    ) -> VerbResult<Summary> {
         let m = self.m;
         let mut in_file_units = vec![0.0; m.axes.len()];
         let sink = |_: usize, q: &[f64]| {
@@ -332,10 +332,10 @@ impl Correction<'_> {
         )
         .map_err(|e| match e {
             Stopped::Run(e @ RunError::NotConverged { .. }) => {
-                CliError::computation(format!("--path: {e}"))
+                Error::computation(format!("--path: {e}"))
             }
-            Stopped::Run(other) => CliError::input(format!("--path: {other}")),
-            Stopped::Sink(e) => CliError::input(format!("-o: {e}")),
+            Stopped::Run(other) => Error::input(format!("--path: {other}")),
+            Stopped::Sink(e) => Error::input(format!("-o: {e}")),
         })
     }
 }
@@ -368,16 +368,16 @@ fn html_report(
     m: &model_spec::Machine,
     inputs: &[ReadFile],
     report: &CompensationReport,
-) -> CliResult<String> {
+) -> VerbResult<String> {
     let mut i = super::report::inputs_for(m, inputs);
-    let fail = |e: ::report::InputError| CliError::input(format!("--params: {e}"));
+    let fail = |e: ::report::InputError| Error::input(format!("--params: {e}"));
     let params = ::report::inputs::classify(params_file, params_text).map_err(fail)?;
     i.add(params_file, params).map_err(fail)?;
     i.add(
         "this run of rtest compensate",
         ::report::Document::Compensation(Box::new(report.clone())),
     )
-    .map_err(|e| CliError::computation(format!("--report: {e}")))?;
+    .map_err(|e| Error::computation(format!("--report: {e}")))?;
     super::report::render("--report", &i)
 }
 

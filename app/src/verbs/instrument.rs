@@ -1,7 +1,8 @@
 //! `rtest instrument`: the R-test instruments (sensor heads): the presets, one described, and
 //! the calibration of an instrument's own errors from known displacements.
 
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use super::{EXIT_CODES, Error, VerbResult, check_outputs};
+use crate::Done;
 use fitting::calibrate::{Calibration, CalibrationError, PARAMETERS, SensorCalibration, calibrate};
 use formats::csv::ReadOptions;
 use formats::sensors::read_calibration_file;
@@ -69,12 +70,12 @@ struct CalibrateArgs {
 }
 
 /// Runs `rtest instrument`.
-pub fn run(args: &InstrumentVerb) -> CliResult {
+pub fn run(args: &InstrumentVerb) -> VerbResult<Done> {
     match &args.action {
-        Action::List => super::print(&list()),
+        Action::List => Ok(Done::text(list())),
         Action::Show { instrument } => {
             let i = super::args::instrument(instrument, "instrument")?;
-            super::print(&show(&i))
+            Ok(Done::text(show(&i)))
         }
         Action::Calibrate(c) => run_calibrate(c),
     }
@@ -259,7 +260,7 @@ fn provenance(c: &Calibration, data: &str, described: &Instrument) -> Vec<String
     lines
 }
 
-fn run_calibrate(args: &CalibrateArgs) -> CliResult {
+fn run_calibrate(args: &CalibrateArgs) -> VerbResult<Done> {
     let described = super::args::instrument(&args.instrument, "--instrument")?;
     let mut inputs = vec![("--data", args.data.as_path())];
     let instrument_file = std::path::Path::new(&args.instrument);
@@ -268,30 +269,28 @@ fn run_calibrate(args: &CalibrateArgs) -> CliResult {
     }
     check_outputs(&inputs, &[("-o", &args.output)], &[])?;
     let record = read_calibration_file(&args.data, &described, &ReadOptions::default())
-        .map_err(|e| CliError::input(format!("--data: {e}")))?;
+        .map_err(|e| Error::input(format!("--data: {e}")))?;
     let data = args.data.display().to_string();
     let c = calibrate(&described, &record).map_err(|e| match e {
         e @ (CalibrationError::Record(_) | CalibrationError::Contact { .. }) => {
-            CliError::input(format!("--data: {e}"))
+            Error::input(format!("--data: {e}"))
         }
-        e => CliError::computation(format!("--data {data}: {e}")),
+        e => Error::computation(format!("--data {data}: {e}")),
     })?;
     let text = to_toml(&c.instrument, &provenance(&c, &data, &described));
     // What is written is what a later run reads: read it back with the same rules.
     let back = parse_instrument(&args.output.to_string(), &text).map_err(|e| {
-        CliError::computation(format!(
+        Error::computation(format!(
             "-o: the calibrated description does not read back, so it is not written: {e}"
         ))
     })?;
     if back != c.instrument {
-        return Err(CliError::computation(
+        return Err(Error::computation(
             "-o: the calibrated description does not read back to the same values, so it is not written",
         ));
     }
     let mut files = Outputs::new();
     files.add("-o", args.output.clone(), text);
-    let written = write(files)?;
-    let mut out = calibration_text(&c, &data);
-    out += &wrote(&written);
-    print_text(&out, matches!(args.output, Target::Stdout))
+    let out = calibration_text(&c, &data);
+    Ok(Done::new(out, files, matches!(args.output, Target::Stdout)))
 }

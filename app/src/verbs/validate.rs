@@ -3,7 +3,8 @@
 
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use super::{EXIT_CODES, Error, VerbResult, check_outputs};
+use crate::Done;
 use fitting::campaign::validate::validate_campaign_with_progress;
 use fitting::validate::Unidentified;
 use fitting::{ValidateError, ValidateOptions};
@@ -96,7 +97,7 @@ pub struct ValidateArgs {
 
 /// Runs `rtest validate`: the identification's values (of one record or several) predict
 /// the records of `--data` or `--campaign`, each on its set-up.
-pub fn run(args: &ValidateArgs) -> CliResult {
+pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
     let m = super::load_machine(&args.machine)?;
     let files = match &args.data {
         Some(list) => args::files("--data", list)?,
@@ -115,7 +116,7 @@ pub fn run(args: &ValidateArgs) -> CliResult {
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
     let id = read_identification(&args.params, &m)
-        .map_err(|e| CliError::input(format!("--params: {e}")))?;
+        .map_err(|e| Error::input(format!("--params: {e}")))?;
     let values = &id.values;
     campaign::check_campaign_values(&m, &values.layout, &values.values, &args.bounds.values())
         .map_err(|e| implausible(args, &e))?;
@@ -147,7 +148,7 @@ pub fn run(args: &ValidateArgs) -> CliResult {
         let setup = match &args.setup {
             Some(setup) => {
                 simulation::campaign::check_label("--setup", setup)
-                    .map_err(|e| CliError::usage(e.to_string()))?;
+                    .map_err(|e| Error::usage(e.to_string()))?;
                 Some(setup.clone())
             }
             None => fitted_setup(values, &loaded.campaign),
@@ -184,7 +185,7 @@ pub fn run(args: &ValidateArgs) -> CliResult {
         exact: !args.first_order,
     };
     let report = ValidationReport::new(&m, source, &v)
-        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
+        .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
     let mut text = validation(&report);
     text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {
         "say `zeroed = true` for it in the campaign file"
@@ -193,11 +194,14 @@ pub fn run(args: &ValidateArgs) -> CliResult {
     }));
     let mut files = Outputs::new();
     if let Some(target) = &args.json {
-        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        let json = to_json(&report).map_err(|e| Error::computation(format!("--json: {e}")))?;
         files.add("--json", target.clone(), json);
     }
-    text.push_str(&wrote(&write(files)?));
-    print_text(&text, matches!(args.json, Some(Target::Stdout)))
+    Ok(Done::new(
+        text,
+        files,
+        matches!(args.json, Some(Target::Stdout)),
+    ))
 }
 
 /// The set-up of `--data` records without `--setup`: the identification's, when it fitted one
@@ -220,8 +224,8 @@ fn fitted_setup(
 }
 
 /// Values that cannot be a machine's, as a verb's error.
-fn implausible(args: &ValidateArgs, e: &fitting::Implausible) -> CliError {
-    CliError::input(format!(
+fn implausible(args: &ValidateArgs, e: &fitting::Implausible) -> Error {
+    Error::input(format!(
         "--params: {}: {e}: these cannot be the errors of a machine tool (--max-error-um, --max-error-urad change the bounds)",
         args.params.display()
     ))
@@ -229,14 +233,14 @@ fn implausible(args: &ValidateArgs, e: &fitting::Implausible) -> CliError {
 
 /// A validation error as a verb's error: a record that does not fit the identification (its
 /// set-up, its start) is a bad input.
-fn validate_error(args: &ValidateArgs, e: ValidateError) -> CliError {
+fn validate_error(args: &ValidateArgs, e: ValidateError) -> Error {
     match e {
-        ValidateError::Unidentified(names) => CliError::input(format!(
+        ValidateError::Unidentified(names) => Error::input(format!(
             "--params: {} gave no value for {} (not determined by the identification) and --refuse-undetermined is set (without it they are set to 0)",
             args.params.display(),
             names.join(", ")
         )),
-        ValidateError::Shape(why) => CliError::input(format!("--data: cannot validate: {why}")),
-        other => CliError::computation(format!("--data: cannot validate: {other}")),
+        ValidateError::Shape(why) => Error::input(format!("--data: cannot validate: {why}")),
+        other => Error::computation(format!("--data: cannot validate: {other}")),
     }
 }

@@ -3,7 +3,8 @@
 //! The record of poses is computed in one function ([`poses`]), written in another
 //! ([`csv_text`]), so that other formats of the same poses are one more writer.
 
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, pose_args, print_text, write};
+use super::{EXIT_CODES, Error, VerbResult, check_outputs, pose_args};
+use crate::Done;
 use formats::csv::{ReadOptions, format_record};
 use formats::paths::parse_path;
 use model_spec::units::short;
@@ -90,7 +91,7 @@ pub struct PathArgs {
 }
 
 /// The options of the generator from the flags.
-fn options(args: &PathArgs) -> CliResult<GeneratorOptions> {
+fn options(args: &PathArgs) -> VerbResult<GeneratorOptions> {
     let opts = GeneratorOptions {
         step_deg: args.step_deg,
         period_s: args.period_s,
@@ -107,7 +108,7 @@ fn options(args: &PathArgs) -> CliResult<GeneratorOptions> {
 /// command line asks (an unknown test, an option out of its domain, a ball position that puts
 /// a test out of its limits), a bad input where the machine cannot follow the ball, a failed
 /// computation otherwise.
-fn generator_error(e: &GeneratorError, args: &PathArgs) -> CliError {
+fn generator_error(e: &GeneratorError, args: &PathArgs) -> Error {
     let ball_flag = if args.param.is_some() {
         "--param"
     } else {
@@ -121,14 +122,14 @@ fn generator_error(e: &GeneratorError, args: &PathArgs) -> CliError {
                 "max tilt" => "--max-tilt-deg",
                 _ => "--min-ball-height-mm",
             };
-            CliError::usage(format!("{flag}: {e}"))
+            Error::usage(format!("{flag}: {e}"))
         }
         GeneratorError::NoRotaryAxis { .. }
         | GeneratorError::UnknownTest { .. }
         | GeneratorError::NoRoom { .. }
-        | GeneratorError::TooManySamples { .. } => CliError::usage(format!("--test: {e}")),
+        | GeneratorError::TooManySamples { .. } => Error::usage(format!("--test: {e}")),
         GeneratorError::ParamCount { .. } | GeneratorError::Param { .. } => {
-            CliError::usage(format!("--param: {e}"))
+            Error::usage(format!("--param: {e}"))
         }
         GeneratorError::BallTooLow { .. } => {
             let flag = if args.param.is_some() {
@@ -136,18 +137,18 @@ fn generator_error(e: &GeneratorError, args: &PathArgs) -> CliError {
             } else {
                 "--min-ball-height-mm"
             };
-            CliError::usage(format!(
+            Error::usage(format!(
                 "{flag}: {e} (or set --min-ball-height-mm to your nest's reach)"
             ))
         }
         GeneratorError::Sample(s) => match s.problem {
-            SampleProblem::Limits(_) => CliError::usage(format!(
+            SampleProblem::Limits(_) => Error::usage(format!(
                 "{ball_flag}: {e}: the linear axes follow the ball; a ball nearer the rotary axes keeps them within their strokes"
             )),
-            SampleProblem::Tilt { .. } => CliError::usage(format!("--test: {e}")),
-            SampleProblem::Ik(_) => CliError::input(format!("--machine: {e}")),
+            SampleProblem::Tilt { .. } => Error::usage(format!("--test: {e}")),
+            SampleProblem::Ik(_) => Error::input(format!("--machine: {e}")),
             SampleProblem::OffBall { .. } | SampleProblem::NotFinite(_) => {
-                CliError::computation(format!("--test: {e}"))
+                Error::computation(format!("--test: {e}"))
             }
         },
     }
@@ -160,7 +161,7 @@ pub fn poses(
     m: &Machine,
     params: &[f64],
     opts: &GeneratorOptions,
-) -> CliResult<(TestSpec, Record)> {
+) -> VerbResult<(TestSpec, Record)> {
     let name = args.test.as_deref().unwrap_or_default();
     let all = generator::tests_with(m, &opts.clearance);
     let unknown = || GeneratorError::UnknownTest {
@@ -207,7 +208,7 @@ pub fn csv_text(
     params: &[f64],
     opts: &GeneratorOptions,
     output: &str,
-) -> CliResult<String> {
+) -> VerbResult<String> {
     let mut comments = vec![
         format!("rtest path: test {} of machine {}", spec.name, m.name),
         spec.description.clone(),
@@ -228,19 +229,19 @@ pub fn csv_text(
         record.samples.len(),
         short(opts.period_s)
     ));
-    let csv = format_record(m, record, &comments)
-        .map_err(|e| CliError::computation(format!("-o: {e}")))?;
+    let csv =
+        format_record(m, record, &comments).map_err(|e| Error::computation(format!("-o: {e}")))?;
     // The nest is on the ball at `params` (checked by the generator); the reader checks it at
     // the defaults, so that check is left to the generator here.
     let mut read = ReadOptions::default();
     read.on_ball_tolerance_mm = f64::INFINITY;
     let back = parse_path(output, &csv, m, &read).map_err(|e| {
-        CliError::computation(format!(
+        Error::computation(format!(
             "-o: the path does not read back, so it is not written: {e}"
         ))
     })?;
     if back != *record {
-        return Err(CliError::computation(
+        return Err(Error::computation(
             "-o: the path does not read back to the same poses, so it is not written",
         ));
     }
@@ -288,7 +289,7 @@ fn extents(m: &Machine, record: &Record) -> String {
 }
 
 /// Runs `rtest path`.
-pub fn run(args: &PathArgs) -> CliResult {
+pub fn run(args: &PathArgs) -> VerbResult<Done> {
     let m = super::load_machine(&args.machine)?;
     let mut inputs = Vec::new();
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
@@ -328,7 +329,6 @@ pub fn run(args: &PathArgs) -> CliResult {
             files.add("-o", target.clone(), csv);
         }
     }
-    let written = write(files)?;
     let mut text = format!(
         "Test {} of machine {}: {} samples.\n  {}\n",
         spec.name,
@@ -346,8 +346,7 @@ pub fn run(args: &PathArgs) -> CliResult {
     if spec.kind == TestKind::Seed {
         text += "The seed's angles are fixed: --max-tilt-deg does not shape them, it only checks them.\n";
     }
-    text += &super::wrote(&written);
-    print_text(&text, matches!(target, Target::Stdout))
+    Ok(Done::new(text, files, matches!(target, Target::Stdout)))
 }
 
 /// A note when the path's nest is off the ball at the description's default parameters by more
@@ -379,7 +378,12 @@ fn off_default_note(m: &Machine, record: &Record) -> String {
 
 /// `--list`: the tests of `m` under `opts`, each with whether it is generated within the limits
 /// at `params`; as text on standard output, or as JSON to `json`.
-fn list(json: Option<&Target>, m: &Machine, params: &[f64], opts: &GeneratorOptions) -> CliResult {
+fn list(
+    json: Option<&Target>,
+    m: &Machine,
+    params: &[f64],
+    opts: &GeneratorOptions,
+) -> VerbResult<Done> {
     let tests = generator::tests_with_orders(m, &opts.clearance);
     let status: Vec<Option<String>> = tests
         .iter()
@@ -434,18 +438,17 @@ fn list(json: Option<&Target>, m: &Machine, params: &[f64], opts: &GeneratorOpti
             "tests": entries,
         });
         let text = serde_json::to_string_pretty(&doc)
-            .map_err(|e| CliError::computation(format!("--json: {e}")))?
+            .map_err(|e| Error::computation(format!("--json: {e}")))?
             + "\n";
         let mut files = Outputs::new();
         files.add("--json", target.clone(), text);
-        let written = write(files)?;
-        return print_text(&super::wrote(&written), matches!(target, Target::Stdout));
+        return Ok(Done::new("", files, matches!(target, Target::Stdout)));
     }
     if tests.is_empty() {
-        return super::print(&format!(
+        return Ok(Done::text(format!(
             "Machine {} has no rotary axis, so it has no R-test test (the tests turn rotary axes): give a path as a CSV file.\n",
             m.name
-        ));
+        )));
     }
     let width = tests.iter().map(|t| t.name.len()).max().unwrap_or(0);
     let mut text = format!(
@@ -463,5 +466,5 @@ fn list(json: Option<&Target>, m: &Machine, params: &[f64], opts: &GeneratorOpti
             text += &format!("  {:width$}  not generated here: {e}\n", "");
         }
     }
-    super::print(&text)
+    Ok(Done::text(text))
 }

@@ -3,18 +3,18 @@
 //! flag in one short line, never a panic; a plan that is read is sound (at most
 //! [`plan::MAX_TESTS`] tests, valid ball names, finite parameters within the largest length).
 //!
-//! The default run takes 600 cases; `RTEST_FUZZ_CASES=100000 cargo test -p rtest --bin rtest
+//! The default run takes 600 cases; `RTEST_FUZZ_CASES=100000 cargo test -p app --lib
 //! plan::fuzz` runs the documented pass (docs/conventions.md §9, "Fuzzing the readers").
 
 use super::{PlanArgs, plan_error, plan_of};
-use crate::cli::EXIT_USAGE;
+use crate::verbs::EXIT_USAGE;
 use clap::Parser;
 use fitting::plan;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-#[path = "../../tests/all/support/fuzz.rs"]
+#[path = "../../../tests/all/support/fuzz.rs"]
 mod fuzzing;
 
 /// `rtest plan`'s flags alone.
@@ -60,7 +60,7 @@ fn check(
                 )
             })?;
         }
-        Ok::<_, crate::cli::CliError>(plan)
+        Ok::<_, crate::verbs::Error>(plan)
     }))
     .map_err(|_| TestCaseError::fail("panicked".to_string()))?;
     match outcome {
@@ -94,11 +94,14 @@ fn check(
             let flagged = line.starts_with("--paths")
                 || line.starts_with("--ball")
                 || line.starts_with("--param");
-            if e.code != EXIT_USAGE || !flagged || line.chars().count() > 600 || line.contains('\n')
+            if e.exit_code() != EXIT_USAGE
+                || !flagged
+                || line.chars().count() > 600
+                || line.contains('\n')
             {
                 return Err(TestCaseError::fail(format!(
                     "exit code {}, message of {} characters: {}",
-                    e.code,
+                    e.exit_code(),
                     line.chars().count(),
                     line.chars().take(300).collect::<String>()
                 )));

@@ -2,7 +2,8 @@
 //! the single added test or ball position that would help most.
 
 use super::args::{self, items, positive};
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, pose_args, print_text, write, wrote};
+use super::{EXIT_CODES, Error, VerbResult, check_outputs, pose_args};
+use crate::Done;
 use fitting::EstimateError;
 use fitting::Tolerances;
 use fitting::noise::{MAX_PHI, NoiseModel, NoiseSource};
@@ -131,7 +132,7 @@ fn phi(s: &str) -> Result<f64, String> {
 }
 
 /// The generator's options from the flags.
-fn options(args: &PlanArgs) -> CliResult<GeneratorOptions> {
+fn options(args: &PlanArgs) -> VerbResult<GeneratorOptions> {
     let opts = GeneratorOptions {
         step_deg: args.step_deg,
         period_s: args.period_s,
@@ -150,23 +151,23 @@ fn options(args: &PlanArgs) -> CliResult<GeneratorOptions> {
             },
             _ => "--paths",
         };
-        CliError::usage(format!("{flag}: {e}"))
+        Error::usage(format!("{flag}: {e}"))
     })?;
     Ok(opts)
 }
 
 /// One `--ball NAME:SYMBOL=VALUE,...`: its name and parameters (`base` overridden).
-fn ball(m: &Machine, text: &str, base: &[f64]) -> CliResult<BallPosition> {
+fn ball(m: &Machine, text: &str, base: &[f64]) -> VerbResult<BallPosition> {
     let example = "expected NAME:SYMBOL=VALUE,..., e.g. high:Zw=260";
     let Some((name, list)) = text.split_once(':') else {
-        return Err(CliError::usage(format!(
+        return Err(Error::usage(format!(
             "--ball: `{}` has no `:` ({example})",
             quoted_start(text)
         )));
     };
     let name = name.trim();
     if name == BASE_BALL || !plan::valid_ball_name(name) {
-        return Err(CliError::usage(format!(
+        return Err(Error::usage(format!(
             "--ball: `{}` is not a ball position name: a letter, then letters, digits, `_`, `-`, `.` or `+`, at most {} characters, and not `{BASE_BALL}` (the position of --param)",
             quoted_start(name),
             plan::MAX_BALL_NAME_CHARS
@@ -182,7 +183,7 @@ fn ball(m: &Machine, text: &str, base: &[f64]) -> CliResult<BallPosition> {
 }
 
 /// The plan of the flags.
-fn plan_of(m: &Machine, args: &PlanArgs) -> CliResult<Plan> {
+fn plan_of(m: &Machine, args: &PlanArgs) -> VerbResult<Plan> {
     let base = pose_args::params(m, args.param.as_deref())?;
     let mut balls = vec![BallPosition {
         name: BASE_BALL.to_string(),
@@ -191,7 +192,7 @@ fn plan_of(m: &Machine, args: &PlanArgs) -> CliResult<Plan> {
     for text in &args.ball {
         let b = ball(m, text, &base)?;
         if balls.iter().any(|o| o.name == b.name) {
-            return Err(CliError::usage(format!(
+            return Err(Error::usage(format!(
                 "--ball: `{}` is given twice",
                 quoted_start(&b.name)
             )));
@@ -206,7 +207,7 @@ fn plan_of(m: &Machine, args: &PlanArgs) -> CliResult<Plan> {
         let (test, name) = (test.trim(), name.trim());
         let Some(b) = balls.iter().position(|b| b.name == name) else {
             let named: Vec<&str> = balls[1..].iter().map(|b| b.name.as_str()).collect();
-            return Err(CliError::usage(format!(
+            return Err(Error::usage(format!(
                 "--paths: `{}`: no ball position `{}` (define it with --ball {}:SYMBOL=VALUE,...; defined: {})",
                 quoted_start(item),
                 quoted_start(name),
@@ -224,7 +225,7 @@ fn plan_of(m: &Machine, args: &PlanArgs) -> CliResult<Plan> {
         });
     }
     if let Some(unused) = (1..balls.len()).find(|&b| !tests.iter().any(|t| t.ball == b)) {
-        return Err(CliError::usage(format!(
+        return Err(Error::usage(format!(
             "--ball {}: no test of --paths is at this position (write TEST:{} in --paths)",
             balls[unused].name, balls[unused].name
         )));
@@ -242,9 +243,9 @@ fn plan_of(m: &Machine, args: &PlanArgs) -> CliResult<Plan> {
 /// line asks (an unknown test, a ball position that puts a test out of a stroke or beyond the
 /// clearance rule), a bad input where the machine cannot follow the ball, a failed computation
 /// otherwise.
-fn plan_error(e: PlanError, args: &PlanArgs) -> CliError {
+fn plan_error(e: PlanError, args: &PlanArgs) -> Error {
     match e {
-        PlanError::Plan(s) => CliError::usage(format!("--paths: {s}")),
+        PlanError::Plan(s) => Error::usage(format!("--paths: {s}")),
         PlanError::Generator { test, ball, error } => {
             let ball_flag = if ball != BASE_BALL {
                 format!("--ball {ball}")
@@ -256,43 +257,41 @@ fn plan_error(e: PlanError, args: &PlanArgs) -> CliError {
             let at = format!("{test} at ball position `{ball}`");
             match &error {
                 GeneratorError::UnknownTest { .. } | GeneratorError::NoRotaryAxis { .. } => {
-                    CliError::usage(format!("--paths: {error}"))
+                    Error::usage(format!("--paths: {error}"))
                 }
                 GeneratorError::NoRoom { .. } | GeneratorError::TooManySamples { .. } => {
-                    CliError::usage(format!("--paths: {at}: {error}"))
+                    Error::usage(format!("--paths: {at}: {error}"))
                 }
-                GeneratorError::Option { .. } => CliError::usage(format!("--paths: {error}")),
+                GeneratorError::Option { .. } => Error::usage(format!("--paths: {error}")),
                 GeneratorError::ParamCount { .. } | GeneratorError::Param { .. } => {
-                    CliError::usage(format!("{ball_flag}: {at}: {error}"))
+                    Error::usage(format!("{ball_flag}: {at}: {error}"))
                 }
-                GeneratorError::BallTooLow { .. } => CliError::usage(format!(
+                GeneratorError::BallTooLow { .. } => Error::usage(format!(
                     "{ball_flag}: {at}: {error} (or set --min-ball-height-mm to your nest's reach)"
                 )),
                 GeneratorError::Sample(s) => match s.problem {
-                    SampleProblem::Limits(_) => CliError::usage(format!(
+                    SampleProblem::Limits(_) => Error::usage(format!(
                         "{ball_flag}: {at}: {error}: the linear axes follow the ball; a ball nearer the rotary axes keeps them within their strokes"
                     )),
-                    SampleProblem::Tilt { .. } => {
-                        CliError::usage(format!("--paths: {at}: {error}"))
-                    }
-                    SampleProblem::Ik(_) => CliError::input(format!("--machine: {at}: {error}")),
+                    SampleProblem::Tilt { .. } => Error::usage(format!("--paths: {at}: {error}")),
+                    SampleProblem::Ik(_) => Error::input(format!("--machine: {at}: {error}")),
                     SampleProblem::OffBall { .. } | SampleProblem::NotFinite(_) => {
-                        CliError::computation(format!("--paths: {at}: {error}"))
+                        Error::computation(format!("--paths: {at}: {error}"))
                     }
                 },
             }
         }
-        PlanError::Estimate(e @ EstimateError::TooFewReadings { .. }) => CliError::usage(format!(
+        PlanError::Estimate(e @ EstimateError::TooFewReadings { .. }) => Error::usage(format!(
             "--paths: the plan has too few samples for its parameters: {e}"
         )),
         PlanError::Estimate(e) => {
-            CliError::computation(format!("--paths: cannot predict the plan: {e}"))
+            Error::computation(format!("--paths: cannot predict the plan: {e}"))
         }
     }
 }
 
 /// Runs `rtest plan`.
-pub fn run(args: &PlanArgs) -> CliResult {
+pub fn run(args: &PlanArgs) -> VerbResult<Done> {
     let m = super::load_machine(&args.machine)?;
     let (label, model) = args::model(&m, args.model.as_deref(), args.terms.as_deref())?;
     plan::check_model(&m, &model).map_err(|e| {
@@ -301,10 +300,10 @@ pub fn run(args: &PlanArgs) -> CliResult {
         } else {
             "--model"
         };
-        CliError::usage(format!("{flag}: {e}"))
+        Error::usage(format!("{flag}: {e}"))
     })?;
     if args.noise_um > simulation::truth::MAX_NOISE_UM {
-        return Err(CliError::usage(format!(
+        return Err(Error::usage(format!(
             "--noise-um: {} µm is beyond {} µm, the largest reading noise rtest takes",
             compact(args.noise_um),
             simulation::truth::MAX_NOISE_UM
@@ -359,16 +358,15 @@ pub fn run(args: &PlanArgs) -> CliResult {
         separation: separation.as_ref(),
     };
     let report =
-        PlanReport::new(&m, source).map_err(|e| CliError::computation(format!("plan: {e}")))?;
-    let mut text = report::text::plan::plan(&report, args.top as usize);
+        PlanReport::new(&m, source).map_err(|e| Error::computation(format!("plan: {e}")))?;
+    let text = report::text::plan::plan(&report, args.top as usize);
     let mut files = Outputs::new();
     if let Some(target) = &args.json {
-        let json = to_json(&report).map_err(|e| CliError::computation(format!("--json: {e}")))?;
+        let json = to_json(&report).map_err(|e| Error::computation(format!("--json: {e}")))?;
         files.add("--json", target.clone(), json);
     }
     let stdout_taken = matches!(args.json, Some(Target::Stdout));
-    text.push_str(&wrote(&write(files)?));
-    print_text(&text, stdout_taken)
+    Ok(Done::new(text, files, stdout_taken))
 }
 
 #[cfg(test)]

@@ -2,12 +2,12 @@
 //! `plots` crate (path figures through `report::figures::path_svg`, the one conversion the
 //! HTML report uses too), which returns SVG text.
 
-use super::{CliError, CliResult};
+use super::{Error, VerbResult};
 use diagnosis::figures::Figures;
 
 /// Every figure as (file name, what it shows, SVG text).
-pub fn svgs(figures: &Figures) -> CliResult<Vec<(String, String, String)>> {
-    let failed = |e: plots::PlotError| CliError::computation(format!("--plot: {e}"));
+pub fn svgs(figures: &Figures) -> VerbResult<Vec<(String, String, String)>> {
+    let failed = |e: plots::PlotError| Error::computation(format!("--plot: {e}"));
     let mut out = Vec::new();
     for f in &figures.paths {
         let svg = ::report::figures::path_svg(f).map_err(failed)?;

@@ -4,7 +4,8 @@
 //! the same function.
 
 use super::ReadFile;
-use super::{CliError, CliResult, EXIT_CODES, check_outputs, print_text, write, wrote};
+use super::{EXIT_CODES, Error, VerbResult, check_outputs};
+use crate::Done;
 use model_spec::sha256::Digest;
 use output::{Outputs, Target};
 use report::{InputFile, Inputs, MachineFacts};
@@ -79,12 +80,12 @@ pub fn inputs_for(m: &model_spec::Machine, files: &[ReadFile]) -> Inputs {
 ///
 /// # Errors
 /// A figure that cannot be drawn (exit code 3).
-pub fn render(flag: &str, inputs: &Inputs) -> CliResult<String> {
-    report::render(inputs).map_err(|e| CliError::computation(format!("{flag}: {e}")))
+pub fn render(flag: &str, inputs: &Inputs) -> VerbResult<String> {
+    report::render(inputs).map_err(|e| Error::computation(format!("{flag}: {e}")))
 }
 
 /// Runs `rtest report`.
-pub fn run(args: &ReportArgs) -> CliResult {
+pub fn run(args: &ReportArgs) -> VerbResult<Done> {
     let mut inputs_list: Vec<(&str, &Path)> =
         args.reports.iter().map(|p| ("JSON", p.as_path())).collect();
     let machine_file = args.machine.as_deref().and_then(super::machine_file);
@@ -93,7 +94,7 @@ pub fn run(args: &ReportArgs) -> CliResult {
     if let Some(dir) = &args.data_dir
         && !dir.is_dir()
     {
-        return Err(CliError::usage(format!(
+        return Err(Error::usage(format!(
             "--data-dir: `{}` is not a directory",
             dir.display()
         )));
@@ -116,11 +117,11 @@ pub fn run(args: &ReportArgs) -> CliResult {
     let mut texts = Vec::with_capacity(args.reports.len());
     for path in &args.reports {
         let (doc, text, digest) =
-            report::inputs::read_document(path).map_err(|e| CliError::input(e.to_string()))?;
+            report::inputs::read_document(path).map_err(|e| Error::input(e.to_string()))?;
         let file = path.display().to_string();
         inputs
             .add(&file, doc)
-            .map_err(|e| CliError::input(e.to_string()))?;
+            .map_err(|e| Error::input(e.to_string()))?;
         files.push(InputFile::read("JSON report", &file, path, digest));
         texts.push((file, text));
     }
@@ -136,8 +137,7 @@ pub fn run(args: &ReportArgs) -> CliResult {
     let mut out = Outputs::new();
     out.add("-o", args.output.clone(), html);
     let stdout_taken = matches!(args.output, Target::Stdout);
-    let text = wrote(&write(out)?);
-    print_text(&text, stdout_taken)
+    Ok(Done::new("", out, stdout_taken))
 }
 
 /// The identified model's prediction along the path of every record of the identification and
@@ -150,7 +150,7 @@ fn draw_paths(
     machine: Option<model_spec::Machine>,
     texts: &[(String, String)],
     records: &Records,
-) -> CliResult<()> {
+) -> VerbResult<()> {
     let Some((id_file, id)) = &inputs.identification else {
         if !inputs.validations.is_empty() {
             inputs.prediction_not_drawn.push(
@@ -309,7 +309,7 @@ struct Named {
 /// # Errors
 /// A bad input naming the report, the field and the name, for an absolute name or one that
 /// leaves the directory (`..`).
-fn named_files(inputs: &Inputs, data_dir: Option<&Path>) -> CliResult<Vec<Named>> {
+fn named_files(inputs: &Inputs, data_dir: Option<&Path>) -> VerbResult<Vec<Named>> {
     use formats::poses::MAX_FILE_BYTES as RECORD;
     use report::json::read::MAX_REPORT_BYTES as VALUES;
     let mut raw: Vec<(&str, String, &'static str, &str, u64)> = Vec::new();
@@ -382,7 +382,7 @@ fn named_files(inputs: &Inputs, data_dir: Option<&Path>) -> CliResult<Vec<Named>
 ///
 /// # Errors
 /// A bad input for an absolute name, or one whose `..` leave that directory.
-fn resolve(json: &str, field: &str, name: &str, data_dir: Option<&Path>) -> CliResult<PathBuf> {
+fn resolve(json: &str, field: &str, name: &str, data_dir: Option<&Path>) -> VerbResult<PathBuf> {
     use std::path::Component;
     let (base, dir_words) = match data_dir {
         Some(d) => (d.to_path_buf(), "--data-dir"),
@@ -395,7 +395,7 @@ fn resolve(json: &str, field: &str, name: &str, data_dir: Option<&Path>) -> CliR
         ),
     };
     let refuse = |what: &str| {
-        CliError::input(format!(
+        Error::input(format!(
             "{json}: field `{field}`: `{name}` is {what}: rtest report reads the files a report names relative to {dir_words}, never elsewhere (give the files beside the report, or --data-dir DIR with the names relative to DIR)"
         ))
     };
@@ -550,7 +550,7 @@ pub fn path_figures(
     values: &fitting::campaign::CampaignValues,
     label: &str,
     records: &[PathRecord<'_>],
-) -> CliResult<(Vec<report::Figure>, Vec<String>)> {
+) -> VerbResult<(Vec<report::Figure>, Vec<String>)> {
     use diagnosis::figures::{Figures, validation_figure};
     use fitting::ValidateOptions;
     use fitting::campaign::validate_record;
@@ -573,6 +573,6 @@ pub fn path_figures(
         }
     }
     let drawn = report::figures::path_figures(&figures)
-        .map_err(|e| CliError::computation(format!("{flag}: {e}")))?;
+        .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
     Ok((drawn, not_drawn))
 }

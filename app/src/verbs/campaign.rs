@@ -2,7 +2,7 @@
 //! its own set-up and its own R-test zero; one file is a campaign of one) or of
 //! `--campaign FILE`, their checks, and the plausibility of a campaign's values.
 
-use super::{CliError, CliResult, ReadFile};
+use super::{Error, ReadFile, VerbResult};
 use fitting::Constraint;
 use fitting::campaign::Layout;
 use fitting::hmatrix::parameter_name;
@@ -42,7 +42,7 @@ pub fn from_files(
     zeroed: bool,
     read: &ReadOptions,
     instrument: Through,
-) -> CliResult<Loaded> {
+) -> VerbResult<Loaded> {
     record_count(flag, files)?;
     let labels = labels_from_files(files);
     let mut records = Vec::with_capacity(files.len());
@@ -58,7 +58,7 @@ pub fn from_files(
             zeroed,
         ));
     }
-    let campaign = Campaign::new(records).map_err(|e| CliError::usage(format!("{flag}: {e}")))?;
+    let campaign = Campaign::new(records).map_err(|e| Error::usage(format!("{flag}: {e}")))?;
     Ok(Loaded {
         campaign,
         files: files.iter().map(|f| f.display().to_string()).collect(),
@@ -71,16 +71,16 @@ pub fn from_files(
 ///
 /// # Errors
 /// A usage error naming `flag` and the limit.
-pub fn record_count(flag: &str, files: &[PathBuf]) -> CliResult<()> {
+pub fn record_count(flag: &str, files: &[PathBuf]) -> VerbResult<()> {
     simulation::campaign::check_record_count(files.len())
-        .map_err(|e| CliError::usage(format!("{flag}: {e}")))
+        .map_err(|e| Error::usage(format!("{flag}: {e}")))
 }
 
 /// The campaign file `path` (given by `flag`) for machine `m`, read once (its records not yet
 /// read: [`from_file`]).
-pub fn read_file(flag: &str, m: &Machine, path: &Path) -> CliResult<(CampaignFile, ReadFile)> {
+pub fn read_file(flag: &str, m: &Machine, path: &Path) -> VerbResult<(CampaignFile, ReadFile)> {
     let (file, digest) =
-        read_campaign_file(path, m).map_err(|e| CliError::input(format!("{flag}: {e}")))?;
+        read_campaign_file(path, m).map_err(|e| Error::input(format!("{flag}: {e}")))?;
     Ok((file, ReadFile::new(flag, path, digest)))
 }
 
@@ -94,10 +94,10 @@ pub fn from_file(
     (file, source): (CampaignFile, ReadFile),
     read: &ReadOptions,
     instrument: Through,
-) -> CliResult<Loaded> {
+) -> VerbResult<Loaded> {
     let (campaign, digests) = file
         .load(m, read, instrument)
-        .map_err(|e| CliError::input(format!("{flag}: {e}")))?;
+        .map_err(|e| Error::input(format!("{flag}: {e}")))?;
     let mut read_files = vec![source];
     read_files.extend(
         file.records
@@ -130,7 +130,7 @@ impl Loaded {
 
     /// Refuses a record without real times for a term that needs them, naming the record (of
     /// several) and its file.
-    pub fn check_times(&self, flag: &str, m: &Machine, model: &Model) -> CliResult<()> {
+    pub fn check_times(&self, flag: &str, m: &Machine, model: &Model) -> VerbResult<()> {
         let one = self.campaign.records.len() == 1;
         for (r, f) in self.campaign.records.iter().zip(&self.files) {
             let mut local = model.clone();

@@ -12,10 +12,12 @@
 //! and two figures: the K1 residual along C before and after, and its spectrum against C.
 
 use diagnosis::{DiagnoseOptions, Diagnosis, diagnose, one_record};
-use fitting::validate::{ValidateOptions, validate};
+use fitting::campaign::CampaignValues;
+use fitting::{ValidateOptions, validate};
 use formats::progress::Unwatched;
 use model_spec::Machine;
 use model_spec::basis::Basis;
+use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::Model;
 use simulation::record::Record;
 
@@ -204,16 +206,24 @@ fn structure(s: &[diagnosis::structure::Component]) {
 
 /// Measured minus predicted (exact machine) on `record`, base or extended model, mm.
 fn residual(m: &Machine, d: &Diagnosis, record: &Record, extended: bool) -> Vec<[f64; 3]> {
-    // The campaign fit as one identification (its columns in the campaign's order).
     let fit = if extended {
-        d.extended_fit.as_identification()
+        &d.extended_fit
     } else {
-        d.base_fit.as_identification()
+        &d.base_fit
     };
+    // The record on the fitted record's ball set-up, at the default kinematic parameters.
+    let setup = fit.records[0].setup.clone();
+    let r = CampaignRecord::new(
+        "check",
+        record.clone(),
+        m.default_parameters(),
+        setup,
+        false,
+    );
+    let c = Campaign::new(vec![r]).unwrap();
     let o = ValidateOptions::new().exact(true);
-    validate(m, &fit.model, &fit.fit.values, record, &o)
-        .unwrap()
-        .residual
+    let v = validate(m, &CampaignValues::of(fit), &c, &o, &Unwatched).unwrap();
+    v.records[0].validation.residual.clone()
 }
 
 /// A text plot of two series over the same samples: 72 columns, 13 rows.

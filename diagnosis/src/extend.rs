@@ -7,9 +7,9 @@ use super::profile::Scan;
 use super::search::Chosen;
 use super::{DiagnoseError, DiagnoseOptions, Dropped, Finding, plausible};
 use fitting::IdentifyOptions;
-use fitting::campaign::{CampaignIdentification, identify_campaign_refined};
+use fitting::campaign::{CampaignIdentification, identify};
 use fitting::noise::NoiseChoice;
-use fitting::refine::{RefineError, RefineOptions};
+use fitting::refine::{IdentifyError, RefineOptions};
 use model_spec::Machine;
 use simulation::campaign::Campaign;
 use simulation::model::{Model, Term};
@@ -18,7 +18,7 @@ use simulation::model::{Model, Term};
 /// kinematic parameters).
 ///
 /// # Errors
-/// As [`identify_campaign_refined`].
+/// As [`identify`].
 pub(super) fn fit(
     m: &Machine,
     model: &Model,
@@ -32,7 +32,7 @@ pub(super) fn fit(
 /// [`fit`] refined as `refine` says.
 ///
 /// # Errors
-/// As [`identify_campaign_refined`].
+/// As [`identify`].
 pub(super) fn fit_refined(
     m: &Machine,
     model: &Model,
@@ -47,7 +47,8 @@ pub(super) fn fit_refined(
     opts.tolerances = o.tolerances;
     opts.params = None;
     opts.noise = noise.clone();
-    Ok(identify_campaign_refined(m, model, c, &opts, refine)?.0)
+    opts.refine = Some(*refine);
+    Ok(identify(m, model, c, &opts)?)
 }
 
 /// The values and standard uncertainties of `term` in `fit` (mm or rad; every owner's columns
@@ -70,7 +71,7 @@ pub(super) fn term_values(
 pub(super) fn not_converged(e: &DiagnoseError) -> Option<String> {
     match e {
         DiagnoseError::Refine(
-            r @ (RefineError::NotConverged { .. } | RefineError::NotFinite { .. }),
+            r @ (IdentifyError::NotConverged { .. } | IdentifyError::NotFinite { .. }),
         ) => Some(r.to_string()),
         _ => None,
     }
@@ -263,7 +264,7 @@ mod tests {
         let mut fake = |model: &Model| {
             calls.borrow_mut().push(model.terms.len());
             if model.terms.contains(&eyc3) {
-                return Err(DiagnoseError::Refine(RefineError::NotConverged {
+                return Err(DiagnoseError::Refine(IdentifyError::NotConverged {
                     iterations: 8,
                     last_step_mm: 3e-6,
                     tolerance_mm: 1e-9,

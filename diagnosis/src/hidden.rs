@@ -4,8 +4,9 @@
 //! diagnosis against the truth it could not see.
 
 use fitting::refine::exact_prediction;
-use fitting::{IdentifyOptions, RefineError, identify};
+use fitting::{IdentifyError, IdentifyOptions, identify};
 use model_spec::Machine;
+use simulation::campaign::Campaign;
 use simulation::model::Model;
 use simulation::record::Record;
 use simulation::truth::Truth;
@@ -36,7 +37,7 @@ pub fn hidden_terms(
     model: &Model,
     fitted: &Record,
     records: &[&Record],
-) -> Result<HiddenTerms, RefineError> {
+) -> Result<HiddenTerms, IdentifyError> {
     let hidden = Model {
         terms: truth
             .model
@@ -68,11 +69,9 @@ pub fn hidden_terms(
             covariance: fitted.covariance.clone(),
             lines: fitted.lines.clone(),
         };
-        Some(
-            identify(m, model, &alone, &IdentifyOptions::default())?
-                .fit
-                .values,
-        )
+        let campaign = Campaign::of_record(alone, m.default_parameters(), false);
+        let ident = identify(m, model, &campaign, &IdentifyOptions::default())?;
+        ident.single_record(m).map(|one| one.fit.values)
     };
     Ok(HiddenTerms {
         model: hidden,

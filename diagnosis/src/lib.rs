@@ -87,7 +87,7 @@ use dictionary::dictionary;
 use fitting::campaign::CampaignIdentification;
 use fitting::hmatrix::HMatrixError;
 use fitting::noise::{NoiseChoice, NoiseError, NoiseSource};
-use fitting::refine::RefineError;
+use fitting::refine::IdentifyError;
 use fitting::validate::ValidateError;
 use fitting::{EstimateError, with_offsets};
 use formats::progress::Progress;
@@ -114,7 +114,7 @@ pub enum DiagnoseError {
     Estimate(#[from] EstimateError),
     /// The refinement failed.
     #[error(transparent)]
-    Refine(#[from] RefineError),
+    Refine(#[from] IdentifyError),
     /// A validation failed.
     #[error(transparent)]
     Validate(#[from] ValidateError),

@@ -9,6 +9,7 @@ use fitting::hmatrix::{GainSource, h_matrix, parameter_names};
 use fitting::{Constraint, IdentifyOptions, Tolerances, identify, least_squares};
 use model_spec::Machine;
 use nalgebra::DVector;
+use simulation::campaign::Campaign;
 use simulation::model::Model;
 use simulation::record::Record;
 use std::hint::black_box;
@@ -61,16 +62,19 @@ fn estimation(c: &mut Criterion) {
     g.bench_function("reduced/least_squares", |b| {
         b.iter(|| least_squares(black_box(&h), &y, &names, &Constraint::None, &tol).unwrap())
     });
+    let params = m.default_parameters();
+    let one = Campaign::of_record(rec.clone(), params.clone(), false);
+    let opts = IdentifyOptions::default();
     g.bench_function("reduced/identify", |b| {
-        b.iter(|| identify(&m, &model, black_box(&rec), &IdentifyOptions::default()).unwrap())
+        b.iter(|| identify(&m, &model, black_box(&one), &opts).unwrap())
     });
-    let zeroed = IdentifyOptions::new().zeroed(true);
+    let zeroed = Campaign::of_record(rec.clone(), params, true);
     g.bench_function("reduced/identify_zeroed", |b| {
-        b.iter(|| identify(&m, &model, black_box(&rec), &zeroed).unwrap())
+        b.iter(|| identify(&m, &model, black_box(&zeroed), &opts).unwrap())
     });
     let full = Model::constant(&m.errors);
     g.bench_function("full/identify", |b| {
-        b.iter(|| identify(&m, &full, black_box(&rec), &IdentifyOptions::default()).unwrap())
+        b.iter(|| identify(&m, &full, black_box(&one), &opts).unwrap())
     });
     g.finish();
 }

@@ -5,12 +5,14 @@
 //!
 //! Run: `cargo run --release -p fitting --example seed_replication`. Prints Markdown tables.
 
-use fitting::hmatrix::GainSource;
-use fitting::refine::{RefineOptions, refine};
-use fitting::validate::{ValidateOptions, validate};
-use fitting::{Identification, IdentifyOptions, Tolerances, identify};
+use fitting::campaign::CampaignValues;
+use fitting::refine::RefineOptions;
+use fitting::validate::ValidateOptions;
+use fitting::{Identification, IdentifyOptions, identify, validate};
+use formats::progress::Unwatched;
 use formats::truth::builtin_truth;
 use model_spec::{ErrorKind, Machine, builtin};
+use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::{Effect, Model};
 use simulation::paths::builtin_path;
 use simulation::readings::simulate;
@@ -38,22 +40,26 @@ fn run(m: &Machine, truth: &Truth) -> Run {
         records.push((name, simulate(m, &t, &path).unwrap()));
     }
     let k4: &Record = &records[0].1;
-    let mut ident = identify(m, &model, k4, &IdentifyOptions::default()).unwrap();
-    let mut source = GainSource::new(m, &ident.model.errors(), &m.default_parameters()).unwrap();
-    refine(
-        m,
-        k4,
-        &mut ident,
-        &mut source,
-        &Tolerances::default(),
-        &RefineOptions::default(),
-    )
-    .unwrap();
+    let params = m.default_parameters();
+    let one = Campaign::of_record(k4.clone(), params.clone(), false);
+    let opts = IdentifyOptions::default().refined(RefineOptions::default());
+    let fit = identify(m, &model, &one, &opts).unwrap();
+    let values = CampaignValues::of(&fit);
+    let ident: Identification = fit.single_record(m).unwrap();
     let opts = ValidateOptions::new().exact(true);
     let paths = records
         .iter()
         .map(|(name, rec)| {
-            let v = validate(m, &ident.model, &ident.fit.values, rec, &opts).unwrap();
+            // Each path on K4's ball set-up (the campaign of one's set-up).
+            let r = CampaignRecord::new(
+                name.to_lowercase(),
+                rec.clone(),
+                params.clone(),
+                "record",
+                false,
+            );
+            let c = Campaign::new(vec![r]).unwrap();
+            let v = validate(m, &values, &c, &opts, &Unwatched).unwrap();
             let d = &v.per_direction;
             (
                 *name,

@@ -1,7 +1,10 @@
-//! Identification of a model on a record: the H matrix of the model (with the sensor zero
-//! offsets `dx0 dy0 dz0` when the readings were zeroed), the least-squares fit of
-//! [`super::least_squares()`], and what the offsets swallow. First order; [`super::refine`]
-//! refines it against the exact machine.
+//! What an identification is made of: its options ([`IdentifyOptions`]), a record's
+//! measurement vector, the fit of rows ([`fit_rows`]: ordinary or generalized least squares,
+//! each sample whitened by its covariance first), the noise model chosen from a residual, and a
+//! fit as one record's model has it ([`Identification`], with what the sensor zero offsets
+//! `dx0 dy0 dz0` swallow). The identification itself is [`crate::identify()`]: it takes a
+//! campaign (a record is a campaign of one), first order or refined against the exact machine
+//! ([`super::refine`]).
 //!
 //! Under a noise model ([`IdentifyOptions::noise`]): first an ordinary fit, then the noise model
 //! ([`choose_noise`]: declared, from a static record, or estimated from the ordinary fit's
@@ -16,10 +19,11 @@
 //! fit's; the residual, σ̂, rank and identifiability those of the readings and the path.
 
 use super::factored::{RowsFactored, check_readings_of};
-use super::hmatrix::{Backend, GainSource, h_matrix, parameter_names};
+use super::hmatrix::{Backend, GainSource};
 use super::identifiability::{Swallowed, swallowed_by_offsets};
 use super::least_squares::{Constraint, EstimateError, Fit, Tolerances};
 use super::noise::{NoiseChoice, NoiseError, NoiseModel, NoiseSource, SampleWhitening};
+use super::refine::RefineOptions;
 use model_spec::{Dir, Machine};
 use nalgebra::{DMatrix, DVector};
 use simulation::model::{Basis, Effect, Model, Term};
@@ -66,25 +70,33 @@ pub fn with_offsets(model: &Model) -> Model {
     out
 }
 
-/// Options of [`identify`] (`IdentifyOptions::default()`, then set the fields wanted; new
+/// Options of [`crate::identify()`] (`IdentifyOptions::default()`, then set the fields wanted; new
 /// fields come with defaults that keep today's behaviour).
 #[derive(Clone, Debug, PartialEq, Default)]
 #[non_exhaustive]
 pub struct IdentifyOptions {
-    /// The readings were zeroed at the first sample: the constant offsets `dx0 dy0 dz0` join
-    /// the model (they absorb the unknown reading subtracted), and [`Identification::swallowed`]
-    /// says which errors they cannot be told from.
+    /// For a streamed record ([`crate::streaming::identify_file`]), which is read in blocks and
+    /// never held as a campaign: its readings were zeroed at the first sample, so the constant
+    /// offsets `dx0 dy0 dz0` join the model (they absorb the unknown reading subtracted), and
+    /// [`Identification::swallowed`] says which errors they cannot be told from. A campaign's
+    /// records say it themselves (`CampaignRecord::zeroed`), and [`crate::identify()`] refuses
+    /// it here.
     pub zeroed: bool,
     /// What to do with undetermined parameters.
     pub constraint: Constraint,
     /// Rank and identifiability tolerances.
     pub tolerances: Tolerances,
-    /// Kinematic parameters (mm, symbol order); `None`: the machine's defaults.
+    /// For a streamed record: its kinematic parameters (mm, symbol order); `None`: the
+    /// machine's defaults. A campaign's records carry their own (`CampaignRecord::params`), and
+    /// [`crate::identify()`] refuses them here.
     pub params: Option<Vec<f64>>,
     /// The noise model the fit assumes: ordinary least squares by default; estimated from the
     /// residual, or a given model, for a generalized least-squares fit (see the module
     /// documentation).
     pub noise: NoiseChoice,
+    /// Refine the first-order fit against the exact machine (Gauss–Newton) with these options;
+    /// `None` (the default): the first-order fit.
+    pub refine: Option<RefineOptions>,
 }
 
 impl IdentifyOptions {
@@ -114,6 +126,12 @@ impl IdentifyOptions {
     /// Under the noise model `noise`.
     pub fn noise(mut self, noise: NoiseChoice) -> IdentifyOptions {
         self.noise = noise;
+        self
+    }
+
+    /// Refined against the exact machine with `refine` (see [`IdentifyOptions::refine`]).
+    pub fn refined(mut self, refine: RefineOptions) -> IdentifyOptions {
+        self.refine = Some(refine);
         self
     }
 
@@ -180,22 +198,6 @@ pub struct Identification {
     /// relative to (the kinematic parameter the record was modelled with, mm); `None` for
     /// every other parameter.
     pub nominal_mm: Vec<Option<f64>>,
-}
-
-/// Identifies `model` of `m` from the measured `record` (first order), with the best gain
-/// source (compiled code for built-in machines, the evaluator otherwise) for the fitted model
-/// (offsets included when the readings are zeroed) at the options' kinematic parameters.
-///
-/// # Errors
-/// See [`identify_with`].
-pub fn identify(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    opts: &IdentifyOptions,
-) -> Result<Identification, EstimateError> {
-    let mut source = gain_source(m, model, opts)?;
-    identify_with(m, model, record, &mut source, opts)
 }
 
 /// The gain source an identification of `model` with `opts` needs: every error of the fitted
@@ -299,65 +301,6 @@ pub fn choose_noise_weighted(
     w.whiten_vector(&mut r)?;
     let sigma = (fit.dof > 0).then(|| (r.norm_squared() / fit.dof as f64).sqrt());
     Ok(choose_noise(choice, r.as_slice(), sigma))
-}
-
-/// As [`identify`], with gains from `source` (which must cover the model's errors; its
-/// parameters are used, `opts.params` is ignored; a caller fitting many records keeps one).
-///
-/// Under the options' noise model: an ordinary fit, the noise model of
-/// [`choose_noise`] from its residual, then generalized least squares
-/// ([`super::least_squares_whitened`]) unless the choice is [`NoiseChoice::Ordinary`]. A record
-/// with covariances is whitened by them first (see the module documentation).
-///
-/// # Errors
-/// A model or record that does not fit `m`, a record without (finite) measurements, fewer
-/// readings than parameters plus one ([`check_readings`]), a bad constraint, an SVD that does
-/// not converge; [`EstimateError::Noise`] when the model or the covariances cannot
-/// whiten, whitening changes the rank, or a declared model meets covariances.
-pub fn identify_with(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    source: &mut GainSource,
-    opts: &IdentifyOptions,
-) -> Result<Identification, EstimateError> {
-    let noise = &opts.noise;
-    let fitted = opts.fitted_model(model);
-    check_readings(record.samples.len(), fitted.width())?;
-    let y = measurement_vector(record)?;
-    let weights = sample_whitening(record, noise)?;
-    let h = h_matrix(m, &fitted, record, source)?;
-    let names = parameter_names(m, &fitted);
-    let samples = record.samples.len();
-    let (c, t) = (&opts.constraint, &opts.tolerances);
-    let (ordinary, weighted_sigma) =
-        fit_rows(&h, &y, &names, c, t, None, &[samples], weights.as_ref())?;
-    if *noise == NoiseChoice::Ordinary {
-        let mut ident = Identification::new(m, fitted, ordinary, samples, opts.zeroed, source);
-        if let (Some(w), Some(s)) = (&weights, weighted_sigma) {
-            ident.noise = NoiseModel::residual(
-                s * w.scale_mm,
-                "ordinary least squares of the rows whitened by each sample's covariance",
-            );
-            ident.whitened_sigma = Some(s);
-        }
-        return Ok(ident);
-    }
-    let model_of_noise = choose_noise_weighted(noise, &ordinary, weights.as_ref())?;
-    let (fit, whitened_sigma) = fit_rows(
-        &h,
-        &y,
-        &names,
-        c,
-        t,
-        Some(&model_of_noise),
-        &[samples],
-        weights.as_ref(),
-    )?;
-    let mut ident = Identification::new(m, fitted, fit, samples, opts.zeroed, source);
-    ident.noise = model_of_noise;
-    ident.whitened_sigma = whitened_sigma;
-    Ok(ident)
 }
 
 impl Identification {

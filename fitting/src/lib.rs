@@ -5,7 +5,9 @@
 //!   the in-process evaluator ([`hmatrix::GainSource`]);
 //! - [`mod@least_squares`]: column-scaled least squares with a stated numerical rank,
 //!   uncertainties, and no number for what the data cannot determine;
-//! - [`mod@identify`]: a model identified on a record (first order), with what the sensor
+//! - [`identify()`] (in [`campaign`]): the one identification, of a campaign (a record is a
+//!   campaign of one), first order or refined; [`mod@identify`]: its options, a record's
+//!   measurement vector, the fit of a record's model ([`Identification`]) and what the sensor
 //!   offsets swallow;
 //! - [`identifiability`]: what the data can and cannot tell apart;
 //! - [`offsets`]: kinematic offsets (symbols of the description) as unknowns: their gains,
@@ -14,7 +16,8 @@
 //!   record, or estimated without trusting the model) and the prewhitening that makes it white;
 //! - [`refine`]: Gauss–Newton against the exact machine, removing the second-order bias;
 //! - [`streaming`]: identification of long records in blocks, memory bounded by the model;
-//! - [`mod@validate`]: the identified model's prediction against another record;
+//! - [`validate()`] (in [`campaign`]): the identified values' prediction of other records;
+//!   [`mod@validate`]: its options, errors and statistics;
 //! - [`distributions`]: the F and t distributions of the significance tests;
 //! - [`plan`]: the records to measure next for a target uncertainty, chosen from the machine's
 //!   tests;
@@ -37,9 +40,12 @@
 //!
 //! ```
 //! use model_spec::builtin;
+//! use fitting::campaign::CampaignValues;
 //! use fitting::{IdentifyOptions, ValidateOptions, identify, validate};
-//! use simulation::model::Model;
+//! use formats::progress::Unwatched;
 //! use formats::truth::builtin_truth;
+//! use simulation::campaign::{Campaign, CampaignRecord};
+//! use simulation::model::Model;
 //! use simulation::{builtin_path, simulate};
 //!
 //! let m = builtin("seed-ac").unwrap().unwrap();
@@ -49,15 +55,21 @@
 //! let k4 = simulate(&m, &truth, &builtin_path(&m, "K4").unwrap().unwrap()).unwrap();
 //! let k1 = simulate(&m, &truth, &builtin_path(&m, "K1").unwrap().unwrap()).unwrap();
 //!
-//! // Identify on K4 (first order; `fitting::identify_refined` removes the second-order bias).
+//! // Identify on K4, a campaign of one record (first order; `IdentifyOptions::refined` removes
+//! // the second-order bias).
+//! let params = m.default_parameters();
+//! let k4 = Campaign::of_record(k4, params.clone(), false);
 //! let ident = identify(&m, &model, &k4, &IdentifyOptions::default()).unwrap();
 //! let xoc = ident.fit.names.iter().position(|n| n == "XOC").unwrap();
 //! let truth_xoc = truth.coefficient(&model.terms[7]).unwrap()[0];
 //! assert!((ident.fit.values[xoc].unwrap() - truth_xoc).abs() < 1e-5); // mm
 //!
-//! // The identified values predict K1, a path they were not fitted on, to well below 0.01 µm.
-//! let opts = ValidateOptions::default();
-//! let v = validate(&m, &ident.model, &ident.fit.values, &k1, &opts).unwrap();
+//! // The identified values predict K1, a path they were not fitted on (on K4's ball set-up),
+//! // to well below 0.01 µm.
+//! let k1 = CampaignRecord::new("k1", k1, params, "record", false);
+//! let k1 = Campaign::new(vec![k1]).unwrap();
+//! let values = CampaignValues::of(&ident);
+//! let v = validate(&m, &values, &k1, &ValidateOptions::default(), &Unwatched).unwrap();
 //! assert!(v.overall.residual_rms < 1e-5); // mm
 //! ```
 
@@ -80,16 +92,18 @@ pub mod streaming;
 mod svd;
 pub mod validate;
 
+pub use campaign::identify;
+pub use campaign::validate::validate;
 pub use hmatrix::{Backend, GainSource, HMatrixError, h_matrix};
 pub use identify::{
-    Identification, IdentifyOptions, check_readings, choose_noise, gain_source, identify,
-    identify_with, measurement_vector, with_offsets,
+    Identification, IdentifyOptions, check_readings, choose_noise, gain_source, measurement_vector,
+    with_offsets,
 };
 pub use least_squares::{
     Constraint, EstimateError, Fit, RANK_RELATIVE_TOLERANCE, Tolerances, WhitenedFit,
     least_squares, least_squares_reduced, least_squares_whitened,
 };
 pub use noise::{NoiseChoice, NoiseModel, NoiseSource};
-pub use refine::{RefineError, RefineOptions, Refinement, identify_refined, identify_refined_with};
+pub use refine::{IdentifyError, RefineOptions, Refinement};
 pub use sanity::{Implausible, ValueLimits, check_values};
-pub use validate::{ValidateError, ValidateOptions, Validation, validate};
+pub use validate::{ValidateError, ValidateOptions, Validation};

@@ -52,14 +52,10 @@
 //! ([`crate::identify::fit_rows`]).
 
 use crate::factored::{RowsFactored, check_readings_of};
-use crate::hmatrix::{GainSource, HMatrixError, h_matrix};
-use crate::identify::{choose_noise_weighted, sample_whitening};
+use crate::hmatrix::HMatrixError;
+use crate::noise::NoiseModel;
 use crate::noise::SampleWhitening;
-use crate::noise::{NoiseChoice, NoiseModel};
-use crate::{
-    EstimateError, Fit, Identification, IdentifyOptions, Tolerances, gain_source, identify_with,
-    measurement_vector,
-};
+use crate::{EstimateError, Fit, Tolerances};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
 use simulation::model::Model;
@@ -150,13 +146,13 @@ pub struct Refinement {
 }
 
 impl Refinement {
-    /// Nothing when the refinement converged, else [`RefineError::NotConverged`] with its
+    /// Nothing when the refinement converged, else [`IdentifyError::NotConverged`] with its
     /// last step: its values are no identification.
-    pub(crate) fn converged(&self) -> Result<(), RefineError> {
+    pub(crate) fn converged(&self) -> Result<(), IdentifyError> {
         if self.converged {
             return Ok(());
         }
-        Err(RefineError::NotConverged {
+        Err(IdentifyError::NotConverged {
             iterations: self.iterations,
             last_step_mm: self.steps_mm.last().copied().unwrap_or(0.0),
             tolerance_mm: self.tolerance_mm,
@@ -179,9 +175,10 @@ impl Refinement {
     }
 }
 
-/// Why a refinement failed.
+/// Why an identification failed: its first-order fit, or its refinement against the exact
+/// machine.
 #[derive(Debug, thiserror::Error)]
-pub enum RefineError {
+pub enum IdentifyError {
     /// The H matrix could not be built.
     #[error(transparent)]
     HMatrix(#[from] HMatrixError),
@@ -242,81 +239,9 @@ pub fn exact_prediction(
     Ok(simulate(m, &truth, record)?.measured)
 }
 
-/// Refines `ident` (identified on `record` with gains from `source`) against the exact machine.
-pub fn refine(
-    m: &Machine,
-    record: &Record,
-    ident: &mut Identification,
-    source: &mut GainSource,
-    tolerances: &Tolerances,
-    opts: &RefineOptions,
-) -> Result<Refinement, RefineError> {
-    refine_under(m, record, ident, source, tolerances, opts, None)
-}
-
-/// As [`refine`], every correction and the final fit by generalized least squares under
-/// `noise` (the record one layout of its samples); `ident.whitened_sigma` is set. From
-/// `ident`'s solution as it is (an ordinary refinement's, usually).
-pub fn refine_whitened(
-    m: &Machine,
-    record: &Record,
-    ident: &mut Identification,
-    source: &mut GainSource,
-    tolerances: &Tolerances,
-    opts: &RefineOptions,
-    noise: &NoiseModel,
-) -> Result<Refinement, RefineError> {
-    refine_under(m, record, ident, source, tolerances, opts, Some(noise))
-}
-
-fn refine_under(
-    m: &Machine,
-    record: &Record,
-    ident: &mut Identification,
-    source: &mut GainSource,
-    tolerances: &Tolerances,
-    opts: &RefineOptions,
-    noise: Option<&NoiseModel>,
-) -> Result<Refinement, RefineError> {
-    let h = h_matrix(m, &ident.model, record, source)?;
-    let y = measurement_vector(record)?;
-    let params = source.params().to_vec();
-    let coordinates = params
-        .iter()
-        .chain(record.samples.iter().flat_map(|s| s.commands.iter()))
-        .fold(1.0f64, |a, v| a.max(v.abs()));
-    // A record read through an instrument weights every fit by its covariances.
-    let weights = SampleWhitening::of(record).map_err(EstimateError::from)?;
-    let problem = GaussNewton {
-        h: &h,
-        y: &y,
-        layout: &[record.samples.len()],
-        tolerances,
-        noise,
-        coordinates,
-        weights: weights.as_ref(),
-        factored: None,
-    };
-    let model = ident.model.clone();
-    let mut predict = |x: &[f64]| -> Result<DVector<f64>, RefineError> {
-        let values: Vec<Option<f64>> = x.iter().map(|&v| Some(v)).collect();
-        let p = exact_prediction(m, &model, &values, record, &params)?;
-        Ok(DVector::from_iterator(
-            y.len(),
-            p.iter().flat_map(|r| r.iter().copied()),
-        ))
-    };
-    let (fit, whitened_sigma, refinement) = gauss_newton(&problem, &ident.fit, opts, &mut predict)?;
-    ident.fit = fit;
-    if noise.is_some() || weights.is_some() {
-        ident.whitened_sigma = whitened_sigma;
-    }
-    Ok(refinement)
-}
-
 /// The exact machine's readings (mm, in the rows of the system) from every parameter's value in
 /// column order (mm, rad).
-pub(crate) type ExactPrediction<'a> = dyn FnMut(&[f64]) -> Result<DVector<f64>, RefineError> + 'a;
+pub(crate) type ExactPrediction<'a> = dyn FnMut(&[f64]) -> Result<DVector<f64>, IdentifyError> + 'a;
 
 /// A Gauss–Newton refinement's system: the first-order H (the Jacobian), the readings, and what
 /// sets the rounding floor.
@@ -351,7 +276,7 @@ pub(crate) fn gauss_newton(
     start: &Fit,
     opts: &RefineOptions,
     predict: &mut ExactPrediction,
-) -> Result<(Fit, Option<f64>, Refinement), RefineError> {
+) -> Result<(Fit, Option<f64>, Refinement), IdentifyError> {
     let GaussNewton {
         h,
         y,
@@ -418,7 +343,7 @@ pub(crate) fn gauss_newton(
     let mut x = start.solution.clone();
     let mut steps = Vec::new();
     let mut converged = false;
-    let mut residual = |x: &[f64]| -> Result<DVector<f64>, RefineError> { Ok(y - predict(x)?) };
+    let mut residual = |x: &[f64]| -> Result<DVector<f64>, IdentifyError> { Ok(y - predict(x)?) };
     for _ in 0..opts.max_iterations {
         let r = residual(&x)?;
         let (correction, _) = fit_of(&r)?;
@@ -428,7 +353,7 @@ pub(crate) fn gauss_newton(
         // The largest change of the prediction at any reading.
         let step = (h * DVector::from_column_slice(&correction.solution)).amax();
         if !step.is_finite() || x.iter().any(|v| !v.is_finite()) {
-            return Err(RefineError::NotFinite {
+            return Err(IdentifyError::NotFinite {
                 iterations: steps.len() + 1,
             });
         }
@@ -462,67 +387,6 @@ pub(crate) fn gauss_newton(
             rms_mm: (linear_rms, refined_rms),
         },
     ))
-}
-
-/// Identifies `model` on `record` ([`crate::identify()`], with the gain source it
-/// needs built here) and refines the result against the exact machine ([`refine`], with the
-/// identification's tolerances), under the options' noise model ([`identify_refined_with`]).
-///
-/// # Errors
-/// As [`crate::identify_with`] and [`refine`]; [`RefineError::NotConverged`] when
-/// the refinement did not converge (its values are no identification).
-pub fn identify_refined(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    opts: &IdentifyOptions,
-    refine_opts: &RefineOptions,
-) -> Result<(Identification, Refinement), RefineError> {
-    let mut source = gain_source(m, model, opts)?;
-    identify_refined_with(m, model, record, &mut source, opts, refine_opts)
-}
-
-/// [`identify_refined`] with gains from `source` (covering the fitted model's errors), for
-/// callers that fit several models of one machine with one source.
-///
-/// Under a noise model other than ordinary least squares ([`IdentifyOptions::noise`], see the
-/// module documentation): the ordinary refinement, the noise model from its exact residual,
-/// then the refinement by generalized least squares from its solution. The [`Refinement`]
-/// counts the steps of both; its first-order RMS is the ordinary linear fit's.
-///
-/// # Errors
-/// As [`identify_refined`]; [`RefineError::NotConverged`] when a refinement does not
-/// converge (its values are no identification).
-pub fn identify_refined_with(
-    m: &Machine,
-    model: &Model,
-    record: &Record,
-    source: &mut GainSource,
-    opts: &IdentifyOptions,
-    refine_opts: &RefineOptions,
-) -> Result<(Identification, Refinement), RefineError> {
-    let noise = &opts.noise;
-    let weights = sample_whitening(record, noise)?;
-    let ordinary_opts = opts.clone().noise(NoiseChoice::Ordinary);
-    let mut ident = identify_with(m, model, record, source, &ordinary_opts)?;
-    let ordinary = refine(m, record, &mut ident, source, &opts.tolerances, refine_opts)?;
-    ordinary.converged()?;
-    if *noise == NoiseChoice::Ordinary {
-        return Ok((ident, ordinary));
-    }
-    let chosen = choose_noise_weighted(noise, &ident.fit, weights.as_ref())?;
-    let r = refine_whitened(
-        m,
-        record,
-        &mut ident,
-        source,
-        &opts.tolerances,
-        refine_opts,
-        &chosen,
-    )?;
-    ident.noise = chosen;
-    r.converged()?;
-    Ok((ident, ordinary.followed_by(&r)))
 }
 
 #[cfg(test)]
@@ -560,7 +424,7 @@ mod tests {
         };
         let mut calls = 0usize;
         let shape = DVector::from_fn(40, |i, _| if i % 2 == 0 { 1.0 } else { 0.3 });
-        let mut predict = |x: &[f64]| -> Result<DVector<f64>, RefineError> {
+        let mut predict = |x: &[f64]| -> Result<DVector<f64>, IdentifyError> {
             calls += 1;
             let sign = if calls.is_multiple_of(2) { 1.0 } else { -1.0 };
             Ok(&h * DVector::from_column_slice(x) + &shape * (sign * jitter))

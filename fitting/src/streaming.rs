@@ -125,7 +125,7 @@ pub struct StreamingIdentification {
 /// Identifies `model` from `blocks` of one record (each a [`Record`] with measurements;
 /// `time_span` `(t0, t1)` is the whole record's, s, for `time:K` and `exp:TAU` terms; `rate`
 /// and `warmup:TAU` count from the record's time 0 and need none), with
-/// gains from `source`. First-order least squares, as [`crate::identify_with`] without
+/// gains from `source`. First-order least squares, as [`crate::identify()`] without
 /// the refinement (which needs the whole record).
 ///
 /// # Errors

@@ -70,7 +70,7 @@ fn compensate(c: &mut Criterion) {
 fn program(c: &mut Criterion) {
     use compensation::run::{CommandedPose, compensate_poses};
     use compensation::values::MachineErrors;
-    use fitting::{IdentifyOptions, RefineOptions, identify_refined};
+    use fitting::{IdentifyOptions, RefineOptions, identify};
     use formats::nc::{Dialect, WriteOptions, parse_program};
     use formats::poses::{axis_words, from_file_units, to_file_units};
     use report::json::read::parse_identification;
@@ -85,14 +85,12 @@ fn program(c: &mut Criterion) {
     model
         .terms
         .push(model_spec::terms::Term::parse(&m, "ECC@harmonic:2").unwrap());
-    let (ident, refinement) = identify_refined(
-        &m,
-        &model,
-        &record,
-        &IdentifyOptions::default(),
-        &RefineOptions::default(),
-    )
-    .unwrap();
+    let one =
+        simulation::campaign::Campaign::of_record(record.clone(), m.default_parameters(), false);
+    let opts = IdentifyOptions::default().refined(RefineOptions::default());
+    let fit = identify(&m, &model, &one, &opts).unwrap();
+    let refinement = fit.refinement.clone().unwrap();
+    let ident = fit.single_record(&m).unwrap();
     let source = IdentificationSource {
         data: "k4.csv",
         label: "extended",

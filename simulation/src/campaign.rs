@@ -6,6 +6,9 @@ use crate::record::Record;
 use model_spec::Machine;
 use model_spec::units::short;
 
+/// The label of the record of [`Campaign::of_record`] and of its set-up.
+pub const SINGLE_LABEL: &str = "record";
+
 /// One record of a campaign: its samples (and readings), the kinematic parameters it was
 /// planned and is modelled with, its set-up and whether its readings were zeroed.
 #[derive(Clone, Debug, PartialEq)]
@@ -157,6 +160,21 @@ impl Campaign {
                 r.label
             ))),
             None => Ok(()),
+        }
+    }
+
+    /// `record` as a campaign of one: labelled and set up as `record`, at kinematic parameters
+    /// `params` (mm, symbol order), zeroed or not, on its own clock. How a single record is
+    /// identified, validated and diagnosed.
+    pub fn of_record(record: Record, params: Vec<f64>, zeroed: bool) -> Campaign {
+        Campaign {
+            records: vec![CampaignRecord::new(
+                SINGLE_LABEL,
+                record,
+                params,
+                SINGLE_LABEL,
+                zeroed,
+            )],
         }
     }
 

@@ -5,6 +5,7 @@
 //! naming the flag, exit code 2 for usage errors and 1 for other failures, no output file left
 //! behind).
 
+use crate::one_record::identify_one;
 use fitting::IdentifyOptions;
 use formats::truth::builtin_truth;
 use model_spec::Machine;
@@ -839,8 +840,7 @@ fn hidden_bias(m: &Machine, t: &Truth, k4: &Record) -> Vec<f64> {
         lines: k4.lines.clone(),
         ..Default::default()
     };
-    let fit =
-        fitting::identify(m, &reduced, &alone, &IdentifyOptions::default()).expect("identify");
+    let fit = identify_one(m, &reduced, &alone, &IdentifyOptions::default()).expect("identify");
     reduced
         .terms
         .iter()

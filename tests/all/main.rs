@@ -3,6 +3,8 @@
 //! `cargo test --test all NAME::` runs one of them.
 
 mod common;
+#[path = "../../fitting/tests/all/one_record.rs"]
+mod one_record;
 mod support;
 
 mod browser_harness;

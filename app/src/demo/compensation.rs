@@ -8,7 +8,6 @@ use compensation::values::MachineErrors;
 use compensation::verify::machine_error_rms;
 use diagnosis::Diagnosis;
 use fitting::campaign::{CampaignIdentification, CampaignValues};
-use fitting::{IdentifyOptions, RefineOptions, identify_refined};
 use formats::poses::to_file_units;
 use model_spec::Machine;
 use model_spec::units::format_scaled;
@@ -81,14 +80,7 @@ pub(crate) fn compensate_held_out(
         (base.clone(), REDUCED.to_string())
     };
     let k4 = &runs[0];
-    let (ident, refinement) = identify_refined(
-        m,
-        &model,
-        &k4.record,
-        &IdentifyOptions::default(),
-        &RefineOptions::default(),
-    )
-    .map_err(failed("compensation"))?;
+    let (ident, refinement) = super::identify_refined(m, &model, &k4.record, "compensation")?;
     let source = IdentificationSource {
         data,
         label: &label,

@@ -14,13 +14,15 @@ use codegen::table::{Format, render};
 use diagnosis::figures::{Figures, figures};
 use diagnosis::hidden::hidden_terms;
 use diagnosis::{DiagnoseOptions, diagnose, one_record};
-use fitting::campaign::{CampaignIdentification, CampaignValues, validate_campaign};
+use fitting::campaign::{CampaignIdentification, CampaignValues};
 use fitting::sanity::{ValueLimits, check_values};
-use fitting::{IdentifyOptions, RefineOptions, ValidateOptions, identify_refined};
+use fitting::{
+    Identification, IdentifyOptions, RefineOptions, Refinement, ValidateOptions, identify, validate,
+};
 use formats::csv::format_record;
 use formats::progress::Unwatched;
 use formats::truth::builtin_truth;
-use model_spec::FULL_MODEL;
+use model_spec::{FULL_MODEL, Machine};
 use report::inputs::Document;
 use report::json::{
     DiagnosisReport, DiagnosisSource, IdentificationReport, IdentificationSource, ValidationReport,
@@ -100,6 +102,27 @@ fn failed<E: std::fmt::Display>(step: &'static str) -> impl Fn(E) -> DemoError {
     }
 }
 
+/// `model` of `m` identified on `record` alone (a campaign of one, on the default kinematic
+/// parameters) and refined against the exact machine: the fit in the model's terms and the
+/// refinement; `step` names the demo's step in an error.
+pub(crate) fn identify_refined(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    step: &'static str,
+) -> Result<(Identification, Refinement), DemoError> {
+    let campaign = Campaign::of_record(record.clone(), m.default_parameters(), false);
+    let opts = IdentifyOptions::default().refined(RefineOptions::default());
+    let fit = identify(m, model, &campaign, &opts).map_err(failed(step))?;
+    match (fit.single_record(m), fit.refinement) {
+        (Some(ident), Some(refinement)) => Ok((ident, refinement)),
+        _ => Err(DemoError {
+            step,
+            message: "the campaign of one record gave no refined fit of it".into(),
+        }),
+    }
+}
+
 /// One simulated path.
 pub(crate) struct Run {
     pub(crate) name: &'static str,
@@ -156,14 +179,7 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
     let k4 = &runs[0];
 
     // 2. Identification on K4, refined against the exact machine.
-    let (ident, refinement) = identify_refined(
-        &m,
-        &model,
-        &k4.record,
-        &IdentifyOptions::default(),
-        &RefineOptions::default(),
-    )
-    .map_err(failed("identification"))?;
+    let (ident, refinement) = identify_refined(&m, &model, &k4.record, "identification")?;
     check_values(&m, &ident, &ValueLimits::default()).map_err(failed("identification"))?;
     let k4_file = path_of(&k4.file);
     let identification = IdentificationReport::new(
@@ -204,7 +220,8 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
             false,
         );
         let campaign = Campaign::new(vec![record]).map_err(failed("validation"))?;
-        let v = validate_campaign(&m, &values, &campaign, &exact).map_err(failed("validation"))?;
+        let v =
+            validate(&m, &values, &campaign, &exact, &Unwatched).map_err(failed("validation"))?;
         let report = ValidationReport::new(
             &m,
             ValidationSource {

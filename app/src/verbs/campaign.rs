@@ -3,9 +3,7 @@
 //! `--campaign FILE`, their checks, and the plausibility of a campaign's values.
 
 use super::{Error, ReadFile, VerbResult};
-use fitting::Constraint;
 use fitting::campaign::Layout;
-use fitting::hmatrix::parameter_name;
 use fitting::sanity::{ValueLimits, check_model_values};
 use formats::campaign::{CampaignFile, labels_from_files, read_campaign_file};
 use formats::csv::ReadOptions;
@@ -195,56 +193,4 @@ pub fn check_campaign_values(
     limits: &ValueLimits,
 ) -> Result<(), fitting::Implausible> {
     check_model_values(m, &columns_model(layout), &layout.names(), values, limits)
-}
-
-/// The constraint of a fit of `campaign`: as given, except that a campaign of one record also
-/// takes the names its report writes (`dx0`, `XOW`) for the columns of its record and set-up
-/// (`dx0[k4]`, `XOW[k4]`), so that one record is constrained as a single identification always
-/// was. A name that is neither stays as it is (the fit names it as unknown).
-pub fn constraint_for(
-    m: &Machine,
-    model: &Model,
-    campaign: &Campaign,
-    constraint: Constraint,
-) -> Constraint {
-    let Constraint::Zero(names) = constraint else {
-        return constraint;
-    };
-    let [r] = campaign.records.as_slice() else {
-        return Constraint::Zero(names);
-    };
-    let spec = fitting::campaign::RecordSpec {
-        label: r.label.clone(),
-        setup: r.setup.clone(),
-        params: r.params.clone(),
-        zeroed: r.zeroed,
-        start_s: r.start_s,
-        samples: r.record.samples.len(),
-    };
-    let Ok(layout) = Layout::of_records(m, model, &[spec], None) else {
-        return Constraint::Zero(names);
-    };
-    let canonical = |z: &str| match z.trim().split_once('@') {
-        Some((e, b)) => format!("{}@{b}", model_spec::canonical_name(e)),
-        None => model_spec::canonical_name(z.trim()),
-    };
-    Constraint::Zero(
-        names
-            .into_iter()
-            .map(|z| {
-                if layout.columns.iter().any(|c| c.name == z.trim()) {
-                    return z;
-                }
-                let want = canonical(&z);
-                layout
-                    .columns
-                    .iter()
-                    .find(|c| {
-                        let bare = parameter_name(m, &c.term, c.component);
-                        bare == z.trim() || bare == want
-                    })
-                    .map_or(z, |c| c.name.clone())
-            })
-            .collect(),
-    )
 }

@@ -281,7 +281,7 @@ pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
     let d = diagnose(&m, &model, &fitted.campaign, &held.campaign, &opts, &bar);
     drop(bar);
     let d = d.map_err(|e| match e {
-        DiagnoseError::Estimate(e) | DiagnoseError::Refine(fitting::RefineError::Estimate(e)) => {
+        DiagnoseError::Estimate(e) | DiagnoseError::Refine(fitting::IdentifyError::Estimate(e)) => {
             super::identify::estimate_error(e)
         }
         DiagnoseError::Campaign(e) => Error::usage(format!("{flag}: {e}")),

@@ -6,13 +6,11 @@ use super::campaign;
 use super::history;
 use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
 use crate::Done;
-use fitting::campaign::{
-    CampaignIdentification, CampaignValues, identify_campaign, identify_campaign_refined,
-};
+use fitting::campaign::{CampaignIdentification, CampaignValues, identify};
 use fitting::hmatrix::HMatrixError;
 use fitting::noise::NoiseChoice;
 use fitting::streaming::{StreamingError, identify_file};
-use fitting::{EstimateError, IdentifyOptions, RefineError, RefineOptions};
+use fitting::{EstimateError, IdentifyError, IdentifyOptions, RefineOptions};
 use output::{Outputs, Target};
 use report::json::identify::StreamingReport;
 use report::json::{CampaignSource, IdentificationReport, to_json};
@@ -234,12 +232,7 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
         loaded.check_times(flag, &m, &model)?;
         let c = &loaded.campaign;
         let opts = IdentifyOptions::new()
-            .constraint(campaign::constraint_for(
-                &m,
-                &model,
-                c,
-                opts.constraint.clone(),
-            ))
+            .constraint(opts.constraint.clone())
             .noise(noise);
         // Records modelled with different values of a machine length cannot share its change:
         // a bad input, said before any fitting.
@@ -250,15 +243,13 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
             .collect();
         fitting::offsets::check_shared_symbols(&m, &model, &labelled)
             .map_err(|e| Error::input(format!("{flag}: {e}")))?;
-        let (ident, refinement) = if args.first_order {
-            let ident = identify_campaign(&m, &model, c, &opts).map_err(estimate_error)?;
-            (ident, None)
+        let opts = if args.first_order {
+            opts
         } else {
-            let (ident, r) =
-                identify_campaign_refined(&m, &model, c, &opts, &RefineOptions::default())
-                    .map_err(refine_error)?;
-            (ident, Some(r))
+            opts.refined(RefineOptions::default())
         };
+        let ident = identify(&m, &model, c, &opts).map_err(refine_error)?;
+        let refinement = ident.refinement.clone();
         read_files.extend(loaded.read.iter().cloned());
         (ident, refinement, None, Some(loaded))
     };
@@ -397,10 +388,10 @@ fn implausible(e: &fitting::Implausible) -> Error {
 }
 
 /// A refinement error as a verb's error.
-fn refine_error(e: RefineError) -> Error {
+fn refine_error(e: IdentifyError) -> Error {
     match e {
-        RefineError::Estimate(e) => estimate_error(e),
-        e @ RefineError::NotConverged { .. } => Error::computation(format!(
+        IdentifyError::Estimate(e) => estimate_error(e),
+        e @ IdentifyError::NotConverged { .. } => Error::computation(format!(
             "--data: {e}: the data do not determine the model well enough for the exact machine (--first-order gives the first-order values)"
         )),
         other => Error::computation(format!(

@@ -5,7 +5,7 @@ use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
 use super::{EXIT_CODES, Error, VerbResult, check_outputs};
 use crate::Done;
-use fitting::campaign::validate::validate_campaign_with_progress;
+use fitting::validate;
 use fitting::validate::Unidentified;
 use fitting::{ValidateError, ValidateOptions};
 use output::{Outputs, Target};
@@ -167,8 +167,7 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
     }
     let v = {
         let bar = super::progress::counting(shown);
-        validate_campaign_with_progress(&m, values, &loaded.campaign, &opts, &bar)
-            .map_err(|e| validate_error(args, e))?
+        validate(&m, values, &loaded.campaign, &opts, &bar).map_err(|e| validate_error(args, e))?
     };
     let params_file = args.params.display().to_string();
     let kinematics: Vec<Vec<f64>> = loaded

@@ -4,12 +4,13 @@
 //! the folded errors at zero and the other values unchanged.
 
 use crate::common;
+use crate::one_record::identify_refined_one;
 
 use common::{Rng, builtin};
 use compensation::kinematics::corrected_description;
 use compensation::values::MachineErrors;
 use fitting::campaign::{CampaignIdentification, CampaignValues};
-use fitting::{Constraint, Identification, IdentifyOptions, RefineOptions, identify_refined};
+use fitting::{Constraint, Identification, IdentifyOptions, RefineOptions};
 use model_spec::{AxisKind, Machine, Side, parse_machine};
 use simulation::exact::{VirtualMachine, tool_centre_point_ik};
 use simulation::model::{Model, Term};
@@ -278,7 +279,7 @@ fn identify(m: &Machine, model: &Model, data: &Record, zero: &[&str]) -> Identif
         Constraint::Zero(zero.iter().map(|s| s.to_string()).collect())
     };
     let opts = IdentifyOptions::new().constraint(constraint);
-    identify_refined(m, model, data, &opts, &RefineOptions::default())
+    identify_refined_one(m, model, data, &opts, &RefineOptions::default())
         .unwrap()
         .0
 }

@@ -4,6 +4,8 @@
 
 #[path = "../../../simulation/tests/all/common/mod.rs"]
 mod common;
+#[path = "../../../fitting/tests/all/one_record.rs"]
+mod one_record;
 
 mod axis_tables;
 mod compensation_engine;

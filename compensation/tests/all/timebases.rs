@@ -14,18 +14,18 @@
 //! - a warm-up refuses samples before its start.
 
 use crate::common;
+use crate::one_record::{identify_one, identify_refined_campaign};
 
 use common::builtin;
 use compensation::values::MachineErrors;
 use fitting::campaign::CampaignValues;
 use fitting::campaign::clock::{own_clock_terms, shifted};
 use fitting::campaign::design::block;
-use fitting::campaign::identify_campaign_refined;
 use fitting::hmatrix::{GainSource, HMatrixError, h_matrix, h_matrix_auto};
 use fitting::noise::NoiseChoice;
 use fitting::refine::{RefineOptions, exact_prediction};
 use fitting::streaming::identify_streaming;
-use fitting::{Constraint, IdentifyOptions, Tolerances, identify};
+use fitting::{Constraint, IdentifyOptions, Tolerances};
 use model_spec::Machine;
 use nalgebra::DVector;
 use simulation::campaign::{Campaign, CampaignRecord};
@@ -287,7 +287,7 @@ fn a_rate_and_a_warm_up_are_identified_on_records_of_60_s_and_600_s() {
     };
     let c = records(&truth(&m, 3));
     let fitted = |model: &Model, c: &Campaign| {
-        identify_campaign_refined(
+        identify_refined_campaign(
             &m,
             model,
             c,
@@ -351,7 +351,7 @@ fn on_a_campaign_clock_one_warm_up_is_shared_and_the_drifts_stay_each_record_s()
             .starting_at(200.0),
     ])
     .unwrap();
-    let (ident, refinement) = identify_campaign_refined(
+    let (ident, refinement) = identify_refined_campaign(
         &m,
         &reduced_with(&m, &["dx0@rate", "EXZ@warmup:40"]),
         &c,
@@ -374,7 +374,7 @@ fn streaming_reads_rates_and_warm_ups_in_one_pass_without_the_span() {
     let m = builtin("seed-ac");
     let rec = simulate(&m, &truth(&m, 11), &k4_timed(&m, 2.5, 30.0)).unwrap();
     let model = reduced_with(&m, &["dx0@rate", "EXZ@warmup:40"]);
-    let whole = identify(&m, &model, &rec, &IdentifyOptions::new()).unwrap();
+    let whole = identify_one(&m, &model, &rec, &IdentifyOptions::new()).unwrap();
     let blocks: Vec<Result<Record, std::convert::Infallible>> = (0..rec.samples.len())
         .step_by(50)
         .map(|a| {

@@ -8,10 +8,13 @@
 
 use crate::diagnose::helpers;
 
+use diagnosis::one_record;
 use diagnosis::plausible::Budget;
-use fitting::hmatrix::GainSource;
-use fitting::validate::{ValidateOptions, validate_with};
+use fitting::campaign::CampaignValues;
+use fitting::{ValidateOptions, validate};
+use formats::progress::Unwatched;
 use helpers::*;
+use simulation::campaign::Campaign;
 
 /// Five 20 µm spikes in the fitted record: each is listed (sample, direction), and the findings
 /// are those of the clean record.
@@ -136,9 +139,27 @@ fn held_out_predictions_use_only_what_the_fit_determined() {
             "the base model is rank-deficient on {}",
             paths[0]
         );
-        let params = m.default_parameters();
-        let mut source = GainSource::new(&m, &base_fit.model.errors(), &params).unwrap();
+        let (_, held) = one_record(
+            &recs[0].0,
+            recs[0].1.clone(),
+            recs[1..].to_vec(),
+            m.default_parameters(),
+            false,
+        )
+        .unwrap();
         let opts = ValidateOptions::new().exact(false);
+        // The held-out records as the diagnosis validates them: on the fitted set-up, the
+        // values given (a record's own zero, when the model has one, refitted on it).
+        let predict = |values: &[Option<f64>], r: usize| {
+            let mut given = CampaignValues::of(&d.base_fit);
+            given.values = values.to_vec();
+            let one = Campaign::new(vec![held.records[r].clone()]).unwrap();
+            validate(&m, &given, &one, &opts, &Unwatched)
+                .unwrap()
+                .records[0]
+                .validation
+                .clone()
+        };
         let solution: Vec<Option<f64>> = fit.solution.iter().map(|&v| Some(v)).collect();
         // The same fit moved along its first null direction by one scaled unit.
         let null = fit.identifiability.null_space.column(0);
@@ -148,9 +169,9 @@ fn held_out_predictions_use_only_what_the_fit_determined() {
             .enumerate()
             .map(|(j, v)| Some(v + null[j] / fit.column_norms[j]))
             .collect();
-        for (h, (_, rec)) in d.validation.iter().zip(&recs[1..]) {
-            let a = validate_with(&m, &base_fit.model, &solution, rec, &mut source, &opts).unwrap();
-            let b = validate_with(&m, &base_fit.model, &moved, rec, &mut source, &opts).unwrap();
+        for (r, h) in d.validation.iter().enumerate() {
+            let a = predict(&solution, r);
+            let b = predict(&moved, r);
             let change = a
                 .prediction
                 .iter()

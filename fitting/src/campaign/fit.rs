@@ -2,16 +2,19 @@
 //! generalized (the rows of each record whitened by one noise model, records independent).
 //!
 //! The columns are solved in [`Layout::solve_order`] and the fit is then given in layout order:
-//! a campaign of one record on the defaults is solved exactly as a single identification
-//! ([`crate::identify()`]), bit for bit; only its names differ (`XOW[k4]`).
+//! a campaign of one record is solved in its model's column order, and
+//! [`CampaignIdentification::single_record`] gives its fit back in that order, named as the
+//! record's model names it (`XOW`, not `XOW[k4]`).
 
 use super::design::{Design, Layout, Owner, design_matrix, measurements};
-use crate::IdentifyOptions;
+use super::names::single_record_names;
 use crate::hmatrix::Backend;
 use crate::identifiability::{NearPair, Swallowed, swallowed_by_offsets};
 use crate::identify::{check_readings, fit_rows};
 use crate::least_squares::{EstimateError, Fit};
 use crate::noise::{NoiseChoice, NoiseModel, SampleWhitening};
+use crate::refine::{IdentifyError, Refinement};
+use crate::{Identification, IdentifyOptions};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
 use simulation::campaign::Campaign;
@@ -62,6 +65,9 @@ pub struct CampaignIdentification {
     /// σ̂ of the whitened residual for a fit whitened by a noise model; `None` for an ordinary
     /// fit.
     pub whitened_sigma: Option<f64>,
+    /// What the refinement against the exact machine did, when it was asked for
+    /// ([`IdentifyOptions::refine`]); the fit is then the refined one.
+    pub refinement: Option<Refinement>,
 }
 
 impl CampaignIdentification {
@@ -213,20 +219,30 @@ pub fn choose_campaign_noise_weighted(
     Ok(choose_campaign_noise(choice, r.as_slice(), rows, sigma))
 }
 
-/// Identifies `model` of `m` on `campaign` (first order): the design matrix with the best
-/// gain sources ([`design_matrix`]), then [`identify_campaign_with`].
+/// Identifies `model` of `m` on `campaign` (a record is a campaign of one): the design matrix
+/// with the best gain sources ([`design_matrix`]), the first-order fit ([`fit_design`]) under
+/// the options' noise model, and, when the options ask for it ([`IdentifyOptions::refine`]),
+/// its refinement against the exact machine ([`CampaignIdentification::refinement`]). A
+/// constraint of a campaign of one record may name the record's columns as the record's model
+/// does (`XOW`, `dx0`: [`single_record_names`]).
 ///
 /// # Errors
-/// As [`design_matrix`] and [`identify_campaign_with`].
-pub fn identify_campaign(
+/// As [`design_matrix`] and [`fit_design`]; [`IdentifyError::NotConverged`] when a refinement
+/// does not converge (its values are no identification).
+pub fn identify(
     m: &Machine,
     model: &Model,
     campaign: &Campaign,
     opts: &IdentifyOptions,
-) -> Result<CampaignIdentification, EstimateError> {
+) -> Result<CampaignIdentification, IdentifyError> {
     check_options(opts)?;
+    let mut opts = opts.clone();
+    opts.constraint = single_record_names(m, model, campaign, opts.constraint);
+    if let Some(refine) = &opts.refine {
+        return super::refine::identify_refined(m, model, campaign, &opts, refine);
+    }
     let design = design_matrix(m, model, campaign)?;
-    identify_campaign_with(m, model, campaign, &design, opts)
+    Ok(fit_design(m, model, campaign, &design, &opts)?)
 }
 
 /// Refuses options that belong to the records in a campaign.
@@ -239,7 +255,8 @@ pub(crate) fn check_options(opts: &IdentifyOptions) -> Result<(), EstimateError>
     Ok(())
 }
 
-/// Identifies `model` on `campaign` with its `design` matrix (first order): the ordinary fit
+/// The first-order fit of `model` on `campaign` with its `design` matrix, for a caller that
+/// keeps the design (the refinement in [`IdentifyOptions::refine`] is not done here): the ordinary fit
 /// (`opts`: constraint and tolerances; the records carry zeroing and parameters), then, unless the
 /// options' noise is [`NoiseChoice::Ordinary`], the noise model from its residual (pooled over the
 /// records) and the generalized least-squares fit, each record's rows whitened on their own.
@@ -247,7 +264,7 @@ pub(crate) fn check_options(opts: &IdentifyOptions) -> Result<(), EstimateError>
 /// # Errors
 /// Readings missing or not finite (the record named), fewer readings than parameters plus
 /// one, a bad constraint, an SVD that does not converge, a noise model that cannot whiten.
-pub fn identify_campaign_with(
+pub fn fit_design(
     m: &Machine,
     model: &Model,
     campaign: &Campaign,
@@ -352,6 +369,7 @@ impl CampaignIdentification {
             backend: design.backend,
             noise,
             whitened_sigma: None,
+            refinement: None,
         }
     }
 
@@ -390,6 +408,54 @@ impl CampaignIdentification {
             whitened_sigma: self.whitened_sigma,
             nominal_mm: self.layout.nominal_mm(),
         }
+    }
+
+    /// For a campaign of one record, its fit as that record's model has it: the columns in
+    /// the record's model order (the sensor offsets `dx0 dy0 dz0` appended when its readings
+    /// were zeroed), named without owners (`XOW`, not `XOW[k4]`), its nominal kinematic
+    /// values; the same values, uncertainties and residual. `None` for several records.
+    pub fn single_record(&self, m: &Machine) -> Option<Identification> {
+        let [record] = self.layout.records.as_slice() else {
+            return None;
+        };
+        let n = self.layout.columns.len();
+        if record.columns.len() != n {
+            return None;
+        }
+        // Layout column `record.columns[p]` becomes column `p`.
+        let mut order = vec![0; n];
+        for (p, &c) in record.columns.iter().enumerate() {
+            order[c] = p;
+        }
+        let mut fit = to_layout_order(self.fit.clone(), &order);
+        fit.names = record
+            .columns
+            .iter()
+            .map(|&c| {
+                let col = &self.layout.columns[c];
+                crate::hmatrix::parameter_name(m, &col.term, col.component)
+            })
+            .collect();
+        let is_offset: Vec<bool> = record
+            .columns
+            .iter()
+            .map(|&c| matches!(self.layout.columns[c].term.effect, Effect::SensorOffset(_)))
+            .collect();
+        let swallowed =
+            swallowed_by_offsets(&fit.names, &fit.identifiability.confounded, &is_offset);
+        let nominal = self.layout.nominal_mm();
+        Some(Identification {
+            machine: self.machine.clone(),
+            model: record.model.clone(),
+            fit,
+            samples: record.samples,
+            zeroed: record.zeroed,
+            swallowed,
+            backend: self.backend,
+            noise: self.noise.clone(),
+            whitened_sigma: self.whitened_sigma,
+            nominal_mm: record.columns.iter().map(|&c| nominal[c]).collect(),
+        })
     }
 
     /// The columns owned by `owner`.

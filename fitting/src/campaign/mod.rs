@@ -18,11 +18,12 @@
 //!   ([`CampaignRecord::start_s`]).
 //!
 //! [`design::Layout`] says which column belongs to whom, [`design::design_matrix`] stacks the
-//! records' H matrices into one, [`fit::identify_campaign`] fits it (first order, ordinary or
-//! generalized least squares), [`refine::identify_campaign_refined`] refines the fit against
-//! the exact machine (each record with its own parameters and set-up values), and
-//! [`validate::validate_campaign`] predicts other records, refitting the set-up errors of a
+//! records' H matrices into one, [`fit::identify`] fits it (first order, ordinary or
+//! generalized least squares) and, when asked, refines the fit against the exact machine (each
+//! record with its own parameters and set-up values, [`refine`]), and
+//! [`validate::validate()`] predicts other records, refitting the set-up errors of a
 //! set-up that was not fitted (and a record's own zero) with the machine's errors held.
+//! [`names`] lets a constraint of a campaign of one record use the record's own names.
 //! `docs/campaigns.md` describes the campaign file and a worked campaign.
 //!
 //! [`CampaignRecord::params`]: simulation::campaign::CampaignRecord::params
@@ -33,18 +34,16 @@
 pub mod clock;
 pub mod design;
 pub mod fit;
+pub mod names;
 pub mod refine;
 pub mod validate;
 
 pub use design::{Column, Design, Layout, Owner, RecordColumns, RecordSpec, design_matrix};
-pub use fit::{
-    CampaignIdentification, RecordFit, choose_campaign_noise, identify_campaign,
-    identify_campaign_with,
-};
-pub use refine::{exact_campaign_prediction, identify_campaign_refined, refine_campaign};
+pub use fit::{CampaignIdentification, RecordFit, choose_campaign_noise, fit_design, identify};
+pub use refine::{exact_campaign_prediction, refine_campaign};
 pub use validate::{
     CampaignValidation, CampaignValues, RecordPlan, RecordValidation, Refitted, record_plan,
-    validate_campaign, validate_record,
+    validate, validate_record,
 };
 
 use simulation::campaign::Campaign;

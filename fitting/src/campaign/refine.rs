@@ -14,7 +14,7 @@ use crate::factored::{RowsFactored, check_readings_of};
 use crate::identify::check_readings;
 use crate::noise::{NoiseChoice, NoiseModel, SampleWhitening};
 use crate::refine::{
-    GaussNewton, RefineError, RefineOptions, Refinement, exact_prediction, gauss_newton,
+    GaussNewton, IdentifyError, RefineOptions, Refinement, exact_prediction, gauss_newton,
 };
 use crate::{IdentifyOptions, Tolerances};
 use model_spec::Machine;
@@ -32,7 +32,7 @@ pub fn exact_campaign_prediction(
     campaign: &Campaign,
     design: &Design,
     x: &[f64],
-) -> Result<DVector<f64>, RefineError> {
+) -> Result<DVector<f64>, IdentifyError> {
     let mut out = Vec::with_capacity(3 * campaign.samples());
     for (rc, rec) in design.layout.records.iter().zip(&campaign.records) {
         let local: Vec<f64> = rc.columns.iter().map(|&c| x[c]).collect();
@@ -65,7 +65,7 @@ struct System {
 }
 
 impl System {
-    fn new(campaign: &Campaign, design: &Design) -> Result<System, RefineError> {
+    fn new(campaign: &Campaign, design: &Design) -> Result<System, IdentifyError> {
         let order = design.layout.solve_order();
         let (h, names) = solve_system(design, &order);
         let coordinates = campaign
@@ -96,7 +96,7 @@ impl System {
 /// are updated.
 ///
 /// # Errors
-/// As [`crate::refine::refine`].
+/// As [`super::identify`]: the exact prediction and its fits.
 pub fn refine_campaign(
     m: &Machine,
     campaign: &Campaign,
@@ -105,7 +105,7 @@ pub fn refine_campaign(
     tolerances: &Tolerances,
     opts: &RefineOptions,
     noise: Option<&NoiseModel>,
-) -> Result<Refinement, RefineError> {
+) -> Result<Refinement, IdentifyError> {
     let system = System::new(campaign, design)?;
     let run = Run {
         m,
@@ -136,7 +136,7 @@ impl Run<'_> {
         ident: &mut CampaignIdentification,
         noise: Option<&NoiseModel>,
         factored: Option<&RowsFactored>,
-    ) -> Result<Refinement, RefineError> {
+    ) -> Result<Refinement, IdentifyError> {
         let System {
             order,
             h,
@@ -160,7 +160,7 @@ impl Run<'_> {
         start.names = names.clone();
         start.solution = to_solve_order(&ident.fit.solution, order);
         let n = order.len();
-        let mut predict = |xs: &[f64]| -> Result<DVector<f64>, RefineError> {
+        let mut predict = |xs: &[f64]| -> Result<DVector<f64>, IdentifyError> {
             let mut x = vec![0.0; n];
             for (k, &c) in order.iter().enumerate() {
                 x[c] = xs[k];
@@ -182,19 +182,21 @@ impl Run<'_> {
 /// Identifies `model` on `campaign` and refines the fit against the exact machine: the ordinary
 /// refinement, then, unless the options' noise is [`NoiseChoice::Ordinary`], the noise model from
 /// its exact residual (pooled over the records) and the refinement by generalized least squares
-/// from its solution (as [`crate::identify_refined_with`]). The ordinary system is factorised once
-/// for the first-order fit and both refinements (the generalized one adds the whitened system's).
+/// from its solution. The [`Refinement`] (in [`CampaignIdentification::refinement`]) counts the
+/// steps of both; its first-order RMS is the ordinary linear fit's. The ordinary system is
+/// factorised once for the first-order fit and both refinements (the generalized one adds the
+/// whitened system's).
 ///
 /// # Errors
-/// As [`super::identify_campaign`]; [`RefineError::NotConverged`] when a refinement does not
+/// As [`super::identify`]; [`IdentifyError::NotConverged`] when a refinement does not
 /// converge (its values are no identification).
-pub fn identify_campaign_refined(
+pub(crate) fn identify_refined(
     m: &Machine,
     model: &Model,
     campaign: &Campaign,
     opts: &IdentifyOptions,
     refine_opts: &RefineOptions,
-) -> Result<(CampaignIdentification, Refinement), RefineError> {
+) -> Result<CampaignIdentification, IdentifyError> {
     let noise = &opts.noise;
     check_options(opts)?;
     let design = design_matrix(m, model, campaign)?;
@@ -218,7 +220,8 @@ pub fn identify_campaign_refined(
     let ordinary = run.refine(&mut ident, None, Some(&factored))?;
     ordinary.converged()?;
     if *noise == NoiseChoice::Ordinary {
-        return Ok((ident, ordinary));
+        ident.refinement = Some(ordinary);
+        return Ok(ident);
     }
     let weights = super::whitening(campaign, noise)?;
     let chosen = choose_campaign_noise_weighted(noise, &ident.fit, &design.rows, weights.as_ref())?;
@@ -226,5 +229,6 @@ pub fn identify_campaign_refined(
     let r = run.refine(&mut ident, Some(&chosen), Some(&under))?;
     ident.noise = chosen;
     r.converged()?;
-    Ok((ident, ordinary.followed_by(&r)))
+    ident.refinement = Some(ordinary.followed_by(&r));
+    Ok(ident)
 }

@@ -39,11 +39,11 @@ use crate::identify::{check_readings, fit_rows, with_offsets};
 use crate::least_squares::{Constraint, Tolerances};
 use crate::measurement_vector;
 use crate::noise::SampleWhitening;
-use crate::refine::{GaussNewton, RefineError, RefineOptions, exact_prediction, gauss_newton};
+use crate::refine::{GaussNewton, IdentifyError, RefineOptions, exact_prediction, gauss_newton};
 use crate::validate::{
     Stats, Unidentified, ValidateError, ValidateOptions, Validation, statistics,
 };
-use formats::progress::{Progress, Unwatched};
+use formats::progress::Progress;
 use model_spec::Machine;
 use nalgebra::DVector;
 use simulation::campaign::{Campaign, CampaignRecord};
@@ -96,27 +96,14 @@ pub struct CampaignValidation {
     pub overall: Stats,
 }
 
-/// Validates `values` on every record of `campaign` (see the module documentation);
-/// `opts.exact` and `opts.unidentified` apply, the records carry their own zeroing and
-/// parameters.
+/// Validates `values` on every record of `campaign` (a record is a campaign of one; see the
+/// module documentation): `opts.exact` and `opts.unidentified` apply, the records carry their
+/// own zeroing and parameters; the records validated are reported to `progress` (one unit per
+/// record; [`formats::progress::Unwatched`] when nobody watches).
 ///
 /// # Errors
 /// As [`validate_record`].
-pub fn validate_campaign(
-    m: &Machine,
-    values: &CampaignValues,
-    campaign: &Campaign,
-    opts: &ValidateOptions,
-) -> Result<CampaignValidation, ValidateError> {
-    validate_campaign_with_progress(m, values, campaign, opts, &Unwatched)
-}
-
-/// As [`validate_campaign`], reporting the records validated to `progress` (`records`, one
-/// unit per record).
-///
-/// # Errors
-/// As [`validate_record`].
-pub fn validate_campaign_with_progress(
+pub fn validate(
     m: &Machine,
     values: &CampaignValues,
     campaign: &Campaign,
@@ -341,7 +328,7 @@ pub fn validate_record(
     let mut source = GainSource::new(m, &model.errors(), &r.params)?;
     let h = block(m, &model, rec, &mut source, clock).map_err(ValidateError::Measurements)?;
     // The prediction with every value at `x` (mm, one per reading).
-    let predict = |x: &[f64]| -> Result<DVector<f64>, RefineError> {
+    let predict = |x: &[f64]| -> Result<DVector<f64>, IdentifyError> {
         if !opts.exact {
             return Ok(&h * DVector::from_column_slice(x));
         }
@@ -361,7 +348,7 @@ pub fn validate_record(
             p.iter().flat_map(|q| q.iter().copied()),
         ))
     };
-    let failed = |e: RefineError| ValidateError::Shape(format!("record `{}`: {e}", r.label));
+    let failed = |e: IdentifyError| ValidateError::Shape(format!("record `{}`: {e}", r.label));
     let mut refitted = Vec::new();
     if !refit.is_empty() {
         check_readings(rec.samples.len(), refit.len())?;
@@ -400,7 +387,7 @@ pub fn validate_record(
             };
             let start = first;
             let base = v.clone();
-            let mut predict_refit = |xr: &[f64]| -> Result<DVector<f64>, RefineError> {
+            let mut predict_refit = |xr: &[f64]| -> Result<DVector<f64>, IdentifyError> {
                 let mut x = base.clone();
                 for (i, &k) in refit.iter().enumerate() {
                     x[k] = xr[i];
@@ -415,7 +402,7 @@ pub fn validate_record(
             )
             .map_err(failed)?;
             if !refinement.converged {
-                return Err(failed(RefineError::NotConverged {
+                return Err(failed(IdentifyError::NotConverged {
                     iterations: refinement.iterations,
                     last_step_mm: refinement.steps_mm.last().copied().unwrap_or(0.0),
                     tolerance_mm: refinement.tolerance_mm,

@@ -1,11 +1,16 @@
-//! Campaign fits: a campaign of one record equals the single identification; the layout names
+//! Campaign fits: a campaign of one record is the least-squares fit of its H matrix; the layout names
 //! and owns its columns as documented; several records share the machine's errors; bad
 //! campaigns are refused with the record named.
 
-use fitting::campaign::{Owner, design_matrix, identify_campaign, identify_campaign_refined};
-use fitting::noise::NoiseChoice;
-use fitting::refine::{RefineOptions, identify_refined};
-use fitting::{Fit, IdentifyOptions, identify};
+use crate::one_record::{identify_one, identify_refined_campaign};
+use fitting::campaign::{Owner, design_matrix, identify};
+use fitting::hmatrix::{GainSource, h_matrix, parameter_names};
+use fitting::identify::fit_rows;
+use fitting::noise::{NoiseChoice, NoiseModel};
+use fitting::refine::RefineOptions;
+use fitting::{
+    Constraint, Fit, IdentifyOptions, Tolerances, choose_noise, measurement_vector, with_offsets,
+};
 use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use simulation::campaign::{Campaign, CampaignError, CampaignRecord};
@@ -99,8 +104,43 @@ fn one_record(m: &Machine, label: &str, record: Record, zeroed: bool) -> Campaig
     .unwrap()
 }
 
+/// The least-squares fit of `record`'s own H matrix for `model` (with `dx0 dy0 dz0` when
+/// zeroed), at the default parameters, by the solver every fit uses: ordinary, or generalized
+/// under `noise`.
+fn fit_of_h(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    zeroed: bool,
+    noise: Option<&NoiseModel>,
+) -> Fit {
+    let fitted = if zeroed {
+        with_offsets(model)
+    } else {
+        model.clone()
+    };
+    let mut source = GainSource::new(m, &fitted.errors(), &m.default_parameters()).unwrap();
+    let h = h_matrix(m, &fitted, record, &mut source).unwrap();
+    let y = measurement_vector(record).unwrap();
+    let names = parameter_names(m, &fitted);
+    let tol = Tolerances::default();
+    let layout = [record.samples.len()];
+    fit_rows(
+        &h,
+        &y,
+        &names,
+        &Constraint::None,
+        &tol,
+        noise,
+        &layout,
+        None,
+    )
+    .unwrap()
+    .0
+}
+
 #[test]
-fn one_record_equals_the_single_identification_bit_for_bit() {
+fn one_record_is_the_least_squares_fit_of_its_h_matrix() {
     let m = machine();
     let model = reduced(&m);
     for (zeroed, noise) in [
@@ -110,41 +150,40 @@ fn one_record_equals_the_single_identification_bit_for_bit() {
     ] {
         let t = truth(&m, "seed-ac-demo", 0.5e-3, 7, zeroed);
         let k4 = simulate(&m, &t, &path(&m, "K4")).unwrap();
-        let opts = IdentifyOptions::new().zeroed(zeroed);
-        let single = identify(&m, &model, &k4, &opts.clone().noise(noise.clone())).unwrap();
         let c = one_record(&m, "k4", k4.clone(), zeroed);
-        let camp = identify_campaign(&m, &model, &c, &IdentifyOptions::new().noise(noise.clone()))
-            .unwrap();
-        assert_same(&single.fit, &camp.fit);
-        assert_eq!(single.noise, camp.noise);
-        assert_eq!(single.whitened_sigma, camp.whitened_sigma);
+        let camp = identify(&m, &model, &c, &IdentifyOptions::new().noise(noise.clone())).unwrap();
+        // The noise model is the one the record's ordinary fit gives ...
+        let ordinary = fit_of_h(&m, &model, &k4, zeroed, None);
+        let chosen = choose_noise(&noise, ordinary.residual.as_slice(), ordinary.sigma);
+        assert_eq!(camp.noise, chosen);
+        // ... and the fit that of the record's H matrix under it, bit for bit.
+        let whitened = (noise != NoiseChoice::Ordinary).then_some(&chosen);
+        let direct = fit_of_h(&m, &model, &k4, zeroed, whitened);
+        assert_same(&direct, &camp.fit);
+        // The fit in the record's model order and names is the same fit.
+        let single = camp.single_record(&m).unwrap();
+        assert_eq!(single.fit.names, direct.names);
+        assert_same(&direct, &single.fit);
+        assert_eq!(single.samples, k4.samples.len());
+        assert_eq!(single.zeroed, zeroed);
         if zeroed {
-            // What the offsets swallow, named with the record.
+            // What the offsets swallow, named with the record in the campaign, without it in
+            // the record's view.
             assert_eq!(camp.swallowed.len(), single.swallowed.len());
             assert!(
                 camp.swallowed
                     .iter()
                     .all(|s| s.offsets[0].ends_with("[k4]"))
             );
+            assert!(single.swallowed.iter().all(|s| !s.offsets[0].contains('[')));
         }
-
-        let (single_r, rs) = identify_refined(
-            &m,
-            &model,
-            &k4,
-            &opts.clone().noise(noise.clone()),
-            &RefineOptions::default(),
-        )
-        .unwrap();
-        let (camp_r, rc) = identify_campaign_refined(
-            &m,
-            &model,
-            &c,
-            &IdentifyOptions::new().noise(noise.clone()),
-            &RefineOptions::default(),
-        )
-        .unwrap();
-        assert_eq!(rs, rc);
+        // Refined: the record's view of the refined campaign fit is that fit.
+        let refined = IdentifyOptions::new()
+            .noise(noise.clone())
+            .refined(RefineOptions::default());
+        let camp_r = identify(&m, &model, &c, &refined).unwrap();
+        let single_r = camp_r.single_record(&m).unwrap();
+        assert!(camp_r.refinement.as_ref().is_some_and(|r| r.converged));
         assert_same(&single_r.fit, &camp_r.fit);
         assert_eq!(
             camp_r.records[0].rss.to_bits(),
@@ -152,6 +191,25 @@ fn one_record_equals_the_single_identification_bit_for_bit() {
             "the record's share is all of it"
         );
     }
+    // Several records have no single record's view.
+    let two = Campaign::new(vec![
+        CampaignRecord::new("k4", path(&m, "K4"), m.default_parameters(), "ball", false),
+        CampaignRecord::new("k1", path(&m, "K1"), m.default_parameters(), "ball", false),
+    ])
+    .unwrap();
+    let t = truth(&m, "seed-ac-demo", 0.5e-3, 7, false);
+    let two = Campaign::new(
+        two.records
+            .into_iter()
+            .map(|mut r| {
+                r.record = simulate(&m, &t, &r.record).unwrap();
+                r
+            })
+            .collect(),
+    )
+    .unwrap();
+    let both = identify(&m, &model, &two, &IdentifyOptions::new()).unwrap();
+    assert!(both.single_record(&m).is_none());
 }
 
 #[test]
@@ -223,7 +281,7 @@ fn two_paths_on_one_set_up_share_it_and_determine_what_one_path_cannot() {
     let k2 = simulate(&m, &t, &path(&m, "K2")).unwrap();
     let p = m.default_parameters();
     let opts = IdentifyOptions::new();
-    let alone = identify(&m, &model, &k1, &opts).unwrap();
+    let alone = identify_one(&m, &model, &k1, &opts).unwrap();
     assert!(
         alone.fit.rank < 11,
         "K1 alone cannot determine the reduced model"
@@ -234,7 +292,7 @@ fn two_paths_on_one_set_up_share_it_and_determine_what_one_path_cannot() {
     ])
     .unwrap();
     let (ident, _) =
-        identify_campaign_refined(&m, &model, &c, &opts, &RefineOptions::default()).unwrap();
+        identify_refined_campaign(&m, &model, &c, &opts, &RefineOptions::default()).unwrap();
     assert_eq!(ident.fit.rank, 11, "K1 and K2 on one ball determine all 11");
     for (j, name) in ident.fit.names.iter().enumerate() {
         let error = name.split('[').next().unwrap();
@@ -287,7 +345,7 @@ fn bad_campaigns_are_refused_naming_the_record() {
     assert!(e.contains("record `a`") && e.contains("`Xw`"), "{e}");
     // Bare paths cannot be identified: the readings are missing, and the record is named.
     let c = Campaign::new(vec![rec("a", "s")]).unwrap();
-    let e = identify_campaign(
+    let e = identify(
         &m,
         &reduced(&m),
         &c,
@@ -318,7 +376,7 @@ fn with_setup(m: &Machine, t: &Truth, setup: [f64; 3]) -> Truth {
 
 #[test]
 fn validation_uses_a_fitted_set_up_and_refits_a_new_one() {
-    use fitting::campaign::{CampaignValues, validate_campaign};
+    use fitting::campaign::CampaignValues;
     use fitting::validate::ValidateOptions;
     let m = machine();
     let model = reduced(&m);
@@ -326,7 +384,7 @@ fn validation_uses_a_fitted_set_up_and_refits_a_new_one() {
     let t = truth(&m, "seed-ac-reduced", 0.0, 1, false);
     let k4 = simulate(&m, &t, &path(&m, "K4")).unwrap();
     let fitted = Campaign::new(vec![CampaignRecord::new("k4", k4, p.clone(), "a", false)]).unwrap();
-    let (ident, _) = identify_campaign_refined(
+    let (ident, _) = identify_refined_campaign(
         &m,
         &model,
         &fitted,
@@ -347,7 +405,7 @@ fn validation_uses_a_fitted_set_up_and_refits_a_new_one() {
     .unwrap();
     let mut opts = ValidateOptions::default();
     opts.exact = true;
-    let v = validate_campaign(&m, &values, &check, &opts).unwrap();
+    let v = fitting::validate(&m, &values, &check, &opts, &formats::progress::Unwatched).unwrap();
     let same = &v.records[0];
     assert!(same.setup_fitted && same.refitted.is_empty());
     assert!(
@@ -385,7 +443,7 @@ fn validation_uses_a_fitted_set_up_and_refits_a_new_one() {
         true,
     )])
     .unwrap();
-    let w = validate_campaign(&m, &values, &wrong, &opts).unwrap();
+    let w = fitting::validate(&m, &values, &wrong, &opts, &formats::progress::Unwatched).unwrap();
     assert!(w.records[0].validation.overall.residual_rms > 1e-3);
 }
 
@@ -417,7 +475,7 @@ fn a_drift_on_the_campaign_clock_is_one_drift_over_the_records() {
         );
     }
     let c = Campaign::new(rs).unwrap();
-    let (ident, _) = identify_campaign_refined(
+    let (ident, _) = identify_refined_campaign(
         &m,
         &model,
         &c,

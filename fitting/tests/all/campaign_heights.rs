@@ -16,10 +16,10 @@
 //! two heights against a hidden truth (0.3 µm noise, refined against the exact machine):
 //! every determined value within 4 standard uncertainties.
 
-use fitting::campaign::identify_campaign_refined;
+use crate::one_record::{identify_one, identify_refined_campaign};
+use fitting::IdentifyOptions;
 use fitting::noise::NoiseChoice;
 use fitting::refine::RefineOptions;
-use fitting::{IdentifyOptions, identify};
 use model_spec::Machine;
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::{Basis, Effect, Model, Term};
@@ -171,7 +171,7 @@ fn two_ball_heights_determine_the_variation_of_z_tilts_that_one_height_cannot() 
 
     // One height: Z stands still, its tilt varying along the stroke is a constant tilt.
     let one = Campaign::new(height(&m, "low", &low, setups[0].1, 1)).unwrap();
-    let (a, _) = identify_campaign_refined(
+    let (a, _) = identify_refined_campaign(
         &m,
         &model,
         &one,
@@ -200,7 +200,7 @@ fn two_ball_heights_determine_the_variation_of_z_tilts_that_one_height_cannot() 
         );
     }
     // The same without a campaign: one record at one height is no better.
-    let single = identify(
+    let single = identify_one(
         &m,
         &model,
         &one.records[0].record,
@@ -213,7 +213,7 @@ fn two_ball_heights_determine_the_variation_of_z_tilts_that_one_height_cannot() 
     let mut records = height(&m, "low", &low, setups[0].1, 1);
     records.extend(height(&m, "high", &high, setups[1].1, 3));
     let two = Campaign::new(records).unwrap();
-    let (b, refinement) = identify_campaign_refined(
+    let (b, refinement) = identify_refined_campaign(
         &m,
         &model,
         &two,

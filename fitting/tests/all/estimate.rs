@@ -3,10 +3,11 @@
 //! zeroed readings, rank tolerance, and bad input.
 
 use crate::common;
+use crate::one_record::identify_one;
 
 use common::{Rng, builtin, id};
 use fitting::hmatrix::{h_matrix_auto, parameter_names};
-use fitting::{Constraint, EstimateError, IdentifyOptions, Tolerances, identify, least_squares};
+use fitting::{Constraint, EstimateError, IdentifyOptions, Tolerances, least_squares};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
 use simulation::error_vector;
@@ -238,7 +239,7 @@ fn zeroed_readings_offsets_swallow_xoc_yoa_zoa_and_the_rest_is_right() {
         let y = synthetic(&h, &x, sigma, seed, true);
         let data = with_measurements(rec.clone(), &y);
         let opts = IdentifyOptions::new().zeroed(true);
-        let ident = identify(&m, &model, &data, &opts).unwrap();
+        let ident = identify_one(&m, &model, &data, &opts).unwrap();
         let fit = &ident.fit;
         assert_eq!(fit.names.len(), 14);
         assert_eq!(&fit.names[11..], ["dx0", "dy0", "dz0"]);
@@ -276,7 +277,7 @@ fn zeroed_readings_offsets_swallow_xoc_yoa_zoa_and_the_rest_is_right() {
                 "YOA".into(),
                 "ZOA".into(),
             ]));
-        let f = identify(&m, &model, &data, &fixed).unwrap().fit;
+        let f = identify_one(&m, &model, &data, &fixed).unwrap().fit;
         assert!(f.identifiability.confounded.is_empty());
         assert!(f.values.iter().all(Option::is_some));
         assert_eq!(f.values[id_col(&names, "XOC")], Some(0.0));
@@ -370,13 +371,13 @@ fn bad_input_is_an_error_not_a_panic() {
             .starts_with("constraint: `q` is not a parameter"),
         "{e}"
     );
-    // A record without measurements.
+    // A record without measurements, named.
     let m = builtin("seed-ac");
     let model = reduced(&m);
-    let e = identify(&m, &model, &k4(&m), &IdentifyOptions::default()).unwrap_err();
+    let e = identify_one(&m, &model, &k4(&m), &IdentifyOptions::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "the record has 241 samples but 0 measured error vectors"
+        "record `record`: the record has 241 samples but 0 measured error vectors"
     );
     // Fixing everything: no SVD, values 0.
     let all = Constraint::Zero(names.clone());
@@ -406,7 +407,7 @@ fn exact_machine_data_are_recovered_to_second_order() {
             [v.x, v.y, v.z]
         })
         .collect();
-    let ident = identify(&m, &model, &rec, &IdentifyOptions::default()).unwrap();
+    let ident = identify_one(&m, &model, &rec, &IdentifyOptions::default()).unwrap();
     let worst_um = (0..11)
         .map(|j| {
             let f = if m.catalogue[m.model_errors("reduced").unwrap()[j]].is_angular() {

@@ -1,11 +1,12 @@
 //! Identification end to end on the exact virtual machine: simulate `seed-ac` with a truth,
 //! identify the reduced model on K4, check the values and the validation on K1 and K2.
 
+use crate::one_record::{identify_one, identify_refined_one, validate_one};
 use fitting::hmatrix::GainSource;
 use fitting::hmatrix::h_matrix;
-use fitting::refine::{self, RefineOptions};
-use fitting::validate::{ValidateOptions, validate};
-use fitting::{Constraint, Identification, IdentifyOptions, identify};
+use fitting::refine::RefineOptions;
+use fitting::validate::ValidateOptions;
+use fitting::{Constraint, Identification, IdentifyOptions};
 use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use simulation::model::{Effect, Model};
@@ -31,10 +32,10 @@ fn reduced(m: &Machine) -> Model {
 }
 
 /// Identifies `model` on `record` and refines against the exact machine.
-fn identify_refined(m: &Machine, model: &Model, record: &Record, zeroed: bool) -> Identification {
+fn refined(m: &Machine, model: &Model, record: &Record, zeroed: bool) -> Identification {
     let opts = IdentifyOptions::new().zeroed(zeroed);
     let (ident, r) =
-        refine::identify_refined(m, model, record, &opts, &RefineOptions::default()).unwrap();
+        identify_refined_one(m, model, record, &opts, &RefineOptions::default()).unwrap();
     assert!(r.converged, "refinement converges: steps {:?}", r.steps_mm);
     ident
 }
@@ -58,7 +59,7 @@ fn noise_free_reduced_truth_is_recovered_and_validates_on_k1_k2() {
 
     // The purely linear fit carries the second-order terms: report them, they are the reason
     // for the refinement.
-    let linear = identify(&m, &model, &k4, &IdentifyOptions::default()).unwrap();
+    let linear = identify_one(&m, &model, &k4, &IdentifyOptions::default()).unwrap();
     let linear_worst = model
         .terms
         .iter()
@@ -73,7 +74,7 @@ fn noise_free_reduced_truth_is_recovered_and_validates_on_k1_k2() {
         "a first-order fit of exact data is biased at second order"
     );
 
-    let ident = identify_refined(&m, &model, &k4, false);
+    let ident = refined(&m, &model, &k4, false);
     for (term, v) in model.terms.iter().zip(&ident.fit.values) {
         let err_um = (v.unwrap() - true_value(&t, term.effect)) * term.effect.display_factor(&m);
         assert!(
@@ -85,12 +86,13 @@ fn noise_free_reduced_truth_is_recovered_and_validates_on_k1_k2() {
     for name in ["K1", "K2"] {
         let data = simulate(&m, &t, &path(&m, name)).unwrap();
         let opts = ValidateOptions::new().exact(true);
-        let v = validate(&m, &ident.model, &ident.fit.values, &data, &opts).unwrap();
-        let first_order = validate(
+        let v = validate_one(&m, &ident.model, &ident.fit.values, &data, false, &opts).unwrap();
+        let first_order = validate_one(
             &m,
             &ident.model,
             &ident.fit.values,
             &data,
+            false,
             &ValidateOptions::default(),
         )
         .unwrap();
@@ -123,7 +125,7 @@ fn with_noise_estimates_are_within_four_uncertainties_and_validation_is_at_noise
     for seed in 0..40u64 {
         t.seed = seed;
         let data = simulate(&m, &t, &k4).unwrap();
-        let ident = identify_refined(&m, &model, &data, false);
+        let ident = refined(&m, &model, &data, false);
         for (j, term) in model.terms.iter().enumerate() {
             let (v, s) = (ident.fit.values[j].unwrap(), ident.fit.std[j].unwrap());
             let z = (v - true_value(&t, term.effect)) / s;
@@ -146,7 +148,7 @@ fn with_noise_estimates_are_within_four_uncertainties_and_validation_is_at_noise
             t.seed = 1000 + seed;
             let data = simulate(&m, &t, p).unwrap();
             let opts = ValidateOptions::new().exact(true);
-            let v = validate(&m, &ident.model, &ident.fit.values, &data, &opts).unwrap();
+            let v = validate_one(&m, &ident.model, &ident.fit.values, &data, false, &opts).unwrap();
             let mut source =
                 GainSource::new(&m, &ident.model.errors(), &m.default_parameters()).unwrap();
             let hv = h_matrix(&m, &ident.model, &data, &mut source).unwrap();
@@ -184,7 +186,7 @@ fn zeroed_readings_name_the_swallowed_errors_and_the_rest_is_right() {
     t.zeroed = true;
     let k4 = simulate(&m, &t, &path(&m, "K4")).unwrap();
     assert_eq!(k4.measured[0], [0.0; 3]);
-    let ident = identify_refined(&m, &reduced(&m), &k4, true);
+    let ident = refined(&m, &reduced(&m), &k4, true);
     let mut swallowed: Vec<(String, Vec<String>)> = ident
         .swallowed
         .iter()
@@ -223,7 +225,7 @@ fn a_path_that_cannot_separate_the_model_is_reported_not_solved_into_nonsense() 
     let m = machine();
     let t = truth(&m, "seed-ac-reduced");
     let k1 = simulate(&m, &t, &path(&m, "K1")).unwrap();
-    let ident = identify(&m, &reduced(&m), &k1, &IdentifyOptions::default()).unwrap();
+    let ident = identify_one(&m, &reduced(&m), &k1, &IdentifyOptions::default()).unwrap();
     assert!(ident.fit.rank < 11, "rank {}", ident.fit.rank);
     let groups: Vec<Vec<String>> = ident
         .fit
@@ -245,7 +247,7 @@ fn a_path_that_cannot_separate_the_model_is_reported_not_solved_into_nonsense() 
     // What K1 does determine (AOC: the tilt of C about x, seen as a once-per-turn wobble) is
     // right, and exactly so after the refinement against the exact machine, which iterates on
     // the whole minimum-norm solution (the undetermined groups included).
-    let refined = identify_refined(&m, &reduced(&m), &k1, false);
+    let refined = refined(&m, &reduced(&m), &k1, false);
     let j = refined.fit.names.iter().position(|n| n == "AOC").unwrap();
     let aoc_refined = refined.fit.values[j].expect("AOC is determined on K1");
     assert!(
@@ -263,6 +265,6 @@ fn a_path_that_cannot_separate_the_model_is_reported_not_solved_into_nonsense() 
     assert!((aoc * 1e6 - 30.0).abs() < 0.01, "AOC {} µrad", aoc * 1e6);
     // A constraint chosen by the user gives numbers, and says so.
     let opts = IdentifyOptions::new().constraint(Constraint::MinimumNorm);
-    let forced = identify(&m, &reduced(&m), &k1, &opts).unwrap();
+    let forced = identify_one(&m, &reduced(&m), &k1, &opts).unwrap();
     assert!(forced.fit.values.iter().all(Option::is_some));
 }

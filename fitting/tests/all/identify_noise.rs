@@ -5,8 +5,9 @@
 //! 1 % of the |z| beyond 4 (the band is justified in `docs/identification.md`, section
 //! "Noise model"); the ordinary fit fails it under AR(1) noise.
 
+use crate::one_record::{identify_one, identify_refined_one};
 use fitting::noise::{NoiseChoice, NoiseModel, NoiseSource};
-use fitting::{IdentifyOptions, RefineOptions, identify, identify_refined};
+use fitting::{IdentifyOptions, RefineOptions};
 use formats::truth::builtin_truth;
 use model_spec::{Machine, builtin};
 use simulation::model::Model;
@@ -59,7 +60,7 @@ fn z_scores(
     for seed in 1..=SEEDS {
         let t = truth(m, sigma_mm, phi, seed);
         let data = simulate(m, &t, &k4).unwrap();
-        let (ident, r) = identify_refined(
+        let (ident, r) = identify_refined_one(
             m,
             &model,
             &data,
@@ -168,14 +169,14 @@ fn white_noise_gls_values_stay_within_noise_of_the_ordinary_ones() {
     let k4 = builtin_path(&m, "K4").unwrap().unwrap();
     let data = simulate(&m, &truth(&m, 0.5e-3, 0.0, 3), &k4).unwrap();
     let opts = IdentifyOptions::new();
-    let ordinary = identify(
+    let ordinary = identify_one(
         &m,
         &model,
         &data,
         &opts.clone().noise(NoiseChoice::Ordinary),
     )
     .unwrap();
-    let gls = identify(
+    let gls = identify_one(
         &m,
         &model,
         &data,
@@ -207,7 +208,7 @@ fn noise_free_data_fall_back_to_white_and_stay_exact() {
     let k4 = builtin_path(&m, "K4").unwrap().unwrap();
     let t = truth(&m, 0.0, 0.0, 1);
     let data = simulate(&m, &t, &k4).unwrap();
-    let (ident, _) = identify_refined(
+    let (ident, _) = identify_refined_one(
         &m,
         &model,
         &data,

@@ -3,12 +3,10 @@
 //! same run; a declared noise model is refused; the sensors' gain errors are the instrument
 //! terms `S`.
 
+use crate::one_record::{identify_one, identify_refined_one};
 use fitting::calibrate::instrument_terms;
 use fitting::noise::{NoiseChoice, NoiseError, NoiseModel, NoiseSource};
-use fitting::{
-    EstimateError, IdentifyOptions, RefineOptions, gain_source, identify, identify_refined,
-    identify_with,
-};
+use fitting::{EstimateError, IdentifyOptions, RefineOptions};
 use formats::truth::builtin_truth;
 use model_spec::instrument::{Instrument, ReadingsFrame, preset};
 use model_spec::{Machine, builtin};
@@ -56,7 +54,6 @@ fn monte_carlo(i: &Instrument, seeds: u64) -> (Vec<String>, [Spreads; 2], f64) {
         .map(|e| head.readings(*e).unwrap())
         .collect();
     let opts = IdentifyOptions::default();
-    let mut source = gain_source(&m, &model, &opts).unwrap();
     let p = model.width();
     let mut values = [vec![Vec::new(); p], vec![Vec::new(); p]];
     let mut stds = [vec![0.0; p], vec![0.0; p]];
@@ -83,7 +80,7 @@ fn monte_carlo(i: &Instrument, seeds: u64) -> (Vec<String>, [Spreads; 2], f64) {
         let mut unweighted = weighted.clone();
         unweighted.covariance.clear();
         for (k, r) in [weighted, unweighted].iter().enumerate() {
-            let id = identify_with(&m, &model, r, &mut source, &opts).unwrap();
+            let id = identify_one(&m, &model, r, &opts).unwrap();
             for j in 0..p {
                 values[k][j].push(id.fit.values[j].unwrap());
                 stds[k][j] += id.fit.std[j].unwrap() / seeds as f64;
@@ -172,8 +169,8 @@ fn a_sensor_record_identifies_what_the_ball_centre_record_of_the_same_run_does()
     let ball = simulate(&m, &truth, &path).unwrap();
     let sensors = simulate_sensors(&m, &truth, &path, &quiet, ReadingsFrame::Tool).unwrap();
     let read = to_record(&SensorHead::new(&quiet), &m, ReadingsFrame::Tool, &sensors).unwrap();
-    let (a, _) = identify_refined(&m, &model, &ball, &opts, &refine).unwrap();
-    let (b, _) = identify_refined(&m, &model, &read, &opts, &refine).unwrap();
+    let (a, _) = identify_refined_one(&m, &model, &ball, &opts, &refine).unwrap();
+    let (b, _) = identify_refined_one(&m, &model, &read, &opts, &refine).unwrap();
     for (j, name) in a.fit.names.iter().enumerate() {
         let (x, y) = (a.fit.values[j].unwrap(), b.fit.values[j].unwrap());
         assert!((x - y).abs() < 1e-8, "{name}: {x} vs {y}");
@@ -185,7 +182,7 @@ fn a_sensor_record_identifies_what_the_ball_centre_record_of_the_same_run_does()
     let ball = simulate(&m, &truth, &path).unwrap();
     let sensors = simulate_sensors(&m, &truth, &path, &i, ReadingsFrame::Tool).unwrap();
     let read = to_record(&SensorHead::new(&i), &m, ReadingsFrame::Tool, &sensors).unwrap();
-    let (a, _) = identify_refined(
+    let (a, _) = identify_refined_one(
         &m,
         &model,
         &ball,
@@ -193,7 +190,7 @@ fn a_sensor_record_identifies_what_the_ball_centre_record_of_the_same_run_does()
         &refine,
     )
     .unwrap();
-    let (b, _) = identify_refined(
+    let (b, _) = identify_refined_one(
         &m,
         &model,
         &read,
@@ -224,7 +221,7 @@ fn a_declared_noise_model_is_refused_for_readings_with_covariances() {
     let sensors = simulate_sensors(&m, &truth, &path, &i, ReadingsFrame::Tool).unwrap();
     let read = to_record(&SensorHead::new(&i), &m, ReadingsFrame::Tool, &sensors).unwrap();
     let declared = NoiseChoice::Model(NoiseModel::white(1e-4, NoiseSource::Declared));
-    let e = identify(
+    let e = identify_one(
         &m,
         &model,
         &read,
@@ -235,7 +232,7 @@ fn a_declared_noise_model_is_refused_for_readings_with_covariances() {
         matches!(e, EstimateError::Noise(NoiseError::DeclaredTwice)),
         "{e}"
     );
-    let e = identify_refined(
+    let e = identify_refined_one(
         &m,
         &model,
         &read,
@@ -250,7 +247,7 @@ fn a_declared_noise_model_is_refused_for_readings_with_covariances() {
     );
     // Estimated (over time, from the whitened rows) and ordinary are fine.
     for choice in [NoiseChoice::Estimate, NoiseChoice::Ordinary] {
-        identify(
+        identify_one(
             &m,
             &model,
             &read,
@@ -354,7 +351,7 @@ fn identifying_s_with_the_machine_identifies_the_gain_errors_but_their_scale() {
         &sensors,
     )
     .unwrap();
-    let (id, _) = identify_refined(
+    let (id, _) = identify_refined_one(
         &m,
         &model,
         &read,

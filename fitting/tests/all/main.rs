@@ -4,6 +4,7 @@
 
 #[path = "../../../simulation/tests/all/common/mod.rs"]
 mod common;
+mod one_record;
 
 mod campaign;
 mod campaign_heights;

@@ -2,7 +2,7 @@
 //!
 //! - the predicted standard uncertainties agree with the spread of the estimates of 1000
 //!   campaigns simulated on the exact virtual machine (a truth made of the model's terms at
-//!   tens of µm and µrad, reading noise σ) and fitted first order by `identify_campaign`,
+//!   tens of µm and µrad, reading noise σ) and fitted first order by `identify`,
 //!   within 10 % for every determined parameter; white noise with ordinary least squares, and
 //!   AR(1) noise with the generalized fit under the declared model;
 //! - following the suggestion (the plan with it, simulated again) reduces the largest
@@ -17,7 +17,7 @@
 //!
 //! The figures: `cargo test -p fitting --test all plan:: -- --nocapture`.
 
-use fitting::campaign::{Owner, design_matrix, identify_campaign, identify_campaign_with};
+use fitting::campaign::{Owner, design_matrix, fit_design, identify};
 use fitting::noise::{NoiseChoice, NoiseModel, NoiseSource};
 use fitting::plan::choose::interest;
 use fitting::plan::{
@@ -174,7 +174,7 @@ fn truth(m: &Machine, rec: &CampaignRecord, setup: usize, noise: (f64, f64), see
 
 /// The sample standard deviation of every column's estimate over `runs` campaigns of
 /// `planned` simulated on the exact machine (noise σ, φ; seeds from `seed0` on, 16 per run) and
-/// fitted first order by `identify_campaign_with` (`identify_campaign` with the campaign's
+/// fitted first order by `fit_design` (`identify` with the campaign's
 /// design matrix built once) with `choice`; `None` for a column that never got a value. Panics when
 /// a column gets a value in some fits and none in others.
 fn monte_carlo(
@@ -187,7 +187,7 @@ fn monte_carlo(
     seed0: u64,
 ) -> Vec<Option<f64>> {
     let setups = planned.setups();
-    // The design matrix needs the poses only: the one `identify_campaign` would build for
+    // The design matrix needs the poses only: the one `identify` would build for
     // every run.
     let design = design_matrix(m, model, planned).unwrap();
     let mut sum: Vec<f64> = Vec::new();
@@ -209,7 +209,7 @@ fn monte_carlo(
             })
             .collect();
         let campaign = Campaign::new(records).unwrap();
-        let fit = identify_campaign_with(
+        let fit = fit_design(
             m,
             model,
             &campaign,
@@ -682,7 +682,7 @@ fn the_prediction_is_what_a_fit_reports_scaled_to_the_stated_noise() {
             ..rec.clone()
         })
         .collect();
-    let ident = identify_campaign(
+    let ident = identify(
         &m,
         &model,
         &Campaign::new(records).unwrap(),

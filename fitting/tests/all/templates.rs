@@ -6,9 +6,10 @@
 //! of the truth, and the others are reported as confounded, in the groups the geometry says.
 
 use crate::common;
+use crate::one_record::identify_refined_one;
 
 use common::builtin;
-use fitting::{IdentifyOptions, RefineOptions, identify_refined};
+use fitting::{IdentifyOptions, RefineOptions};
 use model_spec::{ErrorKind, Machine};
 use simulation::generator::{GeneratorError, GeneratorOptions, generate, tests};
 use simulation::model::Model;
@@ -154,7 +155,7 @@ fn identify_on_the_templates_own_paths_recovers_the_truth() {
         let t = truth(&m, 11 + k as u64);
         let data = simulate(&m, &t, &path).unwrap();
         let model = Model::constant(m.model_errors("location").unwrap());
-        let (ident, refinement) = identify_refined(
+        let (ident, refinement) = identify_refined_one(
             &m,
             &model,
             &data,

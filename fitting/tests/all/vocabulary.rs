@@ -5,11 +5,12 @@
 //! samples.
 
 use crate::common;
+use crate::one_record::{identify_one, identify_refined_one};
 
 use common::builtin;
+use fitting::IdentifyOptions;
 use fitting::hmatrix::{HMatrixError, h_matrix_auto};
-use fitting::refine::{RefineOptions, identify_refined};
-use fitting::{IdentifyOptions, identify};
+use fitting::refine::RefineOptions;
 use formats::truth::builtin_truth;
 use model_spec::Machine;
 use simulation::model::{Model, Term};
@@ -102,14 +103,14 @@ fn identification_recovers_each_hidden_term() {
             // error there, which the reduced model's errors already span.
             let mut model = Model::of(&m, "reduced").unwrap();
             model.terms.push(Term::parse(&m, spelling).unwrap());
-            let fit = identify(&m, &model, &data, &IdentifyOptions::default()).unwrap();
+            let fit = identify_one(&m, &model, &data, &IdentifyOptions::default()).unwrap();
             assert_eq!(fit.fit.values.last(), Some(&None), "{spelling}");
             continue;
         }
         let term = Term::parse(&m, spelling).unwrap();
         let mut model = Model::of(&m, "reduced").unwrap();
         model.terms.push(term);
-        let (ident, r) = identify_refined(
+        let (ident, r) = identify_refined_one(
             &m,
             &model,
             &data,
@@ -143,7 +144,7 @@ fn the_first_order_fit_of_an_instrument_term_is_biased_by_its_own_size() {
     let data = simulate(&m, &t, &k4(&m)).unwrap();
     let mut model = Model::of(&m, "reduced").unwrap();
     model.terms.push(Term::parse(&m, "SYY").unwrap());
-    let fit = identify(&m, &model, &data, &IdentifyOptions::default()).unwrap();
+    let fit = identify_one(&m, &model, &data, &IdentifyOptions::default()).unwrap();
     let got = fit.fit.values[model.width() - 1].unwrap();
     assert!((got - 0.05 / 1.05).abs() < 1e-5, "{got}");
     assert!((got - 0.05).abs() > 2e-3, "{got}");

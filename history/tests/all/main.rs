@@ -3,6 +3,8 @@
 //! NAME::` runs one of them.
 
 mod common;
+#[path = "../../../fitting/tests/all/one_record.rs"]
+mod one_record;
 
 mod store;
 mod trend;

@@ -5,6 +5,7 @@
 //! read back, flagged).
 
 use crate::common;
+use crate::one_record::identify_refined_one;
 
 use common::{TempDir, check};
 use history::trend::{
@@ -465,7 +466,7 @@ fn truth_text(xoc: f64, noise_um: f64, seed: u64) -> String {
 
 #[test]
 fn the_real_pipeline_flags_a_drifting_location_error() {
-    use fitting::{IdentifyOptions, RefineOptions, identify_refined};
+    use fitting::{IdentifyOptions, RefineOptions};
     use report::json::{IdentificationReport, IdentificationSource};
     use simulation::model::Model;
     use simulation::{builtin_path, simulate};
@@ -487,7 +488,7 @@ fn the_real_pipeline_flags_a_drifting_location_error() {
             let t =
                 formats::truth::parse_truth("truth", &truth_text(xoc, noise, seed), &m).unwrap();
             let record = simulate(&m, &t, &k4).unwrap();
-            let (ident, refinement) = identify_refined(
+            let (ident, refinement) = identify_refined_one(
                 &m,
                 &model,
                 &record,

@@ -4,9 +4,10 @@
 //! be cut is refused with the sample and the times.
 
 use crate::common;
+use crate::one_record::identify_one;
 
 use common::{Scratch, builtin};
-use fitting::{IdentifyOptions, identify};
+use fitting::IdentifyOptions;
 use formats::csv::{ReadOptions, parse_measurement};
 use formats::nc::Dialect;
 use formats::truth::builtin_truth;
@@ -114,8 +115,8 @@ fn a_static_log_gives_the_static_record() {
     assert!(csv.starts_with("# segmented\nX,Y,Z,A,C,dx_um,dy_um,dz_um,t_s\n"));
     let record = parse_measurement("rec.csv", &csv, &m, &ReadOptions::default()).unwrap();
     let model = Model::of(&m, "reduced").unwrap();
-    let a = identify(&m, &model, &record, &IdentifyOptions::default()).unwrap();
-    let b = identify(&m, &model, &fixed, &IdentifyOptions::default()).unwrap();
+    let a = identify_one(&m, &model, &record, &IdentifyOptions::default()).unwrap();
+    let b = identify_one(&m, &model, &fixed, &IdentifyOptions::default()).unwrap();
     for (x, y) in a.fit.values.iter().zip(&b.fit.values) {
         assert!((x.unwrap() - y.unwrap()).abs() < 1e-9, "{x:?} {y:?}");
     }
@@ -152,11 +153,11 @@ fn with_noise_the_values_agree_within_their_uncertainty() {
     let csv = format_segmented(&m, &plan, &seg, &[]).unwrap();
     let record = parse_measurement("rec.csv", &csv, &m, &ReadOptions::default()).unwrap();
     let model = Model::of(&m, "reduced").unwrap();
-    let a = identify(&m, &model, &record, &IdentifyOptions::default()).unwrap();
+    let a = identify_one(&m, &model, &record, &IdentifyOptions::default()).unwrap();
     let mut quiet = truth.clone();
     quiet.noise_mm = 0.0;
     let fixed = simulate(&m, &quiet, &plan.record()).unwrap();
-    let b = identify(&m, &model, &fixed, &IdentifyOptions::default()).unwrap();
+    let b = identify_one(&m, &model, &fixed, &IdentifyOptions::default()).unwrap();
     for ((x, y), s) in a.fit.values.iter().zip(&b.fit.values).zip(&a.fit.std) {
         let (x, y, s) = (x.unwrap(), y.unwrap(), s.unwrap());
         assert!((x - y).abs() < 4.0 * s, "{x} {y} ± {s}");

@@ -11,11 +11,12 @@
 //! The machine's error is measured without the ball's set-up error: where the ball sits on
 //! the table is not the machine's doing, and compensation leaves it alone.
 
+use crate::one_record::{identify_refined_one, validate_one};
 use compensation::run::{CommandedPose, compensate_poses};
 use compensation::values::MachineErrors;
 use compensation::verify::machine_error_rms;
 use diagnosis::{DiagnoseOptions, diagnose, one_record};
-use fitting::{IdentifyOptions, RefineOptions, ValidateOptions, identify_refined, validate};
+use fitting::{IdentifyOptions, RefineOptions, ValidateOptions};
 use formats::progress::Unwatched;
 use formats::truth::builtin_truth;
 use model_spec::basis::BasisContext;
@@ -48,7 +49,7 @@ fn records(m: &Machine, truth: &Truth) -> Vec<(&'static str, Record)> {
 /// The identification of `model` on `record`, as `identify --json` writes it and
 /// `compensate` reads it back.
 fn identified(m: &Machine, model: &Model, record: &Record) -> MachineErrors {
-    let (ident, refinement) = identify_refined(
+    let (ident, refinement) = identify_refined_one(
         m,
         model,
         record,
@@ -256,7 +257,7 @@ fn budget_truth_compensated_within_the_validated_residual() {
     let recs = records(&m, &truth);
     let model = Model::of(&m, "reduced").unwrap();
     let errors = identified(&m, &model, &recs[0].1);
-    let (ident, _) = identify_refined(
+    let (ident, _) = identify_refined_one(
         &m,
         &model,
         &recs[0].1,
@@ -283,11 +284,12 @@ fn budget_truth_compensated_within_the_validated_residual() {
     }
     let quiet_recs = records(&m, &quiet);
     for (name, r) in &quiet_recs[1..] {
-        let v = validate(
+        let v = validate_one(
             &m,
             &ident.model,
             &ident.fit.values,
             r,
+            false,
             &ValidateOptions::new().exact(true),
         )
         .unwrap();

@@ -3,13 +3,14 @@
 //! listed with its value; undetermined values are refused unless the fit was constrained.
 
 use crate::common;
+use crate::one_record::identify_refined_one;
 
 use codegen::GainModel;
 use common::{Rng, builtin};
 use compensation::values::{CompensationError, MachineErrors, ValueSource};
 use fitting::campaign::CampaignValues;
 use fitting::hmatrix::h_matrix_auto;
-use fitting::{Constraint, IdentifyOptions, RefineOptions, identify_refined};
+use fitting::{Constraint, IdentifyOptions, RefineOptions};
 use model_spec::Machine;
 use nalgebra::DVector;
 use report::json::read::parse_identification;
@@ -223,7 +224,7 @@ fn zeroed_identification(constraint: Constraint) -> (Machine, IdentifiedValues) 
     let model = Model::of(&m, "reduced").unwrap();
     let opts = IdentifyOptions::new().zeroed(true).constraint(constraint);
     let (ident, refinement) =
-        identify_refined(&m, &model, &data, &opts, &RefineOptions::default()).unwrap();
+        identify_refined_one(&m, &model, &data, &opts, &RefineOptions::default()).unwrap();
     let source = IdentificationSource {
         data: "k4.csv",
         label: "reduced",

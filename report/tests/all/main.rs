@@ -6,6 +6,8 @@
 mod common;
 #[path = "../../../diagnosis/tests/all/diagnose/helpers.rs"]
 mod diagnose_helpers;
+#[path = "../../../fitting/tests/all/one_record.rs"]
+mod one_record;
 
 mod compensation_loop;
 mod compensation_values;

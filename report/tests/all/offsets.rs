@@ -6,12 +6,15 @@
 //! written and read back; validation on records modelled with another value; bad terms and
 //! bad symbol names refused with their reason.
 
-use fitting::campaign::{CampaignValues, Owner, identify_campaign_refined, validate_campaign};
+use crate::one_record::{
+    identify_one, identify_refined_campaign, identify_refined_one, validate_one,
+};
+use fitting::campaign::{CampaignValues, Owner};
 use fitting::hmatrix::h_matrix_auto;
 use fitting::noise::NoiseChoice;
 use fitting::offsets::{OffsetGains, is_setup_symbol};
-use fitting::refine::{RefineOptions, identify_refined};
-use fitting::{Identification, IdentifyOptions, ValidateOptions, identify, validate};
+use fitting::refine::RefineOptions;
+use fitting::{Identification, IdentifyOptions, ValidateOptions};
 use model_spec::{Machine, builtin, parse_machine};
 use report::json::read::parse_identification;
 use report::json::{IdentificationReport, IdentificationSource, to_json};
@@ -282,12 +285,12 @@ fn a_pivot_length_off_its_nominal_is_recovered_within_four_standard_uncertaintie
     // Noise-free, every parameter determined: the change is found exactly once refined
     // against the exact machine.
     let clean = simulate(&m, &head_table_truth(&m, 0.0, 0, false), &rec).unwrap();
-    let (id, _) = identify_refined(&m, &determined(&m), &clean, &opts, &refine).unwrap();
+    let (id, _) = identify_refined_one(&m, &determined(&m), &clean, &opts, &refine).unwrap();
     assert_eq!(id.fit.rank, id.fit.names.len());
     let (v, _) = value(&id, "Zt");
     let v = v.expect("Zt is determined on pair-B-C");
     assert!((v + 0.040).abs() < 1e-10, "{v}");
-    let first = identify(&m, &determined(&m), &clean, &opts).unwrap();
+    let first = identify_one(&m, &determined(&m), &clean, &opts).unwrap();
     let first_order = value(&first, "Zt").0.unwrap();
     println!(
         "noise-free: Zt change {:.6e} µm off (refined), {:.3e} µm off (first order)",
@@ -300,7 +303,7 @@ fn a_pivot_length_off_its_nominal_is_recovered_within_four_standard_uncertaintie
     let seeds = 20;
     for seed in 1..=seeds {
         let noisy = simulate(&m, &head_table_truth(&m, 0.3, seed, true), &rec).unwrap();
-        let (id, _) = identify_refined(&m, &location_zt, &noisy, &opts, &refine).unwrap();
+        let (id, _) = identify_refined_one(&m, &location_zt, &noisy, &opts, &refine).unwrap();
         let (v, s) = value(&id, "Zt");
         let (v, s) = (v.unwrap(), s.unwrap());
         let z = (v + 0.040) / s;
@@ -330,7 +333,7 @@ fn a_ball_position_is_not_separable_from_its_set_up_error() {
         &builtin_path(&m, "pair-B-C").unwrap().unwrap(),
     )
     .unwrap();
-    let id = identify(
+    let id = identify_one(
         &m,
         &model(&m, Some("location"), "Xw,Zt"),
         &rec,
@@ -345,7 +348,7 @@ fn a_ball_position_is_not_separable_from_its_set_up_error() {
     assert_eq!(value(&id, "Xw").0, None);
     assert_eq!(value(&id, "XOW").0, None);
     // One rank short of the columns the location model already leaves undetermined.
-    let alone = identify(
+    let alone = identify_one(
         &m,
         &model(&m, Some("location"), "Zt"),
         &rec,
@@ -414,7 +417,7 @@ BOC = -12.0
     let rec = simulate(&m, &truth, &k4).unwrap();
     // The reduced model with Zp: Zp and ZOA both move the nest along z of the (unturned) tool
     // frame at every pose, so K4 cannot separate them.
-    let both = identify(
+    let both = identify_one(
         &m,
         &model(&m, Some("reduced"), "Zp"),
         &rec,
@@ -424,7 +427,7 @@ BOC = -12.0
     let g = groups(&both.fit.names, &both.fit.identifiability.confounded);
     assert_eq!(g, vec![vec!["ZOA".to_string(), "Zp".to_string()]]);
     // Every symbol of seed-ac is confounded with an error of the reduced model on K4.
-    let all = identify(
+    let all = identify_one(
         &m,
         &model(
             &m,
@@ -452,7 +455,7 @@ BOC = -12.0
     let mut zp_model = model(&m, Some("reduced"), "Zp");
     let zoa = m.error_by_name("ZOA").unwrap();
     zp_model.terms.retain(|t| t.effect != Effect::Error(zoa));
-    let (id, _) = identify_refined(
+    let (id, _) = identify_refined_one(
         &m,
         &zp_model,
         &rec,
@@ -485,7 +488,7 @@ fn a_campaign_shares_a_machine_length_and_gives_each_set_up_its_ball_position() 
     }
     let campaign = Campaign::new(records.clone()).unwrap();
     let model_zt = model(&m, Some("location"), "Zt,Xw");
-    let (id, _) = identify_campaign_refined(
+    let (id, _) = identify_refined_campaign(
         &m,
         &model_zt,
         &campaign,
@@ -541,7 +544,7 @@ fn a_campaign_shares_a_machine_length_and_gives_each_set_up_its_ball_position() 
     // Records that disagree on a machine's length cannot share one change of it.
     let mut other = records.clone();
     other[1].params[zt] = -250.01;
-    let e = identify_campaign_refined(
+    let e = identify_refined_campaign(
         &m,
         &model_zt,
         &Campaign::new(other).unwrap(),
@@ -565,7 +568,7 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
     let location_zt = determined(&m);
     let truth = head_table_truth(&m, 0.3, 21, false);
     let rec = simulate(&m, &truth, &builtin_path(&m, "pair-B-C").unwrap().unwrap()).unwrap();
-    let (id, r) = identify_refined(
+    let (id, r) = identify_refined_one(
         &m,
         &location_zt,
         &rec,
@@ -617,11 +620,12 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
     assert!(e.contains("nominal_mm") && e.contains("missing"), "{e}");
     // The values predict another record of the same machine to the noise.
     let turn_c = simulate(&m, &truth, &builtin_path(&m, "turn-C").unwrap().unwrap()).unwrap();
-    let v = validate(
+    let v = validate_one(
         &m,
         &back_model,
         &back_values,
         &turn_c,
+        false,
         &ValidateOptions::new().exact(true),
     )
     .unwrap();
@@ -640,7 +644,7 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
     t2.seed = 22;
     let other = simulate(&m, &t2, &path_at(&m, "turn-B", &params)).unwrap();
     let values = CampaignValues::of(
-        &fitting::campaign::identify_campaign(
+        &fitting::campaign::identify(
             &m,
             &location_zt,
             &Campaign::new(vec![CampaignRecord::new(
@@ -656,7 +660,14 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
         .unwrap(),
     );
     let check = Campaign::new(vec![CampaignRecord::new("b", other, params, "b", false)]).unwrap();
-    let v = validate_campaign(&m, &values, &check, &ValidateOptions::new().exact(true)).unwrap();
+    let v = fitting::validate(
+        &m,
+        &values,
+        &check,
+        &ValidateOptions::new().exact(true),
+        &formats::progress::Unwatched,
+    )
+    .unwrap();
     println!(
         "turn-B at Zt = -250.02: {:.3} µm RMS before, {:.3} µm after",
         v.overall.measured_rms * 1e3,
@@ -682,7 +693,7 @@ fn a_change_identified_at_another_value_is_read_back_against_the_default() {
         &path_at(&m, "pair-B-C", &params),
     )
     .unwrap();
-    let (id, r) = identify_refined(
+    let (id, r) = identify_refined_one(
         &m,
         &determined(&m),
         &rec,
@@ -918,7 +929,7 @@ fn what_every_symbol_is_confounded_with_on_the_test_paths() {
         let m = machine(name);
         let mut rec = builtin_path(&m, path).unwrap().unwrap();
         rec.measured = vec![[0.0; 3]; rec.samples.len()];
-        let id = identify(
+        let id = identify_one(
             &m,
             &model(&m, Some(base), symbols),
             &rec,

@@ -3,7 +3,8 @@
 //! located message. (The CSV readers have their own properties in `csvprop.rs`; machine
 //! descriptions theirs in model-spec's `robustness.rs`.)
 
-use fitting::{IdentifyOptions, identify};
+use crate::one_record::identify_one;
+use fitting::IdentifyOptions;
 use formats::truth::builtin_truth;
 use formats::truth::{BUILTIN_TRUTHS, TruthError};
 use model_spec::Machine;
@@ -177,7 +178,7 @@ fn report(m: &Machine) -> Vec<u8> {
     model
         .terms
         .push(simulation::model::Term::parse(m, "ECC@harmonic:2").unwrap());
-    let ident = identify(m, &model, &k4, &IdentifyOptions::new().zeroed(true)).unwrap();
+    let ident = identify_one(m, &model, &k4, &IdentifyOptions::new().zeroed(true)).unwrap();
     let source = IdentificationSource {
         data: "k4.csv",
         label: "reduced + ECC@harmonic:2",

@@ -23,7 +23,7 @@ use compensation::run::{CommandedPose, compensate_poses};
 use compensation::values::MachineErrors;
 use compensation::verify::{SetupRefitted, setup_refitted};
 use diagnosis::{DiagnoseOptions, Diagnosis, diagnose};
-use fitting::campaign::{CampaignIdentification, CampaignValues, Owner, identify_campaign_refined};
+use fitting::campaign::{CampaignIdentification, CampaignValues, Owner};
 use fitting::least_squares::Constraint;
 use fitting::{IdentifyOptions, NoiseChoice, RefineOptions};
 use formats::truth::builtin_truth;
@@ -203,16 +203,11 @@ fn identify(
     campaign: &Campaign,
     constraint: Constraint,
 ) -> CampaignIdentification {
-    identify_campaign_refined(
-        m,
-        model,
-        campaign,
-        &IdentifyOptions::clone(&IdentifyOptions::new().constraint(constraint))
-            .noise(NoiseChoice::Estimate),
-        &RefineOptions::default(),
-    )
-    .unwrap()
-    .0
+    let opts = IdentifyOptions::new()
+        .constraint(constraint)
+        .noise(NoiseChoice::Estimate)
+        .refined(RefineOptions::default());
+    fitting::identify(m, model, campaign, &opts).unwrap()
 }
 
 /// The truth's model identified on `campaign` and made determined: in every confounded group

@@ -175,6 +175,7 @@ impl CampaignIdentification {
             backend: ident.backend,
             noise: ident.noise.clone(),
             whitened_sigma: ident.whitened_sigma,
+            refinement: None,
         })
     }
 }

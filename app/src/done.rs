@@ -3,7 +3,7 @@
 //! outputs (all or none), commits the check, and returns what to print where.
 
 use crate::error::VerbResult;
-use crate::verbs::history::{Recorder, history_error};
+use crate::verbs::record::{Recorder, history_error};
 use crate::verbs::{write_error, wrote};
 use history::Check;
 use output::Outputs;

@@ -62,7 +62,7 @@ pub fn run(_args: &DemoArgs) -> VerbResult<Done> {
     // A history left by an earlier run is checked before any work.
     let db = dir.join(HISTORY);
     let mut recorder =
-        super::history::Recorder::open("demo:", &db, MACHINE_ID, &["K4"])?.saying(recorded);
+        super::record::Recorder::open("demo:", &db, MACHINE_ID, &["K4"])?.saying(recorded);
     let result = demo::run(OUT_DIR).map_err(|e| Error::computation(e.to_string()))?;
     let mut files = Outputs::new();
     let mut listed = Vec::new();
@@ -100,7 +100,7 @@ pub fn run(_args: &DemoArgs) -> VerbResult<Done> {
 /// The check of the demo's identification on K4 (its `identify.json`, from `k4.csv`), for the
 /// history, with `k4.csv` among the recorder's inputs.
 fn check_of(
-    recorder: &mut super::history::Recorder,
+    recorder: &mut super::record::Recorder,
     files: &[demo::DemoFile],
 ) -> VerbResult<history::Check> {
     let file = |name: &str| {

@@ -3,7 +3,7 @@
 
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
-use super::history;
+use super::record;
 use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
 use crate::Done;
 use fitting::campaign::{CampaignIdentification, CampaignValues, identify};
@@ -118,7 +118,7 @@ pub struct IdentifyArgs {
     #[command(flatten)]
     bounds: ValueBounds,
     #[command(flatten)]
-    history: history::RecordArgs,
+    history: record::RecordArgs,
 }
 
 /// Runs `rtest identify`: one record or several, read as a campaign (a record is a campaign

@@ -44,7 +44,7 @@ use crate::identify::with_offsets;
 use crate::offsets::{check_shared_symbols, is_setup_symbol};
 use model_spec::{ErrorKind, Machine};
 use nalgebra::{DMatrix, DVector};
-use simulation::campaign::{Campaign, CampaignError};
+use simulation::campaign::{Campaign, CampaignError, CampaignRecord};
 use simulation::model::{Effect, Model, Term};
 
 /// Whose parameter a column is.
@@ -145,6 +145,20 @@ pub struct RecordSpec {
     pub samples: usize,
 }
 
+impl RecordSpec {
+    /// What the layout needs of the campaign record `r`.
+    pub fn of(r: &CampaignRecord) -> RecordSpec {
+        RecordSpec {
+            label: r.label.clone(),
+            setup: r.setup.clone(),
+            params: r.params.clone(),
+            zeroed: r.zeroed,
+            start_s: r.start_s,
+            samples: r.record.samples.len(),
+        }
+    }
+}
+
 impl Layout {
     /// The layout of `model` of `m` on `campaign` (checked against `m` first).
     ///
@@ -162,18 +176,7 @@ impl Layout {
                 .map(|r| (&r.record, r.start_s))
                 .collect::<Vec<_>>(),
         );
-        let specs: Vec<RecordSpec> = campaign
-            .records
-            .iter()
-            .map(|r| RecordSpec {
-                label: r.label.clone(),
-                setup: r.setup.clone(),
-                params: r.params.clone(),
-                zeroed: r.zeroed,
-                start_s: r.start_s,
-                samples: r.record.samples.len(),
-            })
-            .collect();
+        let specs: Vec<RecordSpec> = campaign.records.iter().map(RecordSpec::of).collect();
         Layout::of_records(m, model, &specs, clock)
     }
 

@@ -24,14 +24,7 @@ pub fn single_record_names(
     let [r] = campaign.records.as_slice() else {
         return Constraint::Zero(names);
     };
-    let spec = RecordSpec {
-        label: r.label.clone(),
-        setup: r.setup.clone(),
-        params: r.params.clone(),
-        zeroed: r.zeroed,
-        start_s: r.start_s,
-        samples: r.record.samples.len(),
-    };
+    let spec = RecordSpec::of(r);
     let Ok(layout) = Layout::of_records(m, model, &[spec], None) else {
         return Constraint::Zero(names);
     };

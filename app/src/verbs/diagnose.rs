@@ -4,18 +4,16 @@
 
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
+use super::diagnose_records::Reader;
 use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
 use crate::Done;
 use diagnosis::dictionary::DictionaryOptions;
 use diagnosis::figures::figures;
 use diagnosis::{DiagnoseError, DiagnoseOptions, diagnose};
 use fitting::check_values;
-use formats::campaign::{labels_from_files, stem_label, unique_label};
 use output::{Outputs, Target};
 use report::json::{DiagnosisReport, DiagnosisSource, to_json};
 use report::text::diagnose::diagnosis;
-use simulation::campaign::{Campaign, CampaignRecord};
-use simulation::record::Record;
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
@@ -67,11 +65,11 @@ pub struct DiagnoseArgs {
     data: Option<String>,
     /// A campaign file (TOML, docs/campaigns.md) whose records are fitted together.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["data", "zeroed", "param"])]
-    campaign: Option<PathBuf>,
+    pub(super) campaign: Option<PathBuf>,
     /// A campaign file of held-out records (their set-ups, ball positions, zeroing): a record
     /// on a fitted set-up takes its set-up errors from the fit.
     #[arg(long, value_name = "FILE")]
-    validate_campaign: Option<PathBuf>,
+    pub(super) validate_campaign: Option<PathBuf>,
     /// Kinematic symbols (mm), `NAME=VALUE,...`, of every --data and --validate record (the
     /// ball's position).
     #[arg(long, value_name = "NAME=VALUE,...")]
@@ -83,7 +81,7 @@ pub struct DiagnoseArgs {
     /// The readings were zeroed at the first sample: every record's own zero offsets dx0 dy0
     /// dz0 join the base model (fitted records) or are refitted on it (held-out records).
     #[arg(long)]
-    zeroed: bool,
+    pub(super) zeroed: bool,
     /// Significance level of each step, after the correction for the candidates tried
     /// (strictly between 0 and 1).
     #[arg(long, value_name = "A", default_value = "0.01", value_parser = parse_alpha,
@@ -186,67 +184,20 @@ pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
         super::check_dir_inputs(&given, "--plot", dir, &|n: &str| n.ends_with(".svg"))?;
     }
 
-    let read = args.records.read_options();
-    let params = super::pose_args::params(&m, args.param.as_deref())?;
     let (instrument, instrument_read) = args.instrument.load_read()?;
     let through = instrument.as_ref().map(|(i, f)| (i, *f));
     // Progress bars on a terminal's standard error, unless the JSON report takes standard output.
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
-    let fitted = match &args.campaign {
-        Some(path) => {
-            let file = campaign::read_file("--campaign", &m, path)?;
-            campaign::from_file("--campaign", &m, path, file, &read, through)?
-        }
-        None => {
-            let labels = labels_from_files(&files);
-            let (records, read_files) =
-                read_records("--data", &m, &files, &params, args, through, shown)?;
-            let records = records
-                .into_iter()
-                .zip(&labels)
-                .map(|(r, l)| CampaignRecord::new(l, r, params.clone(), l, args.zeroed))
-                .collect();
-            loaded(records, &files, read_files)?
-        }
+    let reader = Reader {
+        m: &m,
+        args,
+        params: super::pose_args::params(&m, args.param.as_deref())?,
+        read: args.records.read_options(),
+        through,
+        shown,
     };
-    // Held-out `--validate` files: on the fitted records' set-up when they have one (the ball
-    // not moved), else each on a set-up of its own; labelled by their stems, unique among the
-    // fitted records' labels.
-    let held = match &args.validate_campaign {
-        Some(path) => {
-            let file = campaign::read_file("--validate-campaign", &m, path)?;
-            campaign::from_file("--validate-campaign", &m, path, file, &read, through)?
-        }
-        None => {
-            let setups = fitted.campaign.setups();
-            let mut taken: Vec<String> = fitted
-                .campaign
-                .records
-                .iter()
-                .map(|r| r.label.clone())
-                .collect();
-            let mut labels = Vec::with_capacity(held_files.len());
-            for f in &held_files {
-                let l = unique_label(&stem_label(f), &taken);
-                taken.push(l.clone());
-                labels.push(l);
-            }
-            let (records, read_files) =
-                read_records("--validate", &m, &held_files, &params, args, through, shown)?;
-            let records = records
-                .into_iter()
-                .zip(&labels)
-                .map(|(r, l)| {
-                    let setup = match setups.as_slice() {
-                        [one] => one.clone(),
-                        _ => l.clone(),
-                    };
-                    CampaignRecord::new(l, r, params.clone(), setup, args.zeroed)
-                })
-                .collect();
-            loaded(records, &held_files, read_files)?
-        }
-    };
+    let fitted = reader.fitted(&files)?;
+    let held = reader.held_out(&fitted, &held_files)?;
     let (fitted_inputs, held_inputs) = (fitted.inputs(), held.inputs());
     let mut inputs: Vec<(&str, &Path)> = fitted_inputs
         .iter()
@@ -270,7 +221,7 @@ pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
     fitted.check_times(flag, &m, &model)?;
     held.check_times("--validate", &m, &model)?;
 
-    let (opts, noise_read) = options(args, &m, &read, through)?;
+    let (opts, noise_read) = options(args, &m, &reader.read, through)?;
     // The files as read, with the digests of the bytes read, for --report.
     let mut read_files: Vec<ReadFile> = fitted.read.clone();
     read_files.extend(held.read.iter().cloned());
@@ -296,78 +247,15 @@ pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
     }
 
     // Everything is computed before anything is written.
-    let data = fitted.files.join(",");
-    let mut out = Outputs::new();
-    out.protect(&inputs);
-    let mut model_out = None;
-    if let Some(target) = &args.model_out {
-        let (name, contents) = d
-            .extended_machine(
-                &m,
-                &machine_text,
-                &label,
-                &format!("rtest diagnose on {data}"),
-            )
-            .map_err(|e| Error::computation(format!("--model-out: {e}")))?;
-        out.add("--model-out", target.clone(), contents);
-        model_out = Some((name, target.to_string()));
-    }
-    let source = DiagnosisSource {
-        machine_source: &args.machine,
+    let diagnosed = Diagnosed {
+        m: &m,
         label: &label,
-        data: fitted.files.clone(),
-        held_out: held.files.clone(),
-        data_arguments: data_arguments(args, &data),
+        d: &d,
+        fitted: &fitted,
+        held: &held,
         opts: &opts,
-        model_out,
     };
-    let report = DiagnosisReport::new(&m, &source, &d)
-        .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
-    if let Some(target) = &args.json {
-        let json = to_json(&report).map_err(|e| Error::computation(format!("--json: {e}")))?;
-        out.add("--json", target.clone(), json);
-    }
-    let figs = if args.plot.is_some() || args.report.is_some() {
-        let what = if args.plot.is_some() {
-            "--plot"
-        } else {
-            "--report"
-        };
-        let mut names = fitted.files.clone();
-        names.extend(held.files.iter().cloned());
-        Some(
-            figures(
-                &m,
-                &d,
-                &label,
-                &opts,
-                &fitted.campaign,
-                &held.campaign,
-                &names,
-            )
-            .map_err(|e| Error::computation(format!("{what}: {e}")))?,
-        )
-    } else {
-        None
-    };
-    if let (Some(dir), Some(figs)) = (&args.plot, &figs) {
-        for (name, _, svg) in super::figures::svgs(figs)? {
-            out.add_in_dir("--plot", dir, &name, svg);
-        }
-    }
-    if let Some(target) = &args.report {
-        let mut i = super::report::inputs_for(&m, &read_files);
-        if let Some(figs) = &figs {
-            i.path_figures = ::report::figures::path_figures(figs)
-                .map_err(|e| Error::computation(format!("--report: {e}")))?;
-        }
-        add_diagnosis(&mut i, &report)?;
-        out.add(
-            "--report",
-            target.clone(),
-            super::report::render("--report", &i)?,
-        );
-    }
+    let (out, report) = diagnosed.outputs(args, &machine_text, &read_files, &inputs)?;
     let mut text = diagnosis(&report);
     text.push_str(&fitted.zeroed_notes(if args.campaign.is_some() {
         "say `zeroed = true` for it in the campaign file"
@@ -378,51 +266,108 @@ pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
     Ok(Done::new(text, out, stdout_taken))
 }
 
-/// The records of `files` (given by `flag`) at kinematic parameters `params` (mm), read through
-/// the `instrument` when it is given, each with a progress bar while it is read (`shown`); and
-/// the files as read.
-fn read_records(
-    flag: &str,
-    m: &model_spec::Machine,
-    files: &[PathBuf],
-    params: &[f64],
-    args: &DiagnoseArgs,
-    instrument: campaign::Through,
-    shown: bool,
-) -> VerbResult<(Vec<Record>, Vec<ReadFile>)> {
-    campaign::record_count(flag, files)?;
-    let read = args.records.read_options();
-    let mut records = Vec::with_capacity(files.len());
-    let mut read_files = Vec::with_capacity(files.len());
-    for f in files {
-        let (_bar, read) = super::progress::reading(shown, f, &read);
-        let (record, digest) = super::read_record(flag, m, f, &read, instrument, params)?;
-        records.push(record);
-        read_files.push(ReadFile::new(flag, f, digest));
-    }
-    Ok((records, read_files))
+/// A diagnosis and what it was made of, for its outputs.
+struct Diagnosed<'a> {
+    m: &'a model_spec::Machine,
+    label: &'a str,
+    d: &'a diagnosis::Diagnosis,
+    fitted: &'a campaign::Loaded,
+    held: &'a campaign::Loaded,
+    opts: &'a DiagnoseOptions,
 }
 
-/// The campaign of `records` read from `files` (as `read` says; an empty campaign for no
-/// records).
-fn loaded(
-    records: Vec<CampaignRecord>,
-    files: &[PathBuf],
-    read: Vec<ReadFile>,
-) -> VerbResult<campaign::Loaded> {
-    let campaign = if records.is_empty() {
-        Campaign {
-            records: Vec::new(),
+impl Diagnosed<'_> {
+    /// The outputs the flags ask for (`--model-out`, `--json`, `--plot`, `--report`), none of
+    /// them over an input, and the report; `machine_text` the description as read,
+    /// `read_files` the inputs as read (for `--report`).
+    fn outputs(
+        &self,
+        args: &DiagnoseArgs,
+        machine_text: &str,
+        read_files: &[ReadFile],
+        inputs: &[(&str, &Path)],
+    ) -> VerbResult<(Outputs, DiagnosisReport)> {
+        let (label, d, fitted, held, opts) =
+            (self.label, self.d, self.fitted, self.held, self.opts);
+        let flag = if args.campaign.is_some() {
+            "--campaign"
+        } else {
+            "--data"
+        };
+        let data = fitted.files.join(",");
+        let mut out = Outputs::new();
+        out.protect(inputs);
+        let mut model_out = None;
+        if let Some(target) = &args.model_out {
+            let (name, contents) = d
+                .extended_machine(
+                    self.m,
+                    machine_text,
+                    label,
+                    &format!("rtest diagnose on {data}"),
+                )
+                .map_err(|e| Error::computation(format!("--model-out: {e}")))?;
+            out.add("--model-out", target.clone(), contents);
+            model_out = Some((name, target.to_string()));
         }
-    } else {
-        Campaign::new(records).map_err(|e| Error::usage(e.0))?
-    };
-    Ok(campaign::Loaded {
-        campaign,
-        files: files.iter().map(|f| f.display().to_string()).collect(),
-        source: None,
-        read,
-    })
+        let source = DiagnosisSource {
+            machine_source: &args.machine,
+            label,
+            data: fitted.files.clone(),
+            held_out: held.files.clone(),
+            data_arguments: data_arguments(args, &data),
+            opts,
+            model_out,
+        };
+        let report = DiagnosisReport::new(self.m, &source, d)
+            .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
+        if let Some(target) = &args.json {
+            let json = to_json(&report).map_err(|e| Error::computation(format!("--json: {e}")))?;
+            out.add("--json", target.clone(), json);
+        }
+        let figs = if args.plot.is_some() || args.report.is_some() {
+            let what = if args.plot.is_some() {
+                "--plot"
+            } else {
+                "--report"
+            };
+            let mut names = fitted.files.clone();
+            names.extend(held.files.iter().cloned());
+            Some(
+                figures(
+                    self.m,
+                    d,
+                    label,
+                    opts,
+                    &fitted.campaign,
+                    &held.campaign,
+                    &names,
+                )
+                .map_err(|e| Error::computation(format!("{what}: {e}")))?,
+            )
+        } else {
+            None
+        };
+        if let (Some(dir), Some(figs)) = (&args.plot, &figs) {
+            for (name, _, svg) in super::figures::svgs(figs)? {
+                out.add_in_dir("--plot", dir, &name, svg);
+            }
+        }
+        if let Some(target) = &args.report {
+            let mut i = super::report::inputs_for(self.m, read_files);
+            if let Some(figs) = &figs {
+                i.path_figures = ::report::figures::path_figures(figs)
+                    .map_err(|e| Error::computation(format!("--report: {e}")))?;
+            }
+            add_diagnosis(&mut i, &report)?;
+            out.add(
+                "--report",
+                target.clone(),
+                super::report::render("--report", &i)?,
+            );
+        }
+        Ok((out, report))
+    }
 }
 
 /// The command-line words that give the fitted records of `args` to another command (`data`

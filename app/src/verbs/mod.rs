@@ -9,6 +9,7 @@ pub mod campaign;
 pub mod compensate;
 pub mod demo;
 pub mod diagnose;
+mod diagnose_records;
 pub mod figures;
 pub mod gains;
 pub mod generate;

@@ -5,14 +5,14 @@
 use super::args::ValueBounds;
 use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
 use crate::Done;
-use compensation::kinematics::corrected_description;
+use compensation::kinematics::{CorrectedDescription, corrected_description};
 use compensation::run::{PoseSource, RunError, Stopped, Summary, compensate_each};
 use compensation::tables::{Pitch, axis_tables};
 use compensation::values::{CompensationError, MachineErrors};
 use formats::nc::{Dialect, WriteOptions, parse_program};
 use formats::poses::{
-    PoseList, axis_words, from_file_units, from_file_units_into, read_keeping_bom, read_pose_csv,
-    to_file_units_into,
+    AxisWord, PoseList, axis_words, from_file_units, from_file_units_into, read_keeping_bom,
+    read_pose_csv, to_file_units_into,
 };
 use model_spec::units::{compact, readable};
 use output::{Outputs, Target};
@@ -98,8 +98,8 @@ pub struct CompensateArgs {
     bounds: ValueBounds,
 }
 
-/// Runs `rtest compensate`.
-pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
+/// Refuses flags that ask for nothing or for what the others do not give.
+fn check_flags(args: &CompensateArgs) -> VerbResult {
     if args.path.is_none() && args.kinematics_out.is_none() && args.tables.is_none() {
         return Err(Error::usage(
             "nothing to write: give --path IN -o OUT, --kinematics-out FILE or --tables DIR",
@@ -119,6 +119,12 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         return Err(Error::usage("--decimals applies to NC programs (--nc)"));
     }
     super::args::nc_decimals(args.decimals)?;
+    Ok(())
+}
+
+/// Runs `rtest compensate`.
+pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
+    check_flags(args)?;
     let machine = super::load_machine_read(&args.machine)?;
     let (m, machine_text) = (machine.machine, machine.text);
     let mut inputs = vec![("--params", args.params.as_path())];
@@ -181,33 +187,8 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         let (path_text, digest) =
             read_keeping_bom(path).map_err(|e| Error::input(format!("--path: {e}")))?;
         read_files.push(ReadFile::new("--path", path, digest));
-        let (text, rounding, format, s) = match &args.nc {
-            Some(name) => {
-                let dialect = Dialect::from_name(name).expect("clap checks the dialect");
-                let program = parse_program(&file, &path_text, dialect, &words)
-                    .map_err(|e| Error::input(format!("--path: {e}")))?;
-                let options = WriteOptions::with_min_decimals(args.decimals.unwrap_or(0));
-                let mut writer = program
-                    .writer(&options)
-                    .map_err(|e| Error::input(format!("-o: {e}")))?;
-                let s = correct.run(program.pose_list(), |q| writer.pose(q))?;
-                let written = writer
-                    .finish()
-                    .map_err(|e| Error::input(format!("-o: {e}")))?;
-                let rounding = from_file_units(&m, &written.rounding);
-                (written.text, Some(rounding), name.clone(), s)
-            }
-            None => {
-                let table = read_pose_csv(&file, &path_text, &words)
-                    .map_err(|e| Error::input(format!("--path: {e}")))?;
-                let mut writer = table.writer();
-                let s = correct.run(table.pose_list(), |q| writer.pose(q))?;
-                let text = writer
-                    .finish()
-                    .map_err(|e| Error::input(format!("-o: {e}")))?;
-                (text, None, "csv".to_string(), s)
-            }
-        };
+        let (text, rounding, format, s) =
+            correct.rewrite(args.nc.as_deref(), args.decimals, &path_text, &words)?;
         files.add("-o", out.clone(), text);
         source.input = file;
         source.output = out.to_string();
@@ -218,37 +199,7 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
     if let Some(target) = &args.kinematics_out {
         let corrected = corrected_description(&m, &machine_text, &errors)
             .map_err(|e| Error::input(format!("--kinematics-out: {e}")))?;
-        source.kinematics = Some(KinematicsReport {
-            file: target.to_string(),
-            folded: corrected
-                .folded
-                .iter()
-                .map(|f| {
-                    format!(
-                        "{} = {} µm into {}: {} -> {} mm",
-                        f.name,
-                        readable(f.value_mm * 1e3, 4),
-                        f.place,
-                        compact(f.before_mm),
-                        compact(f.after_mm)
-                    )
-                })
-                .chain(corrected.symbols.iter().map(|f| {
-                    format!(
-                        "{} = {} µm into its default: {} -> {} mm",
-                        f.name,
-                        readable(f.change_mm * 1e3, 4),
-                        compact(f.before_mm),
-                        compact(f.after_mm)
-                    )
-                }))
-                .collect(),
-            not_folded: corrected
-                .not_folded
-                .iter()
-                .map(|n| format!("{}: {}", n.spelling, n.reason))
-                .collect(),
-        });
+        source.kinematics = Some(kinematics_report(target, &corrected));
         files.add("--kinematics-out", target.clone(), corrected.toml);
     }
     if let Some(dir) = &args.tables {
@@ -297,6 +248,42 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
     Ok(Done::new(text, files, stdout_taken))
 }
 
+/// What `--kinematics-out` wrote into `target`: each error folded into the description (µm,
+/// the value before and after, mm) and each one that could not be, with why.
+fn kinematics_report(target: &Target, corrected: &CorrectedDescription) -> KinematicsReport {
+    KinematicsReport {
+        file: target.to_string(),
+        folded: corrected
+            .folded
+            .iter()
+            .map(|f| {
+                format!(
+                    "{} = {} µm into {}: {} -> {} mm",
+                    f.name,
+                    readable(f.value_mm * 1e3, 4),
+                    f.place,
+                    compact(f.before_mm),
+                    compact(f.after_mm)
+                )
+            })
+            .chain(corrected.symbols.iter().map(|f| {
+                format!(
+                    "{} = {} µm into its default: {} -> {} mm",
+                    f.name,
+                    readable(f.change_mm * 1e3, 4),
+                    compact(f.before_mm),
+                    compact(f.after_mm)
+                )
+            }))
+            .collect(),
+        not_folded: corrected
+            .not_folded
+            .iter()
+            .map(|n| format!("{}: {}", n.spelling, n.reason))
+            .collect(),
+    }
+}
+
 /// The correction of the poses of `--path`: what [`compensate_each`] takes besides the poses.
 struct Correction<'a> {
     m: &'a model_spec::Machine,
@@ -309,6 +296,47 @@ struct Correction<'a> {
 impl Correction<'_> {
     /// Corrects `poses` (mm and degrees, as the file holds them), handing each corrected pose
     /// (mm and degrees) to `write`, the writer of `-o`; the summary.
+    /// The corrected `--path` file, whose `text` is an NC program of dialect `nc` (written with
+    /// at least `decimals` decimals) or a pose CSV, its axes named by `words`: the corrected
+    /// text, the rounding of the written words (mm and rad; NC only), the format's name and the
+    /// summary of the correction.
+    fn rewrite(
+        &self,
+        nc: Option<&str>,
+        decimals: Option<usize>,
+        text: &str,
+        words: &[AxisWord],
+    ) -> VerbResult<(String, Option<Vec<f64>>, String, Summary)> {
+        let (m, file) = (self.m, self.file);
+        Ok(match nc {
+            Some(name) => {
+                let dialect = Dialect::from_name(name).expect("clap checks the dialect");
+                let program = parse_program(file, text, dialect, words)
+                    .map_err(|e| Error::input(format!("--path: {e}")))?;
+                let options = WriteOptions::with_min_decimals(decimals.unwrap_or(0));
+                let mut writer = program
+                    .writer(&options)
+                    .map_err(|e| Error::input(format!("-o: {e}")))?;
+                let s = self.run(program.pose_list(), |q| writer.pose(q))?;
+                let written = writer
+                    .finish()
+                    .map_err(|e| Error::input(format!("-o: {e}")))?;
+                let rounding = from_file_units(m, &written.rounding);
+                (written.text, Some(rounding), name.to_string(), s)
+            }
+            None => {
+                let table = read_pose_csv(file, text, words)
+                    .map_err(|e| Error::input(format!("--path: {e}")))?;
+                let mut writer = table.writer();
+                let s = self.run(table.pose_list(), |q| writer.pose(q))?;
+                let text = writer
+                    .finish()
+                    .map_err(|e| Error::input(format!("-o: {e}")))?;
+                (text, None, "csv".to_string(), s)
+            }
+        })
+    }
+
     fn run<E: std::fmt::Display>(
         &self,
         poses: &PoseList,

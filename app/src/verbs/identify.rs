@@ -138,21 +138,7 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
     };
     let declared = args.noise.declared()?;
     if args.stream {
-        if files.len() > 1 {
-            return Err(Error::usage(
-                "--stream reads one long record in blocks into an incremental QR; several records are fitted whole (each with its own set-up and zero, in one design matrix held in memory): give one --data file, or drop --stream",
-            ));
-        }
-        if args.noise.noise_record.is_some() || matches!(declared, NoiseChoice::Model(_)) {
-            return Err(Error::usage(
-                "--stream fits by ordinary least squares in one pass; --noise models and --noise-record need the whole record (drop --stream, or use --noise white)",
-            ));
-        }
-        if args.param.is_some() {
-            return Err(Error::usage(
-                "--stream reads the file at the machine's default kinematic parameters; drop --param, or --stream",
-            ));
-        }
+        check_stream_flags(args, files.len(), &declared)?;
     }
     let params = super::pose_args::params(&m, args.param.as_deref())?;
     let read = args.records.read_options();
@@ -195,21 +181,8 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
     let mut read_files: Vec<ReadFile> = Vec::new();
     let opts = IdentifyOptions::new().constraint(args::constraint(args.constraint.as_deref())?);
     let (ident, refinement, streaming, loaded) = if args.stream {
-        let data_path = files[0].as_path();
-        let (bar, read) = super::progress::reading(shown, data_path, &read);
-        let opts = opts.clone().zeroed(args.zeroed);
-        let fitted = identify_file(&m, &model, data_path, &opts, args.block as usize, &read);
-        drop(bar);
-        let (ident, run, digest) = fitted.map_err(|e| stream_error(e, data_path))?;
-        read_files.push(ReadFile::new("--data", data_path, digest));
-        let streaming = StreamingReport {
-            blocks: run.blocks,
-            block: args.block as usize,
-            first_block: run.first_block,
-        };
-        let record_label = formats::campaign::stem_label(data_path);
-        let ident = CampaignIdentification::of_record(&m, &ident, &record_label, params.clone())
-            .map_err(estimate_error)?;
+        let (ident, streaming, file) = streamed(args, &m, &model, &files[0], &opts, &read, shown)?;
+        read_files.push(file);
         (ident, None, Some(streaming), None)
     } else {
         let loaded = {
@@ -313,6 +286,57 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
         }
         None => done,
     })
+}
+
+/// Refuses, with `--stream`, what a stream read once in blocks cannot do: several `files`,
+/// a noise model (`declared`) or a noise record, other kinematic parameters.
+fn check_stream_flags(args: &IdentifyArgs, files: usize, declared: &NoiseChoice) -> VerbResult {
+    if files > 1 {
+        return Err(Error::usage(
+            "--stream reads one long record in blocks into an incremental QR; several records are fitted whole (each with its own set-up and zero, in one design matrix held in memory): give one --data file, or drop --stream",
+        ));
+    }
+    if args.noise.noise_record.is_some() || matches!(declared, NoiseChoice::Model(_)) {
+        return Err(Error::usage(
+            "--stream fits by ordinary least squares in one pass; --noise models and --noise-record need the whole record (drop --stream, or use --noise white)",
+        ));
+    }
+    if args.param.is_some() {
+        return Err(Error::usage(
+            "--stream reads the file at the machine's default kinematic parameters; drop --param, or --stream",
+        ));
+    }
+    Ok(())
+}
+
+/// The one `--data` record at `path` identified as a stream (read in blocks into an
+/// incremental QR with the options `opts`, at the default kinematic parameters: `--param` is
+/// refused with `--stream`), as a campaign of one; the blocks read and the file as read.
+fn streamed(
+    args: &IdentifyArgs,
+    m: &model_spec::Machine,
+    model: &simulation::model::Model,
+    path: &std::path::Path,
+    opts: &IdentifyOptions,
+    read: &formats::csv::ReadOptions,
+    shown: bool,
+) -> VerbResult<(CampaignIdentification, StreamingReport, ReadFile)> {
+    let data_path = path;
+    let (bar, read) = super::progress::reading(shown, data_path, read);
+    let opts = opts.clone().zeroed(args.zeroed);
+    let fitted = identify_file(m, model, data_path, &opts, args.block as usize, &read);
+    drop(bar);
+    let (ident, run, digest) = fitted.map_err(|e| stream_error(e, data_path))?;
+    let file = ReadFile::new("--data", data_path, digest);
+    let streaming = StreamingReport {
+        blocks: run.blocks,
+        block: args.block as usize,
+        first_block: run.first_block,
+    };
+    let record_label = formats::campaign::stem_label(data_path);
+    let ident = CampaignIdentification::of_record(m, &ident, &record_label, m.default_parameters())
+        .map_err(estimate_error)?;
+    Ok((ident, streaming, file))
 }
 
 /// The HTML report (`--report`) of this identification: its records, set-ups and values, and

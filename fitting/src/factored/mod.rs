@@ -5,6 +5,12 @@
 //! residual at every step: it factorises once. A fit made from a factorisation is the fit
 //! [`super::least_squares()`] makes, bit for bit (the same operations in the same order); the
 //! method is in [`mod@super::least_squares`]'s documentation.
+//!
+//! A tall H (more rows than free columns) is reduced by its QR decomposition folded in blocks
+//! of rows, the streaming identification's fold; `Q` is not kept. A fit of readings `y` takes
+//! `Qᵀ·y` from the fold of `[A | y]` (A the scaled H): made with the factorisation for the
+//! readings given to it (the first fit of a refinement, the only one of an identification),
+//! and again, one pass over H's rows, for other readings.
 
 mod rows;
 
@@ -12,7 +18,7 @@ pub use rows::{RowsFactored, WhitenedFactored};
 
 use crate::identifiability::{Identifiability, near_confounded, null_space_groups};
 use crate::least_squares::{Constraint, EstimateError, Fit, Tolerances};
-use crate::svd::{Left, decompose};
+use crate::svd::{Left, Scaled, decompose};
 use nalgebra::{DMatrix, DVector};
 
 /// The factorisation of one H (m × n, mm per unit of each parameter) under one constraint and
@@ -111,6 +117,23 @@ impl Factored {
         tol: &Tolerances,
         rows_total: usize,
     ) -> Result<Factored, EstimateError> {
+        Factored::with_readings(h, None, names, constraint, tol, rows_total)
+    }
+
+    /// [`Factored::new`] with the readings `y` (mm, as many as `h` has rows) of the fit to come
+    /// folded with H (when H is tall), so that [`Factored::fit`] of those readings needs no
+    /// second pass over H's rows; the factorisation is the same, bit for bit.
+    ///
+    /// # Errors
+    /// As [`Factored::new`].
+    pub(crate) fn with_readings(
+        h: &DMatrix<f64>,
+        y: Option<&DVector<f64>>,
+        names: &[String],
+        constraint: &Constraint,
+        tol: &Tolerances,
+        rows_total: usize,
+    ) -> Result<Factored, EstimateError> {
         let (m, n) = h.shape();
         check_shape(h, m, names.len())?;
         check_finite("H", h.as_slice(), n)?;
@@ -145,14 +168,12 @@ impl Factored {
                 norms[j] = s;
             }
         }
-        let rows = m.max(nf);
-        let mut a = DMatrix::<f64>::zeros(rows, nf);
-        for (k, &j) in free.iter().enumerate() {
-            for i in 0..m {
-                a[(i, k)] = h[(i, j)] / norms[j];
-            }
-        }
-        let (sv, left, v) = decompose(a, m)?;
+        let scaled = Scaled {
+            h,
+            free: &free,
+            norms: &norms,
+        };
+        let (sv, left, v) = decompose(scaled, y)?;
         let smax = sv.first().copied().unwrap_or(0.0);
         let tau = smax
             * tol
@@ -231,7 +252,8 @@ impl Factored {
     }
 
     /// The fit of readings `y` (mm; as many as `h` has rows) by `h`, the matrix factorised;
-    /// `rss_outside` adds to the residual sum of squares (mm²).
+    /// `rss_outside` adds to the residual sum of squares (mm²). Readings other than those the
+    /// factorisation was made with are folded with `h`'s rows again (a pass over them).
     ///
     /// # Errors
     /// Readings of another number than `h`'s rows, or not finite.
@@ -247,10 +269,22 @@ impl Factored {
         let (free, norms, sv, rank) = (&self.free, &self.norms, &self.sv, self.rank);
         let nf = free.len();
         // Minimum-norm solution in the identifiable subspace (scaled coordinates).
-        let mut ypad = DVector::<f64>::zeros(m.max(nf));
-        ypad.rows_mut(0, m).copy_from(y);
+        let padded;
+        let ypad = if m >= nf {
+            y
+        } else {
+            padded = y.clone().resize_vertically(nf, 0.0);
+            &padded
+        };
         let mut z = DVector::<f64>::zeros(nf);
-        for (i, (uty, s)) in self.left.project(&ypad, rank).iter().zip(sv).enumerate() {
+        let scaled = Scaled { h, free, norms };
+        for (i, (uty, s)) in self
+            .left
+            .project(scaled, ypad, rank)
+            .iter()
+            .zip(sv)
+            .enumerate()
+        {
             z.axpy(uty / s, &self.v.column(i), 1.0);
         }
         let mut x = vec![0.0; n];

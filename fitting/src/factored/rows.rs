@@ -1,12 +1,45 @@
 //! The factorisations of the fits that whiten rows: generalized least squares under a noise
 //! model ([`WhitenedFactored`]), and the fits of [`crate::identify::fit_rows`] with per-sample
-//! weights ([`RowsFactored`]), each made of [`Factored`]s (the ordinary, the weighted, the
-//! whitened H).
+//! weights ([`RowsFactored`]). Every H they factorise (the ordinary, the weighted, the whitened)
+//! is a [`Factored`]: its QR decomposition is folded in blocks of its rows, whitened rows folded
+//! as whitened. Made for given readings (`for_readings`), each folds the readings it will fit
+//! (whitened as its rows are) along with its H.
 
 use super::Factored;
 use crate::least_squares::{Constraint, EstimateError, Fit, Tolerances, WhitenedFit};
 use crate::noise::{NoiseError, NoiseModel, SampleWhitening};
 use nalgebra::{DMatrix, DVector};
+
+/// What every factorisation of one fit shares: the parameter names, the constraint and the
+/// tolerances.
+#[derive(Clone, Copy, Debug)]
+struct Setup<'b> {
+    names: &'b [String],
+    constraint: &'b Constraint,
+    tol: &'b Tolerances,
+}
+
+impl Setup<'_> {
+    /// The factorisation of `h` (all its rows real), with the readings `y` folded along.
+    fn factor(
+        &self,
+        h: &DMatrix<f64>,
+        y: Option<&DVector<f64>>,
+    ) -> Result<Factored, EstimateError> {
+        Factored::with_readings(h, y, self.names, self.constraint, self.tol, h.nrows())
+    }
+}
+
+/// `y` whitened by `whiten`, when given.
+fn whitened(
+    y: Option<&DVector<f64>>,
+    whiten: impl FnOnce(&mut DVector<f64>) -> Result<(), NoiseError>,
+) -> Result<Option<DVector<f64>>, EstimateError> {
+    let Some(y) = y else { return Ok(None) };
+    let mut wy = y.clone();
+    whiten(&mut wy)?;
+    Ok(Some(wy))
+}
 
 /// The factorisations of a generalized least-squares fit under a noise model
 /// ([`crate::least_squares_whitened`]): the ordinary H's, and the whitened H with its own
@@ -33,8 +66,35 @@ impl WhitenedFactored {
         noise: &NoiseModel,
         layout: &[usize],
     ) -> Result<WhitenedFactored, EstimateError> {
-        let ordinary = Factored::new(h, names, constraint, tol, h.nrows())?;
-        WhitenedFactored::with_ordinary(ordinary, h, names, constraint, tol, noise, layout)
+        let setup = Setup {
+            names,
+            constraint,
+            tol,
+        };
+        WhitenedFactored::whiten(setup.factor(h, None)?, setup, h, None, noise, layout)
+    }
+
+    /// [`WhitenedFactored::new`] for the fit of the readings `y` (mm): they are folded with H,
+    /// and whitened with the whitened H.
+    ///
+    /// # Errors
+    /// As [`WhitenedFactored::new`].
+    pub(crate) fn for_readings(
+        h: &DMatrix<f64>,
+        y: &DVector<f64>,
+        names: &[String],
+        constraint: &Constraint,
+        tol: &Tolerances,
+        noise: &NoiseModel,
+        layout: &[usize],
+    ) -> Result<WhitenedFactored, EstimateError> {
+        let setup = Setup {
+            names,
+            constraint,
+            tol,
+        };
+        let ordinary = setup.factor(h, Some(y))?;
+        WhitenedFactored::whiten(ordinary, setup, h, Some(y), noise, layout)
     }
 
     /// As [`WhitenedFactored::new`] with `ordinary` the factorisation of `h` that
@@ -52,6 +112,24 @@ impl WhitenedFactored {
         noise: &NoiseModel,
         layout: &[usize],
     ) -> Result<WhitenedFactored, EstimateError> {
+        let setup = Setup {
+            names,
+            constraint,
+            tol,
+        };
+        WhitenedFactored::whiten(ordinary, setup, h, None, noise, layout)
+    }
+
+    /// [`WhitenedFactored::with_ordinary`] with the readings `y` (when given) whitened and
+    /// folded with the whitened H.
+    fn whiten(
+        ordinary: Factored,
+        setup: Setup,
+        h: &DMatrix<f64>,
+        y: Option<&DVector<f64>>,
+        noise: &NoiseModel,
+        layout: &[usize],
+    ) -> Result<WhitenedFactored, EstimateError> {
         if noise.is_uniform_white() {
             return Ok(WhitenedFactored {
                 ordinary,
@@ -60,7 +138,8 @@ impl WhitenedFactored {
         }
         let mut wh = h.clone();
         noise.whiten_matrix(layout, &mut wh)?;
-        let w = Factored::new(&wh, names, constraint, tol, wh.nrows())?;
+        let wy = whitened(y, |v| noise.whiten_vector(layout, v))?;
+        let w = setup.factor(&wh, wy.as_ref())?;
         if w.rank != ordinary.rank || w.determined() != ordinary.determined() {
             return Err(NoiseError::RankChanged {
                 ordinary: ordinary.rank,
@@ -129,19 +208,19 @@ enum Inner {
 }
 
 impl Inner {
+    /// The factorisation of `h`, under `noise` when given, with the readings `y` folded along.
     fn new(
+        setup: Setup,
         h: &DMatrix<f64>,
-        names: &[String],
-        constraint: &Constraint,
-        tol: &Tolerances,
+        y: Option<&DVector<f64>>,
         noise: Option<&NoiseModel>,
         layout: &[usize],
     ) -> Result<Inner, EstimateError> {
-        let ordinary = Factored::new(h, names, constraint, tol, h.nrows())?;
+        let ordinary = setup.factor(h, y)?;
         Ok(match noise {
             None => Inner::Ordinary(Box::new(ordinary)),
-            Some(n) => Inner::Whitened(Box::new(WhitenedFactored::with_ordinary(
-                ordinary, h, names, constraint, tol, n, layout,
+            Some(n) => Inner::Whitened(Box::new(WhitenedFactored::whiten(
+                ordinary, setup, h, y, n, layout,
             )?)),
         })
     }
@@ -211,18 +290,61 @@ impl<'a> RowsFactored<'a> {
         layout: &'a [usize],
         weights: Option<&'a SampleWhitening>,
     ) -> Result<RowsFactored<'a>, EstimateError> {
+        let setup = Setup {
+            names,
+            constraint,
+            tol,
+        };
+        RowsFactored::build(setup, h, None, noise, layout, weights)
+    }
+
+    /// [`RowsFactored::new`] for the fit of the readings `y` (mm): every H factorised folds
+    /// them along, whitened as its rows are, so that [`RowsFactored::fit`] of `y` makes no
+    /// second pass over the rows.
+    ///
+    /// # Errors
+    /// As [`RowsFactored::new`].
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn for_readings(
+        h: &DMatrix<f64>,
+        y: &DVector<f64>,
+        names: &[String],
+        constraint: &Constraint,
+        tol: &Tolerances,
+        noise: Option<&'a NoiseModel>,
+        layout: &'a [usize],
+        weights: Option<&'a SampleWhitening>,
+    ) -> Result<RowsFactored<'a>, EstimateError> {
+        let setup = Setup {
+            names,
+            constraint,
+            tol,
+        };
+        RowsFactored::build(setup, h, Some(y), noise, layout, weights)
+    }
+
+    /// [`RowsFactored::new`], with the readings `y` folded along when given.
+    fn build(
+        setup: Setup,
+        h: &DMatrix<f64>,
+        y: Option<&DVector<f64>>,
+        noise: Option<&'a NoiseModel>,
+        layout: &'a [usize],
+        weights: Option<&'a SampleWhitening>,
+    ) -> Result<RowsFactored<'a>, EstimateError> {
         let Some(weights) = weights else {
             return Ok(RowsFactored {
                 noise,
                 layout,
                 weighted: None,
-                inner: Inner::new(h, names, constraint, tol, noise, layout)?,
+                inner: Inner::new(setup, h, y, noise, layout)?,
             });
         };
         let mut wh = h.clone();
         weights.whiten_matrix(&mut wh)?;
-        let ordinary = Factored::new(h, names, constraint, tol, h.nrows())?;
-        let inner = Inner::new(&wh, names, constraint, tol, noise, layout)?;
+        let wy = whitened(y, |v| weights.whiten_vector(v))?;
+        let ordinary = setup.factor(h, y)?;
+        let inner = Inner::new(setup, &wh, wy.as_ref(), noise, layout)?;
         let weighted = inner.reported();
         if weighted.rank != ordinary.rank || weighted.determined() != ordinary.determined() {
             return Err(NoiseError::RankChanged {

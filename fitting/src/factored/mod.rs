@@ -76,9 +76,25 @@ fn check_shape(h: &DMatrix<f64>, readings: usize, names: usize) -> Result<(), Es
     Ok(())
 }
 
+/// Whether every entry of `v` is finite: `x·0` is NaN exactly for an infinite or NaN `x`, so
+/// a sum of them is 0 exactly when all are finite (in running sums, so that it vectorises).
+fn all_finite(v: &[f64]) -> bool {
+    let (chunks, rest) = v.as_chunks::<8>();
+    let mut sum = [0.0; 8];
+    for c in chunks {
+        for i in 0..8 {
+            sum[i] += c[i] * 0.0;
+        }
+    }
+    sum.iter().all(|s| *s == 0.0) && rest.iter().all(|x| x.is_finite())
+}
+
 /// `v` (`cols` columns, or a vector when 0) with no NaN or infinite entry, else the error
 /// naming the first one in `what`.
 pub(crate) fn check_finite(what: &str, v: &[f64], cols: usize) -> Result<(), EstimateError> {
+    if all_finite(v) {
+        return Ok(());
+    }
     match v.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
         Some(i) if cols > 0 => Err(EstimateError::NotFinite(format!(
@@ -136,7 +152,12 @@ impl Factored {
     ) -> Result<Factored, EstimateError> {
         let (m, n) = h.shape();
         check_shape(h, m, names.len())?;
-        check_finite("H", h.as_slice(), n)?;
+        // Every column's norm: all finite when every entry is (and no sum of squares overflows),
+        // else the first entry that is not.
+        let all_norms: Vec<f64> = h.column_iter().map(|c| c.norm()).collect();
+        if !all_norms.iter().all(|s| s.is_finite()) {
+            check_finite("H", h.as_slice(), n)?;
+        }
         let mut fixed = vec![false; n];
         if let Constraint::Zero(zero) = constraint {
             for z in zero {
@@ -157,7 +178,7 @@ impl Factored {
         // Column scaling.
         let mut norms = vec![1.0; n];
         for &j in &free {
-            let s = h.column(j).norm();
+            let s = all_norms[j];
             if !s.is_finite() {
                 return Err(EstimateError::NotFinite(format!(
                     "the norm of column `{}` of H",

@@ -11,7 +11,7 @@
 //! rank, uncertainties, covariance and identifiability. Memory: `(p+1)²` numbers plus one block,
 //! whatever the number of samples. Time: `O(rows · p²)`, like one QR of the whole H.
 
-use crate::fold::{BLOCK_ROWS, Triangular};
+use crate::fold::{BLOCK_ROWS, Blocks, Triangular};
 use crate::hmatrix::{GainSource, HMatrixError, h_matrix_spanned, parameter_names};
 use crate::{
     Constraint, EstimateError, Fit, Identification, IdentifyOptions, Tolerances, check_readings,
@@ -56,7 +56,11 @@ impl StreamingQr {
             "block has {b} rows and {} measurements",
             y.len()
         );
-        self.fold.fold_blocks(b, BLOCK_ROWS, |start, len, scratch| {
+        let blocks = Blocks {
+            first: b,
+            rest: BLOCK_ROWS,
+        };
+        self.fold.fold_blocks(b, blocks, |start, len, scratch| {
             scratch
                 .view_mut((0, 0), (len, p))
                 .copy_from(&h.view((start, 0), (len, p)));

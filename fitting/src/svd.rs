@@ -3,7 +3,7 @@
 //! `U = Q·U_R` nor `Q` formed; every SVD checked by rebuilding its matrix. [`super::factored`]
 //! builds a fit on it.
 
-use crate::fold::{BLOCK_ROWS, Triangular, fold_in_blocks};
+use crate::fold::{Blocks, Triangular, fold_in_blocks};
 use crate::least_squares::EstimateError;
 use nalgebra::{DMatrix, DVector, SVD};
 
@@ -41,12 +41,13 @@ impl Scaled<'_> {
         }
     }
 
-    /// The triangular factor of the scaled H (or of `[scaled H | y]`), folded in blocks of
-    /// `block` rows.
-    fn fold(&self, y: Option<&[f64]>, block: usize) -> Triangular {
+    /// The triangular factor of the scaled H (or of `[scaled H | y]`), folded in `blocks`.
+    fn fold(&self, y: Option<&[f64]>, blocks: Blocks) -> Triangular {
         let (m, nf) = (self.h.nrows(), self.free.len());
         let c = nf + usize::from(y.is_some());
-        fold_in_blocks(m, c, block, |start, len, out| self.fill(start, len, y, out))
+        fold_in_blocks(m, c, blocks, |start, len, out| {
+            self.fill(start, len, y, out)
+        })
     }
 
     /// The whole scaled H, padded with zero rows to at least as many rows as free columns.
@@ -61,9 +62,10 @@ impl Scaled<'_> {
 /// The SVD of the scaled H `a` (padded with zero rows when the record has fewer readings than
 /// free columns): its singular values (descending), its left singular vectors as the readings
 /// meet them, and its right singular vectors as columns. More rows than free columns (every
-/// real record): the SVD of the triangular factor of the QR decomposition folded in blocks of
-/// [`BLOCK_ROWS`], with `y` (readings, as many as rows) folded along when given, so that their
-/// fit needs no second fold.
+/// real record): the SVD of the triangular factor of the QR decomposition folded in blocks
+/// ([`Blocks::IN_MEMORY`]: up to 65 536 rows factorised as before the fold, bit for bit), with
+/// `y` (readings, as many as rows) folded along when given, so that their fit needs no second
+/// fold.
 ///
 /// # Errors
 /// [`EstimateError::Svd`]: an SVD that does not converge, or none that rebuilds the matrix.
@@ -71,14 +73,14 @@ pub(crate) fn decompose(
     a: Scaled,
     y: Option<&DVector<f64>>,
 ) -> Result<(Vec<f64>, Left, DMatrix<f64>), EstimateError> {
-    decompose_in(a, y, BLOCK_ROWS)
+    decompose_in(a, y, Blocks::IN_MEMORY)
 }
 
-/// [`decompose`] folding blocks of `block` rows.
+/// [`decompose`] folding in `blocks`.
 pub(crate) fn decompose_in(
     a: Scaled,
     y: Option<&DVector<f64>>,
-    block: usize,
+    blocks: Blocks,
 ) -> Result<(Vec<f64>, Left, DMatrix<f64>), EstimateError> {
     let (m, nf) = (a.h.nrows(), a.free.len());
     if nf == 0 {
@@ -90,7 +92,7 @@ pub(crate) fn decompose_in(
     }
     if m > nf {
         let y = y.filter(|y| y.len() == m);
-        let folded = a.fold(y.map(|y| y.as_slice()), block);
+        let folded = a.fold(y.map(|y| y.as_slice()), blocks);
         let r = folded.r().view((0, 0), (nf, nf)).into_owned();
         if let Some((sv, u_r, v)) = checked_svd(&r, m, true)? {
             let first = y.map(|y| Readings {
@@ -99,7 +101,7 @@ pub(crate) fn decompose_in(
             });
             let left = Left::Fold {
                 u_r,
-                block,
+                blocks,
                 first: first.map(Box::new),
             };
             return Ok((sv, left, v));
@@ -135,8 +137,8 @@ pub(crate) enum Left {
     Fold {
         /// The left singular vectors of R (n × n).
         u_r: DMatrix<f64>,
-        /// The rows per block of the fold.
-        block: usize,
+        /// How the fold cuts the rows into blocks.
+        blocks: Blocks,
         /// The readings folded with A, if any.
         first: Option<Box<Readings>>,
     },
@@ -148,12 +150,12 @@ impl Left {
     pub(crate) fn project(&self, a: Scaled, y: &DVector<f64>, rank: usize) -> Vec<f64> {
         match self {
             Left::Vectors(u) => (0..rank).map(|i| u.column(i).dot(y)).collect(),
-            Left::Fold { u_r, block, first } => {
+            Left::Fold { u_r, blocks, first } => {
                 let nf = u_r.nrows();
                 let top = match first {
                     Some(f) if same(&f.y, y) => f.top.clone(),
                     _ => a
-                        .fold(Some(y.as_slice()), *block)
+                        .fold(Some(y.as_slice()), *blocks)
                         .r()
                         .view((0, nf), (nf, 1))
                         .column(0)
@@ -295,7 +297,15 @@ mod tests {
                 }
                 z
             };
-            for block in [1, 2, 5, 6, 7, 64, 100, 301, 1000] {
+            // First blocks of one row, fewer rows than columns, as many, more, all rows and
+            // more; later blocks of one row, fewer than columns, as many, and longer (the last
+            // one partial for every size but 1).
+            let cuts = [1, 2, 5, 6, 7, 100]
+                .into_iter()
+                .flat_map(|first| [1, 5, 6, 64].map(|rest| (first, rest)))
+                .chain([(301, 256), (1000, 1)]);
+            for (first, rest) in cuts {
+                let block = Blocks { first, rest };
                 let folded = a.fold(None, block);
                 assert_eq!(folded.rows(), m);
                 for i in 0..n {
@@ -304,17 +314,17 @@ mod tests {
                         let (f, w) = (folded.r()[(i, j)], r_whole[(i, j)]);
                         assert!(
                             (f - sign * w).abs() <= 1e-12 * r_whole.norm(),
-                            "block {block}, R[{i},{j}]: {f} vs {w}"
+                            "{block:?}, R[{i},{j}]: {f} vs {w}"
                         );
                     }
                 }
                 for given in [None, Some(&y)] {
                     let (sv, left, v) = decompose_in(a, given, block).unwrap();
-                    assert!(matches!(left, Left::Fold { .. }), "block {block}");
+                    assert!(matches!(left, Left::Fold { .. }), "{block:?}");
                     for (s, w) in sv.iter().zip(&sv_whole).take(rank) {
                         assert!(
                             (s - w).abs() <= 1e-12 * sv_whole[0],
-                            "block {block}: σ {s} vs {w}"
+                            "{block:?}: σ {s} vs {w}"
                         );
                     }
                     for readings in [&y, &other] {
@@ -322,7 +332,7 @@ mod tests {
                         let want = direct(readings);
                         assert!(
                             (&z - &want).norm() <= 1e-10 * want.norm(),
-                            "block {block}, deficient {deficient}: {z} vs {want}"
+                            "{block:?}, deficient {deficient}: {z} vs {want}"
                         );
                     }
                 }
@@ -330,6 +340,16 @@ mod tests {
                 let (_, memo, _) = decompose_in(a, Some(&y), block).unwrap();
                 let (_, again, _) = decompose_in(a, None, block).unwrap();
                 assert_eq!(memo.project(a, &y, rank), again.project(a, &y, rank));
+                if first >= m {
+                    // One block: the Householder QR of the whole matrix, bit for bit.
+                    assert_eq!(folded.r(), &r_whole, "{block:?}");
+                    let (sv, left, v) = decompose_in(a, Some(&y), block).unwrap();
+                    assert_eq!((&sv, &v), (&sv_whole, &v_whole));
+                    for readings in [&y, &other] {
+                        let z = solve(&sv, &left, &v, a, readings, rank);
+                        assert_eq!(z, direct(readings), "{block:?}");
+                    }
+                }
             }
             if !deficient {
                 // And the normal equations of the well-conditioned full-rank system.

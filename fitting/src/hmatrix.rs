@@ -598,7 +598,8 @@ pub fn h_matrix_spanned(
     let mut symbol_gains: Vec<[f64; 3]> = Vec::new();
     let n_axes = m.axes.len();
     let n = record.samples.len();
-    let mut h = DMatrix::<f64>::zeros(3 * n, cols.len());
+    // Every entry is written below: zeroed pages from the allocator, not a pass of zeros.
+    let mut h = DMatrix::from_vec(3 * n, cols.len(), vec![0.0; 3 * n * cols.len()]);
     let mut g = vec![[0.0; 3]; source.errors().len()];
     for i in 0..n {
         check_sample(m, record, i)?;

@@ -281,7 +281,8 @@ pub fn fit_rows(
     weights: Option<&SampleWhitening>,
 ) -> Result<(Fit, Option<f64>), EstimateError> {
     check_readings_of(h, y, names)?;
-    RowsFactored::new(h, names, constraint, tolerances, noise, layout, weights)?.fit(h, y)
+    RowsFactored::for_readings(h, y, names, constraint, tolerances, noise, layout, weights)?
+        .fit(h, y)
 }
 
 /// [`choose_noise`] for a fit of a record whitened by `weights` (when it has covariances): the

@@ -11,9 +11,11 @@
 //!    and rad columns compare.
 //! 2. SVD `A = U·Σ·Vᵀ` (singular values descending; more parameters than rows: `A` is padded
 //!    with zero rows so that `V` is complete). A tall `A` (more rows than free parameters, the
-//!    usual case) is first reduced by a Householder QR, `A = Q·R`, and the SVD is that of the
-//!    small `R = U_R·Σ·Vᵀ`: `U = Q·U_R` is never formed, `Uᵀ·y = U_Rᵀ·(Qᵀ·y)`. The results
-//!    agree with the SVD of `A` to rounding (5e-14 relative on 10⁶ samples).
+//!    usual case) is first reduced by a Householder QR, `A = Q·R`, folded in blocks of 256
+//!    rows as the streaming identification folds its blocks (one implementation), and the SVD
+//!    is that of the small `R = U_R·Σ·Vᵀ`: neither `U = Q·U_R` nor `Q` is kept, `Uᵀ·y =
+//!    U_Rᵀ·(Qᵀ·y)` with `Qᵀ·y` folded with `A` (the last column of the factor of `[A | y]`). The
+//!    results agree with the SVD of `A` to rounding (5e-14 relative on 10⁶ samples).
 //! 3. Rank `r` = number of `σ_i > τ = σ_max · max(ρ, max(m, n)·ε)`, `ρ` =
 //!    [`RANK_RELATIVE_TOLERANCE`] = 1e-8, `ε` = 2.2e-16, `m = 3N` rows, `n` parameters.
 //! 4. Estimate (minimum norm in scaled coordinates, restricted to the identifiable subspace):
@@ -227,7 +229,8 @@ pub fn least_squares_whitened(
     layout: &[usize],
 ) -> Result<WhitenedFit, EstimateError> {
     check_readings_of(h, y, names)?;
-    WhitenedFactored::new(h, names, constraint, tol, noise, layout)?.fit(h, y, noise, layout)
+    WhitenedFactored::for_readings(h, y, names, constraint, tol, noise, layout)?
+        .fit(h, y, noise, layout)
 }
 
 /// [`least_squares`] on a reduced system: `r` (p × p or (p+1) × p) and `z` with `rᵀr = HᵀH`
@@ -259,5 +262,5 @@ fn solve(
     rss_outside: f64,
 ) -> Result<Fit, EstimateError> {
     check_readings_of(h, y, names)?;
-    Factored::new(h, names, constraint, tol, rows_total)?.fit(h, y, rss_outside)
+    Factored::with_readings(h, Some(y), names, constraint, tol, rows_total)?.fit(h, y, rss_outside)
 }

@@ -22,9 +22,10 @@
 //! - [`plan`]: the records to measure next for a target uncertainty, chosen from the machine's
 //!   tests;
 //! - [`sanity`]: plausibility limits on identified values;
-//! - [`factored`] (the fits on one factorization of the scaled H) and `svd` (QR first for a
-//!   tall H, then the SVD of R, every SVD checked by rebuilding its matrix): the numerics
-//!   behind [`mod@least_squares`];
+//! - [`factored`] (the fits on one factorization of the scaled H), `svd` (for a tall H its QR
+//!   decomposition first, then the SVD of R, every SVD checked by rebuilding its matrix) and
+//!   `fold` (that QR decomposition folded in blocks of rows, shared with [`streaming`]): the
+//!   numerics behind [`mod@least_squares`];
 //! - [`mod@calibrate`]: an instrument's own errors (sensor gain errors, zeros, direction
 //!   errors) from a calibration record of known displacements.
 //!
@@ -79,6 +80,7 @@ pub mod calibrate;
 pub mod campaign;
 pub mod distributions;
 pub mod factored;
+mod fold;
 pub mod hmatrix;
 pub mod identifiability;
 pub mod identify;

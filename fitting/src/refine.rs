@@ -296,8 +296,9 @@ pub(crate) fn gauss_newton(
         let f = match (given, &mut factored) {
             (Some(f), _) => f,
             (None, Some(f)) => &*f,
-            (None, none) => &*none.insert(RowsFactored::new(
+            (None, none) => &*none.insert(RowsFactored::for_readings(
                 h,
+                r,
                 &start.names,
                 &start.constraint,
                 tolerances,

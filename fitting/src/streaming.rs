@@ -1,7 +1,8 @@
 //! Identification from long records without holding the H matrix.
 //!
 //! Blocks of rows of `[H | y]` are folded into the upper-triangular factor `R` ((p+1) × (p+1))
-//! of a QR decomposition: `R ← triangular factor of [R; H_b y_b]` (Householder). At every
+//! of a QR decomposition: `R ← triangular factor of [R; H_b y_b]` (Householder; the fold of
+//! `crate::fold`, which every in-memory fit of a tall system uses as well). At every
 //! step `RᵀR` equals the Gram matrix of all rows seen, so at the end
 //! - `R₁₁` (p × p) and `z = R₁₂` (p) satisfy `R₁₁ᵀR₁₁ = HᵀH` and `R₁₁ᵀz = Hᵀy`;
 //! - `R₂₂²` is the part of `‖y‖²` that no combination of the columns reaches,
@@ -10,6 +11,7 @@
 //! rank, uncertainties, covariance and identifiability. Memory: `(p+1)²` numbers plus one block,
 //! whatever the number of samples. Time: `O(rows · p²)`, like one QR of the whole H.
 
+use crate::fold::{BLOCK_ROWS, Blocks, Triangular};
 use crate::hmatrix::{GainSource, HMatrixError, h_matrix_spanned, parameter_names};
 use crate::{
     Constraint, EstimateError, Fit, Identification, IdentifyOptions, Tolerances, check_readings,
@@ -22,25 +24,29 @@ use simulation::model::Basis;
 use simulation::model::Model;
 use simulation::record::Record;
 
-/// The running triangular factor of `[H | y]`.
+/// The running triangular factor of `[H | y]` (`crate::fold`: the fold of every in-memory
+/// fit, here on blocks as they are read).
 #[derive(Clone, Debug)]
 pub struct StreamingQr {
-    r: DMatrix<f64>,
+    fold: Triangular,
     p: usize,
-    rows: usize,
 }
 
 impl StreamingQr {
     /// For `p` parameters.
     pub fn new(p: usize) -> StreamingQr {
         StreamingQr {
-            r: DMatrix::zeros(p + 1, p + 1),
+            fold: Triangular::new(p + 1),
             p,
-            rows: 0,
         }
     }
 
-    /// Folds in a block of rows `h` (b × p) with measurements `y` (b).
+    /// Folds in a block of rows `h` (b × p, mm per unit of each parameter) with measurements
+    /// `y` (b, mm).
+    ///
+    /// # Panics
+    /// When `h` has another number of columns than the fit's parameters, or `y` another length
+    /// than `h` rows (a caller's block, not the user's data).
     pub fn add(&mut self, h: &DMatrix<f64>, y: &DVector<f64>) {
         let (b, p) = (h.nrows(), self.p);
         assert_eq!(h.ncols(), p, "block has {} columns, the fit {p}", h.ncols());
@@ -50,25 +56,28 @@ impl StreamingQr {
             "block has {b} rows and {} measurements",
             y.len()
         );
-        if b == 0 {
-            return;
-        }
-        let mut a = DMatrix::zeros(p + 1 + b, p + 1);
-        a.view_mut((0, 0), (p + 1, p + 1)).copy_from(&self.r);
-        a.view_mut((p + 1, 0), (b, p)).copy_from(h);
-        a.view_mut((p + 1, p), (b, 1)).copy_from(y);
-        self.r = a.qr().r();
-        self.rows += b;
+        let blocks = Blocks {
+            first: b,
+            rest: BLOCK_ROWS,
+        };
+        self.fold.fold_blocks(b, blocks, |start, len, scratch| {
+            scratch
+                .view_mut((0, 0), (len, p))
+                .copy_from(&h.view((start, 0), (len, p)));
+            scratch
+                .view_mut((0, p), (len, 1))
+                .copy_from(&y.rows(start, len));
+        });
     }
 
     /// Rows folded in so far.
     pub fn rows(&self) -> usize {
-        self.rows
+        self.fold.rows()
     }
 
     /// Bytes held between blocks (the factor).
     pub fn state_bytes(&self) -> usize {
-        self.r.len() * std::mem::size_of::<f64>()
+        self.fold.r().len() * std::mem::size_of::<f64>()
     }
 
     /// The least-squares fit of all rows seen (see [`crate::least_squares()`]).
@@ -78,11 +87,11 @@ impl StreamingQr {
         constraint: &Constraint,
         tol: &Tolerances,
     ) -> Result<Fit, EstimateError> {
-        let p = self.p;
-        let r11 = self.r.view((0, 0), (p, p)).into_owned();
-        let z = self.r.view((0, p), (p, 1)).column(0).into_owned();
-        let outside = self.r[(p, p)] * self.r[(p, p)];
-        least_squares_reduced(&r11, &z, names, constraint, tol, self.rows, outside)
+        let (p, r) = (self.p, self.fold.r());
+        let r11 = r.view((0, 0), (p, p)).into_owned();
+        let z = r.view((0, p), (p, 1)).column(0).into_owned();
+        let outside = r[(p, p)] * r[(p, p)];
+        least_squares_reduced(&r11, &z, names, constraint, tol, self.rows(), outside)
     }
 }
 

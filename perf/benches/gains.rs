@@ -5,7 +5,8 @@
 //!   differences, (d) the runtime first-order product;
 //! - `fill/*`: 10^6 poses of the full H (position rows) in blocks of 65 536 poses (larger than
 //!   the last-level cache) against a plain write of the same bytes;
-//! - `streaming/identify-1e6`: the reduced model from 10^6 synthetic samples, in blocks.
+//! - `streaming/identify-1e6`: the reduced model from 10^6 synthetic samples, in blocks;
+//!   `streaming/in-memory-1e6`: the same samples identified in memory (whole record and H).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use generated::seed_ac::{Params, Pose, full};
@@ -86,6 +87,9 @@ fn fill_and_stream(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("identify-1e6", |b| {
         b.iter(|| black_box(perf::streaming_identify(1_000_000)))
+    });
+    g.bench_function("in-memory-1e6", |b| {
+        b.iter(|| black_box(perf::memory_identify(1_000_000)))
     });
     g.finish();
 }

@@ -9,7 +9,8 @@
 //! 2. The H matrix of the full model (3 rows × 44 columns per pose, the generated
 //!    `position_gains` writing straight into the rows) filled for many poses in blocks into a
 //!    reused buffer, against a plain write of the same bytes into that buffer.
-//! 3. Streaming identification of a long record (the reduced model), with the peak memory.
+//! 3. Identification of a long record (the reduced model) streamed in blocks and in memory, in
+//!    the same run, each with its own peak memory ([`identification`]).
 //! 4. Code generation of every built-in machine.
 //!
 //! This crate also holds the baseline the generated code is measured against, a runtime
@@ -19,19 +20,17 @@
 #![warn(missing_docs)]
 
 pub mod first_order;
+pub mod identification;
 pub mod report;
+
+pub use identification::{IdentifyRun, memory_identify, peak_rss_bytes, streaming_identify};
 
 use crate::first_order::FirstOrderChain;
 use codegen::{GainModel, compile};
-use fitting::hmatrix::GainSource;
-use fitting::streaming::identify_streaming;
-use fitting::{Constraint, Tolerances};
 use generated::seed_ac::{Params, Pose, full};
 use model_spec::{AxisKind, Machine};
 use simulation::exact::{VirtualMachine, tool_centre_point_ik};
 use simulation::fd::{FdSteps, fd_gains_with};
-use simulation::model::Model;
-use simulation::record::{Record, Sample};
 use simulation::rng::Rng;
 use std::hint::black_box;
 use std::time::Instant;
@@ -60,7 +59,7 @@ pub struct MethodTime {
     pub ratio_to_generated: f64,
 }
 
-fn machine() -> Machine {
+pub(crate) fn machine() -> Machine {
     model_spec::builtin("seed-ac")
         .expect("built in")
         .expect("valid")
@@ -260,122 +259,6 @@ pub fn fill_bandwidth(poses: usize, block: usize, runs: usize) -> FillBandwidth 
         bytes: (poses * 3 * cols * 8) as f64,
         fill_seconds: fill,
         write_seconds: write,
-    }
-}
-
-/// A streaming identification run.
-#[derive(Clone, Debug, PartialEq)]
-pub struct StreamingRun {
-    /// Samples.
-    pub samples: usize,
-    /// Generating the record's blocks alone (poses, first-order readings, noise), s.
-    pub generate_seconds: f64,
-    /// Generating and identifying, s.
-    pub total_seconds: f64,
-    /// Peak resident memory of the process afterwards (VmHWM), bytes, if known.
-    pub peak_rss_bytes: Option<u64>,
-    /// Largest estimate error against the values used to generate, in units of its standard
-    /// uncertainty.
-    pub worst_z: f64,
-}
-
-/// Blocks of a long dynamic record of seed-ac: C turning continuously, A swinging, readings from
-/// the first-order reduced model at `truth` (mm, rad) plus 0.5 µm noise.
-fn synthetic_blocks(
-    m: &Machine,
-    samples: usize,
-    block: usize,
-    truth: Vec<f64>,
-) -> impl Iterator<Item = Result<Record, std::convert::Infallible>> + '_ {
-    let model = Model::of(m, "reduced").expect("seed-ac has a reduced model");
-    let params = m.default_parameters();
-    let mut source = GainSource::new(m, &model.errors(), &params).expect("compiled");
-    let mut rng = Rng::new(99);
-    let (ia, ic) = (
-        m.axis_by_name("A").expect("A"),
-        m.axis_by_name("C").expect("C"),
-    );
-    let mut done = 0;
-    std::iter::from_fn(move || {
-        if done >= samples {
-            return None;
-        }
-        let b = block.min(samples - done);
-        let mut rec = Record::default();
-        let mut g = vec![[0.0; 3]; model.errors().len()];
-        for i in done..done + b {
-            let t = i as f64 * 1e-3;
-            let mut c = vec![0.0; m.axes.len()];
-            c[ic] = 0.7 * t;
-            c[ia] = -0.6 * (1.0 - (0.05 * t).cos());
-            source.position_gains(&c, &mut g).expect("valid pose");
-            let mut y = [0.0; 3];
-            for (j, v) in truth.iter().enumerate() {
-                for d in 0..3 {
-                    y[d] += g[j][d] * v;
-                }
-            }
-            rec.measured.push(y.map(|v| v + 0.5e-3 * rng.normal()));
-            rec.samples.push(Sample {
-                commands: c,
-                t,
-                motion: vec![1; m.axes.len()],
-                timed: true,
-            });
-        }
-        done += b;
-        Some(Ok(rec))
-    })
-}
-
-/// The process's peak resident memory (Linux `VmHWM`), bytes.
-pub fn peak_rss_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
-
-/// Identifies the reduced model of seed-ac from `samples` synthetic samples in blocks.
-pub fn streaming_identify(samples: usize) -> StreamingRun {
-    let m = machine();
-    let model = Model::of(&m, "reduced").expect("reduced");
-    // The same values as the `seed-ac-reduced` truth, mm and rad.
-    let truth = vec![
-        12e-3, -18e-3, 15e-3, 20e-3, -15e-3, 25e-6, -18e-6, 10e-3, -22e-3, 30e-6, -12e-6,
-    ];
-    let block = 4096;
-    let start = Instant::now();
-    for b in synthetic_blocks(&m, samples, block, truth.clone()) {
-        black_box(b.expect("infallible"));
-    }
-    let generate_seconds = start.elapsed().as_secs_f64();
-    let start = Instant::now();
-    let mut source =
-        GainSource::new(&m, &model.errors(), &m.default_parameters()).expect("compiled");
-    let run = identify_streaming(
-        &m,
-        &model,
-        synthetic_blocks(&m, samples, block, truth.clone()),
-        None,
-        &mut source,
-        &Constraint::None,
-        &Tolerances::default(),
-    )
-    .expect("a well-posed synthetic record");
-    let total_seconds = start.elapsed().as_secs_f64();
-    let worst_z = (0..truth.len())
-        .map(|j| match (run.fit.values[j], run.fit.std[j]) {
-            (Some(v), Some(s)) => ((v - truth[j]) / s).abs(),
-            _ => f64::INFINITY,
-        })
-        .fold(0.0, f64::max);
-    StreamingRun {
-        samples,
-        generate_seconds,
-        total_seconds,
-        peak_rss_bytes: peak_rss_bytes(),
-        worst_z,
     }
 }
 

@@ -2,20 +2,24 @@
 //! text for people. Times are medians on this computer, one core; ratios are measured in the
 //! same run.
 
-use crate::{FillBandwidth, MethodTime, StreamingRun};
+use crate::{FillBandwidth, IdentifyRun, MethodTime};
 use serde::Serialize;
 
-/// Streaming identification of a long record.
+/// An identification of a long record (streamed, or in memory).
 #[derive(Clone, Debug, Serialize)]
-pub struct StreamingReport {
+pub struct IdentifyReport {
     /// Samples.
     pub samples: usize,
     /// Generating and identifying, s.
     pub seconds: f64,
     /// Generating the synthetic record alone, s.
     pub data_generation_seconds: f64,
-    /// Peak resident memory, MB; `null` where the system does not say (undetermined).
+    /// Peak resident memory of the process during this run (reset before it), MB, what the
+    /// process held before it included; `null` where the system does not say or cannot reset
+    /// the peak (undetermined).
     pub peak_rss_mb: Option<f64>,
+    /// Resident memory of the process just before this run, MB; `null` where unknown.
+    pub rss_before_mb: Option<f64>,
     /// Largest estimate error against the values used, in standard uncertainties.
     pub worst_z: f64,
 }
@@ -51,8 +55,12 @@ pub struct FillReport {
 pub struct BenchReport {
     /// Whether the quick sizes were used.
     pub quick: bool,
-    /// Streaming identification.
-    pub streaming_identify: StreamingReport,
+    /// Streaming identification (blocks folded, the record never whole).
+    pub streaming_identify: IdentifyReport,
+    /// In-memory identification of the same record (the whole record and H).
+    pub memory_identify: IdentifyReport,
+    /// The in-memory identification's time over the streaming one's (same run).
+    pub memory_over_streaming: f64,
     /// The gains at one pose, per method.
     pub gains_per_pose: Vec<MethodReport>,
     /// The H-matrix fills.
@@ -61,11 +69,12 @@ pub struct BenchReport {
     pub codegen_ms: Vec<(String, f64)>,
 }
 
-/// Runs the four measurements (10^6 samples and poses, or 10^5 with `quick`), streaming first
-/// so that the peak memory is its own.
+/// Runs the four measurements (10^6 samples and poses, or 10^5 with `quick`), the
+/// identifications first, each with its own peak memory.
 pub fn run(quick: bool) -> BenchReport {
     let n = if quick { 100_000 } else { 1_000_000 };
     let streaming = crate::streaming_identify(n);
+    let memory = crate::memory_identify(n);
     let methods = crate::gain_methods(quick);
     let fills: Vec<FillBandwidth> = [4096, 65536]
         .iter()
@@ -74,19 +83,22 @@ pub fn run(quick: bool) -> BenchReport {
     let codegen = crate::codegen_times(if quick { 3 } else { 9 });
     BenchReport {
         quick,
-        streaming_identify: streaming_report(&streaming),
+        streaming_identify: identify_report(&streaming),
+        memory_identify: identify_report(&memory),
+        memory_over_streaming: memory.total_seconds / streaming.total_seconds,
         gains_per_pose: methods.iter().map(method_report).collect(),
         h_fill: fills.iter().map(fill_report).collect(),
         codegen_ms: codegen.into_iter().map(|(m, s)| (m, s * 1e3)).collect(),
     }
 }
 
-fn streaming_report(s: &StreamingRun) -> StreamingReport {
-    StreamingReport {
+fn identify_report(s: &IdentifyRun) -> IdentifyReport {
+    IdentifyReport {
         samples: s.samples,
         seconds: s.total_seconds,
         data_generation_seconds: s.generate_seconds,
         peak_rss_mb: s.peak_rss_bytes.map(|b| b as f64 / 1e6),
+        rss_before_mb: s.rss_before_bytes.map(|b| b as f64 / 1e6),
         worst_z: s.worst_z,
     }
 }
@@ -112,19 +124,24 @@ fn fill_report(f: &FillBandwidth) -> FillReport {
 /// The first number of the report that is not finite (a failed measurement: a zero time, an
 /// empty run), named by its place; `None` when every number is finite.
 pub fn non_finite(r: &BenchReport) -> Option<String> {
-    let s = &r.streaming_identify;
-    let mut numbers: Vec<(String, f64)> = vec![
-        ("streaming_identify.seconds".into(), s.seconds),
-        (
-            "streaming_identify.data_generation_seconds".into(),
+    let mut numbers: Vec<(String, f64)> = Vec::new();
+    for (name, s) in [
+        ("streaming_identify", &r.streaming_identify),
+        ("memory_identify", &r.memory_identify),
+    ] {
+        numbers.push((format!("{name}.seconds"), s.seconds));
+        numbers.push((
+            format!("{name}.data_generation_seconds"),
             s.data_generation_seconds,
-        ),
-        ("streaming_identify.worst_z".into(), s.worst_z),
-    ];
-    numbers.extend(
-        s.peak_rss_mb
-            .map(|x| ("streaming_identify.peak_rss_mb".into(), x)),
-    );
+        ));
+        numbers.push((format!("{name}.worst_z"), s.worst_z));
+        numbers.extend(s.peak_rss_mb.map(|x| (format!("{name}.peak_rss_mb"), x)));
+        numbers.extend(
+            s.rss_before_mb
+                .map(|x| (format!("{name}.rss_before_mb"), x)),
+        );
+    }
+    numbers.push(("memory_over_streaming".into(), r.memory_over_streaming));
     for m in &r.gains_per_pose {
         numbers.push((format!("gains_per_pose[{}].ns", m.method), m.ns));
         numbers.push((
@@ -192,13 +209,30 @@ pub fn text(r: &BenchReport) -> String {
     }
     let s = &r.streaming_identify;
     out.push_str(&format!(
-        "\nStreaming identification, reduced model, {} samples: {:.2} s ({:.2} s of it generating the synthetic record), peak memory {}; worst estimate {:.1} std from the values used\n",
-        s.samples,
-        s.seconds,
-        s.data_generation_seconds,
-        s.peak_rss_mb
-            .map_or("unknown".into(), |mb| format!("{mb:.0} MB")),
-        s.worst_z
+        "\nIdentification of the reduced model (11 parameters) from {} synthetic samples; peak memory of each run, the process's before it included:\n",
+        s.samples
+    ));
+    out.push_str(&format!(
+        "  {:<30} {:>8} {:>12} {:>12} {:>12} {:>8}\n",
+        "run", "s", "generating", "peak memory", "before", "worst z"
+    ));
+    let mb = |x: Option<f64>| x.map_or("unknown".into(), |mb| format!("{mb:.0} MB"));
+    for (label, s) in [
+        ("streamed (blocks of 4096)", &r.streaming_identify),
+        ("in memory (whole record, H)", &r.memory_identify),
+    ] {
+        out.push_str(&format!(
+            "  {label:<30} {:>8.2} {:>10.2} s {:>12} {:>12} {:>8.1}\n",
+            s.seconds,
+            s.data_generation_seconds,
+            mb(s.peak_rss_mb),
+            mb(s.rss_before_mb),
+            s.worst_z
+        ));
+    }
+    out.push_str(&format!(
+        "  in memory / streamed: {:.2} (times include generating the record; worst z: largest estimate error in standard uncertainties)\n",
+        r.memory_over_streaming
     ));
     out.push_str("\nCode generation (every model, Rust source):\n");
     for (m, ms) in &r.codegen_ms {

@@ -6,9 +6,10 @@ use crate::Done;
 const LONG_ABOUT: &str = "\
 Measures, on this computer and in this process, what the generated code buys (medians of \
 repeated runs; ratios as well as times):
-  1. streaming identification of a long synthetic R-test record (10^6 samples; --quick 10^5) of \
-the seed machine, reduced model, blocks folded into an incremental QR: time and peak memory \
-(measured first, so that the peak is this step's);
+  1. identification of a long synthetic R-test record (10^6 samples; --quick 10^5) of the seed \
+machine, reduced model, streamed (blocks folded into an incremental QR) and in memory (the whole \
+record and H): both times, their ratio, and each run's peak memory (the process's peak reset \
+before each run);
   2. the gains of the whole seed-ac model (44 errors x 6) at one pose, sines and cosines \
 included, by (a) the generated code, (b) the in-process IR evaluator, (c) the exact HTM chain \
 with central finite differences, (d) a runtime first-order product of the chain;

@@ -206,7 +206,7 @@ pub(crate) fn identify_refined(
     let (c, t) = (&opts.constraint, &opts.tolerances);
     check_readings_of(h, y, names)?;
     let weights = system.weights.as_ref();
-    let factored = RowsFactored::new(h, names, c, t, None, &design.rows, weights)?;
+    let factored = RowsFactored::for_readings(h, y, names, c, t, None, &design.rows, weights)?;
     let fit = factored.fit(h, y)?;
     let mut ident = ordinary_identification(m, model, &design, &system.order, fit, weights);
     let run = Run {

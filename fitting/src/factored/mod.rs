@@ -5,11 +5,20 @@
 //! residual at every step: it factorises once. A fit made from a factorisation is the fit
 //! [`super::least_squares()`] makes, bit for bit (the same operations in the same order); the
 //! method is in [`mod@super::least_squares`]'s documentation.
+//!
+//! A tall H (more rows than free columns) is reduced by its QR decomposition folded in blocks
+//! of rows, the streaming identification's fold; `Q` is not kept. A fit of readings `y` takes
+//! `Qᵀ·y` from the fold of `[A | y]` (A the scaled H): made with the factorisation for the
+//! readings given to it (the first fit of a refinement, the only one of an identification),
+//! and again, one pass over H's rows, for other readings.
+
+mod rows;
+
+pub use rows::{RowsFactored, WhitenedFactored};
 
 use crate::identifiability::{Identifiability, near_confounded, null_space_groups};
-use crate::least_squares::{Constraint, EstimateError, Fit, Tolerances, WhitenedFit};
-use crate::noise::{NoiseError, NoiseModel, SampleWhitening};
-use crate::svd::{Left, decompose};
+use crate::least_squares::{Constraint, EstimateError, Fit, Tolerances};
+use crate::svd::{Left, Scaled, decompose};
 use nalgebra::{DMatrix, DVector};
 
 /// The factorisation of one H (m × n, mm per unit of each parameter) under one constraint and
@@ -67,9 +76,25 @@ fn check_shape(h: &DMatrix<f64>, readings: usize, names: usize) -> Result<(), Es
     Ok(())
 }
 
+/// Whether every entry of `v` is finite: `x·0` is NaN exactly for an infinite or NaN `x`, so
+/// a sum of them is 0 exactly when all are finite (in running sums, so that it vectorises).
+fn all_finite(v: &[f64]) -> bool {
+    let (chunks, rest) = v.as_chunks::<8>();
+    let mut sum = [0.0; 8];
+    for c in chunks {
+        for i in 0..8 {
+            sum[i] += c[i] * 0.0;
+        }
+    }
+    sum.iter().all(|s| *s == 0.0) && rest.iter().all(|x| x.is_finite())
+}
+
 /// `v` (`cols` columns, or a vector when 0) with no NaN or infinite entry, else the error
 /// naming the first one in `what`.
 pub(crate) fn check_finite(what: &str, v: &[f64], cols: usize) -> Result<(), EstimateError> {
+    if all_finite(v) {
+        return Ok(());
+    }
     match v.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
         Some(i) if cols > 0 => Err(EstimateError::NotFinite(format!(
@@ -108,9 +133,31 @@ impl Factored {
         tol: &Tolerances,
         rows_total: usize,
     ) -> Result<Factored, EstimateError> {
+        Factored::with_readings(h, None, names, constraint, tol, rows_total)
+    }
+
+    /// [`Factored::new`] with the readings `y` (mm, as many as `h` has rows) of the fit to come
+    /// folded with H (when H is tall), so that [`Factored::fit`] of those readings needs no
+    /// second pass over H's rows; the factorisation is the same, bit for bit.
+    ///
+    /// # Errors
+    /// As [`Factored::new`].
+    pub(crate) fn with_readings(
+        h: &DMatrix<f64>,
+        y: Option<&DVector<f64>>,
+        names: &[String],
+        constraint: &Constraint,
+        tol: &Tolerances,
+        rows_total: usize,
+    ) -> Result<Factored, EstimateError> {
         let (m, n) = h.shape();
         check_shape(h, m, names.len())?;
-        check_finite("H", h.as_slice(), n)?;
+        // Every column's norm: all finite when every entry is (and no sum of squares overflows),
+        // else the first entry that is not.
+        let all_norms: Vec<f64> = h.column_iter().map(|c| c.norm()).collect();
+        if !all_norms.iter().all(|s| s.is_finite()) {
+            check_finite("H", h.as_slice(), n)?;
+        }
         let mut fixed = vec![false; n];
         if let Constraint::Zero(zero) = constraint {
             for z in zero {
@@ -131,7 +178,7 @@ impl Factored {
         // Column scaling.
         let mut norms = vec![1.0; n];
         for &j in &free {
-            let s = h.column(j).norm();
+            let s = all_norms[j];
             if !s.is_finite() {
                 return Err(EstimateError::NotFinite(format!(
                     "the norm of column `{}` of H",
@@ -142,14 +189,12 @@ impl Factored {
                 norms[j] = s;
             }
         }
-        let rows = m.max(nf);
-        let mut a = DMatrix::<f64>::zeros(rows, nf);
-        for (k, &j) in free.iter().enumerate() {
-            for i in 0..m {
-                a[(i, k)] = h[(i, j)] / norms[j];
-            }
-        }
-        let (sv, left, v) = decompose(a, m)?;
+        let scaled = Scaled {
+            h,
+            free: &free,
+            norms: &norms,
+        };
+        let (sv, left, v) = decompose(scaled, y)?;
         let smax = sv.first().copied().unwrap_or(0.0);
         let tau = smax
             * tol
@@ -228,7 +273,8 @@ impl Factored {
     }
 
     /// The fit of readings `y` (mm; as many as `h` has rows) by `h`, the matrix factorised;
-    /// `rss_outside` adds to the residual sum of squares (mm²).
+    /// `rss_outside` adds to the residual sum of squares (mm²). Readings other than those the
+    /// factorisation was made with are folded with `h`'s rows again (a pass over them).
     ///
     /// # Errors
     /// Readings of another number than `h`'s rows, or not finite.
@@ -244,10 +290,22 @@ impl Factored {
         let (free, norms, sv, rank) = (&self.free, &self.norms, &self.sv, self.rank);
         let nf = free.len();
         // Minimum-norm solution in the identifiable subspace (scaled coordinates).
-        let mut ypad = DVector::<f64>::zeros(m.max(nf));
-        ypad.rows_mut(0, m).copy_from(y);
+        let padded;
+        let ypad = if m >= nf {
+            y
+        } else {
+            padded = y.clone().resize_vertically(nf, 0.0);
+            &padded
+        };
         let mut z = DVector::<f64>::zeros(nf);
-        for (i, (uty, s)) in self.left.project(&ypad, rank).iter().zip(sv).enumerate() {
+        let scaled = Scaled { h, free, norms };
+        for (i, (uty, s)) in self
+            .left
+            .project(scaled, ypad, rank)
+            .iter()
+            .zip(sv)
+            .enumerate()
+        {
             z.axpy(uty / s, &self.v.column(i), 1.0);
         }
         let mut x = vec![0.0; n];
@@ -300,323 +358,6 @@ impl Factored {
             identifiability: self.identifiability.clone(),
             constraint: self.constraint.clone(),
         })
-    }
-}
-
-/// The factorisations of a generalized least-squares fit under a noise model
-/// ([`super::least_squares_whitened`]): the ordinary H's, and the whitened H with its own
-/// (none for a uniform white model, whose fit is the ordinary one).
-#[derive(Clone, Debug)]
-pub struct WhitenedFactored {
-    /// The ordinary H's.
-    ordinary: Factored,
-    /// The whitened H and its factorisation.
-    whitened: Option<(DMatrix<f64>, Factored)>,
-}
-
-impl WhitenedFactored {
-    /// The factorisations of `h` (rows of records of `layout` samples) under `noise`.
-    ///
-    /// # Errors
-    /// As [`Factored::new`]; [`EstimateError::Noise`] when the layout does not fit the rows, the
-    /// model cannot whiten, or the whitened H has another rank or other undetermined parameters.
-    pub fn new(
-        h: &DMatrix<f64>,
-        names: &[String],
-        constraint: &Constraint,
-        tol: &Tolerances,
-        noise: &NoiseModel,
-        layout: &[usize],
-    ) -> Result<WhitenedFactored, EstimateError> {
-        let ordinary = Factored::new(h, names, constraint, tol, h.nrows())?;
-        WhitenedFactored::with_ordinary(ordinary, h, names, constraint, tol, noise, layout)
-    }
-
-    /// As [`WhitenedFactored::new`] with `ordinary` the factorisation of `h` that
-    /// [`Factored::new`] makes with the same arguments (and `h.nrows()` rows): it is not made
-    /// again.
-    ///
-    /// # Errors
-    /// As [`WhitenedFactored::new`].
-    pub fn with_ordinary(
-        ordinary: Factored,
-        h: &DMatrix<f64>,
-        names: &[String],
-        constraint: &Constraint,
-        tol: &Tolerances,
-        noise: &NoiseModel,
-        layout: &[usize],
-    ) -> Result<WhitenedFactored, EstimateError> {
-        if noise.is_uniform_white() {
-            return Ok(WhitenedFactored {
-                ordinary,
-                whitened: None,
-            });
-        }
-        let mut wh = h.clone();
-        noise.whiten_matrix(layout, &mut wh)?;
-        let w = Factored::new(&wh, names, constraint, tol, wh.nrows())?;
-        if w.rank != ordinary.rank || w.determined() != ordinary.determined() {
-            return Err(NoiseError::RankChanged {
-                ordinary: ordinary.rank,
-                whitened: w.rank,
-            }
-            .into());
-        }
-        Ok(WhitenedFactored {
-            ordinary,
-            whitened: Some((wh, w)),
-        })
-    }
-
-    /// The generalized least-squares fit of `y` by `h` (the matrix factorised) under `noise`
-    /// with `layout`, as [`super::least_squares_whitened`] makes it.
-    ///
-    /// # Errors
-    /// As [`Factored::fit`]; [`EstimateError::Noise`] when `y` cannot be whitened.
-    pub fn fit(
-        &self,
-        h: &DMatrix<f64>,
-        y: &DVector<f64>,
-        noise: &NoiseModel,
-        layout: &[usize],
-    ) -> Result<WhitenedFit, EstimateError> {
-        let ordinary = self.ordinary.fit(h, y, 0.0)?;
-        let Some((wh, w)) = &self.whitened else {
-            let s = noise.sigma_mm[0];
-            return Ok(WhitenedFit {
-                whitened_sigma: ordinary.sigma.filter(|_| s > 0.0).map(|x| x / s),
-                fit: ordinary,
-            });
-        };
-        let mut wy = y.clone();
-        noise.whiten_vector(layout, &mut wy)?;
-        let w = w.fit(wh, &wy, 0.0)?;
-        let residual = y - h * DVector::from_column_slice(&w.solution);
-        let rss = residual.norm_squared();
-        let sigma = (ordinary.dof > 0).then(|| (rss / ordinary.dof as f64).sqrt());
-        let mut identifiability = ordinary.identifiability;
-        identifiability.near_confounded = w.identifiability.near_confounded;
-        Ok(WhitenedFit {
-            whitened_sigma: w.sigma,
-            fit: Fit {
-                values: w.values,
-                solution: w.solution,
-                std: w.std,
-                covariance: w.covariance,
-                correlation: w.correlation,
-                identifiability,
-                residual,
-                rss,
-                sigma,
-                ..ordinary
-            },
-        })
-    }
-}
-
-/// One factorisation of a fit of rows ([`super::identify::fit_rows`]): ordinary, or
-/// generalized under a noise model.
-#[derive(Clone, Debug)]
-enum Inner {
-    Ordinary(Box<Factored>),
-    Whitened(Box<WhitenedFactored>),
-}
-
-impl Inner {
-    fn new(
-        h: &DMatrix<f64>,
-        names: &[String],
-        constraint: &Constraint,
-        tol: &Tolerances,
-        noise: Option<&NoiseModel>,
-        layout: &[usize],
-    ) -> Result<Inner, EstimateError> {
-        let ordinary = Factored::new(h, names, constraint, tol, h.nrows())?;
-        Ok(match noise {
-            None => Inner::Ordinary(Box::new(ordinary)),
-            Some(n) => Inner::Whitened(Box::new(WhitenedFactored::with_ordinary(
-                ordinary, h, names, constraint, tol, n, layout,
-            )?)),
-        })
-    }
-
-    /// The factorisation whose rank and identifiability the fit reports.
-    fn reported(&self) -> &Factored {
-        match self {
-            Inner::Ordinary(f) => f.as_ref(),
-            Inner::Whitened(w) => &w.ordinary,
-        }
-    }
-
-    /// The fit and its σ̂ (ordinary: the fit's own; generalized: the whitened residual's).
-    fn fit(
-        &self,
-        h: &DMatrix<f64>,
-        y: &DVector<f64>,
-        noise: Option<&NoiseModel>,
-        layout: &[usize],
-    ) -> Result<(Fit, Option<f64>), EstimateError> {
-        match (self, noise) {
-            (Inner::Whitened(w), Some(n)) => {
-                let w = w.fit(h, y, n, layout)?;
-                Ok((w.fit, w.whitened_sigma))
-            }
-            (Inner::Ordinary(f), _) => {
-                let f = f.fit(h, y, 0.0)?;
-                let s = f.sigma;
-                Ok((f, s))
-            }
-            (Inner::Whitened(w), None) => {
-                let f = w.ordinary.fit(h, y, 0.0)?;
-                let s = f.sigma;
-                Ok((f, s))
-            }
-        }
-    }
-}
-
-/// The factorisations of [`super::identify::fit_rows`] for one H, noise model, layout and
-/// per-sample weights: every fit of that H to other readings made from them.
-#[derive(Clone, Debug)]
-pub struct RowsFactored<'a> {
-    /// The noise model of a generalized fit.
-    noise: Option<&'a NoiseModel>,
-    /// Samples per record, in row order.
-    layout: &'a [usize],
-    /// With per-sample weights: the weights, the ordinary H's factorisation and the weighted H.
-    weighted: Option<(&'a SampleWhitening, Factored, DMatrix<f64>)>,
-    /// The factorisation of H, or of the weighted H.
-    inner: Inner,
-}
-
-impl<'a> RowsFactored<'a> {
-    /// The factorisations of `h` (rows of records of `layout` samples) for the fits of
-    /// [`super::identify::fit_rows`] with the same arguments.
-    ///
-    /// # Errors
-    /// As [`Factored::new`] and [`WhitenedFactored::new`]; [`EstimateError::Noise`] when the
-    /// weights do not fit the rows or change the rank.
-    pub fn new(
-        h: &DMatrix<f64>,
-        names: &[String],
-        constraint: &Constraint,
-        tol: &Tolerances,
-        noise: Option<&'a NoiseModel>,
-        layout: &'a [usize],
-        weights: Option<&'a SampleWhitening>,
-    ) -> Result<RowsFactored<'a>, EstimateError> {
-        let Some(weights) = weights else {
-            return Ok(RowsFactored {
-                noise,
-                layout,
-                weighted: None,
-                inner: Inner::new(h, names, constraint, tol, noise, layout)?,
-            });
-        };
-        let mut wh = h.clone();
-        weights.whiten_matrix(&mut wh)?;
-        let ordinary = Factored::new(h, names, constraint, tol, h.nrows())?;
-        let inner = Inner::new(&wh, names, constraint, tol, noise, layout)?;
-        let weighted = inner.reported();
-        if weighted.rank != ordinary.rank || weighted.determined() != ordinary.determined() {
-            return Err(NoiseError::RankChanged {
-                ordinary: ordinary.rank,
-                whitened: weighted.rank,
-            }
-            .into());
-        }
-        Ok(RowsFactored {
-            noise,
-            layout,
-            weighted: Some((weights, ordinary, wh)),
-            inner,
-        })
-    }
-
-    /// The factorisations for the fits under `noise` of the H, layout and weights of `self`, an
-    /// ordinary one ([`RowsFactored::new`] without a noise model, `h`, `names`, `constraint`
-    /// and `tol` its arguments): as [`RowsFactored::new`] makes them with `noise`, the
-    /// factorisation of the ordinary H (or the weighted H) taken from `self`, not made again.
-    ///
-    /// # Errors
-    /// As [`WhitenedFactored::new`]; [`EstimateError::Shape`] when `self` is not ordinary.
-    pub fn under(
-        &self,
-        h: &DMatrix<f64>,
-        names: &[String],
-        constraint: &Constraint,
-        tol: &Tolerances,
-        noise: &'a NoiseModel,
-    ) -> Result<RowsFactored<'a>, EstimateError> {
-        let (Inner::Ordinary(ordinary), None) = (&self.inner, self.noise) else {
-            return Err(EstimateError::Shape(
-                "a generalized fit's factorisations are made from an ordinary fit's".into(),
-            ));
-        };
-        let h = self.weighted.as_ref().map_or(h, |(_, _, wh)| wh);
-        let whitened = WhitenedFactored::with_ordinary(
-            ordinary.as_ref().clone(),
-            h,
-            names,
-            constraint,
-            tol,
-            noise,
-            self.layout,
-        )?;
-        Ok(RowsFactored {
-            noise: Some(noise),
-            layout: self.layout,
-            weighted: self.weighted.clone(),
-            inner: Inner::Whitened(Box::new(whitened)),
-        })
-    }
-
-    /// The fit of readings `y` (mm) by `h`, the matrix factorised, as
-    /// [`super::identify::fit_rows`] makes it.
-    ///
-    /// # Errors
-    /// As [`Factored::fit`]; [`EstimateError::Noise`] when `y` cannot be whitened.
-    pub fn fit(
-        &self,
-        h: &DMatrix<f64>,
-        y: &DVector<f64>,
-    ) -> Result<(Fit, Option<f64>), EstimateError> {
-        let Some((weights, ordinary, wh)) = &self.weighted else {
-            let (f, s) = self.inner.fit(h, y, self.noise, self.layout)?;
-            return Ok((f, s.filter(|_| self.noise.is_some())));
-        };
-        let mut wy = y.clone();
-        weights.whiten_vector(&mut wy)?;
-        let ordinary = ordinary.fit(h, y, 0.0)?;
-        let (weighted, whitened_sigma) = match self.noise {
-            None => {
-                let (f, _) = self.inner.fit(wh, &wy, None, self.layout)?;
-                let s = f.sigma.map(|s| s / weights.scale_mm);
-                (f, s)
-            }
-            Some(n) => self.inner.fit(wh, &wy, Some(n), self.layout)?,
-        };
-        let residual = y - h * DVector::from_column_slice(&weighted.solution);
-        let rss = residual.norm_squared();
-        let sigma = (ordinary.dof > 0).then(|| (rss / ordinary.dof as f64).sqrt());
-        let mut identifiability = ordinary.identifiability;
-        identifiability.near_confounded = weighted.identifiability.near_confounded;
-        Ok((
-            Fit {
-                values: weighted.values,
-                solution: weighted.solution,
-                std: weighted.std,
-                covariance: weighted.covariance,
-                correlation: weighted.correlation,
-                identifiability,
-                residual,
-                rss,
-                sigma,
-                ..ordinary
-            },
-            whitened_sigma,
-        ))
     }
 }
 

@@ -1,12 +1,13 @@
 //! Identification of one long synthetic record of seed-ac (the reduced model, 11 parameters),
 //! two ways, for `rtest bench`: streamed in blocks ([`streaming_identify`]: `[H | y]` folded
-//! block by block, never held whole) and in memory ([`memory_identify`]: the whole record, its
-//! whole H and the fit of [`fitting::identify_with`]). Both generate the same samples, so their
+//! block by block, never held whole) and in memory ([`memory_identify`]: the whole record as a
+//! campaign of one, its whole H and the one [`fitting::identify()`]). Both generate the same samples, so their
 //! times compare; each reports the peak memory of its own run.
 
 use fitting::hmatrix::GainSource;
 use fitting::streaming::identify_streaming;
-use fitting::{Constraint, Fit, IdentifyOptions, Tolerances, identify_with};
+use fitting::{Constraint, Fit, IdentifyOptions, Tolerances, identify};
+use simulation::campaign::Campaign;
 use model_spec::Machine;
 use simulation::model::Model;
 use simulation::record::{Record, Sample};
@@ -176,8 +177,8 @@ pub fn streaming_identify(samples: usize) -> IdentifyRun {
 }
 
 /// Identifies the reduced model of seed-ac from the same `samples` synthetic samples in memory:
-/// the whole record generated, then [`fitting::identify_with`] (its whole H, first order,
-/// default options).
+/// the whole record generated, then [`fitting::identify()`] of it as a campaign of one (its
+/// whole H, first order, default options).
 pub fn memory_identify(samples: usize) -> IdentifyRun {
     let m = crate::machine();
     let model = Model::of(&m, "reduced").expect("reduced");
@@ -187,16 +188,11 @@ pub fn memory_identify(samples: usize) -> IdentifyRun {
             .next()
             .map(|r| r.expect("infallible"))
             .unwrap_or_default();
-        let mut source =
-            GainSource::new(&m, &model.errors(), &m.default_parameters()).expect("compiled");
-        identify_with(
-            &m,
-            &model,
-            &record,
-            &mut source,
-            &IdentifyOptions::default(),
-        )
-        .expect("a well-posed synthetic record")
+        let campaign = Campaign::of_record(record, m.default_parameters(), false);
+        identify(&m, &model, &campaign, &IdentifyOptions::default())
+            .expect("a well-posed synthetic record")
+            .single_record(&m)
+            .expect("a campaign of one record")
     });
     IdentifyRun {
         samples,

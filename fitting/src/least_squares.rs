@@ -11,11 +11,13 @@
 //!    and rad columns compare.
 //! 2. SVD `A = U·Σ·Vᵀ` (singular values descending; more parameters than rows: `A` is padded
 //!    with zero rows so that `V` is complete). A tall `A` (more rows than free parameters, the
-//!    usual case) is first reduced by a Householder QR, `A = Q·R`, folded in blocks of 256
-//!    rows as the streaming identification folds its blocks (one implementation), and the SVD
-//!    is that of the small `R = U_R·Σ·Vᵀ`: neither `U = Q·U_R` nor `Q` is kept, `Uᵀ·y =
+//!    usual case) is first reduced by a Householder QR, `A = Q·R`, folded in blocks of rows as
+//!    the streaming identification folds its blocks (one implementation: the first 65 536 rows
+//!    by the Householder QR of those rows, then blocks of 256), and the SVD is that of the
+//!    small `R = U_R·Σ·Vᵀ`: neither `U = Q·U_R` nor `Q` is kept, `Uᵀ·y =
 //!    U_Rᵀ·(Qᵀ·y)` with `Qᵀ·y` folded with `A` (the last column of the factor of `[A | y]`). The
-//!    results agree with the SVD of `A` to rounding (5e-14 relative on 10⁶ samples).
+//!    results agree with the SVD of `A` to rounding (5e-14 relative on 10⁶ samples; the fold
+//!    with the QR of the whole `A` to 4e-13).
 //! 3. Rank `r` = number of `σ_i > τ = σ_max · max(ρ, max(m, n)·ε)`, `ρ` =
 //!    [`RANK_RELATIVE_TOLERANCE`] = 1e-8, `ε` = 2.2e-16, `m = 3N` rows, `n` parameters.
 //! 4. Estimate (minimum norm in scaled coordinates, restricted to the identifiable subspace):

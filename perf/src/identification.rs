@@ -7,8 +7,8 @@
 use fitting::hmatrix::GainSource;
 use fitting::streaming::identify_streaming;
 use fitting::{Constraint, Fit, IdentifyOptions, Tolerances, identify};
-use simulation::campaign::Campaign;
 use model_spec::Machine;
+use simulation::campaign::Campaign;
 use simulation::model::Model;
 use simulation::record::{Record, Sample};
 use simulation::rng::Rng;

@@ -496,8 +496,7 @@ pub fn design_matrix(
         by_params: Vec::new(),
     };
     let rows: usize = 3 * campaign.samples();
-    let mut h = DMatrix::zeros(rows, layout.columns.len());
-    let mut at = 0;
+    let mut blocks = Vec::with_capacity(campaign.records.len());
     for (r, rec) in campaign.records.iter().enumerate() {
         let source = sources.get(m, &rec.params)?;
         let block = record_block(m, &layout, r, &rec.record, source).map_err(|e| match e {
@@ -506,12 +505,9 @@ pub fn design_matrix(
             }
             other => other,
         })?;
-        for (k, &c) in layout.records[r].columns.iter().enumerate() {
-            h.view_mut((at, c), (block.nrows(), 1))
-                .copy_from(&block.column(k));
-        }
-        at += block.nrows();
+        blocks.push(block);
     }
+    let h = stack(&layout, blocks, rows);
     Ok(Design {
         h,
         names: layout.names(),
@@ -520,6 +516,37 @@ pub fn design_matrix(
         backend: sources.backend(),
         layout,
     })
+}
+
+/// The records' H matrices (`blocks`, each in its record's model order) stacked into the
+/// design matrix of `layout` (`rows` rows): a campaign of one record is its block with the
+/// columns put in layout order (one copy, no pass of zeros first); several records are copied
+/// into a zero matrix, each into its own columns.
+fn stack(layout: &Layout, mut blocks: Vec<DMatrix<f64>>, rows: usize) -> DMatrix<f64> {
+    let n = layout.columns.len();
+    if let ([block], [record]) = (blocks.as_slice(), layout.records.as_slice())
+        && record.columns.len() == n
+    {
+        // Layout column `c` is the block's column `k` with `record.columns[k] == c`.
+        let mut from = vec![0; n];
+        for (k, &c) in record.columns.iter().enumerate() {
+            from[c] = k;
+        }
+        if from.iter().enumerate().all(|(c, &k)| c == k) {
+            return blocks.pop().unwrap_or_else(|| DMatrix::zeros(rows, n));
+        }
+        return block.select_columns(&from);
+    }
+    let mut h = DMatrix::zeros(rows, n);
+    let mut at = 0;
+    for (block, record) in blocks.iter().zip(&layout.records) {
+        for (k, &c) in record.columns.iter().enumerate() {
+            h.view_mut((at, c), (block.nrows(), 1))
+                .copy_from(&block.column(k));
+        }
+        at += block.nrows();
+    }
+    h
 }
 
 /// The stacked readings of every record of `campaign` (mm, three rows per sample, records in

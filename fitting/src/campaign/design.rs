@@ -524,7 +524,7 @@ pub fn design_matrix(
 /// into a zero matrix, each into its own columns.
 fn stack(layout: &Layout, mut blocks: Vec<DMatrix<f64>>, rows: usize) -> DMatrix<f64> {
     let n = layout.columns.len();
-    if let ([block], [record]) = (blocks.as_slice(), layout.records.as_slice())
+    if let (1, [record]) = (blocks.len(), layout.records.as_slice())
         && record.columns.len() == n
     {
         // Layout column `c` is the block's column `k` with `record.columns[k] == c`.
@@ -532,10 +532,9 @@ fn stack(layout: &Layout, mut blocks: Vec<DMatrix<f64>>, rows: usize) -> DMatrix
         for (k, &c) in record.columns.iter().enumerate() {
             from[c] = k;
         }
-        if from.iter().enumerate().all(|(c, &k)| c == k) {
-            return blocks.pop().unwrap_or_else(|| DMatrix::zeros(rows, n));
-        }
-        return block.select_columns(&from);
+        let mut h = blocks.pop().unwrap_or_else(|| DMatrix::zeros(rows, n));
+        permute_columns(&mut h, &from);
+        return h;
     }
     let mut h = DMatrix::zeros(rows, n);
     let mut at = 0;
@@ -547,6 +546,28 @@ fn stack(layout: &Layout, mut blocks: Vec<DMatrix<f64>>, rows: usize) -> DMatrix
         at += block.nrows();
     }
     h
+}
+
+/// Puts the columns of `h` in the order `from` says, in place (column `c` becomes the column
+/// that was `from[c]`; `from` a permutation of `0..h.ncols()`): by swaps of whole columns, so
+/// that a tall H is never held twice.
+pub(crate) fn permute_columns(h: &mut DMatrix<f64>, from: &[usize]) {
+    let n = h.ncols();
+    debug_assert_eq!(from.len(), n);
+    // `at[p]`: the original column now at position p; `pos[j]`: where original column j is.
+    let mut at: Vec<usize> = (0..n).collect();
+    let mut pos: Vec<usize> = (0..n).collect();
+    for (c, &j) in from.iter().enumerate() {
+        let p = pos[j];
+        if p != c {
+            h.swap_columns(c, p);
+            let k = at[c];
+            at[p] = k;
+            pos[k] = p;
+            at[c] = j;
+            pos[j] = c;
+        }
+    }
 }
 
 /// The stacked readings of every record of `campaign` (mm, three rows per sample, records in
@@ -562,4 +583,41 @@ pub fn measurements(campaign: &Campaign) -> Result<DVector<f64>, EstimateError> 
         out.extend_from_slice(y.as_slice());
     }
     Ok(DVector::from_vec(out))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::permute_columns;
+    use nalgebra::DMatrix;
+
+    /// Every permutation of five columns (120) put in place gives the matrix that
+    /// `select_columns` copies, entry for entry.
+    #[test]
+    fn columns_permuted_in_place_are_the_selected_columns() {
+        let h = DMatrix::from_fn(7, 5, |i, j| (10 * i + j) as f64);
+        let mut from: Vec<usize> = (0..5).collect();
+        let mut count = 0;
+        // Heap's algorithm over the orders of `from`.
+        let mut c = [0usize; 5];
+        let mut check = |from: &[usize]| {
+            let mut permuted = h.clone();
+            permute_columns(&mut permuted, from);
+            assert_eq!(permuted, h.select_columns(from), "order {from:?}");
+            count += 1;
+        };
+        check(&from);
+        let mut i = 1;
+        while i < 5 {
+            if c[i] < i {
+                from.swap(if i % 2 == 0 { 0 } else { c[i] }, i);
+                check(&from);
+                c[i] += 1;
+                i = 1;
+            } else {
+                c[i] = 0;
+                i += 1;
+            }
+        }
+        assert_eq!(count, 120);
+    }
 }

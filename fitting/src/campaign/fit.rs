@@ -6,11 +6,12 @@
 //! [`CampaignIdentification::single_record`] gives its fit back in that order, named as the
 //! record's model names it (`XOW`, not `XOW[k4]`).
 
-use super::design::{Design, Layout, Owner, design_matrix, measurements};
+use super::design::{Design, Layout, Owner, design_matrix, measurements, permute_columns};
 use super::names::single_record_names;
+use crate::factored::{RowsFactored, check_readings_of};
 use crate::hmatrix::Backend;
 use crate::identifiability::{NearPair, Swallowed, swallowed_by_offsets};
-use crate::identify::{check_readings, fit_rows};
+use crate::identify::check_readings;
 use crate::least_squares::{EstimateError, Fit};
 use crate::noise::{NoiseChoice, NoiseModel, SampleWhitening};
 use crate::refine::{IdentifyError, Refinement};
@@ -241,8 +242,20 @@ pub fn identify(
     if let Some(refine) = &opts.refine {
         return super::refine::identify_refined(m, model, campaign, &opts, refine);
     }
-    let design = design_matrix(m, model, campaign)?;
-    Ok(fit_design(m, model, campaign, &design, &opts)?)
+    let mut design = design_matrix(m, model, campaign)?;
+    // The design is not kept: its H is put in solve order in place rather than copied.
+    let order = design.layout.solve_order();
+    let mut h = std::mem::replace(&mut design.h, DMatrix::zeros(0, 0));
+    permute_columns(&mut h, &order);
+    let names = order.iter().map(|&c| design.names[c].clone()).collect();
+    Ok(fit_system(
+        m,
+        model,
+        campaign,
+        &design,
+        (&h, names, &order),
+        &opts,
+    )?)
 }
 
 /// Refuses options that belong to the records in a campaign.
@@ -271,36 +284,44 @@ pub fn fit_design(
     design: &Design,
     opts: &IdentifyOptions,
 ) -> Result<CampaignIdentification, EstimateError> {
+    let order = design.layout.solve_order();
+    let (h, names) = solve_system(design, &order);
+    fit_system(m, model, campaign, design, (&h, names, &order), opts)
+}
+
+/// [`fit_design`] with the design's H already in solve `order` (`h`, its columns named by
+/// `names`): the design gives the layout and the records' rows, not its H.
+fn fit_system(
+    m: &Machine,
+    model: &Model,
+    campaign: &Campaign,
+    design: &Design,
+    (h, names, order): (&DMatrix<f64>, Vec<String>, &[usize]),
+    opts: &IdentifyOptions,
+) -> Result<CampaignIdentification, EstimateError> {
     let noise = &opts.noise;
     check_options(opts)?;
     let samples = campaign.samples();
     check_readings(samples, design.names.len())?;
     let y = measurements(campaign)?;
-    let order = design.layout.solve_order();
-    let (h, names) = solve_system(design, &order);
     let weights = super::whitening(campaign, noise)?;
     let (c, t) = (&opts.constraint, &opts.tolerances);
-    let (ordinary, weighted_sigma) =
-        fit_rows(&h, &y, &names, c, t, None, &design.rows, weights.as_ref())?;
+    check_readings_of(h, &y, &names)?;
+    let w = weights.as_ref();
+    let factored = RowsFactored::for_readings(h, &y, &names, c, t, None, &design.rows, w)?;
+    let (ordinary, weighted_sigma) = factored.fit(h, &y)?;
     if *noise == NoiseChoice::Ordinary {
         let ordinary = (ordinary, weighted_sigma);
-        let w = weights.as_ref();
         return Ok(ordinary_identification(
-            m, model, design, &order, ordinary, w,
+            m, model, design, order, ordinary, w,
         ));
     }
-    let chosen = choose_campaign_noise_weighted(noise, &ordinary, &design.rows, weights.as_ref())?;
-    let (fit, whitened_sigma) = fit_rows(
-        &h,
-        &y,
-        &names,
-        c,
-        t,
-        Some(&chosen),
-        &design.rows,
-        weights.as_ref(),
-    )?;
-    let mut ident = CampaignIdentification::new(m, model, design, to_layout_order(fit, &order));
+    let chosen = choose_campaign_noise_weighted(noise, &ordinary, &design.rows, w)?;
+    // The generalized fit reuses the ordinary factorisation: only the whitened H is new.
+    let (fit, whitened_sigma) = factored
+        .under_for_readings(h, &y, &names, c, t, &chosen)?
+        .fit(h, &y)?;
+    let mut ident = CampaignIdentification::new(m, model, design, to_layout_order(fit, order));
     ident.noise = chosen;
     ident.whitened_sigma = whitened_sigma;
     Ok(ident)

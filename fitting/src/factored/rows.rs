@@ -376,21 +376,55 @@ impl<'a> RowsFactored<'a> {
         tol: &Tolerances,
         noise: &'a NoiseModel,
     ) -> Result<RowsFactored<'a>, EstimateError> {
+        let setup = Setup {
+            names,
+            constraint,
+            tol,
+        };
+        self.under_with(setup, h, None, noise)
+    }
+
+    /// [`RowsFactored::under`] for the fit of the readings `y` (mm): the whitened H folds them
+    /// along (whitened), so that [`RowsFactored::fit`] of `y` makes no second pass over its
+    /// rows (without per-sample weights; with them, `y` is folded when fitted).
+    ///
+    /// # Errors
+    /// As [`RowsFactored::under`].
+    pub(crate) fn under_for_readings(
+        &self,
+        h: &DMatrix<f64>,
+        y: &DVector<f64>,
+        names: &[String],
+        constraint: &Constraint,
+        tol: &Tolerances,
+        noise: &'a NoiseModel,
+    ) -> Result<RowsFactored<'a>, EstimateError> {
+        let setup = Setup {
+            names,
+            constraint,
+            tol,
+        };
+        let y = self.weighted.is_none().then_some(y);
+        self.under_with(setup, h, y, noise)
+    }
+
+    /// [`RowsFactored::under`], with the readings `y` (of the H factorised) folded along
+    /// when given.
+    fn under_with(
+        &self,
+        setup: Setup,
+        h: &DMatrix<f64>,
+        y: Option<&DVector<f64>>,
+        noise: &'a NoiseModel,
+    ) -> Result<RowsFactored<'a>, EstimateError> {
         let (Inner::Ordinary(ordinary), None) = (&self.inner, self.noise) else {
             return Err(EstimateError::Shape(
                 "a generalized fit's factorisations are made from an ordinary fit's".into(),
             ));
         };
         let h = self.weighted.as_ref().map_or(h, |(_, _, wh)| wh);
-        let whitened = WhitenedFactored::with_ordinary(
-            ordinary.as_ref().clone(),
-            h,
-            names,
-            constraint,
-            tol,
-            noise,
-            self.layout,
-        )?;
+        let ordinary = ordinary.as_ref().clone();
+        let whitened = WhitenedFactored::whiten(ordinary, setup, h, y, noise, self.layout)?;
         Ok(RowsFactored {
             noise: Some(noise),
             layout: self.layout,

@@ -42,8 +42,10 @@ use codegen::{GainModel, Program};
 use generated::CompiledModel;
 use model_spec::{ErrorId, FULL_MODEL, Machine};
 use nalgebra::DMatrix;
-use simulation::model::{Basis, BasisContext, Effect, Model, Term};
+use simulation::model::{Basis, Effect, Model, Term};
 use simulation::record::Record;
+
+mod fill;
 
 /// Why an H matrix (or its gain source) cannot be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -549,7 +551,8 @@ pub fn h_matrix(
     h_matrix_spanned(m, model, record, source, None)
 }
 
-/// [`h_matrix`] of a block of a longer record: `time_span` `(t0, t1)` (s) is the whole
+/// [`h_matrix`] of a block of a longer record (or of a whole record with `None`; a record of
+/// 100 000 samples or more is filled on every core, the same matrix bit for bit): `time_span` `(t0, t1)` (s) is the whole
 /// record's, so that `time:K` terms are normalised over the record and `exp:TAU` counts from
 /// its first sample, not the block's (`rate` and `warmup:TAU` count from time 0 and need no
 /// span). With a `time_span`, `velocity` terms are refused (they need the whole record).
@@ -559,6 +562,20 @@ pub fn h_matrix_spanned(
     record: &Record,
     source: &mut GainSource,
     time_span: Option<(f64, f64)>,
+) -> Result<DMatrix<f64>, HMatrixError> {
+    let threads = fill::threads_for(record.samples.len());
+    h_matrix_on(m, model, record, source, time_span, threads)
+}
+
+/// [`h_matrix_spanned`] with the rows filled on `threads` threads (the same matrix, bit for
+/// bit, on any number).
+fn h_matrix_on(
+    m: &Machine,
+    model: &Model,
+    record: &Record,
+    source: &mut GainSource,
+    time_span: Option<(f64, f64)>,
+    threads: usize,
 ) -> Result<DMatrix<f64>, HMatrixError> {
     check_model(m, model)?;
     // Per column: where its gain comes from, carrier, basis, component.
@@ -595,63 +612,19 @@ pub fn h_matrix_spanned(
     let velocities = times_for(m, model, record, time_span.is_some())?;
     let offsets =
         crate::offsets::has_kinematic_offsets(model).then(|| crate::offsets::OffsetGains::new(m));
-    let mut symbol_gains: Vec<[f64; 3]> = Vec::new();
-    let n_axes = m.axes.len();
     let n = record.samples.len();
     // Every entry is written below: zeroed pages from the allocator, not a pass of zeros.
     let mut h = DMatrix::from_vec(3 * n, cols.len(), vec![0.0; 3 * n * cols.len()]);
-    let mut g = vec![[0.0; 3]; source.errors().len()];
-    for i in 0..n {
-        check_sample(m, record, i)?;
-        let s = &record.samples[i];
-        source
-            .position_gains(&s.commands, &mut g)
-            .map_err(|e| match e {
-                HMatrixError::Sample { message, .. } => HMatrixError::Sample { sample: i, message },
-                other => other,
-            })?;
-        if let Some(o) = &offsets {
-            symbol_gains = o.gains(&s.commands);
-        }
-        let (tau, elapsed_s) = match time_span {
-            Some((t0, t1)) if t1 > t0 => (2.0 * (s.t - t0) / (t1 - t0) - 1.0, s.t - t0),
-            Some((t0, _)) => (0.0, s.t - t0),
-            None => (record.tau(i), record.elapsed_s(i)),
-        };
-        let cx = BasisContext {
-            commands: &s.commands,
-            motion: &s.motion,
-            tau,
-            elapsed_s,
-            since_start_s: s.t,
-            velocity: velocities.get(i * n_axes..(i + 1) * n_axes).unwrap_or(&[]),
-            reading: record.measured.get(i).copied().unwrap_or([0.0; 3]),
-        };
-        for (c, &(gain, carrier, basis, k)) in cols.iter().enumerate() {
-            let b = basis.values(m, carrier, &cx)[k];
-            let mut v = [0.0; 3];
-            match gain {
-                Gain::Slot(slot) => v = g[slot],
-                Gain::Unit(d) => v[d] = 1.0,
-                Gain::Reading(d, j) => v[d] = cx.reading[j],
-                Gain::Symbol(s) => v = symbol_gains[s],
-            }
-            for d in 0..3 {
-                let x = v[d] * b;
-                if !x.is_finite() {
-                    let (t, k) = model.columns()[c];
-                    return Err(HMatrixError::NotFinite {
-                        row: 3 * i + d,
-                        column: c,
-                        sample: i,
-                        name: parameter_name(m, &model.terms[t], k),
-                        value: x,
-                    });
-                }
-                h[(3 * i + d, c)] = x;
-            }
-        }
-    }
+    let rows = fill::Rows {
+        m,
+        model,
+        cols: &cols,
+        record,
+        velocities: &velocities,
+        offsets: offsets.as_ref(),
+        time_span,
+    };
+    rows.fill(h.as_mut_slice(), source, threads)?;
     Ok(h)
 }
 

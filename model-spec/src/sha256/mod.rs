@@ -18,7 +18,9 @@
 //! assert!(r.digest().sha256.starts_with("ba7816bf"));
 //! ```
 
-use std::io::Read;
+mod reader;
+
+pub use reader::HashingReader;
 
 /// The round constants: the first 32 bits of the fractional parts of the cube roots of the
 /// first 64 primes.
@@ -168,44 +170,6 @@ impl Digest {
     }
 }
 
-/// A reader that hashes every byte it hands out: wrap the source a parser reads, and the
-/// [`HashingReader::digest`] after the parser is done is that of exactly what it read (of the
-/// whole file when it read to the end).
-#[derive(Debug)]
-pub struct HashingReader<R> {
-    inner: R,
-    hash: Sha256,
-    bytes: u64,
-}
-
-impl<R> HashingReader<R> {
-    /// Hashes what is read from `inner`.
-    pub fn new(inner: R) -> HashingReader<R> {
-        HashingReader {
-            inner,
-            hash: Sha256::new(),
-            bytes: 0,
-        }
-    }
-
-    /// The digest of the bytes read so far.
-    pub fn digest(&self) -> Digest {
-        Digest {
-            bytes: self.bytes,
-            sha256: self.hash.clone().hex(),
-        }
-    }
-}
-
-impl<R: Read> Read for HashingReader<R> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let n = self.inner.read(buf)?;
-        self.hash.update(&buf[..n]);
-        self.bytes += n as u64;
-        Ok(n)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -243,22 +207,6 @@ mod tests {
             h.hex(),
             "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0"
         );
-    }
-
-    #[test]
-    fn a_hashing_reader_hashes_what_it_hands_out() {
-        let bytes: Vec<u8> = (0..200_000u32).map(|i| (i % 251) as u8).collect();
-        let mut r = HashingReader::new(&bytes[..]);
-        // Read in uneven pieces, stopping short of the end: the digest is of what was read.
-        let mut buf = [0u8; 777];
-        let mut taken = 0usize;
-        while taken < 150_000 {
-            taken += r.read(&mut buf).unwrap();
-        }
-        assert_eq!(r.digest(), Digest::of(&bytes[..taken]));
-        std::io::copy(&mut r, &mut std::io::sink()).unwrap();
-        assert_eq!(r.digest(), Digest::of(&bytes));
-        assert_eq!(r.digest().bytes, 200_000);
     }
 
     #[test]

@@ -13,6 +13,7 @@ mod diagnose_records;
 pub mod figures;
 pub mod gains;
 pub mod generate;
+pub mod generator_args;
 pub mod history;
 pub mod identify;
 pub mod instrument;

@@ -3,6 +3,7 @@
 //! The record of poses is computed in one function ([`poses`]), written in another
 //! ([`csv_text`]), so that other formats of the same poses are one more writer.
 
+use super::generator_args::option_flag;
 use super::{EXIT_CODES, Error, VerbResult, check_outputs, pose_args};
 use crate::Done;
 use formats::csv::{ReadOptions, format_record};
@@ -11,7 +12,7 @@ use model_spec::units::short;
 use model_spec::{AxisKind, Machine};
 use output::{Outputs, Target};
 use simulation::generator::{
-    self, Clearance, GeneratorError, GeneratorOptions, Order, SampleProblem, TestKind, TestSpec,
+    self, GeneratorError, GeneratorOptions, Order, SampleProblem, TestKind, TestSpec,
 };
 use simulation::record::Record;
 
@@ -64,22 +65,8 @@ pub struct PathArgs {
     /// them (`Xw=-200,Zw=180`).
     #[arg(long, value_name = "SYMBOL=VALUE,...")]
     param: Option<String>,
-    /// Step of the turning axis, degrees (default: 1°, 1.5° for pair tests and K4); the step
-    /// used divides the span into equal steps of at most this.
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
-    step_deg: Option<f64>,
-    /// Time between two samples, s.
-    #[arg(long, value_name = "S", default_value_t = simulation::paths::SAMPLE_PERIOD_S,
-          allow_negative_numbers = true)]
-    period_s: f64,
-    /// Largest angle between the tool axis and the table normal, degrees (0 to 180).
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true,
-          default_value_t = generator::clearance::DEFAULT_MAX_TILT_DEG)]
-    max_tilt_deg: f64,
-    /// Least height of the ball centre above the table face, mm: the reach of your nest.
-    #[arg(long, value_name = "MM", allow_negative_numbers = true,
-          default_value_t = generator::clearance::DEFAULT_MIN_BALL_HEIGHT_MM)]
-    min_ball_height_mm: f64,
+    #[command(flatten)]
+    generator: super::generator_args::GeneratorArgs,
     /// With --list: the list as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE", requires = "list")]
     json: Option<Target>,
@@ -88,20 +75,6 @@ pub struct PathArgs {
     output: Option<Target>,
     #[command(flatten)]
     nc: super::path_nc::NcArgs,
-}
-
-/// The options of the generator from the flags.
-fn options(args: &PathArgs) -> VerbResult<GeneratorOptions> {
-    let opts = GeneratorOptions {
-        step_deg: args.step_deg,
-        period_s: args.period_s,
-        clearance: Clearance {
-            max_tilt_deg: args.max_tilt_deg,
-            min_ball_height_mm: args.min_ball_height_mm,
-        },
-    };
-    generator::check_options(&opts).map_err(|e| generator_error(&e, args))?;
-    Ok(opts)
 }
 
 /// A generator error as a verb's error, naming the flag at fault: a usage error for what the
@@ -115,13 +88,8 @@ fn generator_error(e: &GeneratorError, args: &PathArgs) -> Error {
         "--test"
     };
     match e {
-        GeneratorError::Option { option, .. } => {
-            let flag = match *option {
-                "step" => "--step-deg",
-                "period" => "--period-s",
-                "max tilt" => "--max-tilt-deg",
-                _ => "--min-ball-height-mm",
-            };
+        GeneratorError::Option { .. } => {
+            let flag = option_flag(e).unwrap_or("--step-deg");
             Error::usage(format!("{flag}: {e}"))
         }
         GeneratorError::NoRotaryAxis { .. }
@@ -308,7 +276,7 @@ pub fn run(args: &PathArgs) -> VerbResult<Done> {
     .collect();
     check_outputs(&inputs, &outputs, &[])?;
     let params = pose_args::params(&m, args.param.as_deref())?;
-    let opts = options(args)?;
+    let opts = args.generator.options()?;
     if args.list {
         return list(args.json.as_ref(), &m, &params, &opts);
     }

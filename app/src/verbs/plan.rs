@@ -17,7 +17,7 @@ use model_spec::units::{UM_PER_MM, compact};
 use output::{Outputs, Target};
 use report::json::plan::{PlanReport, PlanSource};
 use report::json::to_json;
-use simulation::generator::{self, Clearance, GeneratorError, GeneratorOptions, SampleProblem};
+use simulation::generator::{GeneratorError, SampleProblem};
 
 const LONG_ABOUT: &str = "\
 Predicts, before measuring, what a campaign of R-test tests will determine: the rank and the \
@@ -101,21 +101,8 @@ pub struct PlanArgs {
     #[arg(long, value_name = "N", default_value_t = 5,
           value_parser = clap::value_parser!(u64).range(1..=10_000))]
     top: u64,
-    /// Step of the turning axis of every test, degrees (default: each test's own).
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
-    step_deg: Option<f64>,
-    /// Time between two samples, s.
-    #[arg(long, value_name = "S", default_value_t = simulation::paths::SAMPLE_PERIOD_S,
-          allow_negative_numbers = true)]
-    period_s: f64,
-    /// Largest angle between the tool axis and the table normal, degrees (0 to 180).
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true,
-          default_value_t = generator::clearance::DEFAULT_MAX_TILT_DEG)]
-    max_tilt_deg: f64,
-    /// Least height of the ball centre above the table face, mm: the reach of your nest.
-    #[arg(long, value_name = "MM", allow_negative_numbers = true,
-          default_value_t = generator::clearance::DEFAULT_MIN_BALL_HEIGHT_MM)]
-    min_ball_height_mm: f64,
+    #[command(flatten)]
+    generator: super::generator_args::GeneratorArgs,
     /// Also write the report as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
@@ -129,31 +116,6 @@ fn phi(s: &str) -> Result<f64, String> {
             "`{s}` is not a lag-1 autocorrelation from 0 up to (not including) {MAX_PHI}"
         )),
     }
-}
-
-/// The generator's options from the flags.
-fn options(args: &PlanArgs) -> VerbResult<GeneratorOptions> {
-    let opts = GeneratorOptions {
-        step_deg: args.step_deg,
-        period_s: args.period_s,
-        clearance: Clearance {
-            max_tilt_deg: args.max_tilt_deg,
-            min_ball_height_mm: args.min_ball_height_mm,
-        },
-    };
-    generator::check_options(&opts).map_err(|e| {
-        let flag = match &e {
-            GeneratorError::Option { option, .. } => match *option {
-                "step" => "--step-deg",
-                "period" => "--period-s",
-                "max tilt" => "--max-tilt-deg",
-                _ => "--min-ball-height-mm",
-            },
-            _ => "--paths",
-        };
-        Error::usage(format!("{flag}: {e}"))
-    })?;
-    Ok(opts)
 }
 
 /// One `--ball NAME:SYMBOL=VALUE,...`: its name and parameters (`base` overridden).
@@ -235,7 +197,7 @@ fn plan_of(m: &Machine, args: &PlanArgs) -> VerbResult<Plan> {
         tests,
         zeroed: args.zeroed,
         shared_setup: args.shared_setup,
-        generator: options(args)?,
+        generator: args.generator.options()?,
     })
 }
 

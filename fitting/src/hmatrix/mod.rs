@@ -7,7 +7,7 @@
 //! - Entry: `g_d(pose_i) · b(sample_i)`, the position gain `g` of the term's effect (mm per mm
 //!   for translational errors, mm per rad for angular ones) times the basis value `b`
 //!   ([`simulation::model::Basis::values`] with the effect's carrier at the sample's
-//!   [`BasisContext`]: commands, motion, [`Record::tau`], [`Record::elapsed_s`], the axis
+//!   [`simulation::model::BasisContext`]: commands, motion, [`Record::tau`], [`Record::elapsed_s`], the axis
 //!   velocities of [`Record::velocities`] and the measured reading). The sensor offsets
 //!   `dx0 dy0 dz0` have gain `+1` in their own direction and 0 in the others.
 //! - Instrument terms `S<i><j>` (dimensionless) act on the reading, not on the machine: the row

@@ -74,7 +74,7 @@ fn program(c: &mut Criterion) {
     use formats::nc::{Dialect, WriteOptions, parse_program};
     use formats::poses::{axis_words, from_file_units, to_file_units};
     use report::json::read::parse_identification;
-    use report::json::{IdentificationReport, IdentificationSource, to_json};
+    use report::json::{CampaignSource, IdentificationReport, to_json};
     let m = model_spec::builtin("seed-ac").unwrap().unwrap();
     let truth = formats::truth::builtin_truth("seed-ac-demo", &m)
         .unwrap()
@@ -85,18 +85,23 @@ fn program(c: &mut Criterion) {
     model
         .terms
         .push(model_spec::terms::Term::parse(&m, "ECC@harmonic:2").unwrap());
-    let one =
-        simulation::campaign::Campaign::of_record(record.clone(), m.default_parameters(), false);
+    let k4_record = simulation::campaign::CampaignRecord::new(
+        "k4",
+        record.clone(),
+        m.default_parameters(),
+        "k4",
+        false,
+    );
+    let one = simulation::campaign::Campaign::new(vec![k4_record]).unwrap();
     let opts = IdentifyOptions::default().refined(RefineOptions::default());
     let fit = identify(&m, &model, &one, &opts).unwrap();
-    let refinement = fit.refinement.clone().unwrap();
-    let ident = fit.single_record(&m).unwrap();
-    let source = IdentificationSource {
-        data: "k4.csv",
+    let source = CampaignSource {
         label: "extended",
         base_model: None,
+        data: &["k4.csv".to_string()],
     };
-    let report = IdentificationReport::new(&m, source, &ident, Some(&refinement)).unwrap();
+    let report =
+        IdentificationReport::of_campaign(&m, source, &fit, fit.refinement.as_ref()).unwrap();
     let values = parse_identification("id.json", &to_json(&report).unwrap(), &m).unwrap();
     let (errors, _) = MachineErrors::from_values(&m, &values.values, &values.file).unwrap();
     // 10^5 blocks along K4, over and over.

@@ -7,13 +7,13 @@ use compensation::run::{CommandedPose, compensate_poses};
 use compensation::values::MachineErrors;
 use compensation::verify::machine_error_rms;
 use diagnosis::Diagnosis;
-use fitting::campaign::{CampaignIdentification, CampaignValues};
+use fitting::campaign::CampaignValues;
 use formats::poses::to_file_units;
 use model_spec::Machine;
 use model_spec::units::format_scaled;
 use report::inputs::Document;
 use report::json::compensate::{CompensationReport, CompensationSource};
-use report::json::{IdentificationReport, IdentificationSource, to_json};
+use report::json::{CampaignSource, IdentificationReport, to_json};
 use simulation::model::Model;
 use simulation::truth::Truth;
 
@@ -80,19 +80,19 @@ pub(crate) fn compensate_held_out(
         (base.clone(), REDUCED.to_string())
     };
     let k4 = &runs[0];
-    let (ident, refinement) = super::identify_refined(m, &model, &k4.record, "compensation")?;
-    let source = IdentificationSource {
-        data,
+    let fitted = super::identify_refined(m, &model, &k4.record, data, "compensation")?;
+    let data = [data.to_string()];
+    let source = CampaignSource {
         label: &label,
         base_model: Some(REDUCED),
+        data: &data,
     };
-    let report = IdentificationReport::new(m, source, &ident, Some(&refinement))
-        .map_err(failed("compensation"))?;
+    let report =
+        IdentificationReport::of_campaign(m, source, &fitted.campaign, Some(&fitted.refinement))
+            .map_err(failed("compensation"))?;
     let json = to_json(&report).map_err(failed("compensation"))?;
     // The values as identified, in process (the JSON above is the file the demo writes).
-    let record = CampaignIdentification::of_record(m, &ident, "k4", m.default_parameters())
-        .map_err(failed("compensation"))?;
-    let values = CampaignValues::of(&record);
+    let values = CampaignValues::of(&fitted.campaign);
     let (errors, left_out) = MachineErrors::from_values(m, &values, "identify-recommended.json")
         .map_err(failed("compensation"))?;
     files.push(DemoFile {

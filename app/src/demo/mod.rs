@@ -25,7 +25,7 @@ use formats::truth::builtin_truth;
 use model_spec::{FULL_MODEL, Machine};
 use report::inputs::Document;
 use report::json::{
-    DiagnosisReport, DiagnosisSource, IdentificationReport, IdentificationSource, ValidationReport,
+    CampaignSource, DiagnosisReport, DiagnosisSource, IdentificationReport, ValidationReport,
     ValidationSource, to_json,
 };
 use simulation::campaign::{Campaign, CampaignRecord};
@@ -102,25 +102,51 @@ fn failed<E: std::fmt::Display>(step: &'static str) -> impl Fn(E) -> DemoError {
     }
 }
 
-/// `model` of `m` identified on `record` alone (a campaign of one, on the default kinematic
-/// parameters) and refined against the exact machine: the fit in the model's terms and the
-/// refinement; `step` names the demo's step in an error.
+/// `model` identified on `record` (the file `data`: its record labelled by the file's stem,
+/// on a set-up of that label, at the machine's default parameters) as a campaign of one,
+/// refined against the exact machine; with what the refinement did and the fit in the
+/// model's own terms.
 pub(crate) fn identify_refined(
     m: &Machine,
     model: &Model,
     record: &Record,
+    data: &str,
     step: &'static str,
-) -> Result<(Identification, Refinement), DemoError> {
-    let campaign = Campaign::of_record(record.clone(), m.default_parameters(), false);
+) -> Result<Identified, DemoError> {
+    let label = formats::campaign::stem_label(std::path::Path::new(data));
+    let one = CampaignRecord::new(
+        label.clone(),
+        record.clone(),
+        m.default_parameters(),
+        label,
+        false,
+    );
+    let campaign = Campaign::new(vec![one]).map_err(failed(step))?;
     let opts = IdentifyOptions::default().refined(RefineOptions::default());
     let fit = identify(m, model, &campaign, &opts).map_err(failed(step))?;
-    match (fit.single_record(m), fit.refinement) {
-        (Some(ident), Some(refinement)) => Ok((ident, refinement)),
+    match (fit.single_record(m), fit.refinement.clone()) {
+        (Some(own), Some(refinement)) => Ok(Identified {
+            campaign: fit,
+            own,
+            refinement,
+        }),
         _ => Err(DemoError {
             step,
             message: "the campaign of one record gave no refined fit of it".into(),
         }),
     }
+}
+
+/// A record identified by [`identify_refined`].
+pub(crate) struct Identified {
+    /// The identification of its campaign of one: what reports, validation and compensation
+    /// take.
+    pub(crate) campaign: CampaignIdentification,
+    /// The same fit in the model's own terms (`XOW`, not `XOW[k4]`): what the text compares
+    /// with the truth.
+    pub(crate) own: Identification,
+    /// What the refinement did.
+    pub(crate) refinement: Refinement,
 }
 
 /// One simulated path.
@@ -179,18 +205,19 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
     let k4 = &runs[0];
 
     // 2. Identification on K4, refined against the exact machine.
-    let (ident, refinement) = identify_refined(&m, &model, &k4.record, "identification")?;
-    check_values(&m, &ident, &ValueLimits::default()).map_err(failed("identification"))?;
     let k4_file = path_of(&k4.file);
-    let identification = IdentificationReport::new(
+    let fitted = identify_refined(&m, &model, &k4.record, &k4_file, "identification")?;
+    let (ident, refinement) = (&fitted.own, &fitted.refinement);
+    check_values(&m, ident, &ValueLimits::default()).map_err(failed("identification"))?;
+    let identification = IdentificationReport::of_campaign(
         &m,
-        IdentificationSource {
-            data: &k4_file,
+        CampaignSource {
             label: REDUCED,
             base_model: Some(REDUCED),
+            data: std::slice::from_ref(&k4_file),
         },
-        &ident,
-        Some(&refinement),
+        &fitted.campaign,
+        Some(refinement),
     )
     .map_err(failed("identification"))?;
     files.push(DemoFile {
@@ -204,10 +231,7 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
     // Every path was measured on K4's ball set-up: each record on the fitted set-up.
     let exact = ValidateOptions::new().exact(true);
     let fitted_label = formats::campaign::stem_label(std::path::Path::new(&k4_file));
-    let values = CampaignValues::of(
-        &CampaignIdentification::of_record(&m, &ident, &fitted_label, m.default_parameters())
-            .map_err(failed("validation"))?,
-    );
+    let values = CampaignValues::of(&fitted.campaign);
     let mut validations = Vec::new();
     for r in &runs {
         let data = path_of(&r.file);
@@ -351,8 +375,8 @@ pub fn run(dir: &str) -> Result<Demo, DemoError> {
         m: &m,
         truth: &truth,
         runs: &runs,
-        ident: &ident,
-        refinement: &refinement,
+        ident,
+        refinement,
         identification: &identification,
         validations: &validations,
         hidden: &hidden,

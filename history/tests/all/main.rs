@@ -5,6 +5,8 @@
 mod common;
 #[path = "../../../fitting/tests/all/one_record.rs"]
 mod one_record;
+#[path = "../../../report/tests/all/one_report.rs"]
+mod one_report;
 
 mod store;
 mod trend;

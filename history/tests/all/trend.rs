@@ -466,8 +466,8 @@ fn truth_text(xoc: f64, noise_um: f64, seed: u64) -> String {
 
 #[test]
 fn the_real_pipeline_flags_a_drifting_location_error() {
+    use crate::one_report::{IdentificationSource, report_of_one};
     use fitting::{IdentifyOptions, RefineOptions};
-    use report::json::{IdentificationReport, IdentificationSource};
     use simulation::model::Model;
     use simulation::{builtin_path, simulate};
 
@@ -501,7 +501,7 @@ fn the_real_pipeline_flags_a_drifting_location_error() {
                 label: "reduced",
                 base_model: Some("reduced"),
             };
-            let report = IdentificationReport::new(&m, source, &ident, Some(&refinement)).unwrap();
+            let report = report_of_one(&m, source, &ident, Some(&refinement)).unwrap();
             let at = Timestamp(start().0 + 7 * 86_400 * (k - 1));
             let check = Check::from_identification(
                 &report,

@@ -44,9 +44,9 @@
 
 mod build;
 
+use super::Ordered;
 pub use super::fit_summary::{constraint_text, poly_stroke};
 use super::read::{ReportError, versioned};
-use super::{NonFinite, Ordered};
 use fitting::hmatrix::Backend;
 use serde::{Deserialize, Serialize};
 
@@ -324,34 +324,6 @@ pub fn backend_name(b: Backend) -> &'static str {
         Backend::Evaluator => "evaluator",
         Backend::Mixed => "mixed",
     }
-}
-
-/// Why the report of one record's identification cannot be made.
-#[derive(Debug, thiserror::Error)]
-pub enum RecordReportError {
-    /// A value, uncertainty or statistic that is not finite: the computation failed.
-    #[error(transparent)]
-    NonFinite(#[from] NonFinite),
-    /// The identification does not make a campaign of one record (its model does not fit the
-    /// machine, or the kinematic parameters are not one per symbol).
-    #[error("the record of {data}: {why}")]
-    Record {
-        /// The record's file.
-        data: String,
-        /// What does not fit.
-        why: String,
-    },
-}
-
-/// What an identification report of one record says besides the identification.
-#[derive(Clone, Copy, Debug)]
-pub struct IdentificationSource<'a> {
-    /// The measurement file fitted.
-    pub data: &'a str,
-    /// The model's label.
-    pub label: &'a str,
-    /// The machine's model it starts from (`--model`), if any.
-    pub base_model: Option<&'a str>,
 }
 
 /// What an identification report says besides the identification: the model's label and base

@@ -32,7 +32,7 @@ pub mod verdict;
 
 pub use diagnose::{DiagnosisReport, DiagnosisSource};
 pub use gains::{GainTableReport, PoseGains, PoseGainsReport};
-pub use identify::{CampaignSource, IdentificationReport, IdentificationSource};
+pub use identify::{CampaignSource, IdentificationReport};
 pub use read::{IdentifiedValues, ReportError, read_identification};
 pub use validate::{ValidationReport, ValidationSource};
 

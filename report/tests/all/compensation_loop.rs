@@ -12,6 +12,7 @@
 //! the table is not the machine's doing, and compensation leaves it alone.
 
 use crate::one_record::{identify_refined_one, validate_one};
+use crate::one_report::{IdentificationSource, report_of_one};
 use compensation::run::{CommandedPose, compensate_poses};
 use compensation::values::MachineErrors;
 use compensation::verify::machine_error_rms;
@@ -22,7 +23,7 @@ use formats::truth::builtin_truth;
 use model_spec::basis::BasisContext;
 use model_spec::{Machine, builtin};
 use report::json::read::parse_identification;
-use report::json::{IdentificationReport, IdentificationSource, to_json};
+use report::json::to_json;
 use simulation::exact::VirtualMachine;
 use simulation::model::{Effect, Model};
 use simulation::record::Record;
@@ -57,7 +58,7 @@ fn identified(m: &Machine, model: &Model, record: &Record) -> MachineErrors {
         &RefineOptions::default(),
     )
     .unwrap();
-    let report = IdentificationReport::new(
+    let report = report_of_one(
         m,
         IdentificationSource {
             data: "k4.csv",

@@ -4,6 +4,7 @@
 
 use crate::common;
 use crate::one_record::identify_refined_one;
+use crate::one_report::{IdentificationSource, report_of_one};
 
 use codegen::GainModel;
 use common::{Rng, builtin};
@@ -14,7 +15,7 @@ use fitting::{Constraint, IdentifyOptions, RefineOptions};
 use model_spec::Machine;
 use nalgebra::DVector;
 use report::json::read::parse_identification;
-use report::json::{IdentificationReport, IdentificationSource, IdentifiedValues, to_json};
+use report::json::{IdentifiedValues, to_json};
 use simulation::model::{Model, Term};
 use simulation::paths::{builtin_path, record_from_commands};
 use simulation::simulate;
@@ -230,7 +231,7 @@ fn zeroed_identification(constraint: Constraint) -> (Machine, IdentifiedValues) 
         label: "reduced",
         base_model: Some("reduced"),
     };
-    let report = IdentificationReport::new(&m, source, &ident, Some(&refinement)).unwrap();
+    let report = report_of_one(&m, source, &ident, Some(&refinement)).unwrap();
     let text = to_json(&report).unwrap();
     let id = parse_identification("k4.json", &text, &m).unwrap();
     (m, id)

@@ -8,6 +8,7 @@ mod common;
 mod diagnose_helpers;
 #[path = "../../../fitting/tests/all/one_record.rs"]
 mod one_record;
+mod one_report;
 
 mod compensation_loop;
 mod compensation_values;

@@ -9,6 +9,7 @@
 use crate::one_record::{
     identify_one, identify_refined_campaign, identify_refined_one, validate_one,
 };
+use crate::one_report::{IdentificationSource, report_of_one};
 use fitting::campaign::{CampaignValues, Owner};
 use fitting::hmatrix::h_matrix_auto;
 use fitting::noise::NoiseChoice;
@@ -17,7 +18,7 @@ use fitting::refine::RefineOptions;
 use fitting::{Identification, IdentifyOptions, ValidateOptions};
 use model_spec::{Machine, builtin, parse_machine};
 use report::json::read::parse_identification;
-use report::json::{IdentificationReport, IdentificationSource, to_json};
+use report::json::{IdentificationReport, to_json};
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::exact::VirtualMachine;
 use simulation::generator::{GeneratorOptions, find_test, generate_test, tests};
@@ -357,7 +358,7 @@ fn a_ball_position_is_not_separable_from_its_set_up_error() {
     .unwrap();
     assert_eq!(id.fit.rank, alone.fit.rank);
     // The report names the group and gives neither a value.
-    let report = IdentificationReport::new(
+    let report = report_of_one(
         &m,
         IdentificationSource {
             data: "rec.csv",
@@ -581,7 +582,7 @@ fn the_report_reads_back_and_validates_records_modelled_with_another_length() {
         label: "location + Zt",
         base_model: None,
     };
-    let report = IdentificationReport::new(&m, source, &id, Some(&r)).unwrap();
+    let report = report_of_one(&m, source, &id, Some(&r)).unwrap();
     let p = report.parameters.iter().find(|p| p.name == "Zt").unwrap();
     assert_eq!(p.unit, "um");
     assert_eq!(p.nominal_mm, Some(-250.0));
@@ -709,7 +710,7 @@ fn a_change_identified_at_another_value_is_read_back_against_the_default() {
         label: "location + Zt",
         base_model: None,
     };
-    let json = to_json(&IdentificationReport::new(&m, source, &id, Some(&r)).unwrap()).unwrap();
+    let json = to_json(&report_of_one(&m, source, &id, Some(&r)).unwrap()).unwrap();
     assert!(json.contains("\"nominal_mm\": -250.01"), "{json}");
     // Version 2: the record says it was modelled with Zt = -250.01, and the change is from it.
     let back = parse_identification("zt.json", &json, &m).unwrap();

@@ -4,6 +4,7 @@
 //! descriptions theirs in model-spec's `robustness.rs`.)
 
 use crate::one_record::identify_one;
+use crate::one_report::{IdentificationSource, report_of_one};
 use fitting::IdentifyOptions;
 use formats::truth::builtin_truth;
 use formats::truth::{BUILTIN_TRUTHS, TruthError};
@@ -11,7 +12,7 @@ use model_spec::Machine;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use report::json::read::parse_identification_bytes;
-use report::json::{IdentificationReport, IdentificationSource, ReportError, to_json};
+use report::json::{ReportError, to_json};
 use simulation::model::Model;
 use simulation::{builtin_path, simulate};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -184,7 +185,7 @@ fn report(m: &Machine) -> Vec<u8> {
         label: "reduced + ECC@harmonic:2",
         base_model: Some("reduced"),
     };
-    let r = IdentificationReport::new(m, source, &ident, None).unwrap();
+    let r = report_of_one(m, source, &ident, None).unwrap();
     to_json(&r).unwrap().into_bytes()
 }
 

@@ -3,6 +3,7 @@
 
 use crate::common;
 use crate::one_record::{identify_one, validate_one};
+use crate::one_report::{IdentificationSource, report_of_one};
 
 use common::{Rng, builtin};
 use fitting::IdentifyOptions;
@@ -12,10 +13,7 @@ use fitting::validate::{Unidentified, ValidateError, ValidateOptions, statistics
 use model_spec::Machine;
 use nalgebra::DVector;
 use report::json::read::parse_identification;
-use report::json::{
-    IdentificationReport, IdentificationSource, ReportError, ValidationReport, ValidationSource,
-    read_identification,
-};
+use report::json::{ReportError, ValidationReport, ValidationSource, read_identification};
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::{Model, Term};
 use simulation::record::{Record, Sample, motion_directions};
@@ -252,7 +250,7 @@ fn identify_json_has_the_fields_and_reads_back() {
         label: "reduced+",
         base_model: Some("reduced"),
     };
-    let report = IdentificationReport::new(&m, source, &ident, None).unwrap();
+    let report = report_of_one(&m, source, &ident, None).unwrap();
     let text = serde_json::to_string_pretty(&report).unwrap();
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     for key in [

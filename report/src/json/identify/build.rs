@@ -1,16 +1,14 @@
-//! The identification report built from an identification: of a campaign
-//! ([`IdentificationReport::of_campaign`]), or of one record's
-//! ([`IdentificationReport::new`], [`IdentificationReport::of_record`]: its campaign of one).
+//! The identification report built from the identification of a campaign (a record is a
+//! campaign of one): [`IdentificationReport::of_campaign`].
 
 use super::super::fit_summary::{
     fit_report, noise_report, notes, parameter_report, refinement_report,
 };
 use super::super::{NonFinite, Ordered, finite};
 use super::{
-    CAMPAIGN_KIND, CampaignSource, ClockReport, IdentificationReport, IdentificationSource,
-    REPORT_VERSION, RecordReport, RecordReportError, SetupReport, SwallowedReport, backend_name,
+    CAMPAIGN_KIND, CampaignSource, ClockReport, IdentificationReport, REPORT_VERSION, RecordReport,
+    SetupReport, SwallowedReport, backend_name,
 };
-use fitting::Identification;
 use fitting::campaign::{CampaignIdentification, Owner};
 use fitting::hmatrix::parameter_name;
 use fitting::refine::Refinement;
@@ -18,64 +16,6 @@ use model_spec::Machine;
 use model_spec::units::UM_PER_MM;
 
 impl IdentificationReport {
-    /// The report of `ident`, one record identified on machine `m` at the machine's default
-    /// kinematic parameters, except the symbols identified as terms (`Zt`), at the values the
-    /// identification modelled them with; see [`IdentificationReport::of_record`].
-    ///
-    /// # Errors
-    /// As [`IdentificationReport::of_record`].
-    pub fn new(
-        m: &Machine,
-        source: IdentificationSource,
-        ident: &Identification,
-        refinement: Option<&Refinement>,
-    ) -> Result<IdentificationReport, RecordReportError> {
-        let mut params = m.default_parameters();
-        for (j, (t, _)) in ident.model.columns().into_iter().enumerate() {
-            if let (Some(s), Some(Some(v))) = (
-                ident.model.terms[t].effect.symbol(),
-                ident.nominal_mm.get(j),
-            ) {
-                params[s] = *v;
-            }
-        }
-        IdentificationReport::of_record(m, source, ident, params, refinement)
-    }
-
-    /// The report of `ident`, one record identified on machine `m` at the kinematic parameters
-    /// `params` (mm, symbol order): the campaign of that record (labelled by the stem of its
-    /// file, on a set-up of that label) reported by [`IdentificationReport::of_campaign`].
-    ///
-    /// # Errors
-    /// [`RecordReportError::NonFinite`] when a value, uncertainty or statistic is not finite;
-    /// [`RecordReportError::Record`] when the identification's model does not fit `m` or
-    /// `params` are not one per symbol.
-    pub fn of_record(
-        m: &Machine,
-        source: IdentificationSource,
-        ident: &Identification,
-        params: Vec<f64>,
-        refinement: Option<&Refinement>,
-    ) -> Result<IdentificationReport, RecordReportError> {
-        let label = formats::campaign::stem_label(std::path::Path::new(source.data));
-        let campaign =
-            CampaignIdentification::of_record(m, ident, &label, params).map_err(|e| {
-                RecordReportError::Record {
-                    data: source.data.to_string(),
-                    why: e.to_string(),
-                }
-            })?;
-        let data = [source.data.to_string()];
-        let source = CampaignSource {
-            label: source.label,
-            base_model: source.base_model,
-            data: &data,
-        };
-        Ok(IdentificationReport::of_campaign(
-            m, source, &campaign, refinement,
-        )?)
-    }
-
     /// The report of `ident` on machine `m`, refined as `refinement` says (`None`: first
     /// order): a record's report when it has one record, a campaign's otherwise (see the module
     /// documentation).

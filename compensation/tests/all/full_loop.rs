@@ -31,16 +31,22 @@ fn seeds() -> Vec<u64> {
         .unwrap_or_else(|| vec![1, 2, 3])
 }
 
-/// The study at every seed, printed.
+/// The study at every seed (the seeds on threads of their own: each is a whole campaign's
+/// identification, diagnosis and compensation), printed in seed order.
 fn studies() -> Vec<study::Study> {
-    seeds()
-        .into_iter()
-        .map(|seed| {
-            let s = study::run(seed);
-            eprint!("{}", study::text(&s));
-            s
-        })
-        .collect()
+    let studies: Vec<study::Study> = std::thread::scope(|scope| {
+        let runs: Vec<_> = seeds()
+            .into_iter()
+            .map(|seed| scope.spawn(move || study::run(seed)))
+            .collect();
+        runs.into_iter()
+            .map(|r| r.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    });
+    for s in &studies {
+        eprint!("{}", study::text(s));
+    }
+    studies
 }
 
 /// The loop at every seed (the set-up of the new ball refitted): the reduced model takes at

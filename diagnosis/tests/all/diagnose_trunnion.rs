@@ -109,6 +109,19 @@ fn campaign(m: &Machine, tests: &[&str], seed: u64, ebb: Option<&str>) -> Campai
     Campaign::new(records).unwrap()
 }
 
+/// [`run`] at noise seeds 1 to 5, each on a thread of its own (a whole campaign's diagnosis
+/// each), in seed order.
+fn run_seeds(m: &Machine, tests: &[&str], ebb: Option<&str>) -> Vec<(u64, Diagnosis)> {
+    std::thread::scope(|scope| {
+        let runs: Vec<_> = (1..=5)
+            .map(|seed| scope.spawn(move || (seed, run(m, tests, seed, ebb))))
+            .collect();
+        runs.into_iter()
+            .map(|r| r.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    })
+}
+
 fn run(m: &Machine, tests: &[&str], seed: u64, ebb: Option<&str>) -> Diagnosis {
     let base = Model::of(m, "location").unwrap();
     let mut o = DiagnoseOptions::default();
@@ -214,8 +227,7 @@ fn urad(d: &Diagnosis, name: &str) -> Option<(f64, f64)> {
 #[test]
 fn the_trunnion_campaign_names_b_s_error_or_says_it_cannot_tell_it_from_a_drift() {
     let m = machine();
-    for seed in 1..=5 {
-        let d = run(&m, &["turn-B", "turn-C", "pair-B-C"], seed, None);
+    for (seed, d) in run_seeds(&m, &["turn-B", "turn-C", "pair-B-C"], None) {
         report(&m, seed, &d);
         names_b_or_says_it_cannot(&m, &d).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         // Where B's error is the finding and nothing is left undecided, the trunnion's location
@@ -239,13 +251,7 @@ fn the_trunnion_campaign_names_b_s_error_or_says_it_cannot_tell_it_from_a_drift(
 #[test]
 fn with_turn_b_there_and_back_in_the_campaign_b_s_error_is_named() {
     let m = machine();
-    for seed in 1..=5 {
-        let d = run(
-            &m,
-            &["turn-B", "turn-B-back", "turn-C", "pair-B-C"],
-            seed,
-            None,
-        );
+    for (seed, d) in run_seeds(&m, &["turn-B", "turn-B-back", "turn-C", "pair-B-C"], None) {
         report(&m, seed, &d);
         assert!(
             d.findings.iter().any(|f| is_b_error(&m, &f.term)),

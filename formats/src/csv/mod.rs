@@ -50,6 +50,7 @@ mod blocks;
 pub(crate) mod checks;
 pub(crate) mod lines;
 pub(crate) mod read;
+mod rows;
 mod whole;
 mod write;
 

@@ -1,7 +1,8 @@
 //! The whole-file reader: every sample of a measurement or path CSV in one [`Record`].
 
 use crate::csv::lines::Lines;
-use crate::csv::read::{header_only, is_data, read_header};
+use crate::csv::read::{header_only, read_header};
+use crate::csv::rows::parse_rows;
 use crate::csv::{CsvError, Ctx, Need, ReadOptions};
 use model_spec::Machine;
 use simulation::paths::record_from_commands;
@@ -43,20 +44,20 @@ pub fn read_csv<R: Read>(
     let cx = Ctx { file };
     let mut lines = Lines::new(reader, opts);
     let header = read_header(&cx, &mut lines, m, need)?;
-    let (mut commands, mut times, mut measured, mut row_lines) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let mut last_t = None;
+    let parsed = parse_rows(&cx, &mut lines, &header, m)?;
+    let row_lines = parsed.lines;
+    let n = parsed.rows.len();
+    let (mut commands, mut times, mut measured) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
     let mut timed = true;
-    while let Some((line, text)) = lines.next_line(&cx)? {
-        if !is_data(text) {
-            continue;
-        }
-        let (c, t, d) = header.row(&cx, line, text, m, &mut last_t)?;
+    for (c, t, d) in parsed.rows {
         timed &= t.is_some();
         times.push(t.unwrap_or(commands.len() as f64));
         commands.push(c);
         measured.push(d);
-        row_lines.push(line);
     }
     if commands.is_empty() {
         return Err(header_only(&cx, &header));

@@ -79,8 +79,8 @@ impl<'m> SampleChecks<'m> {
         let vm = VirtualMachine::new(nominal);
         let tol = self.opts.on_ball_tolerance_mm;
         let mut off = Offenders::default();
-        for (c, &line) in commands.iter().zip(lines) {
-            let d = vm.nominal_error_vector(c, params).position.norm();
+        let distances = off_ball_distances(&vm, commands, params);
+        for (&d, &line) in distances.iter().zip(lines) {
             if !at_most(d, tol) {
                 off.add(line, || {
                     if d.is_finite() {
@@ -247,6 +247,34 @@ fn at_most(x: f64, bound: f64) -> bool {
     x <= bound
 }
 
+/// Samples per thread at least when the distances of [`off_ball_distances`] are shared out.
+const SAMPLES_PER_THREAD: usize = 50_000;
+
+/// Per sample, the distance (mm) between the nominal tool point and the nominal workpiece point
+/// at its commands: on up to [`std::thread::available_parallelism`] threads for a long record
+/// (each sample's on its own; the same numbers however cut).
+fn off_ball_distances(vm: &VirtualMachine, commands: &[Vec<f64>], params: &[f64]) -> Vec<f64> {
+    let distance = |c: &Vec<f64>| vm.nominal_error_vector(c, params).position.norm();
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(commands.len() / SAMPLES_PER_THREAD)
+        .max(1);
+    if threads == 1 {
+        return commands.iter().map(distance).collect();
+    }
+    let part = commands.len().div_ceil(threads);
+    std::thread::scope(|s| {
+        let parts: Vec<_> = commands
+            .chunks(part)
+            .map(|chunk| s.spawn(move || chunk.iter().map(distance).collect::<Vec<f64>>()))
+            .collect();
+        parts
+            .into_iter()
+            .flat_map(|p| p.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -281,5 +309,31 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The distances of a record long enough for several threads are those of one sample
+    /// after another, in order.
+    #[test]
+    fn off_ball_distances_on_several_threads_are_those_of_one() {
+        let m = model_spec::builtin("seed-ac").unwrap().unwrap();
+        let vm = VirtualMachine::new(&m);
+        let params = m.default_parameters();
+        let mut rng = Rng::new(3);
+        let commands: Vec<Vec<f64>> = (0..2 * SAMPLES_PER_THREAD + 17)
+            .map(|_| {
+                m.axes
+                    .iter()
+                    .map(|a| match a.kind {
+                        AxisKind::Linear => 300.0 * rng.normal(),
+                        AxisKind::Rotary => 3.0 * rng.normal(),
+                    })
+                    .collect()
+            })
+            .collect();
+        let one: Vec<f64> = commands
+            .iter()
+            .map(|c| vm.nominal_error_vector(c, &params).position.norm())
+            .collect();
+        assert_eq!(off_ball_distances(&vm, &commands, &params), one);
     }
 }

@@ -319,7 +319,7 @@ fn fit_system(
     let chosen = choose_campaign_noise_weighted(noise, &ordinary, &design.rows, w)?;
     // The generalized fit reuses the ordinary factorisation: only the whitened H is new.
     let (fit, whitened_sigma) = factored
-        .under_for_readings(h, &y, &names, c, t, &chosen)?
+        .under(h, Some(&y), &names, c, t, &chosen)?
         .fit(h, &y)?;
     let mut ident = CampaignIdentification::new(m, model, design, to_layout_order(fit, order));
     ident.noise = chosen;

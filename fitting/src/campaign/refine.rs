@@ -245,7 +245,7 @@ pub(crate) fn identify_refined(
     }
     let weights = super::whitening(campaign, noise)?;
     let chosen = choose_campaign_noise_weighted(noise, &ident.fit, &design.rows, weights.as_ref())?;
-    let under = factored.under(h, names, c, t, &chosen)?;
+    let under = factored.under(h, None, names, c, t, &chosen)?;
     let r = run.refine(&mut ident, Some(&chosen), Some(&under))?;
     ident.noise = chosen;
     r.converged()?;

@@ -366,11 +366,16 @@ impl<'a> RowsFactored<'a> {
     /// and `tol` its arguments): as [`RowsFactored::new`] makes them with `noise`, the
     /// factorisation of the ordinary H (or the weighted H) taken from `self`, not made again.
     ///
+    /// With the readings `y` (mm) of the fit to come, the whitened H folds them along
+    /// (whitened), so that [`RowsFactored::fit`] of `y` makes no second pass over its rows
+    /// (without per-sample weights; with them, `y` is folded when fitted).
+    ///
     /// # Errors
     /// As [`WhitenedFactored::new`]; [`EstimateError::Shape`] when `self` is not ordinary.
     pub fn under(
         &self,
         h: &DMatrix<f64>,
+        y: Option<&DVector<f64>>,
         names: &[String],
         constraint: &Constraint,
         tol: &Tolerances,
@@ -381,30 +386,7 @@ impl<'a> RowsFactored<'a> {
             constraint,
             tol,
         };
-        self.under_with(setup, h, None, noise)
-    }
-
-    /// [`RowsFactored::under`] for the fit of the readings `y` (mm): the whitened H folds them
-    /// along (whitened), so that [`RowsFactored::fit`] of `y` makes no second pass over its
-    /// rows (without per-sample weights; with them, `y` is folded when fitted).
-    ///
-    /// # Errors
-    /// As [`RowsFactored::under`].
-    pub(crate) fn under_for_readings(
-        &self,
-        h: &DMatrix<f64>,
-        y: &DVector<f64>,
-        names: &[String],
-        constraint: &Constraint,
-        tol: &Tolerances,
-        noise: &'a NoiseModel,
-    ) -> Result<RowsFactored<'a>, EstimateError> {
-        let setup = Setup {
-            names,
-            constraint,
-            tol,
-        };
-        let y = self.weighted.is_none().then_some(y);
+        let y = y.filter(|_| self.weighted.is_none());
         self.under_with(setup, h, y, noise)
     }
 

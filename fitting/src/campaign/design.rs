@@ -490,6 +490,61 @@ pub fn design_matrix(
     model: &Model,
     campaign: &Campaign,
 ) -> Result<Design, EstimateError> {
+    design_in(m, model, campaign, |layout| {
+        (0..layout.columns.len()).collect()
+    })
+}
+
+/// A design's H with its columns in the order they are solved ([`Layout::solve_order`]), and
+/// their names.
+#[derive(Clone, Debug)]
+pub(crate) struct Solved {
+    /// H, column `k` the layout column `order[k]`.
+    pub(crate) h: DMatrix<f64>,
+    /// The columns' names, in that order.
+    pub(crate) names: Vec<String>,
+    /// Entry `k`: the layout column solved `k`-th.
+    pub(crate) order: Vec<usize>,
+}
+
+impl Solved {
+    /// The columns of `design` copied into solve order, for a caller that keeps the design.
+    pub(crate) fn copied(design: &Design) -> Solved {
+        let order = design.layout.solve_order();
+        Solved {
+            h: design.h.select_columns(&order),
+            names: order.iter().map(|&c| design.names[c].clone()).collect(),
+            order,
+        }
+    }
+
+    /// The design of `model` on `campaign` for a fit that does not keep it: its H built in
+    /// solve order from the start (a campaign of one record is its record's H as computed, no
+    /// column moved), and the design without its H (left 0 × 0: the layout, names and rows).
+    ///
+    /// # Errors
+    /// As [`design_matrix`].
+    pub(crate) fn design(
+        m: &Machine,
+        model: &Model,
+        campaign: &Campaign,
+    ) -> Result<(Design, Solved), EstimateError> {
+        let mut design = design_in(m, model, campaign, Layout::solve_order)?;
+        let order = design.layout.solve_order();
+        let h = std::mem::replace(&mut design.h, DMatrix::zeros(0, 0));
+        let names = order.iter().map(|&c| design.names[c].clone()).collect();
+        Ok((design, Solved { h, names, order }))
+    }
+}
+
+/// [`design_matrix`] with the columns of its H in the order `order` gives for the layout
+/// (entry `k`: the layout column put `k`-th); `names` and `owners` stay in layout order.
+fn design_in(
+    m: &Machine,
+    model: &Model,
+    campaign: &Campaign,
+    order: impl FnOnce(&Layout) -> Vec<usize>,
+) -> Result<Design, EstimateError> {
     let layout = Layout::new(m, model, campaign)?;
     let mut sources = Sources {
         errors: model.errors(),
@@ -507,7 +562,8 @@ pub fn design_matrix(
         })?;
         blocks.push(block);
     }
-    let h = stack(&layout, blocks, rows);
+    let order = order(&layout);
+    let h = stack(&layout, blocks, rows, &order);
     Ok(Design {
         h,
         names: layout.names(),
@@ -518,19 +574,30 @@ pub fn design_matrix(
     })
 }
 
-/// The records' H matrices (`blocks`, each in its record's model order) stacked into the
-/// design matrix of `layout` (`rows` rows): a campaign of one record is its block with the
-/// columns put in layout order (one copy, no pass of zeros first); several records are copied
-/// into a zero matrix, each into its own columns.
-fn stack(layout: &Layout, mut blocks: Vec<DMatrix<f64>>, rows: usize) -> DMatrix<f64> {
+/// The records' H matrices (`blocks`, each in its record's model order) stacked into one
+/// matrix of `rows` rows whose column `k` is layout column `order[k]`: a campaign of one
+/// record is its block with the columns put in that order in place (no copy, no pass of zeros;
+/// in solve order nothing moves); several records are copied into a zero matrix, each into its
+/// own columns.
+fn stack(
+    layout: &Layout,
+    mut blocks: Vec<DMatrix<f64>>,
+    rows: usize,
+    order: &[usize],
+) -> DMatrix<f64> {
     let n = layout.columns.len();
+    // Where each layout column goes.
+    let mut to = vec![0; n];
+    for (k, &c) in order.iter().enumerate() {
+        to[c] = k;
+    }
     if let (1, [record]) = (blocks.len(), layout.records.as_slice())
         && record.columns.len() == n
     {
-        // Layout column `c` is the block's column `k` with `record.columns[k] == c`.
+        // Column `k` is the block's column `from[k]`.
         let mut from = vec![0; n];
-        for (k, &c) in record.columns.iter().enumerate() {
-            from[c] = k;
+        for (j, &c) in record.columns.iter().enumerate() {
+            from[to[c]] = j;
         }
         let mut h = blocks.pop().unwrap_or_else(|| DMatrix::zeros(rows, n));
         permute_columns(&mut h, &from);
@@ -539,9 +606,9 @@ fn stack(layout: &Layout, mut blocks: Vec<DMatrix<f64>>, rows: usize) -> DMatrix
     let mut h = DMatrix::zeros(rows, n);
     let mut at = 0;
     for (block, record) in blocks.iter().zip(&layout.records) {
-        for (k, &c) in record.columns.iter().enumerate() {
-            h.view_mut((at, c), (block.nrows(), 1))
-                .copy_from(&block.column(k));
+        for (j, &c) in record.columns.iter().enumerate() {
+            h.view_mut((at, to[c]), (block.nrows(), 1))
+                .copy_from(&block.column(j));
         }
         at += block.nrows();
     }
@@ -551,7 +618,7 @@ fn stack(layout: &Layout, mut blocks: Vec<DMatrix<f64>>, rows: usize) -> DMatrix
 /// Puts the columns of `h` in the order `from` says, in place (column `c` becomes the column
 /// that was `from[c]`; `from` a permutation of `0..h.ncols()`): by swaps of whole columns, so
 /// that a tall H is never held twice.
-pub(crate) fn permute_columns(h: &mut DMatrix<f64>, from: &[usize]) {
+fn permute_columns(h: &mut DMatrix<f64>, from: &[usize]) {
     let n = h.ncols();
     debug_assert_eq!(from.len(), n);
     // `at[p]`: the original column now at position p; `pos[j]`: where original column j is.

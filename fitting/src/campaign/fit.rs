@@ -6,7 +6,7 @@
 //! [`CampaignIdentification::single_record`] gives its fit back in that order, named as the
 //! record's model names it (`XOW`, not `XOW[k4]`).
 
-use super::design::{Design, Layout, Owner, design_matrix, measurements, permute_columns};
+use super::design::{Design, Layout, Owner, Solved, measurements};
 use super::names::single_record_names;
 use crate::factored::{RowsFactored, check_readings_of};
 use crate::hmatrix::Backend;
@@ -153,14 +153,6 @@ pub(crate) fn to_solve_order(x: &[f64], order: &[usize]) -> Vec<f64> {
     order.iter().map(|&c| x[c]).collect()
 }
 
-/// The design matrix's columns in solve `order`, and their names.
-pub(crate) fn solve_system(design: &Design, order: &[usize]) -> (DMatrix<f64>, Vec<String>) {
-    (
-        design.h.select_columns(order),
-        order.iter().map(|&c| design.names[c].clone()).collect(),
-    )
-}
-
 /// The noise model of `choice` for an ordinary campaign fit with `residual` (mm, the records'
 /// rows in order, `rows` samples each) and σ̂ `sigma` (mm): as
 /// [`crate::choose_noise`], the estimate pooled over the records.
@@ -242,20 +234,8 @@ pub fn identify(
     if let Some(refine) = &opts.refine {
         return super::refine::identify_refined(m, model, campaign, &opts, refine);
     }
-    let mut design = design_matrix(m, model, campaign)?;
-    // The design is not kept: its H is put in solve order in place rather than copied.
-    let order = design.layout.solve_order();
-    let mut h = std::mem::replace(&mut design.h, DMatrix::zeros(0, 0));
-    permute_columns(&mut h, &order);
-    let names = order.iter().map(|&c| design.names[c].clone()).collect();
-    Ok(fit_system(
-        m,
-        model,
-        campaign,
-        &design,
-        (&h, names, &order),
-        &opts,
-    )?)
+    let (design, solved) = Solved::design(m, model, campaign)?;
+    Ok(fit_system(m, model, campaign, &design, &solved, &opts)?)
 }
 
 /// Refuses options that belong to the records in a campaign.
@@ -284,21 +264,20 @@ pub fn fit_design(
     design: &Design,
     opts: &IdentifyOptions,
 ) -> Result<CampaignIdentification, EstimateError> {
-    let order = design.layout.solve_order();
-    let (h, names) = solve_system(design, &order);
-    fit_system(m, model, campaign, design, (&h, names, &order), opts)
+    fit_system(m, model, campaign, design, &Solved::copied(design), opts)
 }
 
-/// [`fit_design`] with the design's H already in solve `order` (`h`, its columns named by
-/// `names`): the design gives the layout and the records' rows, not its H.
+/// [`fit_design`] with the design's H in solve order (`solved`): the design gives the layout
+/// and the records' rows, not its H.
 fn fit_system(
     m: &Machine,
     model: &Model,
     campaign: &Campaign,
     design: &Design,
-    (h, names, order): (&DMatrix<f64>, Vec<String>, &[usize]),
+    solved: &Solved,
     opts: &IdentifyOptions,
 ) -> Result<CampaignIdentification, EstimateError> {
+    let Solved { h, names, order } = solved;
     let noise = &opts.noise;
     check_options(opts)?;
     let samples = campaign.samples();
@@ -306,9 +285,9 @@ fn fit_system(
     let y = measurements(campaign)?;
     let weights = super::whitening(campaign, noise)?;
     let (c, t) = (&opts.constraint, &opts.tolerances);
-    check_readings_of(h, &y, &names)?;
+    check_readings_of(h, &y, names)?;
     let w = weights.as_ref();
-    let factored = RowsFactored::for_readings(h, &y, &names, c, t, None, &design.rows, w)?;
+    let factored = RowsFactored::for_readings(h, &y, names, c, t, None, &design.rows, w)?;
     let (ordinary, weighted_sigma) = factored.fit(h, &y)?;
     if *noise == NoiseChoice::Ordinary {
         let ordinary = (ordinary, weighted_sigma);
@@ -319,7 +298,7 @@ fn fit_system(
     let chosen = choose_campaign_noise_weighted(noise, &ordinary, &design.rows, w)?;
     // The generalized fit reuses the ordinary factorisation: only the whitened H is new.
     let (fit, whitened_sigma) = factored
-        .under(h, Some(&y), &names, c, t, &chosen)?
+        .under(h, Some(&y), names, c, t, &chosen)?
         .fit(h, &y)?;
     let mut ident = CampaignIdentification::new(m, model, design, to_layout_order(fit, order));
     ident.noise = chosen;

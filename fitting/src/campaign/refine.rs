@@ -5,10 +5,10 @@
 //! [`super::clock::own_clock_terms`]).
 
 use super::clock::own_clock_terms;
-use super::design::{Design, design_matrix, measurements, permute_columns};
+use super::design::{Design, Solved, measurements};
 use super::fit::{
     CampaignIdentification, check_options, choose_campaign_noise_weighted, ordinary_identification,
-    solve_system, to_layout_order, to_solve_order,
+    to_layout_order, to_solve_order,
 };
 use crate::factored::{RowsFactored, check_readings_of};
 use crate::identify::check_readings;
@@ -67,27 +67,12 @@ struct System {
 impl System {
     /// The system of `design` (its H copied into solve order).
     fn new(campaign: &Campaign, design: &Design) -> Result<System, IdentifyError> {
-        let order = design.layout.solve_order();
-        let (h, names) = solve_system(design, &order);
-        System::of(campaign, order, h, names)
+        System::of(campaign, Solved::copied(design))
     }
 
-    /// The system of `design`, its H moved out (left empty) and put in solve order in place:
-    /// for a design nobody keeps, so that a tall H is held once.
-    fn taking(campaign: &Campaign, design: &mut Design) -> Result<System, IdentifyError> {
-        let order = design.layout.solve_order();
-        let mut h = std::mem::replace(&mut design.h, DMatrix::zeros(0, 0));
-        permute_columns(&mut h, &order);
-        let names = order.iter().map(|&c| design.names[c].clone()).collect();
-        System::of(campaign, order, h, names)
-    }
-
-    fn of(
-        campaign: &Campaign,
-        order: Vec<usize>,
-        h: DMatrix<f64>,
-        names: Vec<String>,
-    ) -> Result<System, IdentifyError> {
+    /// The system of the design's H in solve order (`solved`).
+    fn of(campaign: &Campaign, solved: Solved) -> Result<System, IdentifyError> {
+        let Solved { h, names, order } = solved;
         let coordinates = campaign
             .records
             .iter()
@@ -219,9 +204,9 @@ pub(crate) fn identify_refined(
 ) -> Result<CampaignIdentification, IdentifyError> {
     let noise = &opts.noise;
     check_options(opts)?;
-    let mut design = design_matrix(m, model, campaign)?;
+    let (design, solved) = Solved::design(m, model, campaign)?;
     check_readings(campaign.samples(), design.names.len())?;
-    let system = System::taking(campaign, &mut design)?;
+    let system = System::of(campaign, solved)?;
     let (h, names, y) = (&system.h, &system.names, &system.y);
     let (c, t) = (&opts.constraint, &opts.tolerances);
     check_readings_of(h, y, names)?;

@@ -25,8 +25,9 @@
 //! determine gets no uncertainty.
 
 use crate::campaign::Owner;
+use crate::campaign::design::Solved;
 use crate::campaign::design::{Design, Layout, design_matrix};
-use crate::campaign::fit::{solve_system, to_layout_order};
+use crate::campaign::fit::to_layout_order;
 use crate::identifiability::NearPair;
 use crate::identify::check_readings;
 use crate::least_squares::{
@@ -113,8 +114,7 @@ pub fn predict_design(
     noise.check()?;
     let samples: usize = design.rows.iter().sum();
     check_readings(samples, design.names.len())?;
-    let order = design.layout.solve_order();
-    let (h, names) = solve_system(design, &order);
+    let Solved { h, names, order } = Solved::copied(design);
     let rows = h.nrows();
     let zero = DVector::zeros(rows);
     let ordinary = least_squares(&h, &zero, &names, &Constraint::None, tol)?;

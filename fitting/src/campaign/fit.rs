@@ -213,14 +213,14 @@ pub fn choose_campaign_noise_weighted(
 }
 
 /// Identifies `model` of `m` on `campaign` (a record is a campaign of one): the design matrix
-/// with the best gain sources ([`design_matrix`]), the first-order fit ([`fit_design`]) under
+/// with the best gain sources ([`super::design::design_matrix`]), the first-order fit ([`fit_design`]) under
 /// the options' noise model, and, when the options ask for it ([`IdentifyOptions::refine`]),
 /// its refinement against the exact machine ([`CampaignIdentification::refinement`]). A
 /// constraint of a campaign of one record may name the record's columns as the record's model
 /// does (`XOW`, `dx0`: [`single_record_names`]).
 ///
 /// # Errors
-/// As [`design_matrix`] and [`fit_design`]; [`IdentifyError::NotConverged`] when a refinement
+/// As [`super::design::design_matrix`] and [`fit_design`]; [`IdentifyError::NotConverged`] when a refinement
 /// does not converge (its values are no identification).
 pub fn identify(
     m: &Machine,

@@ -2,6 +2,7 @@
 //! the work: the same results, bit for bit, as a loop that does them one after the other
 //! (each piece computes alone; nothing is summed across pieces here).
 
+use model_spec::parallel;
 use std::thread;
 
 /// `f` of every item, in the order of `items`, computed on up to
@@ -42,26 +43,13 @@ pub(crate) fn for_each_column(data: &mut [f64], n: usize, f: impl Fn(&mut [f64])
         return;
     }
     let columns = data.len() / n;
-    let workers = thread::available_parallelism()
-        .map_or(1, |w| w.get())
-        .min(columns / MIN_COLUMNS)
-        .max(1);
-    let run = columns.div_ceil(workers) * n;
-    let f = &f;
-    let each = move |part: &mut [f64]| part.chunks_exact_mut(n).for_each(f);
+    let workers = parallel::threads_for(columns, MIN_COLUMNS);
+    let each = |part: &mut [f64]| part.chunks_exact_mut(n).for_each(&f);
     if workers == 1 {
         return each(data);
     }
-    thread::scope(|s| {
-        let mut parts = data.chunks_mut(run);
-        let first = parts.next();
-        for part in parts {
-            s.spawn(move || each(part));
-        }
-        if let Some(part) = first {
-            each(part);
-        }
-    });
+    let run = columns.div_ceil(workers) * n;
+    parallel::map_parts(data.chunks_mut(run).collect(), each);
 }
 
 /// `f` of the items `first`, `first + step`, …, with their indices.

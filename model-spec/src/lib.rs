@@ -12,7 +12,8 @@
 //! the `file:line:column` every message names; [`write`](mod@write) gives a machine's text and appends a
 //! model to it; [`Machine::fingerprint`] tells whether two descriptions are the same machine;
 //! [`Machine::check_pose`] checks commands against the strokes and ranges; [`describe`] writes
-//! a machine for people.
+//! a machine for people. Beside it, for every reader: [`sha256`] hashes the files read, and
+//! [`parallel`] shares the work of a long record out over the cores.
 //!
 //! Units: offsets and linear commands in mm, rotary commands in degrees at every boundary a
 //! person sees (radians inside), translational errors in mm inside (µm for people), angular
@@ -72,6 +73,7 @@ pub mod kinematics;
 pub mod limits;
 pub mod locate;
 pub mod machine;
+pub mod parallel;
 pub mod pose;
 mod raw;
 pub mod sha256;

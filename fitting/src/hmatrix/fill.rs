@@ -4,10 +4,9 @@
 
 use super::{Gain, GainSource, HMatrixError, check_sample, parameter_name};
 use crate::offsets::OffsetGains;
-use model_spec::Machine;
+use model_spec::{Machine, parallel};
 use simulation::model::{Basis, BasisContext, Carrier, Model};
 use simulation::record::Record;
-use std::thread;
 
 /// Samples per thread at least: a shorter record is filled on the calling thread alone (a
 /// thread costs more than the rows it would fill).
@@ -15,10 +14,7 @@ pub(super) const SAMPLES_PER_THREAD: usize = 50_000;
 
 /// The threads to fill `samples` on: one per core, each with [`SAMPLES_PER_THREAD`] at least.
 pub(super) fn threads_for(samples: usize) -> usize {
-    thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(samples / SAMPLES_PER_THREAD)
-        .max(1)
+    parallel::threads_for(samples, SAMPLES_PER_THREAD)
 }
 
 /// What every sample's rows are made from: the machine, the model and its columns, the record
@@ -71,27 +67,20 @@ impl Rows<'_> {
                 rest = others;
             }
         }
-        let mut parts = parts.into_iter();
-        let Some(mut first) = parts.next() else {
-            return Ok(());
-        };
-        thread::scope(|s| {
-            let others: Vec<_> = parts
-                .enumerate()
-                .map(|(p, mut part)| {
-                    let mut own = source.clone();
-                    let start = bounds[p + 1];
-                    let end = bounds[p + 2];
-                    s.spawn(move || self.fill_samples(start..end, &mut part, &mut own))
-                })
-                .collect();
-            self.fill_samples(bounds[0]..bounds[1], &mut first, source)?;
-            for t in others {
-                t.join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
-            }
-            Ok(())
+        if threads == 1 {
+            return self.fill_samples(0..n, &mut parts[0], source);
+        }
+        // Each part with its own copy of the source (its buffers are written per sample).
+        let parts: Vec<_> = parts
+            .into_iter()
+            .enumerate()
+            .map(|(p, columns)| (bounds[p]..bounds[p + 1], columns, source.clone()))
+            .collect();
+        parallel::map_parts(parts, |(samples, mut columns, mut own)| {
+            self.fill_samples(samples, &mut columns, &mut own)
         })
+        .into_iter()
+        .collect()
     }
 
     /// Fills the rows of `samples` into `columns` (each column's rows of those samples, from

@@ -13,8 +13,8 @@
 //! readings offend, and the first [`LISTED`] of them by line.
 
 use crate::csv::{CsvError, MEASURED, ReadOptions};
-use model_spec::Machine;
 use model_spec::units::{compact, plural, significant};
+use model_spec::{Machine, parallel};
 use simulation::exact::VirtualMachine;
 
 /// How many offending samples a refusal lists.
@@ -251,28 +251,16 @@ fn at_most(x: f64, bound: f64) -> bool {
 const SAMPLES_PER_THREAD: usize = 50_000;
 
 /// Per sample, the distance (mm) between the nominal tool point and the nominal workpiece point
-/// at its commands: on up to [`std::thread::available_parallelism`] threads for a long record
-/// (each sample's on its own; the same numbers however cut).
+/// at its commands, a long record's shared out over the cores ([`parallel::map_parts`]: each
+/// sample's on its own, the same numbers however cut).
 fn off_ball_distances(vm: &VirtualMachine, commands: &[Vec<f64>], params: &[f64]) -> Vec<f64> {
     let distance = |c: &Vec<f64>| vm.nominal_error_vector(c, params).position.norm();
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(commands.len() / SAMPLES_PER_THREAD)
-        .max(1);
-    if threads == 1 {
-        return commands.iter().map(distance).collect();
-    }
-    let part = commands.len().div_ceil(threads);
-    std::thread::scope(|s| {
-        let parts: Vec<_> = commands
-            .chunks(part)
-            .map(|chunk| s.spawn(move || chunk.iter().map(distance).collect::<Vec<f64>>()))
-            .collect();
-        parts
-            .into_iter()
-            .flat_map(|p| p.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
+    let threads = parallel::threads_for(commands.len(), SAMPLES_PER_THREAD);
+    let part = commands.len().div_ceil(threads).max(1);
+    parallel::map_parts(commands.chunks(part).collect(), |chunk| {
+        chunk.iter().map(distance).collect::<Vec<f64>>()
     })
+    .concat()
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 
 use crate::csv::read::{Header, Row, is_data};
 use crate::csv::{CsvError, Ctx};
-use model_spec::Machine;
+use model_spec::{Machine, parallel};
 use std::io::Read;
 use std::thread;
 
@@ -118,24 +118,10 @@ fn parse_batch(
             .collect();
         parsed.map(|rows| (rows, t))
     };
-    let results: Vec<Result<PartRows, CsvError>> = if parts == 1 {
-        vec![part(0, *last_t)]
-    } else {
-        let first_t = *last_t;
-        thread::scope(|s| {
-            let others: Vec<_> = (1..parts)
-                .map(|p| {
-                    let part = &part;
-                    s.spawn(move || part(p, None))
-                })
-                .collect();
-            let mut results = vec![part(0, first_t)];
-            for h in others {
-                results.push(h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
-            }
-            results
-        })
-    };
+    let first_t = *last_t;
+    let results: Vec<Result<PartRows, CsvError>> = parallel::map_parts((0..parts).collect(), |p| {
+        part(p, if p == 0 { first_t } else { None })
+    });
     for (p, result) in results.into_iter().enumerate() {
         if p > 0 {
             // The part's first row against the last time of the rows before it.

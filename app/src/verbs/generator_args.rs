@@ -40,24 +40,23 @@ impl GeneratorArgs {
                 min_ball_height_mm: self.min_ball_height_mm,
             },
         };
-        generator::check_options(&opts).map_err(|e| match option_flag(&e) {
-            Some(flag) => Error::usage(format!("{flag}: {e}")),
-            None => Error::usage(e.to_string()),
+        generator::check_options(&opts).map_err(|e| match &e {
+            GeneratorError::Option { option, .. } => {
+                Error::usage(format!("{}: {e}", option_flag(option)))
+            }
+            _ => Error::usage(e.to_string()),
         })?;
         Ok(opts)
     }
 }
 
-/// The flag an option error of the generator is about (`--step-deg` …); `None` for an error
-/// that is not about one of these flags.
-pub fn option_flag(e: &GeneratorError) -> Option<&'static str> {
-    let GeneratorError::Option { option, .. } = e else {
-        return None;
-    };
-    Some(match *option {
+/// The flag of the generator's option `option` as a [`GeneratorError::Option`] names it
+/// (`"step"` → `--step-deg`).
+pub fn option_flag(option: &str) -> &'static str {
+    match option {
         "step" => "--step-deg",
         "period" => "--period-s",
         "max tilt" => "--max-tilt-deg",
         _ => "--min-ball-height-mm",
-    })
+    }
 }

@@ -88,9 +88,8 @@ fn generator_error(e: &GeneratorError, args: &PathArgs) -> Error {
         "--test"
     };
     match e {
-        GeneratorError::Option { .. } => {
-            let flag = option_flag(e).unwrap_or("--step-deg");
-            Error::usage(format!("{flag}: {e}"))
+        GeneratorError::Option { option, .. } => {
+            Error::usage(format!("{}: {e}", option_flag(option)))
         }
         GeneratorError::NoRotaryAxis { .. }
         | GeneratorError::UnknownTest { .. }

@@ -1,12 +1,10 @@
 //! refuse_overwriting_inputs: every way of naming an input as an output is refused.
 
-mod common;
-
 use std::fs;
 use std::os::unix::fs::symlink;
 use std::path::Path;
 
-use common::{TestDir, assert_only_changed, snapshot};
+use crate::common::{TestDir, assert_only_changed, snapshot};
 use output::{Target, refuse_overwriting_inputs};
 
 fn check(input: &Path, output: &Path) -> Result<(), output::WriteError> {

@@ -1,13 +1,11 @@
 //! All or none: a failure at any step before the streams leaves every file as it was, no
 //! temporary, no backup and no directory created for the outputs.
 
-mod common;
-
 use std::fs;
 use std::os::unix::fs::{MetadataExt, PermissionsExt};
 use std::path::Path;
 
-use common::{TestDir, assert_only_changed, leftovers, read, snapshot, unprivileged};
+use crate::common::{TestDir, assert_only_changed, leftovers, read, snapshot, unprivileged};
 use output::{Outputs, Target, testing};
 
 /// Replaces `path` by a non-empty directory (a rename or an open onto it then fails, even for
@@ -42,25 +40,28 @@ fn a_missing_directory_for_the_second_output_changes_nothing() {
 
 #[test]
 fn a_read_only_second_output_changes_nothing() {
-    unprivileged("a_read_only_second_output_changes_nothing", |dir| {
-        let a = dir.join("a.csv");
-        fs::write(&a, "old a").unwrap();
-        let ro = dir.join("ro.csv");
-        fs::write(&ro, "old ro").unwrap();
-        fs::set_permissions(&ro, fs::Permissions::from_mode(0o444)).unwrap();
-        let before = snapshot(dir);
-        let mut o = Outputs::new();
-        o.add("-o", Target::Path(a.clone()), "new a");
-        o.add_in_dir("--plot", dir.join("plots"), "p.svg", "<svg/>");
-        o.add("--json", Target::Path(ro.clone()), "new ro");
-        let err = o.write_all().unwrap_err();
-        assert_eq!(
-            err.to_string(),
-            format!("--json: cannot write `{}`: permission denied", ro.display())
-        );
-        assert_eq!(read(&a), "old a");
-        assert_only_changed(&before, &snapshot(dir), &[]);
-    });
+    unprivileged(
+        "all_or_none::a_read_only_second_output_changes_nothing",
+        |dir| {
+            let a = dir.join("a.csv");
+            fs::write(&a, "old a").unwrap();
+            let ro = dir.join("ro.csv");
+            fs::write(&ro, "old ro").unwrap();
+            fs::set_permissions(&ro, fs::Permissions::from_mode(0o444)).unwrap();
+            let before = snapshot(dir);
+            let mut o = Outputs::new();
+            o.add("-o", Target::Path(a.clone()), "new a");
+            o.add_in_dir("--plot", dir.join("plots"), "p.svg", "<svg/>");
+            o.add("--json", Target::Path(ro.clone()), "new ro");
+            let err = o.write_all().unwrap_err();
+            assert_eq!(
+                err.to_string(),
+                format!("--json: cannot write `{}`: permission denied", ro.display())
+            );
+            assert_eq!(read(&a), "old a");
+            assert_only_changed(&before, &snapshot(dir), &[]);
+        },
+    );
 }
 
 #[test]

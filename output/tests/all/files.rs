@@ -1,12 +1,10 @@
 //! Regular files, hard links and symbolic links: what is written where, what is kept.
 
-mod common;
-
 use std::fs;
 use std::os::unix::fs::{MetadataExt, PermissionsExt, symlink};
 use std::path::Path;
 
-use common::{TestDir, assert_only_changed, leftovers, mode, read, snapshot};
+use crate::common::{TestDir, assert_only_changed, leftovers, mode, read, snapshot};
 use output::{Outputs, Target};
 
 fn write_one(path: &Path, contents: &str) -> Result<Vec<output::Written>, output::WriteError> {
@@ -56,15 +54,18 @@ fn replacing_keeps_the_mode() {
 
 #[test]
 fn replacing_keeps_the_owner_where_permitted() {
-    if !common::is_root() {
+    if !crate::common::is_root() {
         return; // only root can make a file owned by someone else
     }
     let dir = TestDir::new("keeps_owner");
     let p = dir.file("owned.csv", "old");
-    std::os::unix::fs::chown(&p, Some(common::NOBODY), Some(common::NOBODY)).unwrap();
+    std::os::unix::fs::chown(&p, Some(crate::common::NOBODY), Some(crate::common::NOBODY)).unwrap();
     write_one(&p, "new").unwrap();
     let m = fs::metadata(&p).unwrap();
-    assert_eq!((m.uid(), m.gid()), (common::NOBODY, common::NOBODY));
+    assert_eq!(
+        (m.uid(), m.gid()),
+        (crate::common::NOBODY, crate::common::NOBODY)
+    );
     assert_eq!(read(&p), "new");
 }
 

@@ -1,12 +1,10 @@
 //! Everything refused before anything changes: the message, and an untouched directory.
 
-mod common;
-
 use std::fs;
 use std::os::unix::fs::{PermissionsExt, symlink};
 use std::path::{Path, PathBuf};
 
-use common::{TestDir, assert_only_changed, read, snapshot, unprivileged};
+use crate::common::{TestDir, assert_only_changed, read, snapshot, unprivileged};
 use output::{Outputs, Target, WriteError, check_dir, check_targets};
 
 fn path(p: impl Into<PathBuf>) -> Target {
@@ -159,7 +157,7 @@ fn standard_output_twice_is_refused() {
 
 #[test]
 fn a_read_only_file_is_refused() {
-    unprivileged("a_read_only_file_is_refused", |dir| {
+    unprivileged("refusals::a_read_only_file_is_refused", |dir| {
         let ro = dir.join("ro.csv");
         fs::write(&ro, "keep me").unwrap();
         fs::set_permissions(&ro, fs::Permissions::from_mode(0o444)).unwrap();
@@ -175,28 +173,31 @@ fn a_read_only_file_is_refused() {
 
 #[test]
 fn a_directory_without_write_permission_is_refused() {
-    unprivileged("a_directory_without_write_permission_is_refused", |dir| {
-        let locked = dir.join("locked");
-        fs::create_dir(&locked).unwrap();
-        let inside = locked.join("x.csv");
-        fs::write(&inside, "old").unwrap();
-        fs::set_permissions(&locked, fs::Permissions::from_mode(0o555)).unwrap();
-        for t in [path(&inside), path(locked.join("new.csv"))] {
-            refused(
-                dir,
-                &[("-o", t.clone())],
-                &format!(
-                    "-o: cannot write `{t}`: cannot create files in the directory `{}`: \
+    unprivileged(
+        "refusals::a_directory_without_write_permission_is_refused",
+        |dir| {
+            let locked = dir.join("locked");
+            fs::create_dir(&locked).unwrap();
+            let inside = locked.join("x.csv");
+            fs::write(&inside, "old").unwrap();
+            fs::set_permissions(&locked, fs::Permissions::from_mode(0o555)).unwrap();
+            for t in [path(&inside), path(locked.join("new.csv"))] {
+                refused(
+                    dir,
+                    &[("-o", t.clone())],
+                    &format!(
+                        "-o: cannot write `{t}`: cannot create files in the directory `{}`: \
                      permission denied",
-                    locked.display()
-                ),
-            );
-        }
-        let err = check_dir("--plot", &locked.join("plots")).unwrap_err();
-        assert!(err.to_string().ends_with("permission denied"), "{err}");
-        fs::set_permissions(&locked, fs::Permissions::from_mode(0o755)).unwrap();
-        assert_eq!(read(&inside), "old");
-    });
+                        locked.display()
+                    ),
+                );
+            }
+            let err = check_dir("--plot", &locked.join("plots")).unwrap_err();
+            assert!(err.to_string().ends_with("permission denied"), "{err}");
+            fs::set_permissions(&locked, fs::Permissions::from_mode(0o755)).unwrap();
+            assert_eq!(read(&inside), "old");
+        },
+    );
 }
 
 #[test]

@@ -1,8 +1,6 @@
 //! Temporary files: never through a planted link, never left behind, not even on SIGINT or
 //! SIGTERM.
 
-mod common;
-
 use std::ffi::OsStr;
 use std::fs;
 use std::os::unix::fs::symlink;
@@ -10,7 +8,7 @@ use std::os::unix::process::ExitStatusExt;
 use std::process::Stdio;
 use std::time::Duration;
 
-use common::{
+use crate::common::{
     TestDir, assert_only_changed, child_command, child_dir, is_child, leftovers, read, snapshot,
     wait_until,
 };
@@ -178,7 +176,7 @@ fn killed_while_staged(test: &str, signal: i32) {
 
 #[test]
 fn sigterm_while_staged_leaves_no_temporary() {
-    const TEST: &str = "sigterm_while_staged_leaves_no_temporary";
+    const TEST: &str = "temporaries::sigterm_while_staged_leaves_no_temporary";
     if is_child(TEST) {
         stage_and_wait();
     }
@@ -187,7 +185,7 @@ fn sigterm_while_staged_leaves_no_temporary() {
 
 #[test]
 fn sigint_while_staged_leaves_no_temporary() {
-    const TEST: &str = "sigint_while_staged_leaves_no_temporary";
+    const TEST: &str = "temporaries::sigint_while_staged_leaves_no_temporary";
     if is_child(TEST) {
         stage_and_wait();
     }
@@ -210,7 +208,7 @@ fn rename_and_wait() {
 /// A signal between two renames undoes the renames already done: all outputs or none.
 #[test]
 fn sigterm_between_renames_puts_the_old_files_back() {
-    const TEST: &str = "sigterm_between_renames_puts_the_old_files_back";
+    const TEST: &str = "temporaries::sigterm_between_renames_puts_the_old_files_back";
     if is_child(TEST) {
         rename_and_wait();
     }

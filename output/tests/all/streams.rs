@@ -1,13 +1,13 @@
 //! FIFOs and standard output: written directly, after the files.
 
-mod common;
-
 use std::fs;
 use std::os::unix::fs::{FileTypeExt, symlink};
 use std::path::PathBuf;
 use std::thread;
 
-use common::{TestDir, assert_only_changed, child_command, is_child, mkfifo, read, snapshot};
+use crate::common::{
+    TestDir, assert_only_changed, child_command, is_child, mkfifo, read, snapshot,
+};
 use output::{Outputs, Target};
 
 /// Reads a FIFO to its end on another thread.
@@ -83,7 +83,7 @@ const STDOUT_CONTENTS: &[u8] = b"x,y\n1,2\n\xff\x00binary tail without newline";
 
 #[test]
 fn stdout_gets_exactly_the_contents() {
-    const TEST: &str = "stdout_gets_exactly_the_contents";
+    const TEST: &str = "streams::stdout_gets_exactly_the_contents";
     if is_child(TEST) {
         let mut o = Outputs::new();
         o.add("-o", Target::parse("-"), STDOUT_CONTENTS);
@@ -109,9 +109,9 @@ fn stdout_gets_exactly_the_contents() {
 
 #[test]
 fn stdout_is_not_written_when_a_file_fails() {
-    const TEST: &str = "stdout_is_not_written_when_a_file_fails";
+    const TEST: &str = "streams::stdout_is_not_written_when_a_file_fails";
     if is_child(TEST) {
-        let dir = common::child_dir();
+        let dir = crate::common::child_dir();
         let mut o = Outputs::new();
         o.add("-o", Target::Stdout, STDOUT_CONTENTS);
         o.add("--json", Target::Path(dir.join("missing/a.json")), "{}");
@@ -132,9 +132,9 @@ fn stdout_is_not_written_when_a_file_fails() {
 
 #[test]
 fn standard_output_redirected_to_an_output_file_is_refused() {
-    const TEST: &str = "standard_output_redirected_to_an_output_file_is_refused";
+    const TEST: &str = "streams::standard_output_redirected_to_an_output_file_is_refused";
     if is_child(TEST) {
-        let dir = common::child_dir();
+        let dir = crate::common::child_dir();
         let mut o = Outputs::new();
         o.add("-o", Target::Stdout, "table\n");
         o.add("--json", Target::Path(dir.join("./out.txt")), "{}");

@@ -10,7 +10,7 @@
 //! cargo run --release -p diagnosis --example diagnose_campaign -- --dump > diagnosis.txt
 //! ```
 
-#[path = "../benches/support/campaign.rs"]
+#[path = "support/campaign.rs"]
 mod campaign;
 
 use diagnosis::{DiagnoseOptions, STAGES, diagnose};

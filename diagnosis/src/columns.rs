@@ -8,7 +8,7 @@
 use super::DiagnoseError;
 use super::weights::Weights;
 use fitting::campaign::CampaignIdentification;
-use fitting::campaign::design::{Layout, design_matrix, measurements};
+use fitting::campaign::design::{Layout, columns_in_order, design_matrix, measurements};
 use fitting::noise::NoiseModel;
 use model_spec::{Dir, Machine};
 use nalgebra::{DMatrix, DVector};
@@ -99,7 +99,9 @@ impl Columns {
             })
             .collect();
         let order: Vec<usize> = columns.iter().flatten().copied().collect();
-        let h_raw = h.select_columns(&order);
+        // The design's own matrix, its columns put in group order (in place when the groups
+        // cover every column): the candidates' columns are the bulk of a diagnosis's memory.
+        let h_raw = columns_in_order(h, &order);
         let widths: Vec<usize> = columns.iter().map(Vec::len).collect();
         let starts: Vec<usize> = widths
             .iter()

@@ -52,19 +52,17 @@ impl Projected {
     ) -> Projected {
         let n = span.rows();
         let mut at = vec![(0usize, 0usize); count];
-        let mut groups = Vec::with_capacity(held.len());
+        // Column after column, as the matrix holds them: one candidate's columns at a time,
+        // never all of them twice.
+        let mut data = Vec::new();
         let mut total = 0;
         for &c in held {
-            let g = columns(c);
+            let g = unit_columns(&columns(c));
             at[c] = (total, g.ncols());
             total += g.ncols();
-            groups.push(g);
+            data.extend_from_slice(g.as_slice());
         }
-        let mut unit = DMatrix::zeros(n, total);
-        for (g, &c) in groups.iter().zip(held) {
-            unit.columns_mut(at[c].0, at[c].1)
-                .copy_from(&unit_columns(g));
-        }
+        let unit = DMatrix::from_vec(n, total, data);
         let mut columns = unit.clone();
         project_out(&span.q, &mut columns);
         let residual = span.project_out(y);

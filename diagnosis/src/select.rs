@@ -288,12 +288,11 @@ fn monte_carlo_p_stopping(
     if total == 0 || draws == 0 {
         return 1.0;
     }
-    let mut all = DMatrix::zeros(n, total);
-    let mut at = 0;
+    let mut all = Vec::with_capacity(n * total);
     for s in scored {
-        all.columns_mut(at, s.width).copy_from(&s.directions());
-        at += s.width;
+        all.extend(s.directions().iter());
     }
+    let all = DMatrix::from_vec(n, total, all);
     let mut rng = Rng::new(seed);
     let mut exceed = 0usize;
     // Blocks of draws: one matrix product per block (small at first, where the sequential

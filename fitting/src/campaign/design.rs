@@ -615,6 +615,24 @@ fn stack(
     h
 }
 
+/// The columns `order` of `h` (indices of its columns), in that order. When `order` names every
+/// column once, they are put in place by swaps of whole columns and `h` is returned, so that a
+/// tall H is never held twice; otherwise (a subset, a repeat) they are copied.
+pub fn columns_in_order(mut h: DMatrix<f64>, order: &[usize]) -> DMatrix<f64> {
+    let n = h.ncols();
+    let mut seen = vec![false; n];
+    let every_column_once = order.len() == n
+        && order
+            .iter()
+            .all(|&j| j < n && !std::mem::replace(&mut seen[j], true));
+    if every_column_once {
+        permute_columns(&mut h, order);
+        h
+    } else {
+        h.select_columns(order)
+    }
+}
+
 /// Puts the columns of `h` in the order `from` says, in place (column `c` becomes the column
 /// that was `from[c]`; `from` a permutation of `0..h.ncols()`): by swaps of whole columns, so
 /// that a tall H is never held twice.
@@ -654,8 +672,28 @@ pub fn measurements(campaign: &Campaign) -> Result<DVector<f64>, EstimateError> 
 
 #[cfg(test)]
 mod tests {
-    use super::permute_columns;
+    use super::{columns_in_order, permute_columns};
     use nalgebra::DMatrix;
+
+    /// A permutation is put in place, a subset or a repeat is copied: the same columns either
+    /// way.
+    #[test]
+    fn columns_in_order_are_the_selected_columns() {
+        let h = DMatrix::from_fn(4, 3, |i, j| (10 * i + j) as f64);
+        for order in [
+            &[2, 0, 1][..],
+            &[0, 1, 2],
+            &[1, 2],
+            &[1, 1, 0],
+            &[2, 2, 2, 0],
+        ] {
+            assert_eq!(
+                columns_in_order(h.clone(), order),
+                h.select_columns(order),
+                "{order:?}"
+            );
+        }
+    }
 
     /// Every permutation of five columns (120) put in place gives the matrix that
     /// `select_columns` copies, entry for entry.

@@ -8,7 +8,7 @@
 //!   axis word rewritten, modal axes inserted where the correction changes them);
 //! - `pose_csv/parse` and `pose_csv/write`: the same poses as a CSV of commanded poses.
 //!
-//! `cargo bench -p formats --bench nc_program`. The set-up prints the size of each text.
+//! `cargo bench -p benches --bench nc_program`. The set-up prints the size of each text.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use formats::nc::{Dialect, WriteOptions, parse_program};

@@ -3,8 +3,8 @@
 The way an engineer writes it without rtest: build the seed's HTMs with all 44 error symbols
 (small-angle matrices as printed in the seed), multiply the chains, take the error vector
 R_tool^T (P_tool - P_work), differentiate with respect to every error at zero and simplify.
-Prints the wall time. Reproduce: `pip install sympy && python3 codegen/benches/sympy_baseline.py`.
-Compare with `cargo bench -p codegen --bench generate` (derive/seed-ac).
+Prints the wall time. Reproduce: `pip install sympy && python3 benches/sympy_baseline.py`.
+Compare with `cargo bench -p benches --bench generate` (derive/seed-ac).
 """
 import time
 import sympy as sp

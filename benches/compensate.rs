@@ -1,5 +1,5 @@
 //! The cost of compensation on the host (BENCHMARKS.md):
-//! `cargo bench -p perf --bench compensate`. One pose of `seed-ac`, full model (44 errors):
+//! `cargo bench -p benches --bench compensate`. One pose of `seed-ac`, full model (44 errors):
 //! - `compensate/generated-f64`: the generated `compensate` (target and three steps, sines and
 //!   cosines by `f64::sin_cos`);
 //! - `compensate/generated-f32`: the generated single-precision first-order correction (the

@@ -1,5 +1,5 @@
 //! The generated code against its baselines, in one run (BENCHMARKS.md):
-//! `cargo bench -p perf --bench gains`.
+//! `cargo bench -p benches --bench gains`.
 //! - `gains/*`: all 44 × 6 gains of seed-ac at one pose (sines and cosines included) by
 //!   (a) the generated code, (b) the IR evaluator, (c) the exact HTM chain with central finite
 //!   differences, (d) the runtime first-order product;

@@ -3,13 +3,13 @@
 //! pretty-printed Rust source (every model of the machine).
 //!
 //! Built-in machines: `derive/NAME`, `derive+cse/NAME`, `rust-source/NAME`. Synthetic chains of
-//! `N` rotary axes (`codeg../tests/all/support/chains.rs`: a serial arm on the tool side, a table
+//! `N` rotary axes (`codegen/tests/all/support/chains.rs`: a serial arm on the tool side, a table
 //! stack on the work side, directions x, z, y and an inclined one in turn, every offset a
 //! symbol): `chain/derive/N`, `chain/derive+cse/N`, `chain/rust-source/N`.
 //!
-//! Run with `cargo bench -p codegen --bench generate` (`-- chain/` for the chains only).
+//! Run with `cargo bench -p benches --bench generate` (`-- chain/` for the chains only).
 
-#[path = "../tests/all/support/chains.rs"]
+#[path = "../codegen/tests/all/support/chains.rs"]
 mod chains;
 
 use codegen::{GainModel, compile};

@@ -2,7 +2,7 @@
 //! full (44 errors) models, compiled code against the IR evaluator; the evaluator's set-up
 //! (derive + compile); and the estimation on K4 (least squares alone, and `identify` end to end).
 //!
-//! Needs `[[bench]] name = "hmatrix"`, `harness = false` in `fitting/Cargo.toml`.
+//! `cargo bench -p benches --bench hmatrix`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use fitting::hmatrix::{GainSource, h_matrix, parameter_names};

@@ -21,10 +21,10 @@
 //! position its own set-up; 1325 samples, 3975 rows. The diagnosis's default options, as
 //! `rtest diagnose --campaign` runs them.
 //!
-//! `cargo bench -p diagnosis --bench diagnose`. The set-up prints the dictionary's size (candidate
+//! `cargo bench -p benches --bench diagnose`. The set-up prints the dictionary's size (candidate
 //! terms and H-matrix columns).
 
-#[path = "support/campaign.rs"]
+#[path = "../diagnosis/examples/support/campaign.rs"]
 mod campaign;
 
 use campaign::campaign;

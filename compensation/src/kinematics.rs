@@ -5,8 +5,10 @@
 //!
 //! A rotary axis is composed as `Trans(offset) · Trans(location translations) · …`
 //! ([`model_spec::kinematics::chain_steps`]), so a location translation adds exactly to the
-//! axis's offset, in the same frame: the corrected machine with these errors at zero is the
-//! original machine with them at their values, at every pose and to every order.
+//! axis's offset: the corrected machine with these errors at zero is the original machine with
+//! them at their values, at every pose and to every order. An inclined axis's location errors
+//! act along its own axes (`Trans(offset) · Frame · Trans(location) · …`): `YOB` along `y′`
+//! adds `YOB·y′` to the offset, which moves every machine coordinate that `y′` has a share in.
 //!
 //! Where the offset coordinate is written:
 //! - **a number**: the number becomes `number + value`;
@@ -29,8 +31,8 @@
 //! The result is parsed back and must be the original machine with exactly these changes.
 //!
 //! Not folded, and listed with their values ([`NotFolded`]): the angular location errors
-//! (`AOC BOC`, …) and the squareness errors, which a description without inclined axes cannot
-//! hold, and the component errors, which move with their axis.
+//! (`AOC BOC`, …) and the squareness errors, which would change the direction of an axis line
+//! (not folded here), and the component errors, which move with their axis.
 //!
 //! Numbers are written as the shortest decimal that reads back to the same `f64` (mm).
 
@@ -39,7 +41,9 @@ mod spans;
 use super::values::{CompensationError, MachineErrors, ValueSource};
 use model_spec::catalogue::Motion;
 use model_spec::units::format_scaled;
-use model_spec::{AxisId, Dir, ErrorId, ErrorKind, Link, Machine, Value, parse_machine};
+use model_spec::{
+    AxisDirection, AxisId, Dir, ErrorId, ErrorKind, Link, Machine, Value, parse_machine,
+};
 use spans::OffsetPlace;
 use std::ops::Range;
 
@@ -50,11 +54,14 @@ pub struct Folded {
     pub error: ErrorId,
     /// Its name (`XOC`).
     pub name: String,
-    /// Its value, mm.
+    /// What it adds to the coordinate, mm: its value, times the coordinate's share of the
+    /// error's direction where the axis is inclined.
     pub value_mm: f64,
     /// The rotary axis whose offset takes it.
     pub axis: String,
-    /// The coordinate of the offset (the error's direction).
+    /// The coordinate of the offset it moves: the error's direction, or for an inclined axis
+    /// each machine coordinate of its own direction (`x′`, `y′`, `z′`) that is not zero, one
+    /// entry each.
     pub coordinate: Dir,
     /// The symbol whose default changed; `None` where a number changed or was written.
     pub symbol: Option<String>,
@@ -117,15 +124,29 @@ fn not_foldable(m: &Machine, e: ErrorId, constant: bool) -> Option<&'static str>
             motion: Motion::Rotation(_),
             ..
         } => Some(
-            "an angular location error: the description has no inclined axes, so the orientation of an axis line cannot be held as an offset",
+            "an angular location error: it turns the axis line, which an offset cannot hold (directions are not corrected here)",
         ),
         ErrorKind::Squareness { .. } => Some(
-            "a squareness error: the description has no inclined axes, so it cannot be held as an offset",
+            "a squareness error: it turns an axis, which an offset cannot hold (directions are not corrected here)",
         ),
         ErrorKind::Component { .. } => Some(
             "a component error: it moves with its axis, so it belongs in the axis's compensation, not in the kinematic offsets",
         ),
         _ => Some("not a constant translation of a rotary axis's line"),
+    }
+}
+
+/// The unit vector, in the frame of the axis's offset (machine coordinates), of the axis's own
+/// coordinate direction `d`: `d` itself for an axis along x, y or z; the row `d` of the own
+/// frame of an inclined axis (its `x′`, `y′` or `z′`).
+fn own_axis(direction: &AxisDirection, d: Dir) -> [f64; 3] {
+    match &direction.inclined {
+        Some(inclined) => inclined.frame.axes[d.index()].map(|x| x.to_f64()),
+        None => {
+            let mut v = [0.0; 3];
+            v[d.index()] = 1.0;
+            v
+        }
     }
 }
 
@@ -228,53 +249,69 @@ pub fn corrected_description(
             // Fixed to 0 by the constraint: nothing moves.
             continue;
         }
-        let k = d.index();
         let name = &m.axes[axis].name;
-        let (symbol, before, place) = match expected.axes[axis].offset[k] {
-            Value::Number(x) => (None, x, format!("offset {d} of axis {name}")),
-            Value::Symbol(s) if uses[s] == 1 => {
-                let sym = &expected.symbols[s].name;
-                (
-                    Some(s),
-                    expected.symbols[s].default,
-                    format!("symbol {sym} (offset {d} of axis {name})"),
-                )
+        // The error acts along the axis's own direction `d`: for an inclined axis, its own
+        // frame's axis in machine coordinates, so that one error can move two or three
+        // coordinates of the offset (the nutating B's `YOB` along y′ moves y and z).
+        let along = own_axis(&m.axes[axis].direction, d);
+        for (k, &share) in along.iter().enumerate() {
+            let part = value * share;
+            if part == 0.0 {
+                continue;
             }
-            Value::Symbol(s) => (
-                None,
-                expected.symbols[s].default,
-                format!(
-                    "offset {d} of axis {name}, which was the shared symbol {} and is now a number",
-                    expected.symbols[s].name
+            let c = Dir::ALL[k];
+            let (symbol, before, place) = match expected.axes[axis].offset[k] {
+                Value::Number(x) => (None, x, format!("offset {c} of axis {name}")),
+                Value::Symbol(s) if uses[s] == 1 => {
+                    let sym = &expected.symbols[s].name;
+                    (
+                        Some(s),
+                        expected.symbols[s].default,
+                        format!("symbol {sym} (offset {c} of axis {name})"),
+                    )
+                }
+                Value::Symbol(s) => (
+                    None,
+                    expected.symbols[s].default,
+                    format!(
+                        "offset {c} of axis {name}, which was the shared symbol {} and is now a number",
+                        expected.symbols[s].name
+                    ),
                 ),
-            ),
-        };
-        let after = before + value;
-        if !after.is_finite() {
-            return Err(CompensationError::NonFinite {
-                file: errors.file().to_string(),
-                what: format!("the corrected {place}"),
-                value: after,
+            };
+            // On an inclined axis, `value_mm` is one coordinate's part of the error: say so.
+            let place = if m.axes[axis].direction.inclined.is_some() {
+                format!("{place}, the {c} part of {}·{d}′", m.catalogue[e].name)
+            } else {
+                place
+            };
+            let after = before + part;
+            if !after.is_finite() {
+                return Err(CompensationError::NonFinite {
+                    file: errors.file().to_string(),
+                    what: format!("the corrected {place}"),
+                    value: after,
+                });
+            }
+            match symbol {
+                Some(s) => expected.symbols[s].default = after,
+                None => {
+                    expected.axes[axis].offset[k] = Value::Number(after);
+                    changed.push((axis, k));
+                }
+            }
+            folded.push(Folded {
+                error: e,
+                name: m.catalogue[e].name.clone(),
+                value_mm: part,
+                axis: name.clone(),
+                coordinate: c,
+                symbol: symbol.map(|s| m.symbols[s].name.clone()),
+                before_mm: before,
+                after_mm: after,
+                place,
             });
         }
-        match symbol {
-            Some(s) => expected.symbols[s].default = after,
-            None => {
-                expected.axes[axis].offset[k] = Value::Number(after);
-                changed.push((axis, k));
-            }
-        }
-        folded.push(Folded {
-            error: e,
-            name: m.catalogue[e].name.clone(),
-            value_mm: value,
-            axis: name.clone(),
-            coordinate: d,
-            symbol: symbol.map(|s| m.symbols[s].name.clone()),
-            before_mm: before,
-            after_mm: after,
-            place,
-        });
     }
 
     let mut edits: Vec<(Range<usize>, String)> = Vec::new();

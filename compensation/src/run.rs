@@ -15,6 +15,12 @@ use std::convert::Infallible;
 /// fully correct (near a singular pose, where the correction is damped): 1 µrad.
 pub const TILT_REPORTED: f64 = 1e-6;
 
+/// How far past a stroke or range limit a corrected command may fall and be put back on the
+/// limit (mm for a linear axis, degrees for a rotary one): a correction of a few thousandths of
+/// a degree at B = 0° on an axis whose range starts at 0° is clamped and listed, not refused
+/// with the whole program. Further out, the pose is refused ([`RunError::OutOfLimits`]).
+pub const CLAMP_MARGIN: f64 = 0.01;
+
 /// Poses corrected at a time, shared among the cores: what is held of the corrected poses
 /// while a list is compensated.
 pub const BATCH: usize = 16_384;
@@ -70,6 +76,53 @@ pub struct AxisCorrections {
     pub rms: f64,
 }
 
+/// A corrected command put back on the limit it passed by at most [`CLAMP_MARGIN`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clamped {
+    /// The 1-based line of the pose.
+    pub line: usize,
+    /// The axis.
+    pub axis: String,
+    /// `true` for a rotary axis (degrees), `false` for a linear one (mm).
+    pub rotary: bool,
+    /// The corrected command before it was clamped (mm or degrees).
+    pub corrected: f64,
+    /// The limit it was put on (mm or degrees).
+    pub limit: f64,
+}
+
+/// Puts every axis of `commands` (mm, rad) that is outside its stroke or range by at most
+/// [`CLAMP_MARGIN`] on that limit, and lists them; changes nothing and gives `None` when an
+/// axis is further outside (the pose is then refused).
+fn clamp(m: &Machine, line: usize, commands: &mut [f64]) -> Option<Vec<Clamped>> {
+    let outside = m.outside_limits(commands);
+    let beyond = |o: &model_spec::pose::OutsideLimits| {
+        let [lo, hi] = o.limits;
+        o.value < lo - CLAMP_MARGIN || o.value > hi + CLAMP_MARGIN
+    };
+    if outside.iter().any(beyond) {
+        return None;
+    }
+    Some(
+        outside
+            .into_iter()
+            .map(|o| {
+                let [lo, hi] = o.limits;
+                let limit = if o.value < lo { lo } else { hi };
+                let rotary = o.kind == AxisKind::Rotary;
+                commands[o.axis] = if rotary { limit.to_radians() } else { limit };
+                Clamped {
+                    line,
+                    axis: o.name,
+                    rotary,
+                    corrected: o.value,
+                    limit,
+                }
+            })
+            .collect(),
+    )
+}
+
 /// The summary of a compensated file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Summary {
@@ -91,6 +144,8 @@ pub struct Summary {
     pub orientation_corrected: bool,
     /// The poses that needed refinement steps after the fixed ones.
     pub refined: usize,
+    /// The corrected commands put back on a limit they passed by at most [`CLAMP_MARGIN`].
+    pub clamped: Vec<Clamped>,
 }
 
 /// Why a file cannot be compensated.
@@ -232,7 +287,8 @@ pub fn compensate_poses(
 ///
 /// The commanded poses are checked against the strokes and ranges first; then they are
 /// corrected [`BATCH`] at a time, each batch shared among the available cores (the result does
-/// not depend on the split), and checked. Once a corrected pose is outside, the sink gets no
+/// not depend on the split), and checked: a corrected command past a limit by at most
+/// [`CLAMP_MARGIN`] is put on the limit and listed in the summary ([`Summary::clamped`]). Once a corrected pose is outside, the sink gets no
 /// more poses (the others are still corrected, to list every pose outside).
 ///
 /// # Errors
@@ -288,8 +344,11 @@ pub fn compensate_each<E>(
             file,
             values_at,
         )) {
-            let c = c.map_err(run)?;
+            let mut c = c.map_err(run)?;
             let line = poses.line(i);
+            if let Some(clamped) = clamp(m, line, &mut c.commands) {
+                summary.clamped.extend(clamped);
+            }
             corrected_outside.check(m, line, &c.commands);
             poses.commands_into(i, &mut q);
             summary.add(line, &q, &c);
@@ -376,6 +435,7 @@ struct Gathered {
     roll_squares: f64,
     refined: usize,
     orientation_corrected: bool,
+    clamped: Vec<Clamped>,
 }
 
 impl Gathered {
@@ -391,6 +451,7 @@ impl Gathered {
             roll_squares: 0.0,
             refined: 0,
             orientation_corrected: m.rotary_axes().count() > 0,
+            clamped: Vec::new(),
         }
     }
 
@@ -440,6 +501,7 @@ impl Gathered {
             roll_rms: (self.roll_squares / n).sqrt(),
             orientation_corrected: self.orientation_corrected,
             refined: self.refined,
+            clamped: self.clamped,
         }
     }
 }

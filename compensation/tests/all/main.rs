@@ -12,5 +12,6 @@ mod compensation_engine;
 mod compensation_firmware;
 mod corrected_kinematics;
 mod full_loop;
+mod range_limits;
 mod timebases;
 mod volumetric;

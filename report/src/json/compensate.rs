@@ -9,6 +9,22 @@ use compensation::run::Summary;
 use model_spec::units::{UM_PER_MM, URAD_PER_RAD};
 use serde::{Deserialize, Serialize};
 
+/// A corrected command put back on the stroke or range limit it passed by at most
+/// `compensation::run::CLAMP_MARGIN` (0.01 mm or 0.01°).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClampedReport {
+    /// The 1-based line of the pose.
+    pub line: usize,
+    /// The axis.
+    pub axis: String,
+    /// `mm` for a linear axis, `deg` for a rotary one.
+    pub unit: String,
+    /// The corrected command before it was clamped (mm or degrees).
+    pub corrected: f64,
+    /// The limit it was put on (mm or degrees).
+    pub limit: f64,
+}
+
 /// The corrections of one axis.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AxisReport {
@@ -93,6 +109,10 @@ pub struct CompensationReport {
     pub roll_rms_urad: f64,
     /// Poses that needed host refinement steps after the generated code's fixed steps.
     pub refined_poses: usize,
+    /// Corrected commands put back on a limit they passed by at most 0.01 mm or 0.01° (absent
+    /// when there are none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub clamped: Vec<ClampedReport>,
     /// The corrected kinematic description, when one was written.
     pub kinematics: Option<KinematicsReport>,
     /// The axis compensation tables written.
@@ -213,6 +233,17 @@ impl CompensationReport {
             )?,
             roll_rms_urad: finite(|| "roll_rms_urad".into(), s.roll_rms * URAD_PER_RAD)?,
             refined_poses: s.refined,
+            clamped: s
+                .clamped
+                .iter()
+                .map(|c| ClampedReport {
+                    line: c.line,
+                    axis: c.axis.clone(),
+                    unit: if c.rotary { "deg" } else { "mm" }.to_string(),
+                    corrected: c.corrected,
+                    limit: c.limit,
+                })
+                .collect(),
             kinematics: source.kinematics,
             tables: source.tables,
         })

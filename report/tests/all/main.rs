@@ -10,6 +10,7 @@ mod diagnose_helpers;
 mod one_record;
 mod one_report;
 
+mod compensation_clamped;
 mod compensation_loop;
 mod compensation_values;
 mod diagnose_instrument_knock;

@@ -25,6 +25,20 @@ pub struct ClampedReport {
     pub limit: f64,
 }
 
+impl ClampedReport {
+    /// For people: `line 7: B = -0.002865° put on 0°`.
+    pub fn for_people(&self) -> String {
+        let unit = if self.unit == "deg" { "°" } else { " mm" };
+        format!(
+            "line {}: {} = {}{unit} put on {}{unit}",
+            self.line,
+            self.axis,
+            model_spec::units::readable(self.corrected, 6),
+            model_spec::units::format_scaled(self.limit + 0.0, 0)
+        )
+    }
+}
+
 /// The corrections of one axis.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AxisReport {

@@ -67,20 +67,7 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
         ));
     }
     if !c.clamped.is_empty() {
-        let each: Vec<String> = c
-            .clamped
-            .iter()
-            .map(|k| {
-                let unit = if k.unit == "deg" { "°" } else { " mm" };
-                format!(
-                    "line {}: {} {}{unit} put on {}{unit}",
-                    k.line,
-                    k.axis,
-                    num(k.corrected, 6),
-                    num(k.limit, 6)
-                )
-            })
-            .collect();
+        let each: Vec<String> = c.clamped.iter().map(|k| k.for_people()).collect();
         b.paragraph(&format!(
             "Corrected commands clamped to a stroke or range limit they passed by at most 0.01 mm or 0.01° (the pose keeps that much of its error): {}.",
             each.join("; ")

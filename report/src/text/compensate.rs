@@ -3,7 +3,7 @@
 
 use super::{header, table};
 use crate::json::compensate::{CompensationReport, KinematicsReport};
-use model_spec::units::{fixed, format_scaled, readable};
+use model_spec::units::{fixed, readable};
 
 /// At most this many line numbers are listed in a sentence.
 const LINES_SHOWN: usize = 12;
@@ -101,21 +101,7 @@ pub fn compensation(r: &CompensationReport) -> String {
         ));
     }
     if !r.clamped.is_empty() {
-        let shown: Vec<String> = r
-            .clamped
-            .iter()
-            .take(10)
-            .map(|c| {
-                let unit = if c.unit == "deg" { "°" } else { " mm" };
-                format!(
-                    "line {}: {} = {}{unit} put on {}{unit}",
-                    c.line,
-                    c.axis,
-                    readable(c.corrected, 6),
-                    format_scaled(c.limit + 0.0, 0)
-                )
-            })
-            .collect();
+        let shown: Vec<String> = r.clamped.iter().take(10).map(|c| c.for_people()).collect();
         let more = r.clamped.len() - shown.len();
         text.push_str(&format!(
             "Clamped to a stroke or range limit they passed by at most 0.01 mm or 0.01° ({} command(s); the pose keeps that much of its error): {}{}.\n",

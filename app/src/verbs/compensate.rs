@@ -33,8 +33,9 @@ left out and listed. A value the identification could not determine is refused.
 axis, named by its letter; mm and degrees) or, with --nc iso|heidenhain, an NC program in \
 machine coordinates (absolute straight moves); OUT has the same format with the corrected axis \
 values, at which the model's predicted tool point and tool axis are the commanded ones (to \
-1 nm). The rotation about the tool axis cannot be corrected and is reported; a corrected pose \
-outside a stroke or range is refused with its line.
+1 nm). The rotation about the tool axis cannot be corrected and is reported. A corrected \
+command past a stroke or range limit by at most 0.01 mm or 0.01° is put on the limit and \
+listed; further out, the pose is refused with its line.
 
 --kinematics-out FILE: the machine description with the location errors and the identified \
 kinematic symbols folded into its offsets and defaults; what cannot be folded is listed. \

@@ -41,9 +41,7 @@ mod spans;
 use super::values::{CompensationError, MachineErrors, ValueSource};
 use model_spec::catalogue::Motion;
 use model_spec::units::format_scaled;
-use model_spec::{
-    AxisDirection, AxisId, Dir, ErrorId, ErrorKind, Link, Machine, Value, parse_machine,
-};
+use model_spec::{AxisId, Dir, ErrorId, ErrorKind, Link, Machine, Value, parse_machine};
 use spans::OffsetPlace;
 use std::ops::Range;
 
@@ -133,20 +131,6 @@ fn not_foldable(m: &Machine, e: ErrorId, constant: bool) -> Option<&'static str>
             "a component error: it moves with its axis, so it belongs in the axis's compensation, not in the kinematic offsets",
         ),
         _ => Some("not a constant translation of a rotary axis's line"),
-    }
-}
-
-/// The unit vector, in the frame of the axis's offset (machine coordinates), of the axis's own
-/// coordinate direction `d`: `d` itself for an axis along x, y or z; the row `d` of the own
-/// frame of an inclined axis (its `x′`, `y′` or `z′`).
-fn own_axis(direction: &AxisDirection, d: Dir) -> [f64; 3] {
-    match &direction.inclined {
-        Some(inclined) => inclined.frame.axes[d.index()].map(|x| x.to_f64()),
-        None => {
-            let mut v = [0.0; 3];
-            v[d.index()] = 1.0;
-            v
-        }
     }
 }
 
@@ -253,7 +237,7 @@ pub fn corrected_description(
         // The error acts along the axis's own direction `d`: for an inclined axis, its own
         // frame's axis in machine coordinates, so that one error can move two or three
         // coordinates of the offset (the nutating B's `YOB` along y′ moves y and z).
-        let along = own_axis(&m.axes[axis].direction, d);
+        let along = m.axes[axis].direction.frame()[d.index()];
         for (k, &share) in along.iter().enumerate() {
             let part = value * share;
             if part == 0.0 {

@@ -493,6 +493,7 @@ pub fn design_matrix(
     design_in(m, model, campaign, |layout| {
         (0..layout.columns.len()).collect()
     })
+    .map(|(design, _)| design)
 }
 
 /// A design's H with its columns in the order they are solved ([`Layout::solve_order`]), and
@@ -529,8 +530,7 @@ impl Solved {
         model: &Model,
         campaign: &Campaign,
     ) -> Result<(Design, Solved), EstimateError> {
-        let mut design = design_in(m, model, campaign, Layout::solve_order)?;
-        let order = design.layout.solve_order();
+        let (mut design, order) = design_in(m, model, campaign, Layout::solve_order)?;
         let h = std::mem::replace(&mut design.h, DMatrix::zeros(0, 0));
         let names = order.iter().map(|&c| design.names[c].clone()).collect();
         Ok((design, Solved { h, names, order }))
@@ -538,13 +538,14 @@ impl Solved {
 }
 
 /// [`design_matrix`] with the columns of its H in the order `order` gives for the layout
-/// (entry `k`: the layout column put `k`-th); `names` and `owners` stay in layout order.
+/// (entry `k`: the layout column put `k`-th), and that order; `names` and `owners` stay in
+/// layout order.
 fn design_in(
     m: &Machine,
     model: &Model,
     campaign: &Campaign,
     order: impl FnOnce(&Layout) -> Vec<usize>,
-) -> Result<Design, EstimateError> {
+) -> Result<(Design, Vec<usize>), EstimateError> {
     let layout = Layout::new(m, model, campaign)?;
     let mut sources = Sources {
         errors: model.errors(),
@@ -564,14 +565,15 @@ fn design_in(
     }
     let order = order(&layout);
     let h = stack(&layout, blocks, rows, &order);
-    Ok(Design {
+    let design = Design {
         h,
         names: layout.names(),
         owners: layout.owners(),
         rows: layout.rows(),
         backend: sources.backend(),
         layout,
-    })
+    };
+    Ok((design, order))
 }
 
 /// The records' H matrices (`blocks`, each in its record's model order) stacked into one

@@ -7,6 +7,9 @@
 //! - [`kinematics`]: the corrected kinematic description (location errors folded into the
 //!   offsets);
 //! - [`tables`]: axis compensation tables;
+//! - [`limits`]: the safety limits (words that cannot carry the correction, changes beyond a
+//!   limit);
+//! - [`confounded`]: whether the tool-side length can be told from what is compensated;
 //! - [`verify`]: the machine's own error at poses of the exact virtual machine, before and
 //!   after;
 //! - [`volumetric`]: the three-axis scheme from 6D laser-interferometer measurements (the
@@ -14,8 +17,10 @@
 
 #![warn(missing_docs)]
 
+pub mod confounded;
 pub mod correct;
 pub mod kinematics;
+pub mod limits;
 pub mod run;
 pub mod tables;
 pub mod values;

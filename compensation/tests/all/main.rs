@@ -13,5 +13,6 @@ mod compensation_firmware;
 mod corrected_kinematics;
 mod full_loop;
 mod range_limits;
+mod safety_limits;
 mod timebases;
 mod volumetric;

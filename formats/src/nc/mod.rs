@@ -62,7 +62,7 @@ mod write;
 use crate::poses::{AxisWord, CommandedPose, MAX_POSES, PoseList, read_keeping_bom};
 pub use error::NcError;
 use std::path::Path;
-pub use write::{MAX_DECIMALS, ProgramWriter, WriteOptions, Written};
+pub use write::{MAX_DECIMALS, ProgramWriter, RoundingAt, WriteOptions, Written};
 
 /// A pose of a program: the 1-based line of the block and the command of every axis (in the
 /// order of the axis words; mm and degrees).

@@ -44,11 +44,31 @@ pub struct Written {
     /// whose correction rounds to the value in force, that value. What the program's
     /// resolution costs.
     pub rounding: Vec<f64>,
+    /// Per axis (in the order of the axis words), where its largest rounding is: the word
+    /// there and its decimals; `None` where no written value differs from its correction.
+    pub largest_rounding: Vec<Option<RoundingAt>>,
     /// Axis words whose text changed.
     pub changed_words: usize,
     /// Axis words inserted in blocks that had left the axis modal.
     pub inserted_words: usize,
 }
+
+/// Where an axis's largest rounding ([`Written::rounding`]) is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RoundingAt {
+    /// The 1-based line of the pose.
+    pub line: usize,
+    /// The axis word as written (`C+90`), or for an axis the block leaves modal, the word that
+    /// set the value in force, written at the correction (which rounds to that value).
+    pub word: String,
+    /// The decimals the word is written with.
+    pub decimals: usize,
+    /// `true` when the block names the axis, `false` when it leaves it modal.
+    pub in_block: bool,
+}
+
+/// The largest rounding of an axis so far: line, value written, style, decimals, in the block.
+type Largest = (usize, f64, NumberStyle, usize, bool);
 
 impl NcProgram {
     /// A writer of the program with corrected poses, given one at a time in the order of the
@@ -73,6 +93,7 @@ impl NcProgram {
             at: 0,
             in_force: vec![None; n],
             rounding: vec![0.0; n],
+            largest: vec![None; n],
             named: vec![false; n],
             changed_words: 0,
             inserted_words: 0,
@@ -124,6 +145,8 @@ pub struct ProgramWriter<'a> {
     /// Per axis, the value in force and the style of the word that set it.
     in_force: Vec<Option<(f64, NumberStyle)>>,
     rounding: Vec<f64>,
+    /// Per axis, where its rounding is largest.
+    largest: Vec<Option<Largest>>,
     /// Per axis, whether the block being written names it.
     named: Vec<bool>,
     changed_words: usize,
@@ -204,7 +227,12 @@ impl ProgramWriter<'_> {
                 value
             };
             self.in_force[f.axis] = Some((value, f.style));
-            self.rounding[f.axis] = self.rounding[f.axis].max((value - c[f.axis]).abs());
+            let r = (value - c[f.axis]).abs();
+            if r > self.rounding[f.axis] {
+                self.rounding[f.axis] = r;
+                let d = f.style.decimals.max(min_decimals);
+                self.largest[f.axis] = Some((line, value, f.style, d, true));
+            }
         }
         out.push_str(&p.text[self.at..block.insert_at]);
         self.at = block.insert_at;
@@ -212,6 +240,7 @@ impl ProgramWriter<'_> {
             let Some((held, style)) = self.in_force[a] else {
                 return Err(value_err(a, "no value in force before the pose".into()));
             };
+            let decimals = style.decimals.max(min_decimals);
             let value = if c[a].to_bits() == held.to_bits() {
                 held
             } else {
@@ -229,7 +258,11 @@ impl ProgramWriter<'_> {
                 }
                 value
             };
-            self.rounding[a] = self.rounding[a].max((value - c[a]).abs());
+            let r = (value - c[a]).abs();
+            if r > self.rounding[a] {
+                self.rounding[a] = r;
+                self.largest[a] = Some((line, value, style, decimals, false));
+            }
         }
         Ok(())
     }
@@ -248,9 +281,27 @@ impl ProgramWriter<'_> {
             )));
         }
         self.out.push_str(&p.text[self.at..]);
+        let largest_rounding = self
+            .largest
+            .iter()
+            .map(|l| {
+                l.map(|(line, value, style, decimals, in_block)| {
+                    let mut word = String::from(style.letter as char);
+                    // The value was written so once: it is written again.
+                    write_number(&mut word, value, &style, decimals);
+                    RoundingAt {
+                        line,
+                        word,
+                        decimals,
+                        in_block,
+                    }
+                })
+            })
+            .collect();
         Ok(Written {
             text: self.out,
             rounding: self.rounding,
+            largest_rounding,
             changed_words: self.changed_words,
             inserted_words: self.inserted_words,
         })

@@ -1,7 +1,9 @@
 //! Measurement programs and what comes back from running them.
 //!
-//! - [`measure`]: the NC program that takes the machine through an R-test's poses (ISO G-code
-//!   or Heidenhain), with its timing plan;
+//! - [`measure`]: the NC program that takes the machine through an R-test's poses (ISO G-code,
+//!   LinuxCNC or Heidenhain), with its timing plan;
+//! - [`reader`]: the blocks of a program rtest wrote, read back in its dialect and sorted into
+//!   the steps of its sequence (for the read-back and the tests);
 //! - [`segment`]: a time-stamped R-test log of that program's run cut into one sample per
 //!   pose of the timing plan;
 //! - [`stream`]: a simulated R-test log of a measurement program's run, streamed row by row.
@@ -12,5 +14,6 @@
 #![warn(missing_docs)]
 
 pub mod measure;
+pub mod reader;
 pub mod segment;
 pub mod stream;

@@ -67,8 +67,8 @@ pub struct CompensateArgs {
     /// Where the corrected poses go, in the format of --path.
     #[arg(short = 'o', long = "output", value_name = "FILE", requires = "path")]
     output: Option<Target>,
-    /// --path is an NC program of this dialect.
-    #[arg(long, value_name = "iso|heidenhain", value_parser = ["iso", "heidenhain"])]
+    /// --path is an NC program of this dialect (iso: Fanuc-type G-code; linuxcnc; heidenhain).
+    #[arg(long, value_name = "iso|linuxcnc|heidenhain", value_parser = ["iso", "linuxcnc", "heidenhain"])]
     nc: Option<String>,
     /// The fewest decimals of a corrected NC word (default: the program's own; at most 9).
     #[arg(long, value_name = "N")]

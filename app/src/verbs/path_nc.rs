@@ -15,9 +15,10 @@ use std::path::PathBuf;
 /// Flags of the measurement program (with `--nc`).
 #[derive(Debug, clap::Args)]
 pub struct NcArgs {
-    /// Write an NC measurement program of the test instead of a path CSV: `iso` (G-code) or
-    /// `heidenhain` (conversational). -o is then the program; --plan its sample-timing plan.
-    #[arg(long, value_name = "iso|heidenhain")]
+    /// Write an NC measurement program of the test instead of a path CSV: `iso` (Fanuc-type
+    /// G-code), `linuxcnc` (LinuxCNC G-code) or `heidenhain` (conversational). -o is then the
+    /// program; --plan its sample-timing plan.
+    #[arg(long, value_name = "iso|linuxcnc|heidenhain")]
     pub nc: Option<String>,
     /// With --nc: the sample-timing plan (CSV) to write beside the program (default: the
     /// program's file name with `.plan.csv` in place of its extension).
@@ -46,6 +47,25 @@ pub struct NcArgs {
     /// Decimals of the axis words (default 4: 0.0001 mm, 0.0001°; at most 9).
     #[arg(long, value_name = "N", requires = "nc")]
     pub decimals: Option<usize>,
+    /// The clearance position of the tool-axis slide (Z on most machines), mm in machine
+    /// coordinates: the program rapids there first, turns the rotary axes there, and returns
+    /// there at the end (default: the end of its stroke away from the ball, from the machine
+    /// description).
+    #[arg(
+        long,
+        value_name = "MM",
+        requires = "nc",
+        allow_negative_numbers = true
+    )]
+    pub clearance_mm: Option<f64>,
+    /// How far above the first pose, along the tool axis, the approach's rapid ends and its
+    /// slow feed onto the ball starts; the retract feeds as far off the last pose. mm (default
+    /// 30; at most 500).
+    #[arg(long, value_name = "MM", requires = "nc", value_parser = super::args::between(1e-3, 500.0))]
+    pub approach_mm: Option<f64>,
+    /// The feed of the approach onto the ball and of the retract off it, mm/min (default 500).
+    #[arg(long, value_name = "MM_PER_MIN", requires = "nc", value_parser = super::args::between(1.0, 99_999.0))]
+    pub approach_feed: Option<f64>,
 }
 
 impl NcArgs {
@@ -55,7 +75,9 @@ impl NcArgs {
             .as_deref()
             .map(|n| {
                 Dialect::from_name(n).ok_or_else(|| {
-                    Error::usage(format!("--nc: `{n}` is not a dialect (iso or heidenhain)"))
+                    Error::usage(format!(
+                        "--nc: `{n}` is not a dialect (iso, linuxcnc or heidenhain; Fanuc-type controls read iso)"
+                    ))
                 })
             })
             .transpose()
@@ -113,6 +135,13 @@ impl NcArgs {
         }
         if let Some(d) = super::args::nc_decimals(self.decimals)? {
             o.decimals = d;
+        }
+        o.clearance_mm = self.clearance_mm;
+        if let Some(a) = self.approach_mm {
+            o.approach_mm = a;
+        }
+        if let Some(f) = self.approach_feed {
+            o.approach_feed_mm_min = f;
         }
         Ok(o)
     }

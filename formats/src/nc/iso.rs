@@ -4,6 +4,12 @@
 //! codes of [`ACCEPTED`], `M` (not `M98 M99 M198`), `F S T`, `P` with `G4`, `O` program numbers,
 //! `%`, a `/` block without G codes and moves, and the machine's axis letters. Everything else
 //! is refused with the reason ([`g_refusal`], [`IsoReader::word`]). Letters may be lower case.
+//!
+//! LinuxCNC programs ([`IsoReader::linuxcnc`]) are read by the same rules but for what
+//! LinuxCNC reads otherwise: `O` words are subroutines, calls and loops there (refused: the
+//! blocks would not run in the order of the file); `G15` and `G69` are not LinuxCNC codes
+//! (refused); `G61.1` (exact stop) is read, and `G64` may carry its tolerances `P` and `Q`.
+//! `G4 P` is a dwell in seconds there, in ms on Fanuc-type controls: no pose depends on it.
 
 use crate::nc::error::{NcError, Place};
 use crate::nc::number::read_number;
@@ -37,6 +43,23 @@ const ACCEPTED: &[(u32, Option<u32>, Option<Group>)] = &[
 pub(crate) const ACCEPTED_LIST: &str =
     "G0 G1 G4 G9 G15 G17 G18 G19 G21 G40 G49 G61 G64 G69 G80 G90 G93 G94 G95";
 
+/// The G codes of LinuxCNC programs, for messages.
+pub(crate) const LINUXCNC_LIST: &str =
+    "G0 G1 G4 G9 G17 G18 G19 G21 G40 G49 G61 G61.1 G64 G80 G90 G93 G94 G95";
+
+/// Whether G code `major.minor` is read in a LinuxCNC program, with its group: the codes of
+/// [`ACCEPTED`] but `G15` and `G69` (not LinuxCNC codes), and `G61.1` (exact stop).
+fn linuxcnc_code(major: u32, minor: Option<u32>) -> Option<Option<Group>> {
+    match (major, minor) {
+        (15 | 69, None) => None,
+        (61, Some(1)) => Some(Some(Group::PathMode)),
+        _ => ACCEPTED
+            .iter()
+            .find(|(a, b, _)| *a == major && *b == minor)
+            .map(|&(.., g)| g),
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Group {
     Motion,
@@ -48,8 +71,8 @@ enum Group {
     Feed,
 }
 
-/// Why G code `major.minor` is refused.
-fn g_refusal(major: u32, minor: Option<u32>) -> String {
+/// Why G code `major.minor` is refused (in a LinuxCNC program when `linuxcnc`).
+fn g_refusal(major: u32, minor: Option<u32>, linuxcnc: bool) -> String {
     const MACHINE: &str = "the program must be in machine coordinates, so nothing in it may move the coordinate system";
     match (major, minor) {
         (2 | 3, None) => "circular arcs are refused: only straight moves (G0, G1) are read, and a corrected end point would no longer lie on the arc's circle".into(),
@@ -67,6 +90,12 @@ fn g_refusal(major: u32, minor: Option<u32>) -> String {
         (73 | 74 | 76 | 81..=89, None) => "canned cycles are refused: their moves are not written in the program".into(),
         (65 | 66, _) => "macro calls are refused: their moves are not written in the program".into(),
         (7 | 12 | 13, Some(1)) | (107 | 112 | 113, None) => "cylindrical and polar interpolation are refused: the program must command the axes themselves".into(),
+        (15 | 69, None) if linuxcnc => format!(
+            "not a LinuxCNC G code (LinuxCNC has neither G15/G16 polar coordinates nor G68/G69 rotation; read: {LINUXCNC_LIST})"
+        ),
+        _ if linuxcnc => {
+            format!("not a G code rtest reads in a LinuxCNC program (read: {LINUXCNC_LIST})")
+        }
         _ => format!("not a G code rtest reads in an ISO program (read: {ACCEPTED_LIST})"),
     }
 }
@@ -74,6 +103,8 @@ fn g_refusal(major: u32, minor: Option<u32>) -> String {
 /// The block reader of ISO programs; its modal state is whether `G90` has been given.
 pub(crate) struct IsoReader<'a> {
     axes: &'a [AxisWord],
+    /// LinuxCNC's rules ([`IsoReader::linuxcnc`]).
+    linuxcnc: bool,
     absolute: bool,
     /// A line with a word was read (a `%` before it starts the program, one after ends it).
     started: bool,
@@ -97,7 +128,10 @@ struct Seen {
     groups: Vec<(Group, usize, usize)>,
     any_g: bool,
     g90: bool,
+    /// A `G64` (LinuxCNC: its `P` and `Q` are tolerances).
+    g64: bool,
     p: Option<(usize, usize)>,
+    q: Option<(usize, usize)>,
     /// The block ends the program (`M2`, `M30`).
     end: Option<&'static str>,
 }
@@ -106,9 +140,18 @@ impl<'a> IsoReader<'a> {
     pub(crate) fn new(axes: &'a [AxisWord]) -> Self {
         IsoReader {
             axes,
+            linuxcnc: false,
             absolute: false,
             started: false,
             ended: None,
+        }
+    }
+
+    /// The reader of LinuxCNC programs (see the module documentation).
+    pub(crate) fn linuxcnc(axes: &'a [AxisWord]) -> Self {
+        IsoReader {
+            linuxcnc: true,
+            ..IsoReader::new(axes)
         }
     }
 
@@ -155,6 +198,14 @@ impl<'a> IsoReader<'a> {
             return Ok(());
         }
         match l {
+            'O' if self.linuxcnc => {
+                return Err(err(
+                    "`O` words are refused in a LinuxCNC program: there they are subroutines, calls and loops, so the blocks would not run in the order of the file".into(),
+                ));
+            }
+            'Q' if self.linuxcnc && read_number(w.letter, num).is_some_and(|(v, _)| v >= 0.0) => {
+                seen.q = Some((w.start, w.end));
+            }
             'N' | 'O' if integer() => {}
             'F' | 'S' | 'T' | 'P' if read_number(w.letter, num).is_some_and(|(v, _)| v < 0.0) => {
                 return Err(err(format!(
@@ -197,13 +248,18 @@ impl<'a> IsoReader<'a> {
                     Some(m) => Some(code(m).ok_or_else(unreadable)?),
                     None => None,
                 };
-                let Some(&(.., group)) =
-                    ACCEPTED.iter().find(|(a, b, _)| *a == major && *b == minor)
-                else {
-                    return Err(err(g_refusal(major, minor)));
+                let group = if self.linuxcnc {
+                    linuxcnc_code(major, minor).ok_or_else(|| err(g_refusal(major, minor, true)))?
+                } else {
+                    ACCEPTED
+                        .iter()
+                        .find(|(a, b, _)| *a == major && *b == minor)
+                        .map(|&(.., g)| g)
+                        .ok_or_else(|| err(g_refusal(major, minor, false)))?
                 };
                 seen.any_g = true;
                 seen.g90 |= major == 90;
+                seen.g64 |= major == 64 && minor.is_none();
                 if let Some(g) = group {
                     if let Some(&(_, s, e)) = seen.groups.iter().find(|(h, ..)| *h == g) {
                         return Err(err(format!(
@@ -234,7 +290,17 @@ impl<'a> IsoReader<'a> {
             }
             _ => {
                 return Err(err(format!(
-                    "a `{l}` word is not read in an ISO program (read: N, G, M, F, S, T, P with G4, O, and the axes {})",
+                    "a `{l}` word is not read in {} program (read: N, G, M, F, S, T, P with G4, {}and the axes {})",
+                    if self.linuxcnc {
+                        "a LinuxCNC"
+                    } else {
+                        "an ISO"
+                    },
+                    if self.linuxcnc {
+                        "P and Q with G64, "
+                    } else {
+                        "O, "
+                    },
                     letters(self.axes)
                 )));
             }
@@ -331,10 +397,26 @@ impl BlockReader for IsoReader<'_> {
             ));
         }
         let dwell = seen.groups.iter().any(|(g, ..)| *g == Group::Dwell);
+        let tolerance = self.linuxcnc && seen.g64;
         if let Some((s, e)) = seen.p
             && !dwell
+            && !tolerance
         {
-            return Err(place.err(s, e, "a `P` word outside a dwell (G4) is not read"));
+            let what = if self.linuxcnc {
+                "a `P` word outside a dwell (G4) or a path tolerance (G64) is not read"
+            } else {
+                "a `P` word outside a dwell (G4) is not read"
+            };
+            return Err(place.err(s, e, what));
+        }
+        if let Some((s, e)) = seen.q
+            && !tolerance
+        {
+            return Err(place.err(
+                s,
+                e,
+                "a `Q` word outside a path tolerance (G64) is not read in a LinuxCNC program",
+            ));
         }
         if dwell && let Some(f) = fields.first() {
             return Err(place.err(

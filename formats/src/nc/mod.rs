@@ -9,8 +9,10 @@
 //! offsets, rotations, scaling, tool compensation, TCP, cycles, subprograms) is refused with
 //! an error that names the file, line, column and word, and says why.
 //!
-//! Two dialects ([`Dialect`]): ISO G-code ([`Dialect::Iso`]: `G90 G1 X10.5 Y-3 A0 C90 F2000`)
-//! and Heidenhain conversational ([`Dialect::Heidenhain`]: `7 L X+10.5 Y-3 A+0 C+90 R0 FMAX`).
+//! Three dialects ([`Dialect`]): ISO G-code as Fanuc-type controls read it ([`Dialect::Iso`]:
+//! `G90 G1 X10.5 Y-3 A0 C90 F2000`), LinuxCNC's G-code ([`Dialect::LinuxCnc`]: the same blocks,
+//! read by the ISO rules but for what LinuxCNC reads otherwise) and Heidenhain conversational
+//! ([`Dialect::Heidenhain`]: `7 L X+10.5 Y-3 A+0 C+90 R0 FMAX`).
 //!
 //! A program is held as its text and its poses ([`PoseList`]: 8 bytes per axis and 4 per pose),
 //! nothing per word: the writer reads the blocks again (the same reading, so the same words) to
@@ -49,8 +51,8 @@
 //! assert!(e.to_string().starts_with("a.nc:1:1: `G91`: incremental positions are refused"));
 //! ```
 //!
-//! Files: `iso` and `heidenhain` (the block readers of the two dialects), `program` (lines,
-//! modal positions, poses), `number` (the numbers of words and their style), `write`, `error`.
+//! Files: `iso` (the block reader of ISO and LinuxCNC programs), `heidenhain` (that of
+//! conversational ones), `program` (lines, modal positions, poses), `number` (the numbers of words and their style), `write`, `error`.
 
 mod error;
 mod heidenhain;
@@ -73,26 +75,42 @@ pub type NcPose = CommandedPose;
 pub enum Dialect {
     /// ISO 6983 G-code as Fanuc-type controls read it: words of a letter and a number.
     Iso,
+    /// G-code as LinuxCNC reads it (RS274/NGC): the words of [`Dialect::Iso`], dwells in
+    /// seconds, no program number (`O` words are subroutines and loops there).
+    LinuxCnc,
     /// Heidenhain conversational (Klartext, `.h` files): `L X+10 Y+5 R0 FMAX` blocks.
     Heidenhain,
 }
 
 impl Dialect {
-    /// The name on the command line: `iso` or `heidenhain`.
+    /// The name on the command line: `iso`, `linuxcnc` or `heidenhain`.
     pub fn name(self) -> &'static str {
         match self {
             Dialect::Iso => "iso",
+            Dialect::LinuxCnc => "linuxcnc",
             Dialect::Heidenhain => "heidenhain",
         }
     }
 
-    /// The dialect called `name` (`iso`, `heidenhain`), `None` for another name.
+    /// The dialect called `name` (`iso`, `linuxcnc`, `heidenhain`), `None` for another name.
+    /// `fanuc` is not a name of [`Dialect::Iso`]: one name per dialect (see
+    /// `docs/nc-programs.md`).
     pub fn from_name(name: &str) -> Option<Dialect> {
         match name {
             "iso" => Some(Dialect::Iso),
+            "linuxcnc" => Some(Dialect::LinuxCnc),
             "heidenhain" => Some(Dialect::Heidenhain),
             _ => None,
         }
+    }
+
+    /// The names of every dialect, as the command line takes them.
+    pub const NAMES: [&'static str; 3] = ["iso", "linuxcnc", "heidenhain"];
+
+    /// Whether programs of this dialect are G-code (words of a letter and a number): ISO and
+    /// LinuxCNC.
+    pub fn is_g_code(self) -> bool {
+        matches!(self, Dialect::Iso | Dialect::LinuxCnc)
     }
 }
 

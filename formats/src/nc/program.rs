@@ -51,7 +51,7 @@ pub(crate) trait BlockReader {
 /// Letters that words other than axis words use, per dialect, with what they are.
 fn reserved(dialect: Dialect) -> &'static [(char, &'static str)] {
     match dialect {
-        Dialect::Iso => &[
+        Dialect::Iso | Dialect::LinuxCnc => &[
             ('D', "radius offset"),
             ('F', "feed"),
             ('G', "preparatory function"),
@@ -107,6 +107,7 @@ impl<'a> Moves<'a> {
             axes,
             reader: match dialect {
                 Dialect::Iso => Box::new(IsoReader::new(axes)),
+                Dialect::LinuxCnc => Box::new(IsoReader::linuxcnc(axes)),
                 Dialect::Heidenhain => Box::new(HeidenhainReader::new(axes)),
             },
             lines: lines(text),

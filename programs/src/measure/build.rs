@@ -1,13 +1,17 @@
 //! The measurement program and its plan, from the poses of a record.
 
+use crate::measure::approach::{Retreat, retreat};
 use crate::measure::motion::largest_gap_mm;
 use crate::measure::plan::TimingPlan;
-use crate::measure::text::{Feed, ProgramText, word_style};
+use crate::measure::text::{ProgramText, word_style};
 use crate::measure::timing::{MAX_F, Move, f_text, ms, plan_moves, timing_plan};
-use crate::measure::{MeasureError, MeasureMode, MeasureOptions, MeasurementProgram};
+use crate::measure::{
+    MAX_APPROACH_MM, MeasureError, MeasureMode, MeasureOptions, MeasurementProgram,
+};
+use crate::reader::{Step, read_program};
 use formats::csv::column_order;
 use formats::nc::number::write_number;
-use formats::nc::{MAX_DECIMALS, NcError, parse_program};
+use formats::nc::{MAX_DECIMALS, NcError};
 use formats::poses::{axis_words, from_file_units, to_file_units};
 use model_spec::Machine;
 use model_spec::units::short;
@@ -67,8 +71,9 @@ pub fn measurement_program(
     }
     let moves = plan_moves(poses, &written, opts)?;
     let plan = timing_plan(&internal, &moves, opts);
-    let text = program_text(m, opts, &words, &moves, &plan, widest);
-    read_back(m, opts, &text, &written)?;
+    let r = retreat(m, opts, &written[0], &written[written.len() - 1])?;
+    let text = program_text(m, opts, &words, &moves, &plan, widest, &r)?;
+    read_back(m, opts, &text, &written, &r)?;
     Ok(MeasurementProgram {
         text,
         plan,
@@ -125,6 +130,15 @@ fn check_options(m: &Machine, o: &MeasureOptions) -> Result<(), MeasureError> {
             "approach feed {} mm/min: above 0 and at most {MAX_F}",
             significant(o.approach_feed_mm_min)
         ));
+    }
+    if !positive(o.approach_mm) || o.approach_mm > MAX_APPROACH_MM {
+        return bad(format!(
+            "approach {} mm along the tool axis: above 0 and at most {MAX_APPROACH_MM} mm",
+            significant(o.approach_mm)
+        ));
+    }
+    if o.clearance_mm.is_some_and(|z| !z.is_finite()) {
+        return bad("the clearance must be a finite position, mm".into());
     }
     if !positive(o.max_gap_mm) {
         return bad(format!(
@@ -217,7 +231,45 @@ fn write_poses(
     Ok((words, written, rounding))
 }
 
-/// The program's text: the header, the approach to the first pose, then the moves and dwells.
+/// The axis words of `values` (mm, degrees, [`Machine::axes`] order) of the axes `which`
+/// picks, in [`column_order`], with `o.decimals` decimals.
+fn words_of(
+    m: &Machine,
+    o: &MeasureOptions,
+    values: &[f64],
+    which: impl Fn(usize) -> bool,
+) -> Result<String, MeasureError> {
+    let letters = axis_words(m);
+    let mut text = String::new();
+    for a in column_order(m).into_iter().filter(|&a| which(a)) {
+        if !text.is_empty() {
+            text.push(' ');
+        }
+        let letter = letters[a].letter;
+        text.push(letter);
+        write_number(
+            &mut text,
+            values[a],
+            &word_style(o.dialect, letter),
+            o.decimals,
+        )
+        .ok_or_else(|| {
+            MeasureError::Options(format!(
+                "axis {letter}: {} {} of the approach or retract cannot be written as an axis word",
+                values[a],
+                letters[a].unit()
+            ))
+        })?;
+    }
+    Ok(text)
+}
+
+/// The operator's message at the stop.
+pub(crate) const STOP_MESSAGE: &str =
+    "check the nest sits on the ball, start the R-test log, then cycle start";
+
+/// The program's text: the header, the setup, the clearance, the orientation and the approach,
+/// the stop, the measuring moves and dwells, the retract, the end.
 fn program_text(
     m: &Machine,
     o: &MeasureOptions,
@@ -225,25 +277,49 @@ fn program_text(
     moves: &[Move],
     plan: &TimingPlan,
     gap_mm: f64,
-) -> String {
+    r: &Retreat,
+) -> Result<String, MeasureError> {
     let mut p = ProgramText::new(
         o.dialect,
         o.program_number,
         "rtest R-test measurement program",
     );
-    for line in super::header::lines(m, o, plan, gap_mm) {
+    for line in super::header::lines(m, o, plan, gap_mm, r) {
         p.comment(&line);
     }
     let exact_stop = matches!(o.mode, MeasureMode::Static(_));
-    p.modes(exact_stop);
+    let letters = axis_words(m);
+    let zero_words: Vec<String> = column_order(m)
+        .into_iter()
+        .map(|a| format!("{}0", letters[a].letter))
+        .collect();
+    p.setup(exact_stop, &zero_words.join(" "));
+    let rotary = |a: usize| m.axes[a].kind == model_spec::AxisKind::Rotary;
+    let linear = |a: usize| !rotary(a);
+    let mut clearance = r.above_first.clone();
+    clearance[r.axis] = r.clearance_mm;
+    p.machine_rapid(&words_of(m, o, &clearance, |a| a == r.axis)?);
+    if m.axes
+        .iter()
+        .any(|a| a.kind == model_spec::AxisKind::Rotary)
+    {
+        p.machine_rapid(&words_of(m, o, &r.above_first, rotary)?);
+    }
+    p.orient();
+    let others = |a: usize| linear(a) && a != r.axis;
+    if m.axes.iter().enumerate().any(|(a, _)| others(a)) {
+        p.machine_rapid(&words_of(m, o, &r.above_first, others)?);
+    }
+    p.machine_rapid(&words_of(m, o, &r.above_first, |a| a == r.axis)?);
     let (approach, _) = f_text(o.approach_feed_mm_min);
-    p.move_to(&words[0], &Feed::Words(Some(approach)), true);
+    p.machine_feed(&words[0], &approach);
+    p.stop(STOP_MESSAGE);
     match o.mode {
         MeasureMode::Static(t) => {
             let (settle, window) = (ms(t.settle_s), ms(t.window_s));
             for (i, w) in words.iter().enumerate() {
                 if i > 0 {
-                    p.move_to(w, &moves[i - 1].feed, false);
+                    p.move_to(w, &moves[i - 1].feed);
                 }
                 let mark = format!("sample {}", i + 1);
                 let comment = t.marker_comment.then_some(mark.as_str());
@@ -263,41 +339,85 @@ fn program_text(
             let lead = ms(t.lead_s);
             p.dwell(lead, Some("lead-in"));
             for (i, w) in words.iter().enumerate().skip(1) {
-                p.move_to(w, &moves[i - 1].feed, false);
+                p.move_to(w, &moves[i - 1].feed);
             }
             p.dwell(lead, Some("lead-out"));
         }
     }
-    p.finish(o.program_number)
+    p.machine_feed(&words_of(m, o, &r.above_last, linear)?, &approach);
+    let mut back = r.above_last.clone();
+    back[r.axis] = r.clearance_mm;
+    p.machine_rapid(&words_of(m, o, &back, |a| a == r.axis)?);
+    Ok(p.finish(o.program_number))
 }
 
-/// Reads `text` back and checks that it gives the written poses, bit for bit.
+/// Reads `text` back with [`crate::reader`] and checks it: the steps in the order of the
+/// sequence, every move in machine coordinates, the clearance first and last, and the
+/// measuring poses the written ones, bit for bit.
 fn read_back(
     m: &Machine,
     o: &MeasureOptions,
     text: &str,
     written: &[Vec<f64>],
+    r: &Retreat,
 ) -> Result<(), MeasureError> {
     let name = "<measurement program>";
     let program =
-        parse_program(name, text, o.dialect, &axis_words(m)).map_err(MeasureError::ReadBack)?;
-    let same = program.poses().len() == written.len()
-        && program.poses().iter().zip(written).all(|(p, w)| {
-            p.commands
-                .iter()
-                .zip(w)
-                .all(|(a, b)| a.to_bits() == b.to_bits())
-        });
+        read_program(name, text, o.dialect, &axis_words(m)).map_err(MeasureError::ReadBack)?;
+    let fail = |message: String| {
+        MeasureError::ReadBack(NcError::Program {
+            file: name.into(),
+            message,
+        })
+    };
+    use Step::*;
+    let expected = [
+        Setup, Spindle, Clearance, Orient, Approach, Stop, Measure, Retract, End,
+    ];
+    let steps = program.steps();
+    if steps != expected {
+        return Err(fail(format!(
+            "its blocks run as {steps:?}, not in the order {expected:?}"
+        )));
+    }
+    if let Some(b) = program
+        .blocks
+        .iter()
+        .find(|b| b.motion.as_ref().is_some_and(|mv| !mv.machine))
+    {
+        return Err(fail(format!(
+            "the move of line {} is not in machine coordinates",
+            b.line
+        )));
+    }
+    let written_clearance = |moves: Vec<&crate::reader::Motion>, first: bool| {
+        let mv = if first { moves.first() } else { moves.last() };
+        mv.is_some_and(|mv| {
+            mv.named == [r.axis]
+                && (mv.pose[r.axis] - r.clearance_mm).abs()
+                    <= 0.6 * 10f64.powi(-(o.decimals as i32))
+        })
+    };
+    if !written_clearance(program.moves(Clearance), true)
+        || !written_clearance(program.moves(Retract), false)
+    {
+        return Err(fail(
+            "it does not go to the clearance first and last".into(),
+        ));
+    }
+    let poses = program.measuring_poses();
+    let same = poses.len() == written.len()
+        && poses
+            .iter()
+            .zip(written)
+            .all(|(p, w)| p.iter().zip(w).all(|(a, b)| a.to_bits() == b.to_bits()));
     if same {
         Ok(())
     } else {
-        Err(MeasureError::ReadBack(NcError::Program {
-            file: name.into(),
-            message: format!(
-                "it reads back as {} poses that differ from the {} written",
-                program.poses().len(),
-                written.len()
-            ),
-        }))
+        Err(fail(format!(
+            "it reads back as {} measuring poses that differ from the {} written",
+            poses.len(),
+            written.len()
+        )))
     }
 }

@@ -2,37 +2,50 @@
 //! R-test path while the R-test streams its readings, and the sample-timing plan that says
 //! when the machine is at each pose (`docs/measurement-programs.md`).
 //!
-//! [`measurement_program`] writes the program in either dialect ([`Dialect::Iso`],
-//! [`Dialect::Heidenhain`]) and mode:
+//! [`measurement_program`] writes the program in one of three dialects ([`Dialect::Iso`]
+//! (Fanuc-type), [`Dialect::LinuxCnc`], [`Dialect::Heidenhain`]) and in one of two modes, in
+//! one sequence:
 //!
-//! - **static** ([`StaticTiming`]): for each pose a straight move of all axes, then a dwell of
-//!   the settle time and the measuring window (ISO `G4 P<ms>`, Heidenhain cycle 9), optionally
-//!   an M function between the two and a comment marking the measurement;
-//! - **continuous** ([`ContinuousTiming`]): a dwell at the first pose (the lead-in), straight
-//!   feed moves through the poses without stopping, a dwell at the last (the lead-out); the
-//!   R-test samples on the fly.
+//! 1. the header: what the program assumes and what the operator checks, in the order the
+//!    program runs;
+//! 2. the modes, machine coordinates (ISO: `G53` rapids and a `G54` set to zero for the feed
+//!    moves; LinuxCNC: `G53` on every move; Heidenhain: `M91` on every positioning block), the
+//!    spindle stopped;
+//! 3. the clearance: the clearance axis (the tool axis at 0°) to its clearance position, then
+//!    the rotary axes to the first pose's angles there;
+//! 4. the spindle oriented (`M19`), the approach: a rapid to [`MeasureOptions::approach_mm`]
+//!    above the first pose along the tool axis, a feed onto the ball;
+//! 5. a program stop (`M0`, `STOP`) for the operator to check the nest on the ball: the program
+//!    clock of the plan starts when the program resumes;
+//! 6. the measuring poses, **static** ([`StaticTiming`]: for each pose a straight move of all
+//!    axes, then a dwell of the settle time and the measuring window, optionally an M function
+//!    between the two and a comment marking the measurement) or **continuous**
+//!    ([`ContinuousTiming`]: a dwell at the first pose (the lead-in), straight feed moves
+//!    through the poses without stopping, a dwell at the last (the lead-out));
+//! 7. the retract: a feed off the ball along the tool axis, a rapid of the clearance axis to
+//!    the clearance; the end.
 //!
-//! Moves are straight lines in the axis commands with tool centre point control off: the
-//! nest leaves the ball between two poses by the chord of the rotary motion, which is checked
-//! on the nominal machine against [`MeasureOptions::max_gap_mm`]. Their durations are set by
-//! the program where the dialect can: ISO feed moves are in inverse time (`G93`: `F` is 1/the
-//! block time in minutes), so each block takes the time the plan computes, whatever the
-//! control makes of five-axis feeds. Heidenhain conversational has no inverse time: `F` is in
-//! mm/min, and the plan assumes the control applies it to the block's combined move with
-//! degrees counted as mm (no `M116`, tool centre point control off); see the documentation.
+//! Measuring moves are straight lines in the axis commands with tool centre point control off:
+//! the nest leaves the ball between two poses by the chord of the rotary motion, which is
+//! checked on the nominal machine against [`MeasureOptions::max_gap_mm`]. Their durations are
+//! set by the program where the dialect can: ISO and LinuxCNC feed moves are in inverse time
+//! (`G93`: `F` is 1/the block time in minutes), so each block takes the time the plan computes,
+//! whatever the control makes of five-axis feeds. Heidenhain conversational has no inverse
+//! time: `F` is in mm/min, and the plan assumes the control applies it to the block's combined
+//! move with degrees counted as mm (no `M116`, tool centre point control off).
 //!
-//! The program's header (comments) states every assumption: machine coordinates (no work
-//! offset or preset shift), tool centre point control and tool length compensation off, mm
-//! and degrees, absolute positions, the machine and test, the ball's kinematic parameters, the
-//! number of poses, the timing and the rates it assumes. The poses are written with
-//! [`MeasureOptions::decimals`] decimals (rounded to nearest); read back with
-//! [`formats::nc::parse_program`] the program gives them exactly (checked before it is
-//! returned), and the plan holds them as written.
+//! The poses are written with [`MeasureOptions::decimals`] decimals (rounded to nearest); the
+//! program is read back by [`crate::reader`] before it is returned: its blocks in the order
+//! above, every move in machine coordinates, and its measuring poses exactly the written ones,
+//! which the plan holds.
 //!
-//! Files: `motion` (move durations, the nest's gap along a move), `text` (the dialects' blocks),
-//! `header` (the assumptions stated in the program), `timing` (the moves' feeds and durations,
-//! the plan's rows), `build` (the program), `plan` (the plan, its CSV written and read).
+//! Files: `motion` (move durations, the nest's gap along a move), `approach` (the clearance,
+//! the approach and the retract along the tool axis), `text` (the dialects' blocks), `header`
+//! (the assumptions and checks stated in the program), `timing` (the moves' feeds and
+//! durations, the plan's rows), `build` (the program), `plan` (the plan, its CSV written and
+//! read).
 
+mod approach;
 mod build;
 mod header;
 mod motion;
@@ -43,6 +56,9 @@ mod timing;
 use formats::nc::{Dialect, NcError};
 use model_spec::{AxisKind, Machine};
 pub use plan::{PLAN_TIMES, PlanKind, PlanRow, TimingPlan, format_plan, parse_plan, read_plan};
+
+/// The longest approach along the tool axis, mm ([`MeasureOptions::approach_mm`]).
+pub const MAX_APPROACH_MM: f64 = 500.0;
 
 /// The rates of one axis the timing plan assumes, in the axis's unit (mm or degrees).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -168,9 +184,19 @@ pub struct MeasureOptions {
     pub test_name: String,
     /// The program number: ISO `O` number, Heidenhain `RTEST<number>`; 1 to 9999. Default 1000.
     pub program_number: u32,
-    /// The feed of the first move, to the first pose, mm/min (a feed per minute move: where the
-    /// machine comes from is not known). Above 0. Default 500 mm/min.
+    /// The feed of the approach onto the ball at the first pose and of the retract off it at
+    /// the last, along the tool axis, mm/min (feed per minute). Above 0. Default 500 mm/min.
     pub approach_feed_mm_min: f64,
+    /// How far above the first pose, along the tool axis, the rapid of the approach ends and
+    /// the feed onto the ball starts; the retract feeds as far off the last pose. mm, above 0
+    /// and at most [`MAX_APPROACH_MM`]. Default 30 mm: beyond the reach of an R-test's sensors
+    /// below the ball's centre.
+    pub approach_mm: f64,
+    /// The clearance position of the clearance axis (the linear axis along the tool axis with
+    /// every rotary axis at 0), mm in machine coordinates: the program goes there first and
+    /// last, and turns the rotary axes there. Default `None`: the end of that axis's stroke
+    /// away from the ball, as the machine description gives it.
+    pub clearance_mm: Option<f64>,
     /// The largest distance between the nest and the ball allowed along a move on the nominal
     /// machine, mm. Above 0. Default 0.5 mm.
     pub max_gap_mm: f64,
@@ -196,6 +222,8 @@ impl MeasureOptions {
             test_name: String::new(),
             program_number: 1000,
             approach_feed_mm_min: 500.0,
+            approach_mm: 30.0,
+            clearance_mm: None,
             max_gap_mm: 0.5,
             params: m.default_parameters(),
         }

@@ -28,7 +28,8 @@ pub(crate) struct Move {
     pub(crate) ramp_s: f64,
 }
 
-/// The moves to poses 2, 3, … (the first move, to pose 1, comes from an unknown position).
+/// The moves to poses 2, 3, … (pose 1 is reached by the approach, before the program clock
+/// starts).
 pub(crate) fn plan_moves(
     poses: &Record,
     written: &[Vec<f64>],
@@ -49,7 +50,7 @@ pub(crate) fn plan_moves(
         let (feed, rate) = if delta.iter().all(|d| *d == 0.0) {
             let feed = match o.dialect {
                 // In inverse time every feed block needs its F; the block moves nothing.
-                Dialect::Iso if !rapid => Feed::Words(Some(f_text(MAX_F).0)),
+                Dialect::Iso | Dialect::LinuxCnc if !rapid => Feed::Words(Some(f_text(MAX_F).0)),
                 _ if rapid => Feed::Rapid,
                 _ => Feed::Words(None),
             };
@@ -58,9 +59,9 @@ pub(crate) fn plan_moves(
             (Feed::Rapid, rate_limit(&delta, &rapids))
         } else {
             let limit = rate_limit(&delta, &feeds);
-            // ISO: inverse time, F = 1/min; Heidenhain: mm/min along the combined move.
+            // ISO, LinuxCNC: inverse time, F = 1/min; Heidenhain: mm/min along the combined move.
             let per_rate = match o.dialect {
-                Dialect::Iso => 60.0,
+                Dialect::Iso | Dialect::LinuxCnc => 60.0,
                 Dialect::Heidenhain => 60.0 * combined_length(&delta),
             };
             let (text, f) = f_text((limit * per_rate).min(MAX_F));

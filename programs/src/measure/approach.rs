@@ -58,6 +58,10 @@ fn det(c: &[[f64; 3]; 3]) -> f64 {
     )
 }
 
+/// The three linear axes of a machine, the columns of `A` (mm per mm, bed frame) and the tool
+/// axis (unit vector, bed frame) at a pose.
+type Columns = ([usize; 3], [[f64; 3]; 3], [f64; 3]);
+
 /// The linear axes of `m` (three, else an error), the columns of `A` at `q` (mm, rad) and the
 /// tool axis there.
 fn columns(
@@ -65,7 +69,7 @@ fn columns(
     vm: &VirtualMachine,
     params: &[f64],
     q: &[f64],
-) -> Result<([usize; 3], [[f64; 3]; 3], [f64; 3]), MeasureError> {
+) -> Result<Columns, MeasureError> {
     let linear: Vec<usize> = m.linear_axes().collect();
     let Ok(linear) = <[usize; 3]>::try_from(linear.as_slice()) else {
         return Err(MeasureError::Options(format!(

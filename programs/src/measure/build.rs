@@ -158,6 +158,11 @@ fn check_options(m: &Machine, o: &MeasureOptions) -> Result<(), MeasureError> {
     };
     match o.mode {
         MeasureMode::Static(t) => {
+            if let Some(code) = t.marker_m
+                && let Some(why) = marker_refusal(code)
+            {
+                return bad(format!("marker M{code}: {why}"));
+            }
             dwell("settle time", t.settle_s, 0.0)?;
             dwell("measuring window", t.window_s, 0.001)?;
             dwell("settle time and window", t.settle_s + t.window_s, 0.001)?;
@@ -173,6 +178,23 @@ fn check_options(m: &Machine, o: &MeasureOptions) -> Result<(), MeasureError> {
         }
     }
     Ok(())
+}
+
+/// Why M function `code` cannot mark the measuring windows: it stops, ends or calls, moves the
+/// spindle the nest sits in, changes tools or how positions are read. `None` for one that may.
+fn marker_refusal(code: u16) -> Option<&'static str> {
+    match code {
+        0 | 1 | 2 | 30 | 60 => Some("it stops or ends the program"),
+        3..=5 | 13 | 14 | 19 | 20 => {
+            Some("it turns, stops or orients the spindle the nest sits in")
+        }
+        6 => Some("it changes tools and would unload the nest"),
+        89 | 98 | 99 | 198 => Some("it calls or returns from a subprogram or cycle"),
+        91 | 92 | 114 | 116 | 118 | 126..=129 | 140 | 144 | 145 => {
+            Some("it changes how the positions or rotary axes are read")
+        }
+        _ => None,
+    }
 }
 
 /// The axis words of every pose (`X-217.5040 Y… A… C…`, in [`column_order`]), the values they

@@ -9,3 +9,4 @@ mod one_record;
 
 mod nc_measure;
 mod segment;
+mod sequence;

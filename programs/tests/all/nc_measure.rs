@@ -1,12 +1,13 @@
 //! Measurement programs: the written program reads back as the path's poses at its resolution,
-//! in both dialects and modes, over several machines and paths; the timing plan follows its
-//! stated model; the plan's CSV reads back exactly and refuses what is malformed.
+//! in every dialect and mode, over several machines and paths; the timing plan follows its
+//! stated model; the plan's CSV reads back exactly and refuses what is malformed. The sequence
+//! of the programs (clearance, approach, stop, retract) is tested in `sequence.rs`.
 
 use crate::common;
 
 use common::builtin;
 use formats::csv::ReadOptions;
-use formats::nc::{Dialect, parse_program};
+use formats::nc::Dialect;
 use formats::paths::load_path;
 use formats::poses::{axis_words, to_file_units};
 use model_spec::{AxisKind, Machine, parse_machine};
@@ -14,6 +15,7 @@ use programs::measure::{
     ContinuousTiming, MeasureError, MeasureMode, MeasureOptions, PlanKind, StaticMotion,
     StaticTiming, TimingPlan, format_plan, measurement_program, parse_plan, plan_comments,
 };
+use programs::reader::read_program;
 use simulation::builtin_path;
 use simulation::paths::{fill_linear_ik, record_from_commands};
 use simulation::record::Record;
@@ -89,7 +91,7 @@ fn rounded(x: f64, d: usize) -> f64 {
 #[test]
 fn programs_read_back_as_the_poses_at_their_resolution() {
     for (name, m, path) in paths() {
-        for dialect in [Dialect::Iso, Dialect::Heidenhain] {
+        for dialect in [Dialect::Iso, Dialect::LinuxCnc, Dialect::Heidenhain] {
             for (mode, decimals) in [
                 (static_mode(), 4),
                 (continuous_mode(), 4),
@@ -107,30 +109,28 @@ fn programs_read_back_as_the_poses_at_their_resolution() {
                 let what = format!("{name}, {dialect:?}, {mode:?}, {decimals} decimals");
                 let p =
                     measurement_program(&m, &path, &o).unwrap_or_else(|e| panic!("{what}: {e}"));
-                let read = parse_program("p", &p.text, dialect, &axis_words(&m)).unwrap();
-                assert_eq!(read.poses().len(), path.samples.len(), "{what}");
+                let read = read_program("p", &p.text, dialect, &axis_words(&m)).unwrap();
+                let poses = read.measuring_poses();
+                assert_eq!(poses.len(), path.samples.len(), "{what}");
                 assert_eq!(p.plan.rows.len(), path.samples.len(), "{what}");
                 let half = 0.5 * 10f64.powi(-(decimals as i32));
-                for ((pose, s), row) in read.poses().iter().zip(&path.samples).zip(&p.plan.rows) {
+                for (i, ((pose, s), row)) in poses
+                    .iter()
+                    .zip(&path.samples)
+                    .zip(&p.plan.rows)
+                    .enumerate()
+                {
                     let given = to_file_units(&m, &s.commands);
                     for (a, &g) in given.iter().enumerate() {
                         // The word is the pose rounded to nearest at the program's resolution.
-                        assert_eq!(
-                            pose.commands[a],
-                            rounded(g, decimals),
-                            "{what}: line {}",
-                            pose.line
-                        );
-                        assert!(
-                            (pose.commands[a] - g).abs() <= half * (1.0 + 1e-9),
-                            "{what}"
-                        );
+                        assert_eq!(pose[a], rounded(g, decimals), "{what}: pose {}", i + 1);
+                        assert!((pose[a] - g).abs() <= half * (1.0 + 1e-9), "{what}");
                         // The plan holds the pose as commanded.
                         let planned = match m.axes[a].kind {
                             AxisKind::Linear => row.commands[a],
                             AxisKind::Rotary => row.commands[a].to_degrees(),
                         };
-                        assert!((planned - pose.commands[a]).abs() < 1e-9, "{what}");
+                        assert!((planned - pose[a]).abs() < 1e-9, "{what}");
                     }
                 }
                 for (a, r) in p.rounding.iter().enumerate() {
@@ -212,14 +212,21 @@ fn the_static_plan_follows_its_timing_model() {
         p.text
             .contains("\nG1 X0.0000 Y0.0000 Z0.0000 A0.0000 C18.0000 F99999.999\n")
     );
-    assert!(p.text.ends_with("G4 P1750\nG94\nM30\n%\n"));
+    // After the last dwell: 30 mm off the ball along the tool axis (Z), then the clearance.
+    assert!(
+        p.text.ends_with(
+            "G4 P1750\nG94 G1 X0.0000 Y0.0000 Z30.0000 F500.000\nG53 G0 Z500.0000\nM30\n%\n"
+        ),
+        "{}",
+        p.text
+    );
 
     // Heidenhain: F in mm/min along the combined move (degrees as mm): 18° in 0.6 s = 1800.
     o.dialect = Dialect::Heidenhain;
     let h = measurement_program(&m, &r, &o).unwrap();
     assert!(
         h.text
-            .contains(" L X+0.0000 Y+0.0000 Z+0.0000 A+0.0000 C+18.0000 R0 F1800.000\n"),
+            .contains(" L X+0.0000 Y+0.0000 Z+0.0000 A+0.0000 C+18.0000 R0 F1800.000 M91\n"),
         "{}",
         h.text
     );
@@ -285,10 +292,9 @@ fn the_continuous_plan_has_lead_dwells_and_timed_blocks() {
         "{}",
         p.text
     );
-    assert!(
-        p.text
-            .contains("C12.0000 F300.000\nG4 P1500 (LEAD-OUT)\nG94\nM30\n")
-    );
+    assert!(p.text.contains(
+        "C12.0000 F300.000\nG4 P1500 (LEAD-OUT)\nG94 G1 X0.0000 Y0.0000 Z30.0000 F500.000\n"
+    ));
 
     // A block shorter than one sampling period is refused.
     o.mode = MeasureMode::Continuous(ContinuousTiming {
@@ -303,43 +309,99 @@ fn the_continuous_plan_has_lead_dwells_and_timed_blocks() {
 }
 
 #[test]
-fn the_header_states_the_assumptions() {
+fn the_header_states_the_assumptions_and_the_checks_in_order() {
     let m = builtin("seed-ac");
     let k4 = builtin_path(&m, "K4").unwrap().unwrap();
     let mut o = MeasureOptions::new(&m, Dialect::Iso, static_mode());
     o.test_name = "K4".into();
+    let in_order = |text: &str, needles: &[&str], what: &str| {
+        let mut at = 0;
+        for needle in needles {
+            match text[at..].find(needle) {
+                Some(i) => at += i + needle.len(),
+                None => panic!("`{needle}` not in the {what} header after byte {at}"),
+            }
+        }
+    };
     let iso = measurement_program(&m, &k4, &o).unwrap().text;
-    for needle in [
-        "%\nO1000 (RTEST R-TEST MEASUREMENT PROGRAM)\n",
-        "(TEST K4, 241 POSES, STATIC: MEASURED AT REST)",
-        "MACHINE COORDINATES",
-        "[G54-G59, G52, G92, G68, G51 CANCELLED OR ZERO]",
-        "(TOOL LENGTH COMPENSATION OFF [G49])",
-        "TOOL CENTRE POINT CONTROL OFF",
-        "  ZC = 29.794",
-        "  XW = -217.504",
-        "(EACH POSE: MOVE, DWELL 3 S = SETTLE 1 S + WINDOW 2 S)",
-        "INVERSE TIME [G93",
-        "LARGEST NEST-BALL GAP ALONG A MOVE",
-        "G90 G21 G94 G17 G40 G49 G80 G69 G15 G61\n",
-    ] {
-        assert!(iso.contains(needle), "`{needle}` not in the ISO header");
-    }
+    in_order(
+        &iso,
+        &[
+            "%\nO1000 (RTEST R-TEST MEASUREMENT PROGRAM)\n",
+            "(TEST K4, 241 POSES, STATIC: MEASURED AT REST)",
+            "G4 P IN MS [NOT LINUXCNC]",
+            "MACHINE COORDINATES",
+            "(1 COORDINATES: G53",
+            "THIS PROGRAM SETS TO ZERO [G10 L2 P1]: NOTE YOUR G54",
+            "(2 TOOL: G49",
+            "(3 TCP OFF",
+            "(4 ROTARY AXES A C",
+            "NO ROLL-OVER [MODULO] AXIS",
+            "PARAMETER 1008 ROA = 0",
+            "(5 CLEARANCE: Z RAPIDS FIRST TO Z500 MM [MACHINE],)",
+            "(6 SPINDLE: M5, THEN M19",
+            "(7 APPROACH: RAPID TO 30 MM ABOVE POSE 1",
+            "FEED ONTO THE BALL AT 500 MM/MIN",
+            "(8 STOP [M0]: CHECK THE NEST SITS ON THE BALL",
+            "(9 END: FEED 30 MM OFF THE BALL",
+            "  ZC = 29.794",
+            "  XW = -217.504",
+            "WHEN THE PROGRAM RESUMES AFTER",
+            "(EACH POSE: MOVE, DWELL 3 S = SETTLE 1 S + WINDOW 2 S)",
+            "INVERSE TIME [G93",
+            "LARGEST NEST-BALL GAP ALONG A MOVE",
+            "G90 G21 G94 G17 G40 G49 G80 G69 G15 G61\nG10 L2 P1 X0 Y0 Z0 A0 C0\nG54\nM5\n",
+        ],
+        "ISO",
+    );
+    o.dialect = Dialect::LinuxCnc;
+    let l = measurement_program(&m, &k4, &o).unwrap().text;
+    assert!(
+        l.starts_with("%\n(rtest R-test measurement program)\n"),
+        "{}",
+        &l[..200]
+    );
+    in_order(
+        &l,
+        &[
+            "G4 P in s",
+            "(1 coordinates: G53 on every move",
+            "(2 tool: G49",
+            "(3 kinematics: trivial",
+            "no WRAPPED_ROTARY",
+            "G90 G21 G94 G17 G40 G49 G80 G61\nM5\n",
+            "(MSG,check the nest sits on the ball",
+            "\nM2\n%\n",
+        ],
+        "LinuxCNC",
+    );
+    // No O word (a subroutine in LinuxCNC), no G69/G15 (not LinuxCNC codes).
+    assert!(!l.contains("\nO") && !l.contains("G69") && !l.contains("G15"));
     o.dialect = Dialect::Heidenhain;
     let h = measurement_program(&m, &k4, &o).unwrap().text;
-    for needle in [
-        "0 BEGIN PGM RTEST1000 MM\n1 ; rtest R-test measurement program\n",
-        "; the preset must be the machine datum",
-        "FUNCTION RESET TCPM\n",
-        "degrees counted as mm (no M116)",
-        "; the active tool must have length 0 and radius 0",
-        "END PGM RTEST1000 MM\n",
-    ] {
-        assert!(
-            h.contains(needle),
-            "`{needle}` not in the Heidenhain header"
-        );
-    }
+    in_order(
+        &h,
+        &[
+            "0 BEGIN PGM RTEST1000 MM\n1 ; rtest R-test measurement program\n",
+            "; 1 coordinates: M91 on every positioning block",
+            "; 2 tool: no TOOL CALL here",
+            "the active tool must have L 0 and R 0",
+            "; 3 TCP off: FUNCTION RESET TCPM here",
+            "M127 here",
+            "degrees counted as mm (no M116)",
+            " FUNCTION RESET TCPM\n",
+            " L M127\n",
+            " L M5\n",
+            " STOP ; check the nest sits on the ball",
+            "END PGM RTEST1000 MM\n",
+        ],
+        "Heidenhain",
+    );
+    // No tool call block (a comment may name it).
+    assert!(h.lines().all(|l| {
+        !l.split_once(' ')
+            .is_some_and(|(_, b)| b.starts_with("TOOL CALL"))
+    }));
     // Block numbers count every line from 0.
     for (i, line) in h.lines().enumerate() {
         assert!(line.starts_with(&format!("{i} ")), "{line}");
@@ -363,7 +425,7 @@ fn markers_split_the_dwell() {
     );
     assert!(
         iso.text
-            .contains("\nG4 P1000\nM100\nG4 P2000 (SAMPLE 241)\nG94\nM30\n")
+            .contains("\nG4 P1000\nM100\nG4 P2000 (SAMPLE 241)\nG94 G1 ")
     );
     let h =
         measurement_program(&m, &k4, &MeasureOptions::new(&m, Dialect::Heidenhain, mode)).unwrap();
@@ -377,6 +439,26 @@ fn markers_split_the_dwell() {
     .unwrap();
     assert_eq!(plain.plan, iso.plan);
     assert!(!plain.text.contains("M100") && !plain.text.contains("SAMPLE"));
+    // A marker that would stop the program, move the spindle the nest sits in or change tools
+    // is refused.
+    for (code, why) in [
+        (0, "stops"),
+        (19, "spindle"),
+        (3, "spindle"),
+        (6, "changes tools"),
+        (91, "positions"),
+    ] {
+        let mode = MeasureMode::Static(StaticTiming {
+            marker_m: Some(code),
+            ..StaticTiming::default()
+        });
+        let e =
+            measurement_program(&m, &k4, &MeasureOptions::new(&m, Dialect::Iso, mode)).unwrap_err();
+        assert!(
+            matches!(e, MeasureError::Options(_)) && e.to_string().contains(why),
+            "M{code}: {e}"
+        );
+    }
 }
 
 #[test]

@@ -447,3 +447,76 @@ impl BlockReader for IsoReader<'_> {
         }))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::nc::{Dialect, parse_program};
+    use crate::poses::AxisWord;
+    use model_spec::AxisKind::{Linear, Rotary};
+
+    fn axes() -> [AxisWord; 3] {
+        [
+            AxisWord {
+                letter: 'X',
+                kind: Linear,
+            },
+            AxisWord {
+                letter: 'Z',
+                kind: Linear,
+            },
+            AxisWord {
+                letter: 'C',
+                kind: Rotary,
+            },
+        ]
+    }
+
+    fn err(text: &str, dialect: Dialect) -> String {
+        parse_program("p.ngc", text, dialect, &axes())
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn linuxcnc_programs_are_read_by_the_iso_rules_but_for_what_linuxcnc_reads_otherwise() {
+        // Dwells (in seconds there), path tolerances, exact stop and comments: the poses.
+        let text = "%\n(a LinuxCNC program)\nG90 G21 G94 G17 G40 G49 G80 G64 P0.01 Q0.01\nG0 X10 Z5 C0\nG4 P1.5\nG61.1\nG1 C360 F500 ; the last pose\nM2\n%\n";
+        let p = parse_program("p.ngc", text, Dialect::LinuxCnc, &axes()).unwrap();
+        assert_eq!(p.pose_list().len(), 2);
+        assert_eq!(p.pose_list().commands(1), [10.0, 5.0, 360.0]);
+        // The same text is not an ISO program: a Q word, P outside a dwell.
+        let e = err(text, Dialect::Iso);
+        assert!(e.starts_with("p.ngc:3:39: `Q0.01`"), "{e}");
+        let e = err(&text.replace(" Q0.01", ""), Dialect::Iso);
+        assert!(e.contains("`P0.01`: a `P` word outside a dwell"), "{e}");
+        // G53 stays refused in every G-code dialect: the programs compensate corrects are
+        // modal G0/G1 blocks in machine coordinates.
+        for d in [Dialect::Iso, Dialect::LinuxCnc] {
+            let e = err("G90\nG53 G0 X0 Z0 C0\n", d);
+            assert!(e.starts_with("p.ngc:2:1: `G53`: a one-shot move"), "{e}");
+            let e = err("G90\nG10 L2 P1 X0 Z0 C0\n", d);
+            assert!(e.starts_with("p.ngc:2:1: `G10`: setting offsets"), "{e}");
+        }
+        // O words are subroutines and loops in LinuxCNC; G15 and G69 are not LinuxCNC codes.
+        let e = err("o100 sub\nG90 G0 X0 Z0 C0\n", Dialect::LinuxCnc);
+        assert!(
+            e.starts_with("p.ngc:1:1: `o100`: `O` words are refused"),
+            "{e}"
+        );
+        let e = err("G90 G69\nG0 X0 Z0 C0\n", Dialect::LinuxCnc);
+        assert!(e.contains("`G69`: not a LinuxCNC G code"), "{e}");
+        let e = err("G90 G0 X0 Z0 C0 Q1\n", Dialect::LinuxCnc);
+        assert!(
+            e.contains("`Q1`: a `Q` word outside a path tolerance"),
+            "{e}"
+        );
+        let e = err("G90 G0 X0 Z0 C0\nG5.1 X1\n", Dialect::LinuxCnc);
+        assert!(
+            e.contains("not a G code rtest reads in a LinuxCNC program"),
+            "{e}"
+        );
+        // An ISO program keeps its O number and G69.
+        let iso = "%\nO1000\nG90 G69 G15\nG0 X0 Z0 C0\nM30\n%\n";
+        assert!(parse_program("p.nc", iso, Dialect::Iso, &axes()).is_ok());
+    }
+}

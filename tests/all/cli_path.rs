@@ -336,9 +336,10 @@ fn bad_input_is_refused_and_writes_nothing() {
 }
 
 #[test]
-fn the_nc_program_of_a_test_reads_back_to_its_poses_in_both_dialects() {
-    use formats::nc::{Dialect, parse_program};
+fn the_nc_program_of_a_test_reads_back_to_its_poses_in_every_dialect() {
+    use formats::nc::Dialect;
     use formats::poses::axis_words;
+    use programs::reader::{Step, read_program};
     let dir = temp_dir_tagged("cli-path", "nc");
     for (machine_name, test, param) in [
         ("seed-ac", "K4", None),
@@ -351,7 +352,11 @@ fn the_nc_program_of_a_test_reads_back_to_its_poses_in_both_dialects() {
             params[z] = 120.0;
         }
         let path = generate(&m, test, &params, &GeneratorOptions::default()).unwrap();
-        for (dialect, file) in [(Dialect::Iso, "p.nc"), (Dialect::Heidenhain, "p.h")] {
+        for (dialect, file) in [
+            (Dialect::Iso, "p.nc"),
+            (Dialect::LinuxCnc, "p.ngc"),
+            (Dialect::Heidenhain, "p.h"),
+        ] {
             let mut args = vec![
                 "path",
                 "--machine",
@@ -369,8 +374,31 @@ fn the_nc_program_of_a_test_reads_back_to_its_poses_in_both_dialects() {
             let out = ok(&dir, &args);
             assert!(out.contains("Measurement program"), "{out}");
             let text = std::fs::read_to_string(dir.join(file)).unwrap();
-            let program = parse_program(file, &text, dialect, &axis_words(&m)).unwrap();
-            let poses = program.poses();
+            let program = read_program(file, &text, dialect, &axis_words(&m)).unwrap();
+            // Machine coordinates, the approach, the stop, the poses, the retract, in order.
+            assert_eq!(
+                program.steps(),
+                [
+                    Step::Setup,
+                    Step::Spindle,
+                    Step::Clearance,
+                    Step::Orient,
+                    Step::Approach,
+                    Step::Stop,
+                    Step::Measure,
+                    Step::Retract,
+                    Step::End
+                ],
+                "{machine_name} {dialect:?}"
+            );
+            assert!(
+                program
+                    .blocks
+                    .iter()
+                    .filter_map(|b| b.motion.as_ref())
+                    .all(|mv| mv.machine)
+            );
+            let poses = program.measuring_poses();
             assert_eq!(poses.len(), path.samples.len(), "{machine_name} {test}");
             for (p, s) in poses.iter().zip(&path.samples) {
                 for (k, a) in m.axes.iter().enumerate() {
@@ -381,11 +409,11 @@ fn the_nc_program_of_a_test_reads_back_to_its_poses_in_both_dialects() {
                     // The program's resolution: 0.0001 mm and 0.0001°.
                     let rounded = (want * 1e4).round() / 1e4;
                     assert!(
-                        (p.commands[k] - rounded).abs() < 1e-9,
+                        (p[k] - rounded).abs() < 1e-9,
                         "{machine_name} {test} {:?}: axis {} {} against {rounded}",
                         dialect,
                         a.name,
-                        p.commands[k]
+                        p[k]
                     );
                 }
             }
@@ -410,7 +438,9 @@ fn the_nc_program_of_a_test_reads_back_to_its_poses_in_both_dialects() {
             "x.nc",
         ],
         2,
-        &["--nc: `fanuc` is not a dialect"],
+        &[
+            "--nc: `fanuc` is not a dialect (iso, linuxcnc or heidenhain; Fanuc-type controls read iso)",
+        ],
     );
     fails(
         &dir,
@@ -523,5 +553,60 @@ fn the_gap_check_names_and_takes_its_flag() {
         &common::words(&format!("{base} --max-gap-mm 9")),
         2,
         &["--max-gap-mm", "`9` is not a number from 0.001 to 5"],
+    );
+}
+
+/// The clearance, the approach and its feed are flags; a clearance outside the stroke of the
+/// tool-axis slide, or nearer the ball than the approach's start, is refused naming the flag,
+/// and nothing is written.
+#[test]
+fn the_clearance_and_the_approach_are_flags() {
+    let dir = temp_dir_tagged("path", "clearance");
+    let base = "path --machine seed-ac --test K4 --nc linuxcnc -o k4.ngc";
+    ok(
+        &dir,
+        &common::words(&format!(
+            "{base} --clearance-mm 300 --approach-mm 20 --approach-feed 250"
+        )),
+    );
+    let text = std::fs::read_to_string(dir.join("k4.ngc")).unwrap();
+    assert!(
+        text.contains("\nG53 G0 Z300.0000\nG53 G0 A0.0000 C0.0000\nM19 R0\n"),
+        "{text}"
+    );
+    assert!(text.contains(
+        "\nG53 G0 Z76.6610\nG53 G94 G1 X217.5040 Y-0.2790 Z56.6610 A0.0000 C0.0000 F250.000\n(MSG,"
+    ));
+    assert!(text.ends_with("G53 G0 Z300.0000\nM2\n%\n"));
+    assert!(
+        text.contains("(5 clearance: Z rapids first to Z300 mm [machine],)"),
+        "{text}"
+    );
+    for (flags, needle) in [
+        (
+            "--clearance-mm 900",
+            "--nc: clearance Z 900 mm: outside the stroke of axis Z",
+        ),
+        (
+            "--clearance-mm 60",
+            "--nc: clearance Z 60 mm: the approach starts at Z 86.661 mm, beyond it",
+        ),
+        ("--clearance-mm -600", "outside the stroke of axis Z"),
+    ] {
+        let d = temp_dir_tagged("path", "clearance-bad");
+        fails(&d, &common::words(&format!("{base} {flags}")), 2, &[needle]);
+        assert!(entries(&d).is_empty());
+    }
+    fails(
+        &dir,
+        &common::words(&format!("{base} --approach-mm 0")),
+        2,
+        &["--approach-mm", "is not a number from 0.001 to 500"],
+    );
+    fails(
+        &dir,
+        &common::words("path --machine seed-ac --test K4 --approach-mm 10 -o x.csv"),
+        2,
+        &["--nc"],
     );
 }

@@ -11,6 +11,7 @@ mod browser_harness;
 mod cli;
 mod cli_campaign;
 mod cli_compensate;
+mod cli_compensate_limits;
 mod cli_diagnose;
 mod cli_gains;
 mod cli_generate_crate;

@@ -5,21 +5,27 @@
 use super::args::ValueBounds;
 use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
 use crate::Done;
+use compensation::confounded::tool_length;
 use compensation::kinematics::{CorrectedDescription, corrected_description};
+use compensation::limits::{
+    ChangeLimits, MAX_CHANGE_UM, MAX_CHANGE_URAD, check_changes, coarse_words,
+};
 use compensation::run::{PoseSource, RunError, Stopped, Summary, compensate_each};
 use compensation::tables::{Pitch, axis_tables};
 use compensation::values::{CompensationError, MachineErrors};
-use formats::nc::{Dialect, WriteOptions, parse_program};
+use formats::nc::{Dialect, WriteOptions, Written, parse_program};
 use formats::poses::{
     AxisWord, PoseList, axis_words, from_file_units, from_file_units_into, read_keeping_bom,
     read_pose_csv, to_file_units_into,
 };
 use model_spec::units::{compact, readable};
 use output::{Outputs, Target};
-use report::json::compensate::{CompensationReport, CompensationSource, KinematicsReport};
+use report::json::compensate::{
+    CompensationReport, CompensationSource, KinematicsReport, LengthReport,
+};
 use report::json::read::parse_identification;
 use report::json::to_json;
-use report::text::compensate::{compensation, kinematics_and_tables};
+use report::text::compensate::{compensation, kinematics_and_tables, length_warning};
 use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
@@ -35,7 +41,9 @@ machine coordinates (absolute straight moves); OUT has the same format with the 
 values, at which the model's predicted tool point and tool axis are the commanded ones (to \
 1 nm). The rotation about the tool axis cannot be corrected and is reported. A corrected \
 command past a stroke or range limit by at most 0.01 mm or 0.01° is put on the limit and \
-listed; further out, the pose is refused with its line.
+listed; further out, the pose is refused with its line. An NC word written with the program's \
+decimals that loses more than 0.1 µm (linear) or 1 µrad (rotary) of its correction is refused \
+with its line and the decimals needed, unless --decimals N says how many to write.
 
 --kinematics-out FILE: the machine description with the location errors and the identified \
 kinematic symbols folded into its offsets and defaults; what cannot be folded is listed. \
@@ -43,6 +51,11 @@ kinematic symbols folded into its offsets and defaults; what cannot be folded is
 against its position, every --pitch mm (--pitch-deg degrees on rotary axes). --param sets \
 kinematic symbols (mm; the tool length, say). --json FILE writes the summary, --report FILE the \
 HTML report (both need --path).
+
+Limits: an error whose largest value over the machine's ranges, or a change folded by \
+--kinematics-out, beyond --max-change-um (default 50) or --max-change-urad (default 250) is \
+refused. When the tool-side length (the probe's Zp) cannot be told from a compensated error \
+(ZOA on seed-ac), a warning names them: give the length measured on a tool setter with --param.
 
 Details: docs/compensation.md, docs/compensation-tables.md, docs/nc-programs.md, docs/report.md.";
 
@@ -70,7 +83,8 @@ pub struct CompensateArgs {
     /// --path is an NC program of this dialect (iso: Fanuc-type G-code; linuxcnc; heidenhain).
     #[arg(long, value_name = "iso|linuxcnc|heidenhain", value_parser = ["iso", "linuxcnc", "heidenhain"])]
     nc: Option<String>,
-    /// The fewest decimals of a corrected NC word (default: the program's own; at most 9).
+    /// The fewest decimals of a corrected NC word (at most 9). Default: the program's own, and a
+    /// program whose words lose more than 0.1 µm or 1 µrad of a correction is refused.
     #[arg(long, value_name = "N")]
     decimals: Option<usize>,
     /// Kinematic symbols (mm), `NAME=VALUE,...`, overriding the machine's defaults.
@@ -88,6 +102,14 @@ pub struct CompensateArgs {
     /// Pitch of the tables of rotary axes, degrees.
     #[arg(long, value_name = "DEG", default_value_t = 5.0, value_parser = super::args::positive)]
     pitch_deg: f64,
+    /// The largest linear error or change compensated, µm (over the axis's range for an error
+    /// that varies with its axis; each change folded by --kinematics-out): a larger one is
+    /// refused.
+    #[arg(long, value_name = "UM", default_value_t = MAX_CHANGE_UM, value_parser = super::args::positive)]
+    max_change_um: f64,
+    /// The largest angular error compensated, µrad: a larger one is refused.
+    #[arg(long, value_name = "URAD", default_value_t = MAX_CHANGE_URAD, value_parser = super::args::positive)]
+    max_change_urad: f64,
     /// Also write the summary as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
@@ -170,9 +192,11 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
     let (errors, left_out) = MachineErrors::from_values(&m, v, &id.file)
         .map_err(|e| Error::input(format!("--params: {e}")))?;
     let symbols_note = symbols_note(&m, &params, errors.record_params(), args.param.is_some());
+    check_change_limits(args, &m, &errors, None)?;
     let mut files = Outputs::new();
     files.protect(&inputs);
     let mut source = CompensationSource::of(&m, &id.model_name, &params_file, &errors, &left_out);
+    source.length_confounded = length_confounded(&m, v, &errors)?;
     let mut summary = None;
     if let (Some(path), Some(out)) = (&args.path, &args.output) {
         let words = axis_words(&m);
@@ -200,6 +224,7 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
     if let Some(target) = &args.kinematics_out {
         let corrected = corrected_description(&m, &machine_text, &errors)
             .map_err(|e| Error::input(format!("--kinematics-out: {e}")))?;
+        check_change_limits(args, &m, &errors, Some(&corrected))?;
         source.kinematics = Some(kinematics_report(target, &corrected));
         files.add("--kinematics-out", target.clone(), corrected.toml);
     }
@@ -234,13 +259,15 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
             }
             compensation(&report)
         }
-        None => format!(
-            "Machine {}, model {} with the values of {}\n{}",
-            source.machine,
-            source.model,
-            source.params_file,
-            kinematics_and_tables(source.kinematics.as_ref(), &source.tables)
-        ),
+        None => {
+            format!(
+                "Machine {}, model {} with the values of {}\n{}",
+                source.machine,
+                source.model,
+                source.params_file,
+                kinematics_and_tables(source.kinematics.as_ref(), &source.tables)
+            ) + &length_warning(source.length_confounded.as_ref())
+        }
     };
     text.push_str(&symbols_note);
     let stdout_taken = [&args.output, &args.kinematics_out, &args.json, &args.report]
@@ -285,6 +312,62 @@ fn kinematics_report(target: &Target, corrected: &CorrectedDescription) -> Kinem
     }
 }
 
+/// Refuses the values of `--params` (`errors`) when an error's largest value over the
+/// machine's ranges, or a change folded into `corrected` (the description `--kinematics-out`
+/// writes), is beyond `--max-change-um` or `--max-change-urad`.
+fn check_change_limits(
+    args: &CompensateArgs,
+    m: &model_spec::Machine,
+    errors: &MachineErrors,
+    corrected: Option<&CorrectedDescription>,
+) -> VerbResult {
+    let limits = ChangeLimits::from_display(args.max_change_um, args.max_change_urad);
+    let flag = if corrected.is_some() {
+        "--kinematics-out"
+    } else {
+        "--params"
+    };
+    check_changes(m, errors, corrected, limits).map_err(|e| Error::input(format!("{flag}: {e}")))
+}
+
+/// The warning that the tool-side length of `m` cannot be told from what the identification
+/// of `values` (`errors`) puts onto the machine, when it cannot (`compensation::confounded`).
+fn length_confounded(
+    m: &model_spec::Machine,
+    values: &fitting::campaign::CampaignValues,
+    errors: &MachineErrors,
+) -> VerbResult<Option<LengthReport>> {
+    let found =
+        tool_length(m, values, errors).map_err(|e| Error::computation(format!("--params: {e}")))?;
+    Ok(found.as_ref().map(LengthReport::of))
+}
+
+/// Refuses a program `written` back from `--path` (`file`) whose words lose more of a
+/// correction than `compensation::limits` allows, unless `--decimals` (`decimals`) says how
+/// many decimals to write.
+fn refuse_coarse_words(
+    m: &model_spec::Machine,
+    file: &str,
+    decimals: Option<usize>,
+    written: &Written,
+) -> VerbResult {
+    if decimals.is_some() {
+        return Ok(());
+    }
+    let coarse = coarse_words(m, &written.rounding, &written.largest_rounding);
+    let Some(needed) = coarse.iter().map(|c| c.needed).max() else {
+        return Ok(());
+    };
+    Err(Error::input(format!(
+        "--path: {file}: the program's words cannot carry the correction: {}; give --decimals {needed} to write every corrected word with at least {needed} decimals (or write the program with more decimals)",
+        coarse
+            .iter()
+            .map(|c| c.for_people())
+            .collect::<Vec<_>>()
+            .join("; ")
+    )))
+}
+
 /// The correction of the poses of `--path`: what [`compensate_each`] takes besides the poses.
 struct Correction<'a> {
     m: &'a model_spec::Machine,
@@ -322,6 +405,7 @@ impl Correction<'_> {
                 let written = writer
                     .finish()
                     .map_err(|e| Error::input(format!("-o: {e}")))?;
+                refuse_coarse_words(m, file, decimals, &written)?;
                 let rounding = from_file_units(m, &written.rounding);
                 (written.text, Some(rounding), name.to_string(), s)
             }

@@ -86,6 +86,46 @@ pub struct KinematicsReport {
     pub not_folded: Vec<String>,
 }
 
+/// The tool-side length (the R-test holder's or the tool's: the offset of the tool chain's end
+/// along the tool axis, `Zp`) that cannot be told from what is compensated
+/// (`compensation::confounded::tool_length`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LengthReport {
+    /// The length's kinematic symbol (`Zp`).
+    pub symbol: String,
+    /// `true` when the length is itself a term of the identification (its change is what
+    /// cannot be told from the location errors in `with`, which the model does not hold).
+    pub identified: bool,
+    /// What it cannot be told from: the compensated errors or folded symbols (`ZOA`), or for
+    /// an identified length the location errors the model lacks.
+    pub with: Vec<String>,
+    /// The warning for people, with the fix (the text prints it after `Warning: `).
+    pub warning: String,
+}
+
+impl LengthReport {
+    /// The report of `c`, with its warning.
+    pub fn of(c: &compensation::confounded::LengthConfounded) -> LengthReport {
+        let with = c.with.join(", ");
+        let (s, end) = (&c.symbol, &c.end);
+        let warning = if c.identified {
+            format!(
+                "The identified change of the {end}'s length {s} cannot be told from {with}, which the model does not hold: a location error of the pivot along the tool axis is taken for a change of the length, folded into {s}'s default, and lost when the length is set from a tool setter. Measure the length on a tool setter, give it with --param {s}=LENGTH (mm), and identify {with} instead of {s}."
+            )
+        } else {
+            format!(
+                "The {end}'s length {s} (the offset of the tool chain's end along the tool axis) cannot be told from {with}: {s} added to the identification's model does not raise the rank of its design. A holder or tool longer or shorter than the description says is identified as {with} and compensated as the machine's error, for every tool. Measure the length on a tool setter and give it with --param {s}=LENGTH (mm) when identifying and compensating."
+            )
+        };
+        LengthReport {
+            symbol: s.clone(),
+            identified: c.identified,
+            with: c.with.clone(),
+            warning,
+        }
+    }
+}
+
 /// The compensation report.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CompensationReport {
@@ -131,6 +171,10 @@ pub struct CompensationReport {
     pub kinematics: Option<KinematicsReport>,
     /// The axis compensation tables written.
     pub tables: Vec<String>,
+    /// The tool-side length that cannot be told from what is compensated (absent when it can,
+    /// or when the description has none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length_confounded: Option<LengthReport>,
 }
 
 /// Where a compensation report comes from, besides the summary.
@@ -158,6 +202,8 @@ pub struct CompensationSource {
     pub kinematics: Option<KinematicsReport>,
     /// The tables written.
     pub tables: Vec<String>,
+    /// The tool-side length that cannot be told from what is compensated.
+    pub length_confounded: Option<LengthReport>,
 }
 
 impl CompensationSource {
@@ -187,6 +233,7 @@ impl CompensationSource {
             rounding: None,
             kinematics: None,
             tables: Vec::new(),
+            length_confounded: None,
         }
     }
 }
@@ -260,6 +307,7 @@ impl CompensationReport {
                 .collect(),
             kinematics: source.kinematics,
             tables: source.tables,
+            length_confounded: source.length_confounded,
         })
     }
 }

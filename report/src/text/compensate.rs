@@ -2,7 +2,7 @@
 //! remainders, and the lines that need a look.
 
 use super::{header, table};
-use crate::json::compensate::{CompensationReport, KinematicsReport};
+use crate::json::compensate::{CompensationReport, KinematicsReport, LengthReport};
 use model_spec::units::{fixed, readable};
 
 /// At most this many line numbers are listed in a sentence.
@@ -111,7 +111,14 @@ pub fn compensation(r: &CompensationReport) -> String {
         ));
     }
     text.push_str(&kinematics_and_tables(r.kinematics.as_ref(), &r.tables));
+    text.push_str(&length_warning(r.length_confounded.as_ref()));
     text
+}
+
+/// The warning that the tool-side length cannot be told from what is compensated, after a
+/// blank line; empty when there is none.
+pub fn length_warning(length: Option<&LengthReport>) -> String {
+    length.map_or(String::new(), |l| format!("\nWarning: {}\n", l.warning))
 }
 
 /// The corrected kinematic description (what was folded, what was not) and the tables

@@ -43,6 +43,7 @@ fn report_of(ecb: f64) -> CompensationReport {
         rounding: None,
         kinematics: None,
         tables: Vec::new(),
+        length_confounded: None,
     };
     CompensationReport::new(source, &done.summary).unwrap()
 }

@@ -11,6 +11,7 @@ mod one_record;
 mod one_report;
 
 mod compensation_clamped;
+mod compensation_length;
 mod compensation_loop;
 mod compensation_values;
 mod diagnose_instrument_knock;

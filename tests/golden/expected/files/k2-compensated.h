@@ -1,6 +1,6 @@
 0 BEGIN PGM RTEST1000 MM
-1 ; rtest R-test measurement program
-2 ; written by rtest 0.1.0 for machine seed-ac
+1 ; K2 of seed-ac as a plain conversational program: an input of compensate
+2 ; the poses of K2, one block each, machine coordinates; not a measurement program
 3 ; test K2, 121 poses, static: measured at rest
 4 ; positions: machine coordinates, absolute, mm and degrees
 5 ; the preset must be the machine datum: no datum shift,

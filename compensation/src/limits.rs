@@ -14,8 +14,8 @@
 //!   more likely a wrong description, a mistaken identification or a machine that needs repair
 //!   than a geometric error to compensate: it is refused ([`check_changes`]). The linear limit
 //!   is the default of Heidenhain KinematicsOpt's largest change of the kinematics (0.05 mm);
-//!   the angular one is the angle that moves a point 250 mm from the axis by 62.5 µm, of the
-//!   same order at the lever arms of a five-axis table.
+//!   the angular one moves a point 200 mm from the axis by 50 µm, the same change at the lever
+//!   arms of the built-in machines (`docs/compensation.md` §7).
 //!
 //! Units inside: mm and rad.
 
@@ -207,7 +207,7 @@ pub fn largest_values(m: &Machine, errors: &MachineErrors) -> Vec<LargestValue> 
             for p in positions(errors, e, rotary, lo, hi) {
                 q[axis] = if rotary { p.to_radians() } else { p };
                 errors.values_at(m, &q, &mut out);
-                if !(out[slot].abs() <= best.value.abs()) {
+                if beyond(out[slot], best.value.abs()) {
                     best.value = out[slot];
                     best.at = Some((a.name.clone(), p));
                 }
@@ -300,6 +300,11 @@ pub enum LimitError {
     },
 }
 
+/// Whether `x` is beyond `limit` in magnitude; a value that is not a number is.
+fn beyond(x: f64, limit: f64) -> bool {
+    x.is_nan() || x.abs() > limit
+}
+
 /// The flags of `beyond`, each once.
 fn flags(beyond: &[Beyond]) -> String {
     let mut f: Vec<&str> = beyond.iter().map(|b| b.flag).collect();
@@ -333,7 +338,7 @@ pub fn beyond_limits(
             } else {
                 limits.linear_mm
             };
-            !(v.value.abs() <= limit)
+            beyond(v.value, limit)
         })
         .map(|v| {
             let what = match &v.at {
@@ -368,7 +373,7 @@ pub fn beyond_limits(
         for f in c
             .folded
             .iter()
-            .filter(|f| !(f.value_mm.abs() <= limits.linear_mm))
+            .filter(|f| beyond(f.value_mm, limits.linear_mm))
         {
             out.push(linear(
                 format!("{} folded into {}", f.name, f.place),
@@ -378,7 +383,7 @@ pub fn beyond_limits(
         for s in c
             .symbols
             .iter()
-            .filter(|s| !(s.change_mm.abs() <= limits.linear_mm))
+            .filter(|s| beyond(s.change_mm, limits.linear_mm))
         {
             out.push(linear(
                 format!("{} folded into its default", s.name),

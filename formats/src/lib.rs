@@ -7,6 +7,8 @@
 //! messages are located and worded alike.
 //!
 //! - [`mod@campaign`]: the campaign file (records, set-ups, ball positions, zeroing, clock);
+//! - [`controllers`]: the files a controller loads (LinuxCNC's HAL pins and joint
+//!   compensation files);
 //! - [`csv`]: the R-test measurement CSV, read whole or in blocks, written so that it reads
 //!   back bit for bit;
 //! - [`paths`]: path files (the commanded samples of a test), or a built-in test by name;
@@ -25,6 +27,7 @@
 #![warn(missing_docs)]
 
 pub mod campaign;
+pub mod controllers;
 pub mod csv;
 pub mod located;
 pub mod nc;

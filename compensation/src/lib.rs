@@ -7,6 +7,8 @@
 //! - [`kinematics`]: the corrected kinematic description (location errors folded into the
 //!   offsets);
 //! - [`tables`]: axis compensation tables;
+//! - [`controllers`]: what a controller's kinematics can hold of a description (LinuxCNC's
+//!   `trt` modules);
 //! - [`limits`]: the safety limits (words that cannot carry the correction, changes beyond a
 //!   limit);
 //! - [`confounded`]: whether the tool-side length can be told from what is compensated;
@@ -18,6 +20,7 @@
 #![warn(missing_docs)]
 
 pub mod confounded;
+pub mod controllers;
 pub mod correct;
 pub mod kinematics;
 pub mod limits;

@@ -316,3 +316,31 @@ fn the_reader_tells_a_program_out_of_order() {
     let e = read_program("p", "%\nG90\nG43 H1\n", Dialect::Iso, &words).unwrap_err();
     assert!(e.to_string().starts_with("p:3:1: `G43`"), "{e}");
 }
+
+#[test]
+fn a_measurement_program_is_not_a_program_compensate_corrects() {
+    use formats::nc::parse_program;
+    let m = builtin("seed-ac");
+    let k4 = simulation::builtin_path(&m, "K4").unwrap().unwrap();
+    for (dialect, needle) in [
+        (
+            Dialect::Iso,
+            "`G10`: setting offsets from the program is refused",
+        ),
+        (
+            Dialect::LinuxCnc,
+            "`G53`: a one-shot move in machine coordinates is refused",
+        ),
+        (
+            Dialect::Heidenhain,
+            "a move with axis X, A, C, Y not yet known",
+        ),
+    ] {
+        let o = MeasureOptions::new(&m, dialect, MeasureMode::Static(StaticTiming::default()));
+        let text = measurement_program(&m, &k4, &o).unwrap().text;
+        let e = parse_program("k4", &text, dialect, &axis_words(&m))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(needle), "{dialect:?}: {e}");
+    }
+}

@@ -113,8 +113,8 @@ pub(crate) fn lines(
         short(o.approach_feed_mm_min)
     ));
     h.push(format!(
-        "8 STOP ({}): check the nest sits on the ball, start the",
-        if g_code { "M0" } else { "STOP" }
+        "8 {}: check the nest sits on the ball, start the",
+        if g_code { "STOP (M0)" } else { "STOP block" }
     ));
     h.push("  R-test log, cycle start: t = 0 of the timing plan".into());
     h.push(format!(

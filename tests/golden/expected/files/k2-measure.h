@@ -21,7 +21,7 @@
 20 ;   approach (at the M19 angle the machine builder set)
 21 ; 7 approach: rapid to 30 mm above pose 1 along the tool
 22 ;   axis, then feed onto the ball at 500 mm/min
-23 ; 8 STOP (STOP): check the nest sits on the ball, start the
+23 ; 8 STOP block: check the nest sits on the ball, start the
 24 ;   R-test log, cycle start: t = 0 of the timing plan
 25 ; 9 end: feed 30 mm off the ball along the tool axis,
 26 ;   rapid Z to the clearance, end of program

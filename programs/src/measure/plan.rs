@@ -2,9 +2,11 @@
 //! there, the measuring window, and when it leaves, on the program clock; written as a CSV
 //! beside the program and read back.
 //!
-//! The program clock starts (`t = 0`) when the machine is at rest at the first pose after the
-//! program's first move: that move comes from wherever the machine stood, so its duration is
-//! not known. Every time is in s on that clock.
+//! The program clock starts (`t = 0`) when the program resumes after its stop (`M0`, `STOP`),
+//! the nest at rest on the ball at the first pose where the approach left it. The clearance,
+//! the approach and the operator's check at the stop come before that, the retract after the
+//! last pose's departure: they take what they take, so none of them is in the plan, whose
+//! times are those of the measuring poses only. Every time is in s on that clock.
 //!
 //! **The CSV** (one row per pose, in the order of the program):
 //!

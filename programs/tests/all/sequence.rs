@@ -257,6 +257,14 @@ fn the_clearance_and_the_approach_are_options_and_are_checked() {
     o.approach_mm = 12.5;
     o.approach_feed_mm_min = 200.0;
     let p = measurement_program(&m, &k4, &o).unwrap();
+    // The clearance, the approach and the retract are outside the plan: its times are the
+    // same whatever they are.
+    let default = MeasureOptions::new(
+        &m,
+        Dialect::LinuxCnc,
+        MeasureMode::Static(StaticTiming::default()),
+    );
+    assert_eq!(measurement_program(&m, &k4, &default).unwrap().plan, p.plan);
     assert!(p.text.contains("\nG53 G0 Z250.0000\n"), "{}", p.text);
     assert!(p.text.contains("\nG53 G0 Z69.1610\n"), "56.661 + 12.5");
     assert!(p.text.contains(" F200.000\n(MSG,"));

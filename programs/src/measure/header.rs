@@ -82,9 +82,9 @@ pub(crate) fn lines(
     }
     if !rotary.is_empty() {
         h.push(format!(
-            "4 rotary axes {rotary}: absolute angles, C up to 360"
+            "4 rotary axes {rotary}: absolute angles, 360 is 360"
         ));
-        h.push("  is 360: no roll-over (modulo) axis, no shortest path".into());
+        h.push("  not 0: no roll-over (modulo) axis, no shortest path".into());
         h.push(match d {
             Dialect::Iso => "  (Fanuc: parameter 1008 ROA = 0 for these axes)".into(),
             Dialect::LinuxCnc => "  (LinuxCNC: no WRAPPED_ROTARY for these axes)".into(),

@@ -12,8 +12,8 @@
 11 ;   still: the active tool must have L 0 and R 0
 12 ; 3 TCP off: FUNCTION RESET TCPM here (M129 on controls
 13 ;   without FUNCTION TCPM)
-14 ; 4 rotary axes A C: absolute angles, C up to 360
-15 ;   is 360: no roll-over (modulo) axis, no shortest path
+14 ; 4 rotary axes A C: absolute angles, 360 is 360
+15 ;   not 0: no roll-over (modulo) axis, no shortest path
 16 ;   (M127 here: shortest path M126 off, not modulo)
 17 ; 5 clearance: Z rapids first to Z500 mm (machine),
 18 ;   then A C turn to pose 1 there: the space must be free

@@ -96,6 +96,10 @@ pub struct CompensateArgs {
     /// Also write one axis compensation table per axis into this directory.
     #[arg(long, value_name = "DIR")]
     tables: Option<PathBuf>,
+    /// Also write LinuxCNC's files into this directory: the pins of its xyzac-trt-kins or
+    /// xyzbc-trt-kins module (kinematics.hal) and joint compensation files (joint_N.comp).
+    #[arg(long, value_name = "DIR")]
+    linuxcnc: Option<PathBuf>,
     /// Pitch of the tables of linear axes, mm.
     #[arg(long, value_name = "MM", default_value_t = 10.0, value_parser = super::args::positive)]
     pitch: f64,
@@ -123,9 +127,13 @@ pub struct CompensateArgs {
 
 /// Refuses flags that ask for nothing or for what the others do not give.
 fn check_flags(args: &CompensateArgs) -> VerbResult {
-    if args.path.is_none() && args.kinematics_out.is_none() && args.tables.is_none() {
+    if args.path.is_none()
+        && args.kinematics_out.is_none()
+        && args.tables.is_none()
+        && args.linuxcnc.is_none()
+    {
         return Err(Error::usage(
-            "nothing to write: give --path IN -o OUT, --kinematics-out FILE or --tables DIR",
+            "nothing to write: give --path IN -o OUT, --kinematics-out FILE, --tables DIR or --linuxcnc DIR",
         ));
     }
     if args.json.is_some() && args.path.is_none() {
@@ -166,11 +174,17 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         .tables
         .iter()
         .map(|d| ("--tables", d.as_path()))
+        .chain(args.linuxcnc.iter().map(|d| ("--linuxcnc", d.as_path())))
         .collect();
     check_outputs(&inputs, &outputs, &dirs)?;
     if let Some(dir) = &args.tables {
         let table = |n: &str| n.starts_with("axis_") && n.ends_with(".csv");
         super::check_dir_inputs(&inputs, "--tables", dir, &table)?;
+    }
+    if let Some(dir) = &args.linuxcnc {
+        let ours =
+            |n: &str| n == "kinematics.hal" || (n.starts_with("joint_") && n.ends_with(".comp"));
+        super::check_dir_inputs(&inputs, "--linuxcnc", dir, &ours)?;
     }
     let params = super::pose_args::params(&m, args.param.as_deref())?;
     // --params is read once: its values, and the identification the report shows.
@@ -243,6 +257,27 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
             files.add_in_dir("--tables", dir, &name, t.to_csv());
         }
     }
+    let mut linuxcnc_summary = String::new();
+    if let Some(dir) = &args.linuxcnc {
+        let pitch = Pitch {
+            linear_mm: args.pitch,
+            rotary_deg: args.pitch_deg,
+        };
+        let written = super::compensate_linuxcnc::linuxcnc_files(
+            &m,
+            &machine_text,
+            &errors,
+            &left_out,
+            args.param.as_deref(),
+            pitch,
+            &params_file,
+        )?;
+        check_change_limits(args, &m, &errors, Some(&written.corrected))?;
+        for (name, text) in written.files {
+            files.add_in_dir("--linuxcnc", dir, &name, text);
+        }
+        linuxcnc_summary = written.summary;
+    }
     let mut text = match &summary {
         Some(s) => {
             let report = CompensationReport::new(source, s)
@@ -269,6 +304,7 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
             ) + &length_warning(source.length_confounded.as_ref())
         }
     };
+    text.push_str(&linuxcnc_summary);
     text.push_str(&symbols_note);
     let stdout_taken = [&args.output, &args.kinematics_out, &args.json, &args.report]
         .iter()

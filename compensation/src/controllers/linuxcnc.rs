@@ -405,7 +405,7 @@ pub fn trt_kinematics(m: &Machine, params: &[f64]) -> Result<TrtKinematics, NotC
         check_mm: 0.0,
     };
     k.check_mm = check(m, &chains, &k);
-    if !(k.check_mm <= CHECK_TOLERANCE_MM) {
+    if k.check_mm.is_nan() || k.check_mm > CHECK_TOLERANCE_MM {
         return Err(not_covered(format!(
             "the module with the pins found misses the description's joints by {:.3e} mm at a check pose",
             k.check_mm
@@ -466,6 +466,24 @@ fn check(m: &Machine, chains: &Chains, k: &TrtKinematics) -> f64 {
 }
 
 impl TrtKinematics {
+    /// The pins in the order of the module's documentation, as a HAL file sets them.
+    pub fn hal_pins(&self) -> Vec<formats::controllers::linuxcnc::Pin> {
+        use formats::controllers::linuxcnc::Pin;
+        let p = &self.pins;
+        [
+            ("x-rot-point", p.x_rot_point),
+            ("y-rot-point", p.y_rot_point),
+            ("z-rot-point", p.z_rot_point),
+            ("x-offset", p.x_offset),
+            ("y-offset", p.y_offset),
+            ("z-offset", p.z_offset),
+            ("tool-offset", p.tool_offset),
+        ]
+        .into_iter()
+        .map(|(name, value)| Pin { name, value })
+        .collect()
+    }
+
     /// The joint positions (mm, degrees; joint order) of the description's commands (mm, rad).
     pub fn joints_of(&self, commands: &[f64]) -> Vec<f64> {
         self.joints

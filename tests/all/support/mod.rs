@@ -1,4 +1,5 @@
-//! Harnesses the end-to-end tests share: a headless browser session and the fuzzing helpers.
+//! Harnesses the end-to-end tests share: a headless browser session, the fuzzing helpers and the real LinuxCNC.
 
 pub mod browser;
 pub mod fuzz;
+pub mod linuxcnc;

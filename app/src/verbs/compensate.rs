@@ -48,7 +48,10 @@ with its line and the decimals needed, unless --decimals N says how many to writ
 --kinematics-out FILE: the machine description with the location errors and the identified \
 kinematic symbols folded into its offsets and defaults; what cannot be folded is listed. \
 --tables DIR: one CSV per axis of its component errors (µm, µrad) and positioning correction \
-against its position, every --pitch mm (--pitch-deg degrees on rotary axes). --param sets \
+against its position, every --pitch mm (--pitch-deg degrees on rotary axes). --linuxcnc DIR: \
+LinuxCNC's files for a table-table machine (xyzac-trt-kins or xyzbc-trt-kins): the module's \
+pins with the location errors folded in (kinematics.hal) and joint compensation files \
+(joint_N.comp); what they cannot hold is listed. --param sets \
 kinematic symbols (mm; the tool length, say). --json FILE writes the summary, --report FILE the \
 HTML report (both need --path).
 
@@ -57,7 +60,7 @@ Limits: an error whose largest value over the machine's ranges, or a change fold
 refused. When the tool-side length (the probe's Zp) cannot be told from a compensated error \
 (ZOA on seed-ac), a warning names them: give the length measured on a tool setter with --param.
 
-Details: docs/compensation.md, docs/compensation-tables.md, docs/nc-programs.md, docs/report.md.";
+Details: docs/compensation.md, docs/compensation-tables.md, docs/controllers.md, docs/nc-programs.md, docs/report.md.";
 
 /// Flags of `rtest compensate`.
 #[derive(Debug, clap::Args)]

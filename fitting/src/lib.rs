@@ -18,6 +18,8 @@
 //! - [`streaming`]: identification of long records in blocks, memory bounded by the model;
 //! - [`validate()`] (in [`campaign`]): the identified values' prediction of other records;
 //!   [`mod@validate`]: its options, errors and statistics;
+//! - [`verdict`]: the conformance verdict of ISO 14253-1 (pass, fail, undecided) on a
+//!   deviation against its tolerance, with its expanded uncertainty;
 //! - [`distributions`]: the F and t distributions of the significance tests;
 //! - [`plan`]: the records to measure next for a target uncertainty, chosen from the machine's
 //!   tests;
@@ -93,6 +95,7 @@ pub mod sanity;
 pub mod streaming;
 mod svd;
 pub mod validate;
+pub mod verdict;
 
 pub use campaign::identify;
 pub use campaign::validate::validate;

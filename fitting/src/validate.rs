@@ -12,6 +12,8 @@
 //!   residual `r_i = m_i − p_i`.
 //! - Per direction d ∈ {x, y, z}: RMS `√(Σ_i r_id² / N)` and max `|r_id|`; over all three:
 //!   RMS `√(Σ_i Σ_d r_id² / 3N)`, max over all.
+//! - For tolerances ([`crate::verdict`]): per direction the [`Extent`] of the measured values
+//!   and of the residual over a record, its largest |value| and its range `max − min`.
 
 use crate::EstimateError;
 use crate::hmatrix::HMatrixError;
@@ -140,4 +142,66 @@ pub fn statistics(measured: &[[f64; 3]], prediction: &[[f64; 3]]) -> ([Stats; 3]
     }
     finish(&mut all, 3 * n);
     (per, all)
+}
+
+/// The extent of the deviation over a test in one direction: its smallest and largest value
+/// (mm, or any one unit).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Extent {
+    /// The smallest value.
+    pub min: f64,
+    /// The largest value.
+    pub max: f64,
+}
+
+impl Extent {
+    /// The extent per direction x, y, z of `samples` (`None` for no sample; a value that is
+    /// not finite makes its direction's extent not finite).
+    pub fn of(samples: &[[f64; 3]]) -> Option<[Extent; 3]> {
+        let first = samples.first()?;
+        let mut e = first.map(|x| Extent { min: x, max: x });
+        for s in samples {
+            for (e, &x) in e.iter_mut().zip(s) {
+                if x.is_nan() || e.min.is_nan() {
+                    *e = Extent {
+                        min: f64::NAN,
+                        max: f64::NAN,
+                    };
+                } else {
+                    e.min = e.min.min(x);
+                    e.max = e.max.max(x);
+                }
+            }
+        }
+        Some(e)
+    }
+
+    /// The largest |value|: `max(|min|, |max|)`.
+    pub fn max_abs(&self) -> f64 {
+        if self.min.is_nan() || self.max.is_nan() {
+            return f64::NAN;
+        }
+        self.min.abs().max(self.max.abs())
+    }
+
+    /// The range `max − min`.
+    pub fn range(&self) -> f64 {
+        self.max - self.min
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extents_give_the_largest_deviation_and_the_range() {
+        let e = Extent::of(&[[1.0, -2.0, 0.0], [-3.0, 1.0, 0.0], [2.0, 0.5, 0.0]]).unwrap();
+        assert_eq!((e[0].max_abs(), e[0].range()), (3.0, 5.0));
+        assert_eq!((e[1].max_abs(), e[1].range()), (2.0, 3.0));
+        assert_eq!((e[2].max_abs(), e[2].range()), (0.0, 0.0));
+        assert!(Extent::of(&[]).is_none());
+        let e = Extent::of(&[[1.0, 0.0, 0.0], [f64::NAN, 0.0, 0.0]]).unwrap();
+        assert!(e[0].max_abs().is_nan() && e[0].range().is_nan());
+    }
 }

@@ -118,3 +118,66 @@ fn a_machine_the_trt_modules_do_not_cover_is_refused_and_nothing_is_written() {
     );
     assert!(!dir.join("lc").exists() || entries(&dir.join("lc")).is_empty());
 }
+
+/// The blocks of an ISG_CSV file: `(header, rows)`, comments and `#` breaks dropped.
+fn isg_blocks(text: &str) -> Vec<(Vec<String>, Vec<Vec<f64>>)> {
+    let mut blocks = Vec::new();
+    for part in text.split("\n#\n") {
+        let mut lines = part.lines().filter(|l| !l.starts_with("//"));
+        let header: Vec<String> = lines
+            .next()
+            .unwrap()
+            .split_whitespace()
+            .map(String::from)
+            .collect();
+        let rows = lines
+            .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+            .collect();
+        blocks.push((header, rows));
+    }
+    blocks
+}
+
+#[test]
+fn isg_gets_the_position_errors_and_a_block_per_axis_and_an_inclined_machine_is_refused() {
+    let dir = seed_ac("isg");
+    let out = ok(
+        &dir,
+        &words("compensate --machine seed-ac --params id.json --isg vol.csv --pitch-deg 30"),
+    );
+    assert!(
+        out.contains(
+            "ISG volumetric compensation: 2 blocks (Y0A Z0A B0A C0A X0C Y0C A0C B0C; C ECC)"
+        ),
+        "{out}"
+    );
+    let text = std::fs::read_to_string(dir.join("vol.csv")).unwrap();
+    assert!(text.starts_with("// ISG volumetric compensation (ISG_CSV) of machine seed-ac"));
+    let blocks = isg_blocks(&text);
+    assert_eq!(blocks.len(), 2);
+    assert_eq!(blocks[0].1.len(), 1);
+    assert_eq!(blocks[0].1[0].len(), 8);
+    // The location errors are tens of µm and µrad: mm and rad in the file.
+    assert!(blocks[0].1[0].iter().all(|v| v.abs() < 0.1));
+    assert_eq!(blocks[1].0, ["C", "ECC"]);
+    assert_eq!(blocks[1].1.len(), 13);
+
+    let dir = common::temp_dir_tagged("cli-linuxcnc", "isg-nutating");
+    ok(
+        &dir,
+        &words("simulate --machine nutating-table-bc --path pair-B-C -o n.csv"),
+    );
+    ok(
+        &dir,
+        &words("identify --machine nutating-table-bc --model location --data n.csv --json id.json"),
+    );
+    fails(
+        &dir,
+        &words("compensate --machine nutating-table-bc --params id.json --isg vol.csv"),
+        2,
+        &[
+            "--isg: machine `nutating-table-bc` is not covered by ISG's volumetric compensation: its axis B is inclined",
+        ],
+    );
+    assert!(!dir.join("vol.csv").exists());
+}

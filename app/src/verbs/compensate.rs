@@ -51,7 +51,8 @@ kinematic symbols folded into its offsets and defaults; what cannot be folded is
 against its position, every --pitch mm (--pitch-deg degrees on rotary axes). --linuxcnc DIR: \
 LinuxCNC's files for a table-table machine (xyzac-trt-kins or xyzbc-trt-kins): the module's \
 pins with the location errors folded in (kinematics.hal) and joint compensation files \
-(joint_N.comp); what they cannot hold is listed. --param sets \
+(joint_N.comp); what they cannot hold is listed. --isg FILE: the errors as ISG-kernel's \
+volumetric compensation file (Beckhoff TwinCAT CNC, ISG_CSV). --param sets \
 kinematic symbols (mm; the tool length, say). --json FILE writes the summary, --report FILE the \
 HTML report (both need --path).
 
@@ -103,6 +104,10 @@ pub struct CompensateArgs {
     /// xyzbc-trt-kins module (kinematics.hal) and joint compensation files (joint_N.comp).
     #[arg(long, value_name = "DIR")]
     linuxcnc: Option<PathBuf>,
+    /// Also write the errors as ISG-kernel's volumetric compensation file (Beckhoff TwinCAT
+    /// CNC, ISG_CSV) to FILE.
+    #[arg(long, value_name = "FILE")]
+    isg: Option<Target>,
     /// Pitch of the tables of linear axes, mm.
     #[arg(long, value_name = "MM", default_value_t = 10.0, value_parser = super::args::positive)]
     pitch: f64,
@@ -134,9 +139,10 @@ fn check_flags(args: &CompensateArgs) -> VerbResult {
         && args.kinematics_out.is_none()
         && args.tables.is_none()
         && args.linuxcnc.is_none()
+        && args.isg.is_none()
     {
         return Err(Error::usage(
-            "nothing to write: give --path IN -o OUT, --kinematics-out FILE, --tables DIR or --linuxcnc DIR",
+            "nothing to write: give --path IN -o OUT, --kinematics-out FILE, --tables DIR, --linuxcnc DIR or --isg FILE",
         ));
     }
     if args.json.is_some() && args.path.is_none() {
@@ -169,6 +175,7 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         ("--kinematics-out", args.kinematics_out.as_ref()),
         ("--json", args.json.as_ref()),
         ("--report", args.report.as_ref()),
+        ("--isg", args.isg.as_ref()),
     ]
     .into_iter()
     .filter_map(|(f, t)| t.map(|t| (f, t)))
@@ -260,7 +267,8 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
             files.add_in_dir("--tables", dir, &name, t.to_csv());
         }
     }
-    let mut linuxcnc_summary = String::new();
+    // What the controller outputs say of themselves.
+    let mut controller_summary = String::new();
     if let Some(dir) = &args.linuxcnc {
         let pitch = Pitch {
             linear_mm: args.pitch,
@@ -279,7 +287,16 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         for (name, text) in written.files {
             files.add_in_dir("--linuxcnc", dir, &name, text);
         }
-        linuxcnc_summary = written.summary;
+        controller_summary = written.summary;
+    }
+    if let Some(target) = &args.isg {
+        let pitch = Pitch {
+            linear_mm: args.pitch,
+            rotary_deg: args.pitch_deg,
+        };
+        let (text, lines) = super::compensate_isg::isg_file(&m, &errors, pitch, &params_file)?;
+        files.add("--isg", target.clone(), text);
+        controller_summary.push_str(&lines);
     }
     let mut text = match &summary {
         Some(s) => {
@@ -307,11 +324,17 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
             ) + &length_warning(source.length_confounded.as_ref())
         }
     };
-    text.push_str(&linuxcnc_summary);
+    text.push_str(&controller_summary);
     text.push_str(&symbols_note);
-    let stdout_taken = [&args.output, &args.kinematics_out, &args.json, &args.report]
-        .iter()
-        .any(|t| matches!(t, Some(Target::Stdout)));
+    let stdout_taken = [
+        &args.output,
+        &args.kinematics_out,
+        &args.json,
+        &args.report,
+        &args.isg,
+    ]
+    .iter()
+    .any(|t| matches!(t, Some(Target::Stdout)));
     Ok(Done::new(text, files, stdout_taken))
 }
 

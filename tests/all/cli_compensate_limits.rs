@@ -203,9 +203,15 @@ fn a_probe_length_error_ends_up_in_zob_and_is_named() {
     let text = ok(
         d,
         &words(
-            "compensate --machine table-table-bc --params id.json --path poses.csv -o out.csv --json c.json --kinematics-out k.toml",
+            "compensate --machine table-table-bc --params id.json --path poses.csv -o out.csv --json c.json --kinematics-out k.toml --report r.html",
         ),
     );
+    // The HTML report says it too, in the compensation section.
+    let html = std::fs::read_to_string(d.join("r.html")).unwrap();
+    let at = html
+        .find("Warning: The probe")
+        .unwrap_or_else(|| panic!("no warning in the report"));
+    assert!(html[at..].contains("cannot be told from ZOB"));
     let warning = text
         .lines()
         .find(|l| l.starts_with("Warning: "))

@@ -66,6 +66,9 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
             lines.join(", ")
         ));
     }
+    if let Some(l) = &c.length_confounded {
+        b.paragraph(&format!("Warning: {}", l.warning));
+    }
     if !c.clamped.is_empty() {
         let each: Vec<String> = c.clamped.iter().map(|k| k.for_people()).collect();
         b.paragraph(&format!(

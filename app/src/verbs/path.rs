@@ -36,12 +36,11 @@ the limit; nothing is clipped.
 
 --nc iso|linuxcnc|heidenhain -o prog.nc: an NC measurement program of the test instead of the CSV, \
 static or --continuous, and its sample-timing plan (CSV, --plan) that `rtest segment` cuts a streamed \
-log with (docs/measurement-programs.md). The program runs in machine coordinates (iso: G53 and a \
-G54 it sets to zero; linuxcnc: G53; heidenhain: M91): the tool-axis slide to --clearance-mm, the \
-rotary axes to the first pose there, M19, a rapid to --approach-mm above the first pose along the \
-tool axis and a slow feed onto the ball, a stop (M0) to check the nest on the ball, the poses, \
-a retract along the tool axis to the clearance. Its header lists what to check, in that order. `rtest simulate --path NAME` takes the same test names. \
-`-o -` writes to standard output.";
+log with (docs/measurement-programs.md). In machine coordinates (iso: G53 and a zeroed G54; \
+linuxcnc: G53; heidenhain: M91) it goes to --clearance-mm, turns the rotary axes there, M19, \
+approaches the first pose along the tool axis (--approach-mm), stops (M0) for the nest check, \
+measures, retracts; its header lists the checks in that order. `rtest simulate --path NAME` takes \
+the same test names. `-o -` writes to standard output.";
 
 /// Flags of `rtest path`.
 #[derive(Debug, clap::Args)]

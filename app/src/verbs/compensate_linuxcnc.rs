@@ -7,7 +7,7 @@
 
 use super::{Error, VerbResult};
 use compensation::controllers::linuxcnc::{TrtKinematics, TrtModule, trt_kinematics};
-use compensation::kinematics::{CorrectedDescription, corrected_description};
+use compensation::kinematics::{CorrectedDescription, Directions, corrected_description_with};
 use compensation::tables::{AxisTable, Pitch, axis_tables};
 use compensation::values::{CompensationError, LeftOut, MachineErrors};
 use formats::controllers::linuxcnc::{CompPoint, comp_file, hal_file};
@@ -40,7 +40,9 @@ pub fn linuxcnc_files(
     pitch: Pitch,
     params_file: &str,
 ) -> VerbResult<LinuxcncFiles> {
-    let corrected = corrected_description(m, source, errors)
+    // The modules' axes are exactly x or y and z: the angular location errors stay out of the
+    // directions and are listed as not held.
+    let corrected = corrected_description_with(m, source, errors, Directions::Keep)
         .map_err(|e| Error::input(format!("--linuxcnc: {e}")))?;
     let folded = parse_machine(&format!("<corrected {}>", m.name), &corrected.toml)
         .map_err(|e| Error::computation(format!("--linuxcnc: the corrected description: {e}")))?;

@@ -1,7 +1,8 @@
 //! The corrected kinematic description: the machine's TOML text with the identified location
-//! errors of its rotary axes that are translations (`XOC YOC`, `YOA ZOA`, `XOB ZOB`, …) folded
-//! into the kinematic offsets, as a controller's kinematics table is updated after a
-//! calibration.
+//! errors of its rotary axes folded in, as a controller's kinematics table is updated after a
+//! calibration: the translations (`XOC YOC`, `YOA ZOA`, `XOB ZOB`, …) into the kinematic
+//! offsets, the angular ones (`AOC BOC`, …) into the axis directions where the description can
+//! hold them.
 //!
 //! A rotary axis is composed as `Trans(offset) · Trans(location translations) · …`
 //! ([`model_spec::kinematics::chain_steps`]), so a location translation adds exactly to the
@@ -19,6 +20,16 @@
 //!   symbol would change the machine's parameter list and its generated code);
 //! - **no `offset`** on the axis entry: an `offset = [x, y, z]` is added after its `axis` line.
 //!
+//! The angular location errors of a rotary axis along +z or inclined already, on the work
+//! side, whose carried axes are such axes too, turn its direction (`direction = [x, y, z]`, a
+//! unit vector) and what it carries (the directions and offsets of the axes it carries; the
+//! ball's place is a set-up): exact at command zero and for the axis motion, see
+//! [`turns`] for the derivation and the one second-order difference (the component errors'
+//! directions about the new axis). Not folded, with the reason: an axis along x or y (inclined,
+//! its errors would be renamed in its own frame, which breaks the models written for it), along
+//! -z (its own frame would flip y and z), on the tool side (the end it carries would have to
+//! turn with it) or carrying such an axis, and every angular error with [`Directions::Keep`].
+//!
 //! An identified kinematic symbol (a length identified as a term under its own name, `Zt`)
 //! changes its default by the identified change, before the location errors are added. A
 //! symbol of the workpiece side (where the ball sits: a set-up, not the machine) and a change
@@ -31,17 +42,21 @@
 //! The result is parsed back and must be the original machine with exactly these changes.
 //!
 //! Not folded, and listed with their values ([`NotFolded`]): the angular location errors
-//! (`AOC BOC`, …) and the squareness errors, which would change the direction of an axis line
-//! (not folded here), and the component errors, which move with their axis.
+//! that cannot be, the squareness errors (they would make a linear axis inclined, whose errors
+//! are named in its own frame), and the component errors, which move with their axis.
 //!
 //! Numbers are written as the shortest decimal that reads back to the same `f64` (mm).
 
 mod spans;
+pub mod turns;
+
+pub use turns::{Directions, FoldedAngle, FoldedDirection, TurnedOffset};
 
 use super::values::{CompensationError, MachineErrors, ValueSource};
 use model_spec::catalogue::Motion;
 use model_spec::units::format_scaled;
-use model_spec::{AxisId, Dir, ErrorId, ErrorKind, Link, Machine, Value, parse_machine};
+use model_spec::{AxisId, Dir, ErrorId, ErrorKind, Link, Machine, Side, Value, parse_machine};
+use nalgebra::{Matrix3, Vector3};
 use spans::OffsetPlace;
 use std::ops::Range;
 
@@ -106,31 +121,44 @@ pub struct CorrectedDescription {
     pub folded: Vec<Folded>,
     /// The identified kinematic symbols folded into their defaults.
     pub symbols: Vec<FoldedSymbol>,
+    /// The axes whose directions it turns: by their own angular location errors, by those of
+    /// the axes carrying them, or both; work chain first, each from the bed outwards.
+    pub directions: Vec<FoldedDirection>,
+    /// The offset coordinates of carried axes turned with the axes that carry them.
+    pub turned: Vec<TurnedOffset>,
+    /// The turn `Q` (rows, machine coordinates) of the work chain's last frame: the original
+    /// machine has the ball at `Q·(p + w)` where the corrected one has it at `p + w`, so an
+    /// identification with the corrected description finds the set-up `w′ = Q·(p + w) − p`;
+    /// `None` when no folded direction turns it.
+    pub set_up_turn: Option<[[f64; 3]; 3]>,
+    /// `(Q − I)·p` (mm) for the ball's place `p` in that frame (the end offset and the fixed
+    /// links after the last axis): what the set-up errors `XOW YOW ZOW` identified with the
+    /// corrected description are larger by, to within the angle times the set-up itself.
+    pub set_up_change_mm: [f64; 3],
     /// The compensated terms it cannot hold.
     pub not_folded: Vec<NotFolded>,
 }
 
-/// Why a compensated error cannot be held as a kinematic offset; `None` for a constant
-/// location translation of a rotary axis.
-fn not_foldable(m: &Machine, e: ErrorId, constant: bool) -> Option<&'static str> {
+/// Why a compensated error cannot be held by the description; `None` for a constant location
+/// translation of a rotary axis, and for a constant angular location error of an axis whose
+/// direction can take it ([`turns::blocked`]).
+fn not_foldable(m: &Machine, e: ErrorId, constant: bool, directions: Directions) -> Option<String> {
     match m.catalogue[e].kind {
         ErrorKind::Location {
             motion: Motion::Translation(_),
             ..
         } if constant => None,
         ErrorKind::Location {
+            axis,
             motion: Motion::Rotation(_),
-            ..
-        } => Some(
-            "an angular location error: it turns the axis line, which an offset cannot hold (directions are not corrected here)",
-        ),
+        } if constant => turns::blocked(m, axis, directions),
         ErrorKind::Squareness { .. } => Some(
-            "a squareness error: it turns an axis, which an offset cannot hold (directions are not corrected here)",
+            "a squareness error: it turns a linear axis, which would then be inclined, and an inclined linear axis has its errors named in its own frame (its positioning error EZ…), which would rename them".into(),
         ),
         ErrorKind::Component { .. } => Some(
-            "a component error: it moves with its axis, so it belongs in the axis's compensation, not in the kinematic offsets",
+            "a component error: it moves with its axis, so it belongs in the axis's compensation, not in the kinematic offsets".into(),
         ),
-        _ => Some("not a constant translation of a rotary axis's line"),
+        _ => Some("not a constant location error of a rotary axis's line".into()),
     }
 }
 
@@ -164,19 +192,33 @@ fn number(x: f64) -> String {
 }
 
 /// The machine `m` described by `source` (its TOML text, [`model_spec::write::source_text`])
-/// with the constant location translations of `errors` folded into the kinematic offsets;
-/// see the module documentation.
+/// with the constant location errors of `errors` folded into the kinematic offsets and, where
+/// the description can hold them, the axis directions; see the module documentation.
+///
+/// # Errors
+/// As [`corrected_description_with`].
+pub fn corrected_description(
+    m: &Machine,
+    source: &str,
+    errors: &MachineErrors,
+) -> Result<CorrectedDescription, CompensationError> {
+    corrected_description_with(m, source, errors, Directions::Fold)
+}
+
+/// [`corrected_description`], the angular location errors folded into the axis directions or
+/// not (`directions`).
 ///
 /// # Errors
 /// [`CompensationError::OtherMachine`] when `errors` were identified on another description;
 /// [`CompensationError::Description`] when `source` is not the text of `m`, or the corrected
 /// text does not read back as `m` with exactly the folded changes (an offset beyond the
-/// limits of a description, say); [`CompensationError::NonFinite`] for a folded coordinate
-/// that is not finite.
-pub fn corrected_description(
+/// limits of a description, a direction within rounding of x); [`CompensationError::NonFinite`]
+/// for a folded coordinate that is not finite.
+pub fn corrected_description_with(
     m: &Machine,
     source: &str,
     errors: &MachineErrors,
+    directions: Directions,
 ) -> Result<CorrectedDescription, CompensationError> {
     errors.check_machine(m)?;
     let file = format!("<{} description>", m.name);
@@ -199,33 +241,33 @@ pub fn corrected_description(
         Err(e) => return Err(bad(format!("the text given does not read: {e}"))),
     }
     let spans = spans::read(text).map_err(bad)?;
-    let uses = symbol_uses(m);
-
-    let mut expected = m.clone();
+    let mut w = Writer {
+        m,
+        uses: symbol_uses(m),
+        expected: m.clone(),
+        changed: Vec::new(),
+        file: errors.file(),
+    };
     let mut folded = Vec::new();
     let mut not_folded = Vec::new();
-    // Per axis, the coordinates whose written value changes: (axis, coordinate index).
-    let mut changed: Vec<(AxisId, usize)> = Vec::new();
-    let symbols = fold_symbols(m, errors, &mut expected, &mut not_folded)?;
+    // Per axis, its angular location errors to fold into its direction.
+    let mut angles: Vec<Vec<FoldedAngle>> = vec![Vec::new(); m.axes.len()];
+    let symbols = fold_symbols(m, errors, &mut w.expected, &mut not_folded)?;
     for t in errors.terms() {
         let model_spec::terms::Effect::Error(e) = t.term.effect else {
             continue;
         };
         let constant = t.term.basis == model_spec::basis::Basis::Const;
-        if let Some(reason) = not_foldable(m, e, constant) {
+        if let Some(reason) = not_foldable(m, e, constant, directions) {
             not_folded.push(NotFolded {
                 term: t.term,
                 spelling: t.spelling.clone(),
                 values: t.coefficients.clone(),
-                reason: reason.to_string(),
+                reason,
             });
             continue;
         }
-        let ErrorKind::Location {
-            axis,
-            motion: Motion::Translation(d),
-        } = m.catalogue[e].kind
-        else {
+        let ErrorKind::Location { axis, motion } = m.catalogue[e].kind else {
             continue;
         };
         let value = t.coefficients[0];
@@ -233,6 +275,17 @@ pub fn corrected_description(
             // Fixed to 0 by the constraint: nothing moves.
             continue;
         }
+        let d = match motion {
+            Motion::Translation(d) => d,
+            Motion::Rotation(_) => {
+                angles[axis].push(FoldedAngle {
+                    error: e,
+                    name: m.catalogue[e].name.clone(),
+                    value_rad: value,
+                });
+                continue;
+            }
+        };
         let name = &m.axes[axis].name;
         // The error acts along the axis's own direction `d`: for an inclined axis, its own
         // frame's axis in machine coordinates, so that one error can move two or three
@@ -244,46 +297,14 @@ pub fn corrected_description(
                 continue;
             }
             let c = Dir::ALL[k];
-            let (symbol, before, place) = match expected.axes[axis].offset[k] {
-                Value::Number(x) => (None, x, format!("offset {c} of axis {name}")),
-                Value::Symbol(s) if uses[s] == 1 => {
-                    let sym = &expected.symbols[s].name;
-                    (
-                        Some(s),
-                        expected.symbols[s].default,
-                        format!("symbol {sym} (offset {c} of axis {name})"),
-                    )
-                }
-                Value::Symbol(s) => (
-                    None,
-                    expected.symbols[s].default,
-                    format!(
-                        "offset {c} of axis {name}, which was the shared symbol {} and is now a number",
-                        expected.symbols[s].name
-                    ),
-                ),
-            };
+            let (symbol, before, place) = w.place(axis, k);
             // On an inclined axis, `value_mm` is one coordinate's part of the error: say so.
             let place = if m.axes[axis].direction.inclined.is_some() {
                 format!("{place}, the {c} part of {}·{d}′", m.catalogue[e].name)
             } else {
                 place
             };
-            let after = before + part;
-            if !after.is_finite() {
-                return Err(CompensationError::NonFinite {
-                    file: errors.file().to_string(),
-                    what: format!("the corrected {place}"),
-                    value: after,
-                });
-            }
-            match symbol {
-                Some(s) => expected.symbols[s].default = after,
-                None => {
-                    expected.axes[axis].offset[k] = Value::Number(after);
-                    changed.push((axis, k));
-                }
-            }
+            let after = w.set(axis, k, symbol, before + part, &place)?;
             folded.push(Folded {
                 error: e,
                 name: m.catalogue[e].name.clone(),
@@ -297,7 +318,10 @@ pub fn corrected_description(
             });
         }
     }
+    let turns = fold_turns(&mut w, &angles).map_err(bad)?;
 
+    let expected = w.expected;
+    let mut changed = w.changed;
     let mut edits: Vec<(Range<usize>, String)> = Vec::new();
     for (s, sym) in expected.symbols.iter().enumerate() {
         if sym.default.to_bits() != m.symbols[s].default.to_bits() {
@@ -307,6 +331,15 @@ pub fn corrected_description(
                 .ok_or_else(|| bad(format!("symbol `{}` is not found in the text", sym.name)))?;
             edits.push((span.clone(), number(sym.default)));
         }
+    }
+    for d in &turns.directions {
+        let span = spans.directions.get(&d.axis).ok_or_else(|| {
+            bad(format!(
+                "the direction of axis {} is not found in the text",
+                d.axis
+            ))
+        })?;
+        edits.push((span.clone(), vector(d.after)));
     }
     changed.sort_unstable();
     changed.dedup();
@@ -347,8 +380,8 @@ pub fn corrected_description(
         }
     }
     let mut toml = spans::apply(text, edits);
-    if !folded.is_empty() || !symbols.is_empty() {
-        toml.push_str(&comment_block(errors.file(), &folded, &symbols, m));
+    if !folded.is_empty() || !symbols.is_empty() || !turns.directions.is_empty() {
+        toml.push_str(&comment_block(errors.file(), &folded, &symbols, &turns, m));
     }
 
     let back_file = format!("<{} corrected>", m.name);
@@ -356,7 +389,7 @@ pub fn corrected_description(
         .map_err(|e| bad(format!("the corrected description does not read back: {e}")))?;
     if back != expected {
         return Err(bad(format!(
-            "the corrected description does not read back as machine `{}` with the folded offsets",
+            "the corrected description does not read back as machine `{}` with the folded offsets and directions",
             m.name
         )));
     }
@@ -364,8 +397,197 @@ pub fn corrected_description(
         toml: format!("{bom}{toml}"),
         folded,
         symbols,
+        directions: turns.directions,
+        turned: turns.turned,
+        set_up_turn: turns.set_up_turn,
+        set_up_change_mm: turns.set_up_change_mm,
         not_folded,
     })
+}
+
+/// The corrected machine as it is being built, and which written offset coordinates changed.
+struct Writer<'a> {
+    /// The original machine.
+    m: &'a Machine,
+    /// How many offset coordinates use each symbol ([`symbol_uses`]).
+    uses: Vec<usize>,
+    /// The corrected machine.
+    expected: Machine,
+    /// The offset coordinates whose written number changes: (axis, coordinate index).
+    changed: Vec<(AxisId, usize)>,
+    /// The values' file, for errors.
+    file: &'a str,
+}
+
+impl Writer<'_> {
+    /// Where coordinate `k` of the offset of `axis` is held: the symbol used there alone (its
+    /// default changes), else `None` (the coordinate is or becomes a number); its value now
+    /// (mm); where that is, for people.
+    fn place(&self, axis: AxisId, k: usize) -> (Option<usize>, f64, String) {
+        let (name, c) = (&self.m.axes[axis].name, Dir::ALL[k]);
+        let e = &self.expected;
+        match e.axes[axis].offset[k] {
+            Value::Number(x) => (None, x, format!("offset {c} of axis {name}")),
+            Value::Symbol(s) if self.uses[s] == 1 => (
+                Some(s),
+                e.symbols[s].default,
+                format!("symbol {} (offset {c} of axis {name})", e.symbols[s].name),
+            ),
+            Value::Symbol(s) => (
+                None,
+                e.symbols[s].default,
+                format!(
+                    "offset {c} of axis {name}, which was the shared symbol {} and is now a number",
+                    e.symbols[s].name
+                ),
+            ),
+        }
+    }
+
+    /// Sets coordinate `k` of the offset of `axis` to `after` (mm) where [`Writer::place`]
+    /// says; returns `after`.
+    fn set(
+        &mut self,
+        axis: AxisId,
+        k: usize,
+        symbol: Option<usize>,
+        after: f64,
+        place: &str,
+    ) -> Result<f64, CompensationError> {
+        if !after.is_finite() {
+            return Err(CompensationError::NonFinite {
+                file: self.file.to_string(),
+                what: format!("the corrected {place}"),
+                value: after,
+            });
+        }
+        match symbol {
+            Some(s) => self.expected.symbols[s].default = after,
+            None => {
+                self.expected.axes[axis].offset[k] = Value::Number(after);
+                self.changed.push((axis, k));
+            }
+        }
+        Ok(after)
+    }
+
+    /// The offset of `axis` in the corrected machine (mm).
+    fn offset(&self, axis: AxisId) -> Vector3<f64> {
+        self.value(&self.expected.axes[axis].offset)
+    }
+
+    /// `o` with the corrected machine's symbol defaults (mm).
+    fn value(&self, o: &[Value; 3]) -> Vector3<f64> {
+        Vector3::from_fn(|k, _| match o[k] {
+            Value::Number(x) => x,
+            Value::Symbol(s) => self.expected.symbols[s].default,
+        })
+    }
+}
+
+/// The directions and offsets a fold of angular location errors changes.
+struct Turns {
+    directions: Vec<FoldedDirection>,
+    turned: Vec<TurnedOffset>,
+    set_up_turn: Option<[[f64; 3]; 3]>,
+    set_up_change_mm: [f64; 3],
+}
+
+/// Folds `angles` (per axis, its angular location errors that [`turns::blocked`] lets fold)
+/// into the directions of `w`'s machine, turning what each axis carries
+/// ([`turns`]); `Err` with why when a carried axis cannot be turned or a direction does not
+/// read.
+fn fold_turns(w: &mut Writer, angles: &[Vec<FoldedAngle>]) -> Result<Turns, String> {
+    let m = w.m;
+    let mut out = Turns {
+        directions: Vec::new(),
+        turned: Vec::new(),
+        set_up_turn: None,
+        set_up_change_mm: [0.0; 3],
+    };
+    for side in [Side::Work, Side::Tool] {
+        let chain = m.chain(side);
+        let mut q = Matrix3::identity();
+        let mut by: Vec<String> = Vec::new();
+        // The fixed links since the last axis (mm).
+        let mut links = Vector3::zeros();
+        for l in &chain.links {
+            let axis = match l {
+                Link::Fixed { offset, .. } => {
+                    links += w.value(offset);
+                    continue;
+                }
+                Link::Axis(a) => *a,
+            };
+            let name = &m.axes[axis].name;
+            let carried = !turns::is_identity(&q);
+            if carried {
+                if m.axes[axis].kind != model_spec::AxisKind::Rotary {
+                    return Err(format!(
+                        "linear axis {name} is carried by the turned axes {}",
+                        by.join(", ")
+                    ));
+                }
+                let o = w.offset(axis);
+                let new = q * (links + o) - links;
+                for k in 0..3 {
+                    if new[k].to_bits() == o[k].to_bits() {
+                        continue;
+                    }
+                    let (symbol, before, place) = w.place(axis, k);
+                    let after = w
+                        .set(axis, k, symbol, new[k], &place)
+                        .map_err(|e| e.to_string())?;
+                    out.turned.push(TurnedOffset {
+                        axis: name.clone(),
+                        coordinate: Dir::ALL[k],
+                        by: by.clone(),
+                        symbol: symbol.map(|s| m.symbols[s].name.clone()),
+                        before_mm: before,
+                        after_mm: after,
+                        place,
+                    });
+                }
+            }
+            links = Vector3::zeros();
+            let own = &angles[axis];
+            if own.is_empty() && !carried {
+                continue;
+            }
+            let r = turns::location_rotation(m, own);
+            let t = turns::turn(m, axis, &q, &r).ok_or_else(|| {
+                format!("the folded direction of axis {name} is within rounding of x")
+            })?;
+            w.expected.axes[axis].direction = t.direction;
+            out.directions.push(FoldedDirection {
+                axis: name.clone(),
+                errors: own.clone(),
+                carried_by: by.clone(),
+                before: m.axes[axis].direction.unit(),
+                after: t.written,
+                frame_turn_rad: t.frame_turn_rad,
+            });
+            q = t.passed_on;
+            if !own.is_empty() {
+                by.push(name.clone());
+            }
+        }
+        if turns::is_identity(&q) {
+            continue;
+        }
+        if side == Side::Tool {
+            return Err(format!(
+                "the {} end would be turned by the axes {}",
+                chain.end_name,
+                by.join(", ")
+            ));
+        }
+        let p = links + w.value(&chain.end_offset);
+        let change = (q - Matrix3::identity()) * p;
+        out.set_up_turn = Some(std::array::from_fn(|i| std::array::from_fn(|j| q[(i, j)])));
+        out.set_up_change_mm = [change[0], change[1], change[2]];
+    }
+    Ok(out)
 }
 
 /// Folds the identified changes of the machine's kinematic symbols into their defaults in
@@ -425,7 +647,13 @@ fn fold_symbols(
 }
 
 /// The comment appended to a corrected description: what was folded, from which file.
-fn comment_block(file: &str, folded: &[Folded], symbols: &[FoldedSymbol], m: &Machine) -> String {
+fn comment_block(
+    file: &str,
+    folded: &[Folded],
+    symbols: &[FoldedSymbol],
+    turns: &Turns,
+    m: &Machine,
+) -> String {
     let clean: String = file
         .chars()
         .map(|c| if c.is_control() { ' ' } else { c })
@@ -453,5 +681,50 @@ fn comment_block(file: &str, folded: &[Folded], symbols: &[FoldedSymbol], m: &Ma
             number(f.after_mm)
         ));
     }
+    for d in &turns.directions {
+        let a = m.axis_by_name(&d.axis).map(|a| &m.axes[a]);
+        let before = a.map_or_else(|| vector(d.before), |a| a.direction.to_string());
+        let own: Vec<String> = d
+            .errors
+            .iter()
+            .map(|e| format!("{} = {} µrad", e.name, format_scaled(e.value_rad + 0.0, 6)))
+            .collect();
+        let what = match (own.is_empty(), d.carried_by.is_empty()) {
+            (false, true) => format!("{} folded into", own.join(" and ")),
+            (false, false) => format!(
+                "{} folded into, and turned with axis {},",
+                own.join(" and "),
+                d.carried_by.join(", ")
+            ),
+            _ => format!("turned with axis {}:", d.carried_by.join(", ")),
+        };
+        let what = if own.is_empty() {
+            format!("#   the direction of axis {} {what}", d.axis)
+        } else {
+            format!("#   {what} the direction of axis {}:", d.axis)
+        };
+        out.push_str(&format!("{what} {before} → {}\n", vector(d.after)));
+    }
+    for t in &turns.turned {
+        out.push_str(&format!(
+            "#   the {} turned with axis {}: {} → {} mm\n",
+            t.place,
+            t.by.join(", "),
+            number(t.before_mm),
+            number(t.after_mm)
+        ));
+    }
+    if turns.set_up_turn.is_some() {
+        let c = turns.set_up_change_mm.map(|x| format_scaled(x + 0.0, 3));
+        out.push_str(&format!(
+            "#   the ball's place in the last frame turns with them (a set-up, not the machine):\n#   identified with this description, XOW YOW ZOW are larger by {} µm, {} µm, {} µm\n",
+            c[0], c[1], c[2]
+        ));
+    }
     out
+}
+
+/// `v` as a direction written into the description: `[x, y, z]`, shortest decimals.
+fn vector(v: [f64; 3]) -> String {
+    format!("[{}, {}, {}]", number(v[0]), number(v[1]), number(v[2]))
 }

@@ -1,6 +1,6 @@
 //! Where the values a correction changes are written in a machine description's text: the
-//! default of every symbol, and the `offset` of every axis entry (each coordinate's span, or
-//! where a missing `offset` goes). Read with the TOML parser's spans, so that the text can be
+//! default of every symbol, the `offset` of every axis entry (each coordinate's span, or
+//! where a missing `offset` goes) and the `direction` of every axis entry. Read with the TOML parser's spans, so that the text can be
 //! edited in place and everything else kept byte for byte.
 
 use serde::Deserialize;
@@ -20,11 +20,12 @@ struct Doc {
     tool: Vec<Spanned<Entry>>,
 }
 
-/// One chain entry: its axis letter (for an axis) and its offset.
+/// One chain entry: its axis letter (for an axis), its offset and its direction.
 #[derive(Deserialize)]
 struct Entry {
     axis: Option<Spanned<String>>,
     offset: Option<Spanned<Vec<Spanned<toml::Value>>>>,
+    direction: Option<Spanned<toml::Value>>,
 }
 
 /// Where an axis's offset is written.
@@ -51,6 +52,8 @@ pub struct Spans {
     pub symbols: BTreeMap<String, Range<usize>>,
     /// Each axis's offset, by axis letter.
     pub offsets: BTreeMap<String, OffsetPlace>,
+    /// Each axis's direction value (`"+z"` with its quotes, or `[0, -1, 1]`), by axis letter.
+    pub directions: BTreeMap<String, Range<usize>>,
 }
 
 /// The spans of `text`, or why they cannot be read (a text that does not parse as TOML, or an
@@ -69,6 +72,9 @@ pub fn read(text: &str) -> Result<Spans, String> {
         let start = entry.span().start;
         let entry = entry.get_ref();
         let Some(axis) = &entry.axis else { continue };
+        if let Some(d) = &entry.direction {
+            spans.directions.insert(axis.get_ref().clone(), d.span());
+        }
         let place = match &entry.offset {
             Some(list) => {
                 let items = list.get_ref();
@@ -149,6 +155,8 @@ end = "probe"
         };
         assert_eq!(&TEXT[a[0].clone()], "\"Xa\"");
         assert_eq!(&TEXT[a[2].clone()], "0");
+        assert_eq!(&TEXT[s.directions["A"].clone()], "\"+x\"");
+        assert_eq!(&TEXT[s.directions["C"].clone()], "\"+z\"");
         let OffsetPlace::Missing { at, inline } = s.offsets["C"] else {
             panic!("{:?}", s.offsets["C"])
         };
@@ -174,5 +182,6 @@ end = "probe"
         };
         assert!(inline);
         assert!(text[..at].ends_with("axis = \"C\""));
+        assert_eq!(&text[s.directions["C"].clone()], "\"+z\"");
     }
 }

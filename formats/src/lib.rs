@@ -17,6 +17,8 @@
 //! - [`sensors`]: records of an R-test head's sensor readings, and calibration records;
 //! - [`progress`]: how far a long read has come, for progress bars;
 //! - [`time`]: UTC times as files write them (RFC 3339, whole seconds);
+//! - [`tolerance`]: the tolerance file of the R-test checks (per test and direction, the
+//!   largest deviation and range in µm, ISO 10791-6 style);
 //! - [`truth`]: truth files (what a simulated machine's errors really are) and the built-in
 //!   truths.
 //!
@@ -36,4 +38,5 @@ pub mod poses;
 pub mod progress;
 pub mod sensors;
 pub mod time;
+pub mod tolerance;
 pub mod truth;

@@ -6,12 +6,17 @@ use super::campaign;
 use super::{EXIT_CODES, Error, VerbResult, check_outputs};
 use crate::Done;
 use fitting::validate;
+use fitting::validate::Extent;
 use fitting::validate::Unidentified;
 use fitting::{ValidateError, ValidateOptions};
+use formats::tolerance::{MAX_TOLERANCE_BYTES, TestTolerances};
+use model_spec::units::UM_PER_MM;
 use output::{Outputs, Target};
-use report::json::{ValidationReport, ValidationSource, read_identification, to_json};
+use report::json::read::{IdentifiedValues, MAX_REPORT_BYTES, ReportError, parse_identification};
+use report::json::tolerance::{NoiseReport, RecordExtents, ToleranceReport};
+use report::json::{ValidationReport, ValidationSource, to_json};
 use report::text::validate::validation;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
 Checks identified values on other measurements: the model and values of an `rtest identify` \
@@ -33,8 +38,18 @@ identification's set-up when it fitted one at their kinematic parameters, else e
 Parameters the identification could not determine (value null) are set to 0 and named; \
 --refuse-undetermined makes that an error instead.
 
+--tolerance FILE judges each record against a tolerance file ([[test]] tables: name, direction \
+x|y|z, max_um, range_um): per test and direction, the largest |deviation| and its range \
+before (the readings: the machine as measured) and after (readings minus prediction: the \
+machine as the identified model would leave it once compensated), each with its expanded \
+uncertainty U = 2·u_c and the verdict of ISO 14253-1: pass when value + U ≤ tolerance, fail \
+when value − U > tolerance, undecided otherwise. u_c is the reading noise σ (the \
+identification's noise model, or --noise-um, or --noise-record), after compensation with the \
+model's lack of fit on the record added. The verdicts are printed and in the JSON; the exit \
+code stays 0 whatever they are (a bad tolerance file is exit code 1).
+
 --json FILE (`-`: standard output) writes the report. Details: docs/campaigns.md §6 (set-ups), \
-docs/identification.md §9, §11, §16.";
+docs/identification.md §9, §11, §16, docs/tolerances.md (tolerances and verdicts).";
 
 /// Flags of `rtest validate`.
 #[derive(Debug, clap::Args)]
@@ -87,6 +102,23 @@ pub struct ValidateArgs {
     /// Also write the report as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
+    /// A tolerance file (TOML: [[test]] tables with name, direction x|y|z, max_um, range_um;
+    /// docs/tolerances.md): a verdict per test and direction, before and after, by ISO 14253-1.
+    #[arg(long, value_name = "FILE")]
+    tolerance: Option<PathBuf>,
+    /// The standard uncertainty of a reading for the verdicts, µm, every direction (default:
+    /// the identification's noise model).
+    #[arg(
+        long,
+        value_name = "S",
+        requires = "tolerance",
+        conflicts_with = "noise_record"
+    )]
+    noise_um: Option<f64>,
+    /// A record of the machine standing still (a measurement CSV, at least 100 samples): the
+    /// reading noise per direction for the verdicts (default: the identification's noise model).
+    #[arg(long, value_name = "FILE", requires = "tolerance")]
+    noise_record: Option<PathBuf>,
     #[command(flatten)]
     records: RecordLimits,
     #[command(flatten)]
@@ -113,10 +145,26 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
     inputs.extend(args.campaign.iter().map(|f| ("--campaign", f.as_path())));
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     inputs.extend(args.instrument.input());
+    inputs.extend(args.tolerance.iter().map(|f| ("--tolerance", f.as_path())));
+    inputs.extend(
+        args.noise_record
+            .iter()
+            .map(|f| ("--noise-record", f.as_path())),
+    );
     let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     check_outputs(&inputs, &outputs, &[])?;
-    let id = read_identification(&args.params, &m)
-        .map_err(|e| Error::input(format!("--params: {e}")))?;
+    let tolerances = args.tolerance.as_deref().map(read_tolerances).transpose()?;
+    let noise_um = match args.noise_um {
+        Some(s) if s.is_finite() && s >= 0.0 => Some(s),
+        Some(s) => {
+            return Err(Error::usage(format!(
+                "--noise-um: {s} is not a standard uncertainty (a finite number ≥ 0, µm)"
+            )));
+        }
+        None => None,
+    };
+    let (id, params_text) =
+        read_params(&args.params, &m).map_err(|e| Error::input(format!("--params: {e}")))?;
     let values = &id.values;
     campaign::check_campaign_values(&m, &values.layout, &values.values, &args.bounds.values())
         .map_err(|e| implausible(args, &e))?;
@@ -159,6 +207,27 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
             }
         }
     }
+    if let Some(t) = &tolerances {
+        let labels: Vec<String> = loaded
+            .campaign
+            .records
+            .iter()
+            .map(|r| r.label.clone())
+            .collect();
+        t.check_names(&labels)
+            .map_err(|e| Error::input(format!("--tolerance {e}")))?;
+    }
+    let noise = match &tolerances {
+        Some(_) => Some(reading_noise(
+            args,
+            noise_um,
+            &params_text,
+            &m,
+            &read,
+            through,
+        )?),
+        None => None,
+    };
     loaded.check_times(flag, &m, &values.model)?;
     let mut opts = ValidateOptions::default();
     opts.exact = !args.first_order;
@@ -183,8 +252,15 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
         kinematics: &kinematics,
         exact: !args.first_order,
     };
-    let report = ValidationReport::new(&m, source, &v)
+    let mut report = ValidationReport::new(&m, source, &v)
         .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
+    if let (Some(t), Some(noise)) = (&tolerances, noise) {
+        let extents = extents(&loaded.campaign, &v)?;
+        report.tolerance = Some(
+            ToleranceReport::new(t, &report, &extents, noise)
+                .map_err(|e| Error::computation(format!("--tolerance: {e}")))?,
+        );
+    }
     let mut text = validation(&report);
     text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {
         "say `zeroed = true` for it in the campaign file"
@@ -242,4 +318,109 @@ fn validate_error(args: &ValidateArgs, e: ValidateError) -> Error {
         ValidateError::Shape(why) => Error::input(format!("--data: cannot validate: {why}")),
         other => Error::computation(format!("--data: cannot validate: {other}")),
     }
+}
+
+/// The identification report at `path` for machine `m`, with its text (read once).
+fn read_params(
+    path: &Path,
+    m: &model_spec::Machine,
+) -> Result<(IdentifiedValues, String), ReportError> {
+    let text = model_spec::text::read_text(path, MAX_REPORT_BYTES)?;
+    let id = parse_identification(&path.display().to_string(), &text, m)?;
+    Ok((id, text))
+}
+
+/// The tolerance file of `--tolerance`, read and checked (its names are checked against the
+/// records once they are read).
+fn read_tolerances(path: &Path) -> VerbResult<TestTolerances> {
+    let text = model_spec::text::read_text(path, MAX_TOLERANCE_BYTES)
+        .map_err(|e| Error::input(format!("--tolerance: {e}")))?;
+    formats::tolerance::parse_file(&path.display().to_string(), &text)
+        .map_err(|e| Error::input(format!("--tolerance {e}")))
+}
+
+/// The standard uncertainty of a reading per direction (µm) the verdicts assume, and where it
+/// comes from: `--noise-um`, the static record of `--noise-record`, or the noise model of the
+/// identification report (`params_text`).
+fn reading_noise(
+    args: &ValidateArgs,
+    noise_um: Option<f64>,
+    params_text: &str,
+    m: &model_spec::Machine,
+    read: &formats::csv::ReadOptions,
+    through: campaign::Through,
+) -> VerbResult<NoiseReport> {
+    if let Some(s) = noise_um {
+        return Ok(NoiseReport {
+            source: format!("--noise-um {}", model_spec::units::significant(s)),
+            sigma_um: [s; 3],
+        });
+    }
+    if let Some(path) = &args.noise_record {
+        let (still, _) = super::read_record(
+            "--noise-record",
+            m,
+            path,
+            read,
+            through,
+            &m.default_parameters(),
+        )?;
+        let model = fitting::NoiseModel::from_static_record(&still)
+            .map_err(|e| Error::input(format!("--noise-record: {}: {e}", path.display())))?;
+        return Ok(NoiseReport {
+            source: format!("the static record {}", path.display()),
+            sigma_um: model.sigma_mm.map(|s| s * UM_PER_MM),
+        });
+    }
+    let params = args.params.display();
+    let json: serde_json::Value = serde_json::from_str(params_text)
+        .map_err(|e| Error::input(format!("--params: {params}: {e}")))?;
+    let Some(noise) = json.get("noise_model") else {
+        return Err(Error::input(format!(
+            "--params: {params} has no `noise_model` (written before noise models): the verdicts of --tolerance need the reading noise; give --noise-um or --noise-record"
+        )));
+    };
+    let sigma: Option<Vec<f64>> = noise
+        .get("sigma_um")
+        .and_then(|s| s.as_array())
+        .and_then(|a| a.iter().map(serde_json::Value::as_f64).collect());
+    let sigma = match sigma.as_deref() {
+        Some(&[x, y, z]) if [x, y, z].iter().all(|s| s.is_finite() && *s >= 0.0) => [x, y, z],
+        _ => {
+            return Err(Error::input(format!(
+                "--params: {params}: field `noise_model.sigma_um` must be three numbers ≥ 0 (µm, x y z)"
+            )));
+        }
+    };
+    let what = noise
+        .get("source")
+        .and_then(|s| s.as_str())
+        .unwrap_or("unknown");
+    Ok(NoiseReport {
+        source: format!("the noise model of {params} ({what})"),
+        sigma_um: sigma,
+    })
+}
+
+/// Per record of `c`, the extents of its readings and of its residual in `v`, mm.
+fn extents(
+    c: &simulation::campaign::Campaign,
+    v: &fitting::campaign::CampaignValidation,
+) -> VerbResult<Vec<RecordExtents>> {
+    c.records
+        .iter()
+        .zip(&v.records)
+        .map(|(r, rv)| {
+            match (
+                Extent::of(&r.record.measured),
+                Extent::of(&rv.validation.residual),
+            ) {
+                (Some(measured), Some(residual)) => Ok(RecordExtents { measured, residual }),
+                _ => Err(Error::input(format!(
+                    "--tolerance: record {} has no sample to judge",
+                    r.label
+                ))),
+            }
+        })
+        .collect()
 }

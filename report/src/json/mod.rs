@@ -27,6 +27,7 @@ pub mod gains;
 pub mod identify;
 pub mod plan;
 pub mod read;
+pub mod tolerance;
 pub mod validate;
 pub mod verdict;
 

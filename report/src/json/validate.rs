@@ -25,12 +25,17 @@
 //! were fitted on it. `unidentified_set_to_zero` at the top lists every parameter some record's
 //! prediction set to 0.
 //!
+//! With `--tolerance FILE`, `tolerance` holds the verdict per test and direction, before and
+//! after, with the rule and the noise it assumed ([`super::tolerance`]); it is absent
+//! otherwise.
+//!
 //! `version` is 2; a report without it is version 1: a record's (`data`, `zeroed`, without
 //! `records`) or a campaign's (`"kind": "campaign"`). [`ValidationReport::from_json`] reads
 //! both.
 
 use super::identify::{CAMPAIGN_KIND, REPORT_VERSION};
 use super::read::{ReportError, versioned};
+use super::tolerance::ToleranceReport;
 use super::{NonFinite, Ordered, finite, finite_opt};
 use fitting::campaign::CampaignValidation;
 use fitting::validate::Stats;
@@ -172,6 +177,9 @@ pub struct ValidationReport {
     /// Per record, in order.
     #[serde(default)]
     pub records: Vec<RecordValidationReport>,
+    /// The verdicts against a tolerance file (`--tolerance`); absent without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<ToleranceReport>,
 }
 
 /// Where the values and records of a validation come from.
@@ -293,6 +301,7 @@ impl ValidationReport {
             zeroed: one.then(|| records[0].zeroed),
             unidentified_set_to_zero: unidentified,
             records,
+            tolerance: None,
         })
     }
 

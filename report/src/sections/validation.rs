@@ -1,12 +1,14 @@
 //! Section 4: the validations: residual RMS and maximum per direction of every validated record,
 //! on the nominal machine and with the identified model, µm, and their figure; for each record
 //! its set-up (fitted, or new: its set-up errors refitted on it, the machine's values held) and
-//! what was refitted; the measured error against the identified model's prediction along each
-//! path.
+//! what was refitted; the verdicts against a tolerance file, before and after (ISO 14253-1);
+//! the measured error against the identified model's prediction along each path.
 
 use super::{num, unit, value_std};
 use crate::html::{Body, Cell};
 use crate::inputs::{Figure, Inputs};
+use crate::json::tolerance::{QuantityReport, VerdictReport};
+use model_spec::units::{fixed, significant};
 
 /// Writes the validation section, with `figure` (the residual RMS per direction) when there
 /// is one.
@@ -80,6 +82,7 @@ pub fn write(
         }
     }
     b.list(&notes);
+    verdicts(b, inputs);
     setups(b, inputs);
     if let Some(f) = figure {
         crate::place_figure(b, f)?;
@@ -159,4 +162,117 @@ fn setups(b: &mut Body, inputs: &Inputs) {
         &["Record", "Set-up", "Set-up values", "Refitted on the record"],
         &rows,
     );
+}
+
+/// A verdict as a cell: its word, in bold when it is not a pass.
+fn verdict_cell(v: VerdictReport) -> Cell {
+    let name = v.name();
+    Cell::Markup(match v {
+        VerdictReport::Pass => format!("<span class=\"verdict-{name}\">{name}</span>"),
+        _ => format!("<strong class=\"verdict-{name}\">{name}</strong>"),
+    })
+}
+
+/// Value, U and verdict of one quantity in one state; empty cells without it.
+fn quantity_cells(q: Option<&QuantityReport>) -> [Cell; 3] {
+    match q {
+        Some(q) => [
+            Cell::number(fixed(q.value_um, 3)),
+            Cell::number(fixed(q.expanded_um, 3)),
+            verdict_cell(q.verdict),
+        ],
+        None => [Cell::text(""), Cell::text(""), Cell::text("")],
+    }
+}
+
+/// The verdicts of every validation given a tolerance file: per test and direction, each
+/// quantity before (the readings) and after (readings minus prediction), with U, and the
+/// test's verdict; the counts, the noise and the rule.
+fn verdicts(b: &mut Body, inputs: &Inputs) {
+    for (file, v) in &inputs.validations {
+        let Some(t) = &v.tolerance else {
+            continue;
+        };
+        b.subheading(&format!("Verdicts against the tolerances of {}", t.file));
+        let mut rows: Vec<Vec<Cell>> = Vec::new();
+        for x in &t.tests {
+            let quantities = [
+                (
+                    "max |deviation|",
+                    x.before.max.as_ref(),
+                    x.after.max.as_ref(),
+                ),
+                ("range", x.before.range.as_ref(), x.after.range.as_ref()),
+            ];
+            for (what, before, after) in quantities {
+                let Some(limit) = before.or(after).map(|q| q.tolerance_um) else {
+                    continue;
+                };
+                let mut row = vec![
+                    Cell::text(format!("{} ({})", x.name, x.record)),
+                    Cell::text(x.direction.clone()),
+                    Cell::text(what),
+                    Cell::number(fixed(limit, 3)),
+                ];
+                row.extend(quantity_cells(before));
+                row.extend(quantity_cells(after));
+                rows.push(row);
+            }
+            if x.max_um.is_some() && x.range_um.is_some() {
+                let row = vec![
+                    Cell::text(format!("{} ({})", x.name, x.record)),
+                    Cell::text(x.direction.clone()),
+                    Cell::text("the test"),
+                    Cell::text(""),
+                    Cell::text(""),
+                    Cell::text(""),
+                    verdict_cell(x.before.verdict),
+                    Cell::text(""),
+                    Cell::text(""),
+                    verdict_cell(x.after.verdict),
+                ];
+                rows.push(row);
+            }
+        }
+        b.table(
+            &format!(
+                "Verdict per test and direction (ISO 14253-1, k = {}), µm: before = the readings (the machine as measured), after = readings minus the identified model's prediction (the machine as the model would leave it once compensated); U the expanded uncertainty (report {file})",
+                significant(t.coverage_k)
+            ),
+            &[
+                "Test (record)",
+                "Direction",
+                "Quantity",
+                "Tolerance",
+                "Before",
+                "U",
+                "Before verdict",
+                "After",
+                "U",
+                "After verdict",
+            ],
+            &rows,
+        );
+        let s = &t.noise.sigma_um;
+        let c = &t.counts;
+        b.list(&[
+            format!(
+                "Before: {} pass, {} fail, {} undecided. After: {} pass, {} fail, {} undecided.",
+                c.before.pass,
+                c.before.fail,
+                c.before.undecided,
+                c.after.pass,
+                c.after.fail,
+                c.after.undecided
+            ),
+            format!(
+                "Reading noise σ = {} (x), {} (y), {} µm (z): {}.",
+                fixed(s[0], 3),
+                fixed(s[1], 3),
+                fixed(s[2], 3),
+                t.noise.source
+            ),
+            format!("Rule: {}.", t.rule),
+        ]);
+    }
 }

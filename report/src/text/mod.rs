@@ -8,6 +8,7 @@ pub mod gains;
 pub mod identify;
 pub mod plan;
 pub mod simulate;
+pub mod tolerance;
 pub mod validate;
 
 pub use simulate::simulation;

@@ -1,6 +1,7 @@
 //! A validation for people, of one record or several: residual RMS and max per direction and
 //! overall (µm), before (the nominal machine) and after (the model), per record and over all of
-//! them, and what was refitted on each record.
+//! them, and what was refitted on each record; with a tolerance file, the verdicts
+//! ([`super::tolerance`]).
 
 use super::{header, table, value, zeroed_text};
 use crate::json::validate::{DirectionReport, RecordValidationReport, ValidationReport};
@@ -62,6 +63,9 @@ pub fn validation(r: &ValidationReport) -> String {
     let one = r.records.len() == 1;
     for x in &r.records {
         text.push_str(&record_line(x, one));
+    }
+    if let Some(t) = &r.tolerance {
+        text.push_str(&super::tolerance::verdicts(t));
     }
     text
 }

@@ -30,38 +30,29 @@ use std::path::PathBuf;
 
 const LONG_ABOUT: &str = "\
 Puts identified errors back onto the machine. The values come from `rtest identify --json` \
-(--params: one record or a campaign; µm and µrad). Only the machine's geometric errors are \
-compensated (of a campaign, its shared values); the ball's set-up errors, the R-test's offsets \
-and instrument terms, each record's own parameters, and time, velocity and reversal terms are \
-left out and listed. A value the identification could not determine is refused.
+(--params: one record or a campaign). Only the machine's geometric errors are compensated; \
+set-up errors, the R-test's offsets and instrument terms, each record's own parameters, and \
+time, velocity and reversal terms are left out and listed. An undetermined value is refused.
 
---path IN -o OUT: corrected commands. IN is a CSV of commanded poses (one column per machine \
-axis, named by its letter; mm and degrees) or, with --nc iso|heidenhain, an NC program in \
-machine coordinates (absolute straight moves); OUT has the same format with the corrected axis \
-values, at which the model's predicted tool point and tool axis are the commanded ones (to \
-1 nm). The rotation about the tool axis cannot be corrected and is reported. A corrected \
-command past a stroke or range limit by at most 0.01 mm or 0.01° is put on the limit and \
-listed; further out, the pose is refused with its line. An NC word written with the program's \
-decimals that loses more than 0.1 µm (linear) or 1 µrad (rotary) of its correction is refused \
-with its line and the decimals needed, unless --decimals N says how many to write.
+--path IN -o OUT: corrected commands, a CSV of poses (one column per axis letter; mm, degrees) \
+or, with --nc iso|linuxcnc|heidenhain, an NC program in machine coordinates: the predicted tool \
+point and tool axis become the commanded ones (to 1 nm); the rotation about the tool axis is \
+reported. A command past a limit by at most 0.01 mm or 0.01° is clamped and listed, further \
+out refused. Words whose decimals lose more than 0.1 µm or 1 µrad are refused unless \
+--decimals N says how many to write.
 
---kinematics-out FILE: the machine description with the location errors and the identified \
-kinematic symbols folded into its offsets and defaults; what cannot be folded is listed. \
---tables DIR: one CSV per axis of its component errors (µm, µrad) and positioning correction \
-against its position, every --pitch mm (--pitch-deg degrees on rotary axes). --linuxcnc DIR: \
-LinuxCNC's files for a table-table machine (xyzac-trt-kins or xyzbc-trt-kins): the module's \
-pins with the location errors folded in (kinematics.hal) and joint compensation files \
-(joint_N.comp); what they cannot hold is listed. --isg FILE: the errors as ISG-kernel's \
-volumetric compensation file (Beckhoff TwinCAT CNC, ISG_CSV). --param sets \
-kinematic symbols (mm; the tool length, say). --json FILE writes the summary, --report FILE the \
-HTML report (both need --path).
+Also: --kinematics-out FILE (the description with the location errors folded in), --tables DIR \
+(per-axis errors and corrections every --pitch mm or --pitch-deg degrees), --linuxcnc DIR \
+(LinuxCNC's trt-kins pins and joint compensation files), --isg FILE (ISG's volumetric \
+compensation file), --json and --report (with --path). What an output cannot hold is listed. \
+--param sets kinematic symbols (mm; the tool length, say).
 
-Limits: an error whose largest value over the machine's ranges, or a change folded by \
---kinematics-out, beyond --max-change-um (default 50) or --max-change-urad (default 250) is \
-refused. When the tool-side length (the probe's Zp) cannot be told from a compensated error \
-(ZOA on seed-ac), a warning names them: give the length measured on a tool setter with --param.
+Limits: a value or a folded change beyond --max-change-um (default 50) or --max-change-urad \
+(250) is refused. A tool-side length that cannot be told from a compensated error (Zp from \
+ZOA on seed-ac) is warned of: give the length measured on a tool setter with --param.
 
-Details: docs/compensation.md, docs/compensation-tables.md, docs/controllers.md, docs/nc-programs.md, docs/report.md.";
+Details: docs/compensation.md, docs/compensation-tables.md, docs/controllers.md, \
+docs/nc-programs.md, docs/report.md.";
 
 /// Flags of `rtest compensate`.
 #[derive(Debug, clap::Args)]

@@ -16,5 +16,6 @@ mod isg_volumetric;
 mod linuxcnc_kinematics;
 mod range_limits;
 mod safety_limits;
+mod siemens_kinematics;
 mod timebases;
 mod volumetric;

@@ -186,3 +186,19 @@ fn an_unfolded_translation_misses_by_its_size() {
     let miss = got.norm();
     assert!((miss - 0.025).abs() < 1e-9, "{miss}");
 }
+
+#[test]
+fn a_table_side_x_described_along_minus_x_is_its_joint_as_written() {
+    // The docs' advice for LinuxCNC machines: describe the table-side X in its joint's
+    // direction, and the joint map is the identity.
+    let text = model_spec::write::source_text("seed-ac").unwrap();
+    let at = text.find("direction = \"+x\"").unwrap();
+    let flipped = format!("{}direction = \"-x\"{}", &text[..at], &text[at + 16..]);
+    let m = parse_machine("seed-ac-joints.toml", &flipped).unwrap();
+    assert_eq!(
+        m.axes[m.axis_by_name("X").unwrap()].direction.own.sign(),
+        -1.0
+    );
+    let k = trt_kinematics(&m, &m.default_parameters()).unwrap();
+    assert!(k.joints.iter().all(|j| j.sign == 1.0), "{:?}", k.joints);
+}

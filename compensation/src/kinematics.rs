@@ -690,18 +690,22 @@ fn comment_block(
             .map(|e| format!("{} = {} µrad", e.name, format_scaled(e.value_rad + 0.0, 6)))
             .collect();
         let what = match (own.is_empty(), d.carried_by.is_empty()) {
-            (false, true) => format!("{} folded into", own.join(" and ")),
-            (false, false) => format!(
-                "{} folded into, and turned with axis {},",
+            (false, true) => format!(
+                "#   {} folded into the direction of axis {}:",
                 own.join(" and "),
+                d.axis
+            ),
+            (false, false) => format!(
+                "#   {} folded into the direction of axis {}, turned with axis {} too:",
+                own.join(" and "),
+                d.axis,
                 d.carried_by.join(", ")
             ),
-            _ => format!("turned with axis {}:", d.carried_by.join(", ")),
-        };
-        let what = if own.is_empty() {
-            format!("#   the direction of axis {} {what}", d.axis)
-        } else {
-            format!("#   {what} the direction of axis {}:", d.axis)
+            _ => format!(
+                "#   the direction of axis {} turned with axis {}:",
+                d.axis,
+                d.carried_by.join(", ")
+            ),
         };
         out.push_str(&format!("{what} {before} → {}\n", vector(d.after)));
     }

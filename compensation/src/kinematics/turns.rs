@@ -20,7 +20,7 @@
 //! `γ = 0` for an axis along z and for an inclined one with no x component (its `x′` is the
 //! machine x), first order in the angles otherwise. The axis's motion is exact either way; its
 //! component errors then act along directions turned by `γ`, a difference of `γ` times the
-//! component error (second order: 10 µrad × 10 µm = 1e-10 mm).
+//! component error (second order: 10 µrad × 10 µm = 1e-7 mm).
 
 use model_spec::catalogue::Motion;
 use model_spec::{AxisDirection, AxisId, AxisKind, Dir, ErrorId, ErrorKind, Link, Machine, Side};

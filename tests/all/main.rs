@@ -33,6 +33,7 @@ mod cli_sensor_campaign;
 mod cli_stream;
 mod cli_templates;
 mod cli_timebases;
+mod cli_validate_tolerance;
 mod cli_vocabulary;
 mod cli_volumetric;
 mod engine_long_chains;

@@ -44,8 +44,9 @@ out refused. Words whose decimals lose more than 0.1 µm or 1 µrad are refused 
 Also: --kinematics-out FILE (the description with the location errors folded in), --tables DIR \
 (per-axis errors and corrections every --pitch mm or --pitch-deg degrees), --linuxcnc DIR \
 (LinuxCNC's trt-kins pins and joint compensation files), --isg FILE (ISG's volumetric \
-compensation file), --json and --report (with --path). What an output cannot hold is listed. \
---param sets kinematic symbols (mm; the tool length, say).
+compensation file), --siemens DIR (a SINUMERIK's swivel data record --carrier N, TRAORI \
+machine data, $AA_ENC_COMP and $AN_CEC tables), --json and --report (with --path). What an \
+output cannot hold is listed. --param sets kinematic symbols (mm; the tool length, say).
 
 Limits: a value or a folded change beyond --max-change-um (default 50) or --max-change-urad \
 (250) is refused. A tool-side length that cannot be told from a compensated error (Zp from \
@@ -99,6 +100,14 @@ pub struct CompensateArgs {
     /// CNC, ISG_CSV) to FILE.
     #[arg(long, value_name = "FILE")]
     isg: Option<Target>,
+    /// Also write a SINUMERIK's files into this directory: swivel data record --carrier
+    /// (TC_CARR_N.MPF), the five-axis transformation's machine data (TRAFO_1.INI) and
+    /// compensation tables (AX_EEC.INI, NC_CEC.INI).
+    #[arg(long, value_name = "DIR")]
+    siemens: Option<PathBuf>,
+    /// The number of the swivel data record --siemens sets (from 1).
+    #[arg(long, value_name = "N", default_value_t = 1, requires = "siemens")]
+    carrier: u32,
     /// Pitch of the tables of linear axes, mm.
     #[arg(long, value_name = "MM", default_value_t = 10.0, value_parser = super::args::positive)]
     pitch: f64,
@@ -131,9 +140,10 @@ fn check_flags(args: &CompensateArgs) -> VerbResult {
         && args.tables.is_none()
         && args.linuxcnc.is_none()
         && args.isg.is_none()
+        && args.siemens.is_none()
     {
         return Err(Error::usage(
-            "nothing to write: give --path IN -o OUT, --kinematics-out FILE, --tables DIR, --linuxcnc DIR or --isg FILE",
+            "nothing to write: give --path IN -o OUT, --kinematics-out FILE, --tables DIR, --linuxcnc DIR, --isg FILE or --siemens DIR",
         ));
     }
     if args.json.is_some() && args.path.is_none() {
@@ -176,6 +186,7 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         .iter()
         .map(|d| ("--tables", d.as_path()))
         .chain(args.linuxcnc.iter().map(|d| ("--linuxcnc", d.as_path())))
+        .chain(args.siemens.iter().map(|d| ("--siemens", d.as_path())))
         .collect();
     check_outputs(&inputs, &outputs, &dirs)?;
     if let Some(dir) = &args.tables {
@@ -186,6 +197,10 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         let ours =
             |n: &str| n == "kinematics.hal" || (n.starts_with("joint_") && n.ends_with(".comp"));
         super::check_dir_inputs(&inputs, "--linuxcnc", dir, &ours)?;
+    }
+    if let Some(dir) = &args.siemens {
+        let ours = super::compensate_siemens::is_ours;
+        super::check_dir_inputs(&inputs, "--siemens", dir, &ours)?;
     }
     let params = super::pose_args::params(&m, args.param.as_deref())?;
     // --params is read once: its values, and the identification the report shows.
@@ -288,6 +303,27 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         let (text, lines) = super::compensate_isg::isg_file(&m, &errors, pitch, &params_file)?;
         files.add("--isg", target.clone(), text);
         controller_summary.push_str(&lines);
+    }
+    if let Some(dir) = &args.siemens {
+        let pitch = Pitch {
+            linear_mm: args.pitch,
+            rotary_deg: args.pitch_deg,
+        };
+        let written = super::compensate_siemens::siemens_files(
+            &m,
+            &machine_text,
+            &errors,
+            &left_out,
+            args.param.as_deref(),
+            pitch,
+            &params_file,
+            args.carrier,
+        )?;
+        check_change_limits(args, &m, &errors, Some(&written.corrected))?;
+        for (name, text) in written.files {
+            files.add_in_dir("--siemens", dir, &name, text);
+        }
+        controller_summary.push_str(&written.summary);
     }
     let mut text = match &summary {
         Some(s) => {

@@ -9,6 +9,7 @@ pub mod campaign;
 pub mod compensate;
 mod compensate_isg;
 mod compensate_linuxcnc;
+mod compensate_siemens;
 pub mod demo;
 pub mod diagnose;
 mod diagnose_records;

@@ -61,6 +61,9 @@ pub const CHECK_POSES: usize = 50;
 /// relative to the table (mm).
 pub const CHECK_TOLERANCE_MM: f64 = 1e-9;
 
+/// A vector of the record (mm, or a unit vector).
+pub type Vector = Vector3<f64>;
+
 /// The kinematic type of a swivel data record, `$TC_CARR23`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum KinematicType {
@@ -380,11 +383,11 @@ pub fn swivel_kinematics(m: &Machine, params: &[f64]) -> Result<SwivelKinematics
     let (l1, l2, l3, l4) = match kind {
         KinematicType::P => {
             let (l2, l3) = (clean_mm(c1 - o), clean_mm(c2 - c1));
-            (zero3, l2, l3, -(l2 + l3))
+            (zero3, l2, l3, clean_mm(-(l2 + l3)))
         }
         KinematicType::T => {
             let (l2, l3) = (clean_mm(c1 - c2), clean_mm(c2 - o));
-            (-(l2 + l3), l2, l3, zero3)
+            (clean_mm(-(l2 + l3)), l2, l3, zero3)
         }
         KinematicType::M => {
             let (l2, l3) = (clean_mm(c1 - o), clean_mm(c2 - o));

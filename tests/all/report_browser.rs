@@ -13,7 +13,7 @@ use common::{TempDir, ok};
 use crate::support::browser;
 
 /// Simulates K4 and K1 of seed-ac with the demo truth; identifies the reduced model on K4,
-/// validates on K1, diagnoses, compensates the first poses of K1; writes the report of the
+/// validates on K1 against a tolerance file (its verdicts in the report), diagnoses, compensates the first poses of K1; writes the report of the
 /// diagnosis (`d.html`) and of the whole check (`check.html`).
 fn a_whole_check(dir: &TempDir) {
     for (path, seed) in [("K4", "1"), ("K1", "2")] {
@@ -37,7 +37,14 @@ fn a_whole_check(dir: &TempDir) {
     }
     let run = |line: &str| ok(dir, &line.split_whitespace().collect::<Vec<_>>());
     run("identify --machine seed-ac --model reduced --data k4.csv --json id.json");
-    run("validate --machine seed-ac --params id.json --data k1.csv --json v1.json");
+    std::fs::write(
+        dir.join("tol.toml"),
+        "[[test]]\nname = \"K1\"\ndirection = [\"x\", \"y\", \"z\"]\nmax_um = 10\nrange_um = 15\n",
+    )
+    .unwrap();
+    run(
+        "validate --machine seed-ac --params id.json --data k1.csv --tolerance tol.toml --json v1.json",
+    );
     run(
         "diagnose --machine seed-ac --model reduced --data k4.csv --validate k1.csv --json d.json --report d.html",
     );
@@ -127,8 +134,10 @@ fn the_report_of_a_check_reads_and_prints_in_a_browser() {
     };
     let dir = common::temp_dir_tagged("report-browser", "check");
     a_whole_check(&dir);
-    // The validation bars, the spectrum, the paths of K4 and K1.
+    // The validation bars, the spectrum, the paths of K4 and K1; the verdicts' table.
     opens_cleanly(&b, &dir, "check.html", 4);
+    let check = std::fs::read_to_string(dir.join("check.html")).unwrap();
+    assert!(check.contains("<h3>Verdicts against the tolerances of tol.toml</h3>"));
     // The identified model's paths, the spectrum, the diagnosis's paths of K4 and K1.
     opens_cleanly(&b, &dir, "d.html", 3);
     // A campaign: its records' paths (K4 and K1 fitted, K2 validated) and the validation bars.

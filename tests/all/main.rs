@@ -46,3 +46,4 @@ mod linuxcnc_oracle;
 mod readers_fuzz;
 mod report_browser;
 mod seed_tables;
+mod siemens_forward;

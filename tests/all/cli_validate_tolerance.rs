@@ -202,6 +202,18 @@ fn pass_fail_and_undecided_follow_iso_14253_1_before_and_after() {
         html.contains("After: 1 pass, 1 fail, 1 undecided."),
         "no counts"
     );
+    // A verdict that is not one of the three words is refused when the report is read back.
+    let json = std::fs::read_to_string(dir.join("v.json")).unwrap();
+    let at = json.find("\"pass\"").expect("a pass");
+    let bad = format!("{}\"ok\"{}", &json[..at], &json[at + 6..]);
+    std::fs::write(dir.join("bad.json"), bad).unwrap();
+    fails(
+        &dir,
+        &["report", "id.json", "bad.json", "-o", "bad.html"],
+        1,
+        &["bad.json", "`ok`"],
+    );
+    assert!(!dir.join("bad.html").exists());
 }
 
 #[test]

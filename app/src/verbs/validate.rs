@@ -38,18 +38,11 @@ identification's set-up when it fitted one at their kinematic parameters, else e
 Parameters the identification could not determine (value null) are set to 0 and named; \
 --refuse-undetermined makes that an error instead.
 
---tolerance FILE judges each record against a tolerance file ([[test]] tables: name, direction \
-x|y|z, max_um, range_um): per test and direction, the largest |deviation| and its range \
-before (the readings: the machine as measured) and after (readings minus prediction: the \
-machine as the identified model would leave it once compensated), each with its expanded \
-uncertainty U = 2·u_c and the verdict of ISO 14253-1: pass when value + U ≤ tolerance, fail \
-when value − U > tolerance, undecided otherwise. u_c is the reading noise σ (the \
-identification's noise model, or --noise-um, or --noise-record), after compensation with the \
-model's lack of fit on the record added. The verdicts are printed and in the JSON; the exit \
-code stays 0 whatever they are (a bad tolerance file is exit code 1).
+--tolerance FILE: verdicts per test and direction, before and after, by ISO 14253-1 (pass, \
+fail, undecided; exit code 0 whatever they are): docs/tolerances.md.
 
 --json FILE (`-`: standard output) writes the report. Details: docs/campaigns.md §6 (set-ups), \
-docs/identification.md §9, §11, §16, docs/tolerances.md (tolerances and verdicts).";
+docs/identification.md §9, §11, §16.";
 
 /// Flags of `rtest validate`.
 #[derive(Debug, clap::Args)]

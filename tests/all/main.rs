@@ -29,6 +29,7 @@ mod cli_report;
 mod cli_report_inputs;
 mod cli_reversal;
 mod cli_segment;
+mod cli_siemens;
 mod cli_sensor_campaign;
 mod cli_stream;
 mod cli_templates;

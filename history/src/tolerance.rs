@@ -18,6 +18,12 @@
 //! name that no check of the machine identified (a misspelt name would silently switch its
 //! tolerance off) is an error naming the file, the line and the column. On the command line,
 //! `--tolerance XOC=5` gives one.
+//!
+//! These limits judge identified values. The deviations of R-test records over a test are
+//! judged against another file, [`formats::tolerance`] (per test and direction, `max_um` and
+//! `range_um`), by `rtest validate --tolerance`; both follow the decision rule of ISO 14253-1,
+//! [`fitting::verdict`] (the tolerance flag's "nonconformance proven" is its fail branch, with
+//! `U = 2σ` of the value's fit: the model's lack of fit is not in that margin).
 
 use crate::check::canonical_key;
 use formats::located::{Located, TomlText, in_order};

@@ -316,7 +316,8 @@ fn flags(beyond: &[Beyond]) -> String {
 
 /// The values beyond `limits`: each compensated error's largest value over the machine's
 /// ranges ([`largest_values`]) and, when the corrected description is given, each change
-/// folded into it (a location error's share of an offset, an identified length's change).
+/// folded into it (a location error's share of an offset, an identified length's change, an
+/// offset of a carried axis turned by a folded direction).
 pub fn beyond_limits(
     m: &Machine,
     errors: &MachineErrors,
@@ -389,6 +390,15 @@ pub fn beyond_limits(
                 format!("{} folded into its default", s.name),
                 s.change_mm,
             ));
+        }
+        for t in &c.turned {
+            let change = t.after_mm - t.before_mm;
+            if beyond(change, limits.linear_mm) {
+                out.push(linear(
+                    format!("{} turned by the axes {}", t.place, t.by.join(", ")),
+                    change,
+                ));
+            }
         }
     }
     out

@@ -392,6 +392,22 @@ fn kinematics_report(target: &Target, corrected: &CorrectedDescription) -> Kinem
                     compact(f.after_mm)
                 )
             }))
+            .chain(corrected.directions.iter().map(direction_line))
+            .chain(corrected.turned.iter().map(|t| {
+                format!(
+                    "{} turned by the axes {}: {} -> {} mm",
+                    t.place,
+                    t.by.join(", "),
+                    compact(t.before_mm),
+                    compact(t.after_mm)
+                )
+            }))
+            .chain(corrected.set_up_turn.map(|_| {
+                let [x, y, z] = corrected.set_up_change_mm.map(|v| readable(v * 1e3, 4));
+                format!(
+                    "the ball's frame turns with them: identified with this description, XOW YOW ZOW come out larger by {x}, {y}, {z} µm"
+                )
+            }))
             .collect(),
         not_folded: corrected
             .not_folded
@@ -399,6 +415,30 @@ fn kinematics_report(target: &Target, corrected: &CorrectedDescription) -> Kinem
             .map(|n| format!("{}: {}", n.spelling, n.reason))
             .collect(),
     }
+}
+
+/// A folded direction for people: `AOC = 29.75 µrad, BOC = -12.5 µrad into the direction of
+/// C: (0, 0, 1) -> (…)`.
+fn direction_line(d: &compensation::kinematics::FoldedDirection) -> String {
+    let vector = |v: &[f64; 3]| {
+        let parts: Vec<String> = v.iter().map(|x| compact(*x)).collect();
+        format!("({})", parts.join(", "))
+    };
+    let mut what: Vec<String> = d
+        .errors
+        .iter()
+        .map(|a| format!("{} = {} µrad", a.name, readable(a.value_rad * 1e6, 4)))
+        .collect();
+    if !d.carried_by.is_empty() {
+        what.push(format!("the turn of {}", d.carried_by.join(", ")));
+    }
+    format!(
+        "{} into the direction of {}: {} -> {}",
+        what.join(", "),
+        d.axis,
+        vector(&d.before),
+        vector(&d.after)
+    )
 }
 
 /// Refuses the values of `--params` (`errors`) when an error's largest value over the

@@ -229,3 +229,27 @@ fn an_identified_length_is_tested_against_the_location_errors_the_model_lacks() 
     let v = identified(&m, &names, &vec![1e-6; names.len()]);
     assert_eq!(tool_length(&m, &v, &errors(&m, &v)).unwrap(), None);
 }
+
+#[test]
+fn an_offset_turned_by_a_folded_direction_is_a_folded_change_too() {
+    // The nutating B's AOB turns B's direction and the C table it carries: C's offset (Zc =
+    // 90 mm along B's z) turns by 90 mm × 200 µrad = 18 µm.
+    let m = builtin("nutating-table-bc");
+    let text = &model_spec::write::source_text("nutating-table-bc").unwrap();
+    let e = errors(&m, &identified(&m, &["AOB"], &[200e-6]));
+    let corrected = corrected_description(&m, text, &e).unwrap();
+    assert!(!corrected.turned.is_empty(), "{corrected:?}");
+    let limits = ChangeLimits::from_display(10.0, 250.0);
+    check_changes(&m, &e, None, limits).unwrap();
+    let refused = check_changes(&m, &e, Some(&corrected), limits)
+        .unwrap_err()
+        .to_string();
+    assert!(refused.contains("turned by the axes B"), "{refused}");
+    check_changes(
+        &m,
+        &e,
+        Some(&corrected),
+        ChangeLimits::from_display(20.0, 250.0),
+    )
+    .unwrap();
+}

@@ -54,6 +54,11 @@ fn the_built_in_five_axis_machines_map_onto_their_kinematic_types() {
             KinematicType::T,
             "X1 = X, Y1 = Y, Z1 = Z, C1 = C, A1 = A",
         ),
+        (
+            "nutating-head-bc",
+            KinematicType::M,
+            "X1 = X, Y1 = Y, Z1 = Z, B1 = B, C1 = C",
+        ),
     ] {
         let m = builtin(name);
         let k = swivel_kinematics(&m, &m.default_parameters()).unwrap();

@@ -439,4 +439,38 @@ mod tests {
             assert!(e.message.contains(needle), "{text:?}: {e}");
         }
     }
+
+    proptest::proptest! {
+        /// A file damaged anywhere (a byte replaced, removed or doubled) is read or refused at a
+        /// place inside the text, never with a panic.
+        #[test]
+        fn damaged_files_are_read_or_refused_at_a_place(at in 0usize..200, what in 0u8..3, byte in 0u8..128) {
+            let good = "# µm\n[[test]]\nname = \"K1\"\ndirection = [\"x\", \"z\"]\nmax_um = 20\nrange_um = 30.5\n\n[[test]]\nname = \"turn-B\"\ndirection = \"y\"\nrange_um = 12\n";
+            let mut bytes = good.as_bytes().to_vec();
+            let at = at % bytes.len();
+            match what {
+                0 => bytes[at] = byte,
+                1 => {
+                    bytes.remove(at);
+                }
+                _ => bytes.insert(at, bytes[at]),
+            }
+            let text = String::from_utf8_lossy(&bytes).into_owned();
+            match parse_file("t.toml", &text) {
+                Ok(t) => {
+                    for e in &t.entries {
+                        proptest::prop_assert!(e.max_um.is_none_or(|x| x > 0.0 && x.is_finite()));
+                        proptest::prop_assert!(e.range_um.is_none_or(|x| x > 0.0 && x.is_finite()));
+                        proptest::prop_assert!(e.max_um.is_some() || e.range_um.is_some());
+                    }
+                }
+                Err(e) => {
+                    proptest::prop_assert_eq!(e.file.as_str(), "t.toml");
+                    let lines = text.lines().count().max(1) + 1;
+                    proptest::prop_assert!(e.line >= 1 && e.line <= lines, "{}", e);
+                    proptest::prop_assert!(!e.message.is_empty());
+                }
+            }
+        }
+    }
 }

@@ -120,25 +120,31 @@ impl TestTolerances {
         })
     }
 
+    /// The index among `labels` of the record `t` names ([`TestTolerances::record_of`]).
+    ///
+    /// # Errors
+    /// [`Located`] at the entry's `name` when no record is called so, listing the labels.
+    pub fn record_index(&self, t: &TestTolerance, labels: &[String]) -> Result<usize, Located> {
+        Self::record_of(t, labels).ok_or_else(|| Located {
+            file: self.file.clone(),
+            line: t.at.0,
+            column: t.at.1,
+            message: format!(
+                "`test[{}].name`: no validated record is called `{}` (the records: {}; a record is named by its campaign label or its file's stem)",
+                t.index,
+                t.name,
+                labels.join(", ")
+            ),
+        })
+    }
+
     /// Refuses a test the records do not have (`labels`: the validated records' labels).
     ///
     /// # Errors
-    /// [`Located`] at the entry's `name`, listing the records' labels.
+    /// [`Located`] at the first such entry's `name`, listing the records' labels.
     pub fn check_names(&self, labels: &[String]) -> Result<(), Located> {
         for t in &self.entries {
-            if Self::record_of(t, labels).is_none() {
-                return Err(Located {
-                    file: self.file.clone(),
-                    line: t.at.0,
-                    column: t.at.1,
-                    message: format!(
-                        "`test[{}].name`: no validated record is called `{}` (the records: {}; a record is named by its campaign label or its file's stem)",
-                        t.index,
-                        t.name,
-                        labels.join(", ")
-                    ),
-                });
-            }
+            self.record_index(t, labels)?;
         }
         Ok(())
     }

@@ -13,7 +13,7 @@ use formats::tolerance::{MAX_TOLERANCE_BYTES, TestTolerances};
 use model_spec::units::UM_PER_MM;
 use output::{Outputs, Target};
 use report::json::read::{IdentifiedValues, MAX_REPORT_BYTES, ReportError, parse_identification};
-use report::json::tolerance::{NoiseReport, RecordExtents, ToleranceReport};
+use report::json::tolerance::{JudgeError, NoiseReport, RecordExtents, ToleranceReport};
 use report::json::{ValidationReport, ValidationSource, to_json};
 use report::text::validate::validation;
 use std::path::{Path, PathBuf};
@@ -249,10 +249,12 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
         .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
     if let (Some(t), Some(noise)) = (&tolerances, noise) {
         let extents = extents(&loaded.campaign, &v)?;
-        report.tolerance = Some(
-            ToleranceReport::new(t, &report, &extents, noise)
-                .map_err(|e| Error::computation(format!("--tolerance: {e}")))?,
-        );
+        report.tolerance = Some(ToleranceReport::new(t, &report, &extents, noise).map_err(
+            |e| match e {
+                JudgeError::Name(e) => Error::input(format!("--tolerance {e}")),
+                other => Error::computation(format!("--tolerance: {other}")),
+            },
+        )?);
     }
     let mut text = validation(&report);
     text.push_str(&loaded.zeroed_notes(if args.campaign.is_some() {

@@ -179,6 +179,25 @@ pub struct ToleranceReport {
     pub counts: StateCounts,
 }
 
+/// Why verdicts cannot be made.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum JudgeError {
+    /// A test of the file that no validated record is called.
+    #[error(transparent)]
+    Name(#[from] formats::located::Located),
+    /// Not one extent per record.
+    #[error("{extents} extents for {records} records")]
+    Extents {
+        /// Records of the validation.
+        records: usize,
+        /// Extents given.
+        extents: usize,
+    },
+    /// A value that is not finite.
+    #[error(transparent)]
+    NonFinite(#[from] NonFinite),
+}
+
 /// The extents of one validated record per direction, mm: of the readings and of the residual.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RecordExtents {
@@ -189,28 +208,31 @@ pub struct RecordExtents {
 }
 
 impl ToleranceReport {
-    /// The verdicts of `report` (the validation, whose records' labels the file's names were
-    /// checked against: [`TestTolerances::check_names`]) against `tolerances`, `extents` one
-    /// per record of `report`, `noise` the reading noise.
+    /// The verdicts of `report` (the validation) against `tolerances`, `extents` one per
+    /// record of `report`, `noise` the reading noise.
     ///
     /// # Errors
-    /// [`NonFinite`] when a value is not finite.
+    /// [`JudgeError::Name`] for a test no record of `report` is called
+    /// ([`TestTolerances::record_index`]), [`JudgeError::Extents`] when `extents` has not one
+    /// entry per record, [`JudgeError::NonFinite`] when a value is not finite.
     pub fn new(
         tolerances: &TestTolerances,
         report: &ValidationReport,
         extents: &[RecordExtents],
         noise: NoiseReport,
-    ) -> Result<ToleranceReport, NonFinite> {
+    ) -> Result<ToleranceReport, JudgeError> {
         let labels: Vec<String> = report.records.iter().map(|r| r.label.clone()).collect();
+        if extents.len() != labels.len() {
+            return Err(JudgeError::Extents {
+                records: labels.len(),
+                extents: extents.len(),
+            });
+        }
         let mut tests = Vec::with_capacity(tolerances.entries.len());
         let mut counts = StateCounts::default();
         for (i, t) in tolerances.entries.iter().enumerate() {
-            let Some(r) = TestTolerances::record_of(t, &labels) else {
-                continue;
-            };
-            let (Some(record), Some(ext)) = (report.records.get(r), extents.get(r)) else {
-                continue;
-            };
+            let r = tolerances.record_index(t, &labels)?;
+            let (record, ext) = (&report.records[r], &extents[r]);
             let d = t.direction;
             let sigma = noise.sigma_um[d.index()];
             let rms = direction_report(record, d).residual_rms_um;
@@ -282,5 +304,105 @@ fn direction_report(
         Direction::X => &record.per_direction.x,
         Direction::Y => &record.per_direction.y,
         Direction::Z => &record.per_direction.z,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A validation of one record `k1` whose residual RMS is `s` µm in every direction.
+    fn validation(s: f64) -> ValidationReport {
+        let d = format!(
+            r#"{{"measured_rms_um": 10, "measured_max_um": 20, "residual_rms_um": {s}, "residual_max_um": 3}}"#
+        );
+        let text = format!(
+            r#"{{"machine": "seed-ac", "model": "reduced", "params": "id.json", "data": "k1.csv",
+               "samples": 10, "prediction": "exact", "measured_rms_um": 10, "measured_max_um": 20,
+               "residual_rms_um": {s}, "residual_max_um": 3, "zeroed": false,
+               "per_direction": {{"x": {d}, "y": {d}, "z": {d}}}}}"#
+        );
+        ValidationReport::from_json("v.json", &text).unwrap()
+    }
+
+    fn extents() -> RecordExtents {
+        // Readings from −0.012 to 0.020 mm, residual from −0.002 to 0.003 mm, every direction.
+        let e = |min, max| [Extent { min, max }; 3];
+        RecordExtents {
+            measured: e(-0.012, 0.020),
+            residual: e(-0.002, 0.003),
+        }
+    }
+
+    fn noise(s: f64) -> NoiseReport {
+        NoiseReport {
+            source: "test".into(),
+            sigma_um: [s; 3],
+        }
+    }
+
+    #[test]
+    fn the_extents_are_judged_in_um_before_and_after() {
+        let file = "[[test]]\nname = \"K1\"\ndirection = \"y\"\nmax_um = 22\nrange_um = 10\n";
+        let t = formats::tolerance::parse_file("tol.toml", file).unwrap();
+        // σ = 0.5 µm, s = 2 µm: b = √(4 − 0.25), u_c after = 2 µm.
+        let r = ToleranceReport::new(&t, &validation(2.0), &[extents()], noise(0.5)).unwrap();
+        let x = &r.tests[0];
+        assert_eq!((x.record.as_str(), x.direction.as_str()), ("k1", "y"));
+        let before_max = x.before.max.as_ref().unwrap();
+        assert!((before_max.value_um - 20.0).abs() < 1e-9);
+        assert!((before_max.expanded_um - 1.0).abs() < 1e-12);
+        assert_eq!(before_max.verdict, VerdictReport::Pass); // 20 + 1 ≤ 22
+        let before_range = x.before.range.as_ref().unwrap();
+        assert!((before_range.value_um - 32.0).abs() < 1e-9);
+        assert_eq!(before_range.verdict, VerdictReport::Fail); // 32 − 1.41 > 10
+        assert_eq!(x.before.verdict, VerdictReport::Fail);
+        assert_eq!(x.before.lack_of_fit_um, None);
+        assert!((x.after.u_um - 2.0).abs() < 1e-12);
+        assert!((x.after.lack_of_fit_um.unwrap() - 3.75f64.sqrt()).abs() < 1e-12);
+        let after_max = x.after.max.as_ref().unwrap();
+        assert!((after_max.value_um - 3.0).abs() < 1e-9);
+        assert_eq!(after_max.verdict, VerdictReport::Pass); // 3 + 4 ≤ 22
+        let after_range = x.after.range.as_ref().unwrap();
+        assert!((after_range.expanded_um - 4.0 * 2f64.sqrt()).abs() < 1e-12);
+        assert_eq!(after_range.verdict, VerdictReport::Undecided); // 5 ± 5.66 about 10
+        assert_eq!(x.after.verdict, VerdictReport::Undecided);
+        assert_eq!((r.counts.before.fail, r.counts.after.undecided), (1, 1));
+        assert_eq!(r.coverage_k, 2.0);
+    }
+
+    #[test]
+    fn a_test_without_its_record_and_missing_extents_are_errors() {
+        let t = formats::tolerance::parse_file(
+            "tol.toml",
+            "[[test]]\nname = \"K2\"\ndirection = \"x\"\nmax_um = 5\n",
+        )
+        .unwrap();
+        let e = ToleranceReport::new(&t, &validation(1.0), &[extents()], noise(0.5)).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("tol.toml:2:8: `test[0].name`: no validated record is called `K2`"),
+            "{e}"
+        );
+        let t = formats::tolerance::parse_file(
+            "tol.toml",
+            "[[test]]\nname = \"k1\"\ndirection = \"x\"\nmax_um = 5\n",
+        )
+        .unwrap();
+        let e = ToleranceReport::new(&t, &validation(1.0), &[], noise(0.5)).unwrap_err();
+        assert_eq!(e.to_string(), "0 extents for 1 records");
+        let nan = RecordExtents {
+            measured: [Extent {
+                min: f64::NAN,
+                max: f64::NAN,
+            }; 3],
+            ..extents()
+        };
+        let e = ToleranceReport::new(&t, &validation(1.0), &[nan], noise(0.5)).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("tolerance.tests[0].before.max.value_um"),
+            "{e}"
+        );
     }
 }

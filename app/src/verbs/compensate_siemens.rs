@@ -299,12 +299,37 @@ fn record_comments(
         "Checked: the chain of W1 2.5 and IM9 with these values gives the description's tool point relative to its table to {:.1e} mm at 50 poses.",
         k.check_mm.max(1e-15)
     ));
+    // An inclined axis's error along its own x′ or y′ moves two or three machine coordinates:
+    // one entry each, one line per error.
+    let mut seen: Vec<&str> = Vec::new();
     for f in &corrected.folded {
+        if seen.contains(&f.name.as_str()) {
+            continue;
+        }
+        seen.push(&f.name);
+        let parts: Vec<_> = corrected
+            .folded
+            .iter()
+            .filter(|g| g.name == f.name)
+            .collect();
+        let value = if parts.len() == 1 {
+            format!("{} µm", readable(f.value_mm * 1e3, 4))
+        } else {
+            parts
+                .iter()
+                .map(|g| {
+                    format!(
+                        "{} µm along {}",
+                        readable(g.value_mm * 1e3, 4),
+                        g.coordinate
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         c.push(format!(
-            "Held: {} = {} µm, in the {} axis line.",
-            f.name,
-            readable(f.value_mm * 1e3, 4),
-            f.axis
+            "Held: {} = {value}, in the {} axis line.",
+            f.name, f.axis
         ));
     }
     for d in &corrected.directions {

@@ -319,7 +319,8 @@ pub fn assess(series: &Series, options: &Options) -> Result<Assessment, TrendErr
         if let Some(limit) = options.tolerance {
             let v = p.value.abs();
             if v > limit {
-                let proven = v - COVERAGE * p.std > limit;
+                let proven = fitting::verdict::Verdict::of(v, COVERAGE * p.std, limit)
+                    == fitting::verdict::Verdict::Fail;
                 flags.push(Flag {
                     test: Test::Tolerance,
                     statistic: v,

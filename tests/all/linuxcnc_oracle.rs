@@ -11,33 +11,19 @@
 //!    through LinuxCNC's identity kinematics, leaves under 0.02 µm.
 
 use crate::common::temp_dir_tagged;
+use crate::identified::errors_of;
 use crate::support::linuxcnc::{Config, LinuxCnc, for_test, number};
 use compensation::controllers::linuxcnc::{TrtKinematics, check_poses, trt_kinematics};
 use compensation::kinematics::corrected_description;
 use compensation::run::{CommandedPose, compensate_poses};
 use compensation::values::MachineErrors;
-use fitting::campaign::CampaignValues;
 use formats::controllers::linuxcnc::hal_file;
 use model_spec::{Machine, Side, parse_machine};
 use nalgebra::Vector3;
 use simulation::exact::{VirtualMachine, tool_centre_point_ik};
-use simulation::model::{Model, Term};
 
 fn machine(name: &str) -> Machine {
     model_spec::builtin::builtin(name).unwrap().unwrap()
-}
-
-/// The compensated errors of `terms` (spelling and coefficient, mm or rad) on `m`.
-fn errors_of(m: &Machine, terms: &[(&str, f64)]) -> MachineErrors {
-    let model = Model {
-        terms: terms
-            .iter()
-            .map(|(s, _)| Term::parse(m, s).unwrap())
-            .collect(),
-    };
-    let values: Vec<Option<f64>> = terms.iter().map(|(_, v)| Some(*v)).collect();
-    let id = CampaignValues::of_model(m, &model, &values, "k4", m.default_parameters()).unwrap();
-    MachineErrors::from_values(m, &id, "truth").unwrap().0
 }
 
 /// The true error values at a pose (catalogue order, mm and rad).

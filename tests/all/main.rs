@@ -3,6 +3,8 @@
 //! `cargo test --test all NAME::` runs one of them.
 
 mod common;
+#[path = "../../compensation/tests/all/identified.rs"]
+mod identified;
 #[path = "../../fitting/tests/all/one_record.rs"]
 mod one_record;
 mod support;

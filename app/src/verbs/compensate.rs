@@ -189,6 +189,10 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         .chain(args.siemens.iter().map(|d| ("--siemens", d.as_path())))
         .collect();
     check_outputs(&inputs, &outputs, &dirs)?;
+    let pitch = Pitch {
+        linear_mm: args.pitch,
+        rotary_deg: args.pitch_deg,
+    };
     if let Some(dir) = &args.tables {
         let table = |n: &str| n.starts_with("axis_") && n.ends_with(".csv");
         super::check_dir_inputs(&inputs, "--tables", dir, &table)?;
@@ -259,10 +263,6 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         files.add("--kinematics-out", target.clone(), corrected.toml);
     }
     if let Some(dir) = &args.tables {
-        let pitch = Pitch {
-            linear_mm: args.pitch,
-            rotary_deg: args.pitch_deg,
-        };
         let tables = axis_tables(&m, &errors, pitch).map_err(|e| match e {
             CompensationError::Pitch { .. } => Error::usage(format!("--tables: {e}")),
             other => Error::computation(format!("--tables: {other}")),
@@ -276,10 +276,6 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
     // What the controller outputs say of themselves.
     let mut controller_summary = String::new();
     if let Some(dir) = &args.linuxcnc {
-        let pitch = Pitch {
-            linear_mm: args.pitch,
-            rotary_deg: args.pitch_deg,
-        };
         let written = super::compensate_linuxcnc::linuxcnc_files(
             &m,
             &machine_text,
@@ -296,19 +292,11 @@ pub fn run(args: &CompensateArgs) -> VerbResult<Done> {
         controller_summary = written.summary;
     }
     if let Some(target) = &args.isg {
-        let pitch = Pitch {
-            linear_mm: args.pitch,
-            rotary_deg: args.pitch_deg,
-        };
         let (text, lines) = super::compensate_isg::isg_file(&m, &errors, pitch, &params_file)?;
         files.add("--isg", target.clone(), text);
         controller_summary.push_str(&lines);
     }
     if let Some(dir) = &args.siemens {
-        let pitch = Pitch {
-            linear_mm: args.pitch,
-            rotary_deg: args.pitch_deg,
-        };
         let written = super::compensate_siemens::siemens_files(
             &m,
             &machine_text,

@@ -11,7 +11,7 @@ use compensation::kinematics::{CorrectedDescription, Directions, corrected_descr
 use compensation::tables::{AxisTable, Pitch, axis_tables};
 use compensation::values::{CompensationError, LeftOut, MachineErrors};
 use formats::controllers::linuxcnc::{CompPoint, comp_file, hal_file};
-use model_spec::units::{compact, readable};
+use model_spec::units::compact;
 use model_spec::{AxisKind, Machine, parse_machine};
 
 /// The files for LinuxCNC, and what the summary says of them.
@@ -177,26 +177,8 @@ fn not_held_lines(
     held_by_comp: &[(String, String)],
     left_out: &[LeftOut],
 ) -> Vec<String> {
-    let mut out = Vec::new();
-    for n in &corrected.not_folded {
-        let error = n.spelling.split('@').next().unwrap_or(&n.spelling);
-        if held_by_comp.iter().any(|(e, _)| e == error) {
-            continue;
-        }
-        let factor = n.term.effect.display_factor(m);
-        let unit = match n.term.unit(m) {
-            "urad" => "µrad",
-            "um" => "µm",
-            other => other,
-        };
-        let values = n
-            .values
-            .iter()
-            .map(|v| readable(v * factor, 4))
-            .collect::<Vec<_>>()
-            .join(", ");
-        out.push(format!("{} = {values} {unit}: {}", n.spelling, n.reason));
-    }
+    let held: Vec<&str> = held_by_comp.iter().map(|(e, _)| e.as_str()).collect();
+    let mut out = super::compensate_held::not_folded_lines(m, corrected, &held);
     for l in left_out {
         let Some(error) = l.term.strip_suffix("@reversal") else {
             continue;
@@ -259,32 +241,10 @@ fn hal_comments(
             k.check_mm.max(1e-15)
         ),
     ];
-    for f in &corrected.folded {
-        c.push(format!(
-            "Held: {} = {} µm, in the {} axis line.",
-            f.name,
-            readable(f.value_mm * 1e3, 4),
-            f.axis
-        ));
-    }
-    for s in &corrected.symbols {
-        c.push(format!(
-            "Held: {} changed by {} µm (a length of the description).",
-            s.name,
-            readable(s.change_mm * 1e3, 4)
-        ));
-    }
+    c.extend(super::compensate_held::held_lines(corrected));
     for l in comp_lines {
         c.push(format!("Joint compensation: {l}."));
     }
-    if not_held.is_empty() {
-        c.push("Not held: nothing.".to_string());
-    } else {
-        c.push(
-            "Not held here (a program corrected with `rtest compensate --path` holds them):"
-                .to_string(),
-        );
-        c.extend(not_held.iter().map(|l| format!("  {l}")));
-    }
+    c.extend(super::compensate_held::not_held_block(not_held));
     c
 }

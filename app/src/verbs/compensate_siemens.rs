@@ -299,68 +299,11 @@ fn record_comments(
         "Checked: the chain of W1 2.5 and IM9 with these values gives the description's tool point relative to its table to {:.1e} mm at 50 poses.",
         k.check_mm.max(1e-15)
     ));
-    // An inclined axis's error along its own x′ or y′ moves two or three machine coordinates:
-    // one entry each, one line per error.
-    let mut seen: Vec<&str> = Vec::new();
-    for f in &corrected.folded {
-        if seen.contains(&f.name.as_str()) {
-            continue;
-        }
-        seen.push(&f.name);
-        let parts: Vec<_> = corrected
-            .folded
-            .iter()
-            .filter(|g| g.name == f.name)
-            .collect();
-        let value = if parts.len() == 1 {
-            format!("{} µm", readable(f.value_mm * 1e3, 4))
-        } else {
-            parts
-                .iter()
-                .map(|g| {
-                    format!(
-                        "{} µm along {}",
-                        readable(g.value_mm * 1e3, 4),
-                        g.coordinate
-                    )
-                })
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        c.push(format!(
-            "Held: {} = {value}, in the {} axis line.",
-            f.name, f.axis
-        ));
-    }
-    for d in &corrected.directions {
-        for e in &d.errors {
-            c.push(format!(
-                "Held: {} = {} µrad, in the direction of the {} axis.",
-                e.name,
-                readable(e.value_rad * 1e6, 4),
-                d.axis
-            ));
-        }
-    }
-    for s in &corrected.symbols {
-        c.push(format!(
-            "Held: {} changed by {} µm (a length of the description).",
-            s.name,
-            readable(s.change_mm * 1e3, 4)
-        ));
-    }
+    c.extend(super::compensate_held::held_lines(corrected));
     for l in table_lines {
         c.push(format!("Held in a table: {l}."));
     }
-    if not_held.is_empty() {
-        c.push("Not held: nothing.".to_string());
-    } else {
-        c.push(
-            "Not held here (a program corrected with `rtest compensate --path` holds them):"
-                .to_string(),
-        );
-        c.extend(not_held.iter().map(|l| format!("  {l}")));
-    }
+    c.extend(super::compensate_held::not_held_block(not_held));
     c
 }
 
@@ -371,26 +314,7 @@ fn not_held_lines(
     held_by_tables: &[&str],
     left_out: &[LeftOut],
 ) -> Vec<String> {
-    let mut out = Vec::new();
-    for n in &corrected.not_folded {
-        let error = n.spelling.split('@').next().unwrap_or(&n.spelling);
-        if held_by_tables.contains(&error) {
-            continue;
-        }
-        let factor = n.term.effect.display_factor(m);
-        let unit = match n.term.unit(m) {
-            "urad" => "µrad",
-            "um" => "µm",
-            other => other,
-        };
-        let values = n
-            .values
-            .iter()
-            .map(|v| readable(v * factor, 4))
-            .collect::<Vec<_>>()
-            .join(", ");
-        out.push(format!("{} = {values} {unit}: {}", n.spelling, n.reason));
-    }
+    let mut out = super::compensate_held::not_folded_lines(m, corrected, held_by_tables);
     for l in left_out {
         if let Some(error) = l.term.strip_suffix("@reversal") {
             let angular = m

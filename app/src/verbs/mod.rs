@@ -7,6 +7,7 @@ pub mod args;
 pub mod bench;
 pub mod campaign;
 pub mod compensate;
+mod compensate_held;
 mod compensate_isg;
 mod compensate_linuxcnc;
 mod compensate_siemens;

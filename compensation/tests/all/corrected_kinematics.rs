@@ -6,6 +6,7 @@
 //! predicted and the other values unchanged; what cannot be folded is listed with why.
 
 use crate::common;
+use crate::identified::errors_of;
 use crate::one_record::identify_refined_one;
 
 use common::{Rng, builtin};
@@ -36,15 +37,6 @@ fn model(m: &Machine, spellings: &[&str]) -> Model {
             .map(|s| Term::parse(m, s).unwrap_or_else(|e| panic!("{s}: {e}")))
             .collect(),
     }
-}
-
-/// The compensated errors of `values` (constant terms of `names`, mm or rad) on `m`.
-fn errors_of(m: &Machine, names: &[(&str, f64)]) -> MachineErrors {
-    let spellings: Vec<&str> = names.iter().map(|(n, _)| *n).collect();
-    let model = model(m, &spellings);
-    let values: Vec<Option<f64>> = names.iter().map(|(_, v)| Some(*v)).collect();
-    let id = CampaignValues::of_model(m, &model, &values, "k4", m.default_parameters()).unwrap();
-    MachineErrors::from_values(m, &id, "id.json").unwrap().0
 }
 
 /// The largest difference (mm) of the exact chains of `a` with `errors_a` and `b` with

@@ -3,24 +3,9 @@
 //! the machines its model does not cover.
 
 use crate::common::builtin;
+use crate::identified::errors_of;
 use compensation::controllers::isg::{IsgError, isg_name, isg_volumetric};
 use compensation::tables::Pitch;
-use compensation::values::MachineErrors;
-use fitting::campaign::CampaignValues;
-use model_spec::Machine;
-use simulation::model::{Model, Term};
-
-fn errors_of(m: &Machine, terms: &[(&str, f64)]) -> MachineErrors {
-    let model = Model {
-        terms: terms
-            .iter()
-            .map(|(s, _)| Term::parse(m, s).unwrap())
-            .collect(),
-    };
-    let values: Vec<Option<f64>> = terms.iter().map(|(_, v)| Some(*v)).collect();
-    let id = CampaignValues::of_model(m, &model, &values, "k4", m.default_parameters()).unwrap();
-    MachineErrors::from_values(m, &id, "id.json").unwrap().0
-}
 
 const PITCH: Pitch = Pitch {
     linear_mm: 250.0,

@@ -5,27 +5,12 @@
 //! root package's `linuxcnc` tests).
 
 use crate::common::{Rng, builtin, random_rotary};
+use crate::identified::errors_of;
 use compensation::controllers::linuxcnc::{TrtModule, module_joints, trt_kinematics};
 use compensation::kinematics::corrected_description;
-use compensation::values::MachineErrors;
-use fitting::campaign::CampaignValues;
 use model_spec::{Machine, Side, parse_machine};
 use nalgebra::Vector3;
 use simulation::exact::VirtualMachine;
-use simulation::model::{Model, Term};
-
-/// The compensated errors of `values` (constant terms, mm or rad) on `m`.
-fn errors_of(m: &Machine, names: &[(&str, f64)]) -> MachineErrors {
-    let model = Model {
-        terms: names
-            .iter()
-            .map(|(s, _)| Term::parse(m, s).unwrap())
-            .collect(),
-    };
-    let values: Vec<Option<f64>> = names.iter().map(|(_, v)| Some(*v)).collect();
-    let id = CampaignValues::of_model(m, &model, &values, "k4", m.default_parameters()).unwrap();
-    MachineErrors::from_values(m, &id, "id.json").unwrap().0
-}
 
 #[test]
 fn seed_ac_maps_onto_xyzac_with_its_table_side_x_negated() {

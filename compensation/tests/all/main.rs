@@ -12,6 +12,7 @@ mod compensation_engine;
 mod compensation_firmware;
 mod corrected_kinematics;
 mod full_loop;
+mod identified;
 mod isg_volumetric;
 mod linuxcnc_kinematics;
 mod range_limits;

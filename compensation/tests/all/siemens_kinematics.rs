@@ -4,27 +4,11 @@
 //! model: the root package's `siemens_forward` tests.)
 
 use crate::common::builtin;
+use crate::identified::errors_of;
 use compensation::controllers::siemens::tables::{TableKind, siemens_tables};
 use compensation::controllers::siemens::{KinematicType, swivel_kinematics};
 use compensation::tables::Pitch;
-use compensation::values::MachineErrors;
-use fitting::campaign::CampaignValues;
-use model_spec::Machine;
 use nalgebra::Vector3;
-use simulation::model::{Model, Term};
-
-/// The compensated errors of `terms` (spelling, coefficients in mm or rad) on `m`.
-fn errors_of(m: &Machine, terms: &[(&str, f64)]) -> MachineErrors {
-    let model = Model {
-        terms: terms
-            .iter()
-            .map(|(s, _)| Term::parse(m, s).unwrap())
-            .collect(),
-    };
-    let values: Vec<Option<f64>> = terms.iter().map(|(_, v)| Some(*v)).collect();
-    let id = CampaignValues::of_model(m, &model, &values, "k4", m.default_parameters()).unwrap();
-    MachineErrors::from_values(m, &id, "id.json").unwrap().0
-}
 
 #[test]
 fn the_built_in_five_axis_machines_map_onto_their_kinematic_types() {

@@ -46,6 +46,7 @@ mod golden;
 mod inclined_axes;
 mod inclined_directions;
 mod linuxcnc_oracle;
+mod linuxcnc_probe;
 mod readers_fuzz;
 mod report_browser;
 mod seed_tables;

@@ -1,8 +1,10 @@
 //! The real LinuxCNC as a test oracle: a headless simulation configuration (Debian's
-//! `linuxcnc-uspace`, HAL's `basic_sim.tcl` with simulated joints) with a kinematics module and
+//! `linuxcnc-uspace`, HAL's `basic_sim.tcl` with simulated joints, without its velocity
+//! signals so that a test may load `hypot` itself) with a kinematics module and
 //! pins of our choosing; a Python driver in place of the GUI (`[DISPLAY] DISPLAY`) resets the
-//! e-stop, switches the machine on, homes it, sends each block as MDI, waits until the joints
-//! stand still, and writes `stat.joint_actual_position`.
+//! e-stop, switches the machine on, homes it, sends each block as MDI (or sets a HAL pin, for a
+//! `setp` line), waits until the joints stand still, and writes `stat.joint_actual_position` and
+//! the probe's latched position.
 //!
 //! Without LinuxCNC the tests say so and pass, except in CI (`CI` set), where they fail and say
 //! how to install it. One LinuxCNC runs at a time (HAL's shared memory is one per machine): a
@@ -76,8 +78,12 @@ pub fn for_test(test: &str) -> Option<LinuxCnc> {
 
 /// The driver: the GUI LinuxCNC starts (`DISPLAY`), run in the configuration's directory.
 const DRIVER: &str = r#"#!/usr/bin/python3
-import linuxcnc, time, sys
+import linuxcnc, hal, time, sys
+# LinuxCNC drops a display's output: the harness reads this file when the run fails.
+sys.stderr = open("driver.err", "w", buffering=1)
 s = linuxcnc.stat(); c = linuxcnc.command(); e = linuxcnc.error_channel()
+# hal.set_p needs a component of this process.
+me = hal.component("rtest-driver"); me.ready()
 def check(after):
     err = e.poll()
     if err and err[0] in (linuxcnc.NML_ERROR, linuxcnc.OPERATOR_ERROR):
@@ -98,11 +104,17 @@ c.home(-1)
 wait(lambda: all(s.homed[i] for i in range(5)), "homing")
 c.mode(linuxcnc.MODE_MDI); c.wait_complete()
 out = open("joints.txt", "w")
+probed = open("probed.txt", "w")
 for line in open("blocks.txt"):
-    c.mdi(line.strip())
-    if c.wait_complete(30) == -1: sys.exit("MDI did not complete: " + line)
-    wait(lambda: s.interp_state == linuxcnc.INTERP_IDLE, "the interpreter")
-    check(line)
+    if line.startswith("setp "):
+        _, pin, value = line.split()
+        hal.set_p(pin, value)
+        time.sleep(0.01)
+    else:
+        c.mdi(line.strip())
+        if c.wait_complete(60) == -1: sys.exit("MDI did not complete: " + line)
+        wait(lambda: s.interp_state == linuxcnc.INTERP_IDLE, "the interpreter", 60)
+        check(line)
     last, still = None, 0
     while still < 5:
         time.sleep(0.003); s.poll()
@@ -110,7 +122,9 @@ for line in open("blocks.txt"):
         still = still + 1 if now == last else 0
         last = now
     out.write(" ".join(repr(v) for v in last) + "\n")
+    probed.write(" ".join(repr(v) for v in s.probed_position[:3]) + " " + str(int(s.probe_tripped)) + "\n")
 out.close()
+probed.close()
 open("done", "w").write("ok\n")
 "#;
 
@@ -119,7 +133,7 @@ fn ini(config: &Config) -> String {
     let mut t = format!(
         "[EMC]\nVERSION = 1.1\nMACHINE = rtest-oracle\n[DISPLAY]\nDISPLAY = ./driver.py\n\
          [RS274NGC]\nPARAMETER_FILE = sim.var\n[KINS]\nKINEMATICS = {}\nJOINTS = 5\n\
-         [HAL]\nHALFILE = LIB:basic_sim.tcl -no_use_hal_manualtoolchange -no_sim_spindle\n\
+         [HAL]\nHALFILE = LIB:basic_sim.tcl -no_make_ddts -no_use_hal_manualtoolchange -no_sim_spindle\n\
          HALFILE = pins.hal\n[TRAJ]\nCOORDINATES = {}\nLINEAR_UNITS = mm\nANGULAR_UNITS = deg\n\
          MAX_LINEAR_VELOCITY = 100000\nDEFAULT_LINEAR_VELOCITY = 100000\n\
          MAX_LINEAR_ACCELERATION = 10000000\nDEFAULT_LINEAR_ACCELERATION = 10000000\n\
@@ -222,7 +236,25 @@ impl LinuxCnc {
             }
             std::thread::sleep(Duration::from_millis(50));
         };
-        let log_text = std::fs::read_to_string(dir.join("linuxcnc.log")).unwrap_or_default();
+        let mut log_text = std::fs::read_to_string(dir.join("linuxcnc.log")).unwrap_or_default();
+        // Without a terminal LinuxCNC writes its messages to a debug file, and copies it to
+        // `$HOME/linuxcnc_debug.txt` when it fails: its lines without the shell trace.
+        if let Some(home) = std::env::var_os("HOME") {
+            let debug = Path::new(&home).join("linuxcnc_debug.txt");
+            if let Ok(text) = std::fs::read_to_string(&debug) {
+                let lines: Vec<&str> = text
+                    .lines()
+                    .filter(|l| !l.starts_with('+') && !l.trim().is_empty())
+                    .collect();
+                let tail = &lines[lines.len().saturating_sub(30)..];
+                log_text += &format!("\n{} (last lines):\n{}", debug.display(), tail.join("\n"));
+            }
+        }
+        if let Ok(text) = std::fs::read_to_string(dir.join("driver.err"))
+            && !text.trim().is_empty()
+        {
+            log_text += &format!("\nthe driver's errors:\n{text}");
+        }
         if !dir.join("done").exists() {
             return Err(format!(
                 "LinuxCNC ({status}) did not run every block; its log:\n{log_text}"
@@ -250,6 +282,47 @@ impl LinuxCnc {
             started.elapsed().as_secs_f64()
         );
         Ok(rows)
+    }
+}
+
+/// One block's result: LinuxCNC's last probed position (`stat.probed_position`, world
+/// coordinates, mm) and whether the probe tripped.
+pub struct BlockResult {
+    /// The position latched at the last probe trip (X, Y, Z; mm).
+    pub probed: [f64; 3],
+    /// `stat.probe_tripped` after the block.
+    pub tripped: bool,
+}
+
+impl LinuxCnc {
+    /// [`LinuxCnc::run`], with the probe's latched positions: a block may also be a
+    /// `setp PIN VALUE` line, which sets a HAL pin (a probing target's centre, say) between
+    /// two blocks.
+    pub fn run_probing(
+        &self,
+        dir: &Path,
+        config: &Config,
+        blocks: &[String],
+    ) -> Result<Vec<BlockResult>, String> {
+        self.run(dir, config, blocks)?;
+        let text = std::fs::read_to_string(dir.join("probed.txt")).map_err(|e| e.to_string())?;
+        let probed: Vec<(Vec<f64>, bool)> = text
+            .lines()
+            .map(|l| {
+                let v: Vec<&str> = l.split(' ').collect();
+                (
+                    v[..3].iter().map(|x| x.parse().unwrap()).collect(),
+                    v[3] == "1",
+                )
+            })
+            .collect();
+        Ok(probed
+            .into_iter()
+            .map(|(p, tripped)| BlockResult {
+                probed: [p[0], p[1], p[2]],
+                tripped,
+            })
+            .collect())
     }
 }
 

@@ -29,7 +29,9 @@
 //!   `fold` (that QR decomposition folded in blocks of rows, shared with [`streaming`]): the
 //!   numerics behind [`mod@least_squares`];
 //! - [`mod@calibrate`]: an instrument's own errors (sensor gain errors, zeros, direction
-//!   errors) from a calibration record of known displacements.
+//!   errors) from a calibration record of known displacements;
+//! - [`sphere`]: a touch probe's sphere fit of one pose (centre, radius, covariance, dirty hits
+//!   refused).
 //!
 //! It builds on [`simulation`] (the model, the record, the campaign, the exact machine) and
 //! [`formats`] (records read in blocks by the streaming identification); the diagnosis and the
@@ -92,6 +94,7 @@ pub mod offsets;
 pub mod plan;
 pub mod refine;
 pub mod sanity;
+pub mod sphere;
 pub mod streaming;
 mod svd;
 pub mod validate;

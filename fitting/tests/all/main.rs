@@ -18,6 +18,7 @@ mod noise_model;
 mod plan;
 mod plan_reversal;
 mod plan_update;
+mod sphere;
 mod streaming;
 mod templates;
 mod vocabulary;

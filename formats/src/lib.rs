@@ -14,6 +14,8 @@
 //! - [`paths`]: path files (the commanded samples of a test), or a built-in test by name;
 //! - [`nc`]: NC programs of commanded poses (ISO G-code, Heidenhain), read and written back;
 //! - [`poses`]: commanded poses, their axis words and their CSV, read and written back;
+//! - [`probe`]: the files of a touch-probe calibration (probe hits, sphere centres, the probe
+//!   instrument), read and written back bit for bit;
 //! - [`sensors`]: records of an R-test head's sensor readings, and calibration records;
 //! - [`progress`]: how far a long read has come, for progress bars;
 //! - [`time`]: UTC times as files write them (RFC 3339, whole seconds);
@@ -35,6 +37,7 @@ pub mod located;
 pub mod nc;
 pub mod paths;
 pub mod poses;
+pub mod probe;
 pub mod progress;
 pub mod sensors;
 pub mod time;

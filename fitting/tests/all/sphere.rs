@@ -231,7 +231,9 @@ fn a_three_micron_error_is_not_refused() {
 
 /// With the five hits of a common short pattern (four at the equator, one at the pole), a
 /// 20 µm pole error moves the centre by 20 µm along z and changes neither the radius nor a
-/// residual: no rule can see it. The nine hits of the default pattern refuse it.
+/// residual: no rule can see it. The nine hits of the default pattern refuse it. A 20 µm
+/// equator error leaves ±5 µm (a quarter) on each of the four equator hits alike, at the
+/// residual limit and without telling which hit it was, and moves the radius by 5 µm.
 #[test]
 fn five_hits_cannot_see_a_pole_error() {
     let five = pick(&default_pattern(SPHERE_MM), &[0, 1, 2, 3, 8]);
@@ -239,6 +241,16 @@ fn five_hits_cannot_see_a_pole_error() {
     assert!(((f.centre_mm - centre()).z - 0.02).abs() < 1e-4);
     assert!((f.sphere_radius_mm - SPHERE_MM).abs() < 1e-4);
     assert!(f.residuals_mm.iter().all(|r| r.abs() < 1e-4));
+    let mut loose = options(RadiusMode::Free {
+        calibrated_mm: None,
+    });
+    loose.noise_mm = 0.01;
+    let f = dirty(&five, 0, 0.02, &loose).unwrap();
+    assert!((f.sphere_radius_mm - SPHERE_MM - 0.005).abs() < 1e-5);
+    for (i, r) in f.residuals_mm[..4].iter().enumerate() {
+        assert!((r.abs() - 0.005).abs() < 1e-5, "hit {i}: {r}");
+    }
+    assert!(f.residuals_mm[4].abs() < 1e-5);
 }
 
 #[test]

@@ -88,7 +88,7 @@ fn read_centres<R: Read>(
     m: &Machine,
     max_poses: usize,
 ) -> Result<SphereCentres, CsvError> {
-    let mut rows = Rows::new(file, reader, m, &CENTRE_COLUMNS, WHAT)?;
+    let mut rows = Rows::new(file, reader, m, &CENTRE_COLUMNS, &["mm"; 7], WHAT)?;
     let present = rows.header.present.clone();
     let missing = |ks: &[usize]| -> Vec<&str> {
         ks.iter()

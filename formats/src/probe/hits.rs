@@ -25,6 +25,9 @@ use std::path::Path;
 /// The columns of a hits CSV beside `pose` and the axes, in the order they are written.
 pub const HIT_COLUMNS: [&str; 4] = ["nx", "ny", "nz", "t_s"];
 
+/// The units of [`HIT_COLUMNS`], for messages.
+const HIT_UNITS: [&str; 4] = ["unit vector", "unit vector", "unit vector", "s"];
+
 const WHAT: &str = "a probe hits CSV";
 
 /// One hit of the probe on the sphere.
@@ -103,7 +106,7 @@ fn read_hits<R: Read>(
     max_hits: usize,
     max_poses: usize,
 ) -> Result<ProbeHits, CsvError> {
-    let mut rows = Rows::new(file, reader, m, &HIT_COLUMNS, WHAT)?;
+    let mut rows = Rows::new(file, reader, m, &HIT_COLUMNS, &HIT_UNITS, WHAT)?;
     if let Some(k) = rows.header.present.iter().position(|p| !p) {
         return Err(rows.err_at(
             rows.header.line,

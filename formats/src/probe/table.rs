@@ -45,6 +45,8 @@ pub(super) struct Rows<'a, R> {
     lines: Lines<R>,
     pub header: Header,
     own: &'a [&'a str],
+    /// The unit of each own column, for messages.
+    units: &'a [&'a str],
     m: &'a Machine,
     /// What the file is, for messages (`a probe hits CSV`).
     what: &'a str,
@@ -52,7 +54,8 @@ pub(super) struct Rows<'a, R> {
 
 impl<'a, R: Read> Rows<'a, R> {
     /// Reads the header of `reader` (named `file`): `own` lists the format's own columns, in
-    /// the order their values are given; `what` names the file's kind in messages.
+    /// the order their values are given, `units` their units (for messages); `what` names the
+    /// file's kind in messages.
     ///
     /// The caller checks which own columns are required with [`Header::present`].
     pub fn new(
@@ -60,6 +63,7 @@ impl<'a, R: Read> Rows<'a, R> {
         reader: R,
         m: &'a Machine,
         own: &'a [&'a str],
+        units: &'a [&'a str],
         what: &'a str,
     ) -> Result<Self, CsvError> {
         let cx = Ctx { file };
@@ -84,6 +88,7 @@ impl<'a, R: Read> Rows<'a, R> {
             lines,
             header,
             own,
+            units,
             m,
             what,
         })
@@ -179,8 +184,7 @@ impl<'a, R: Read> Rows<'a, R> {
                     row.axes[a] = x;
                 }
                 Col::Own(k) => {
-                    let unit = self.own[k].rsplit('_').next().unwrap_or("");
-                    row.own[k] = Some(number_of(t, unit).map_err(at)?);
+                    row.own[k] = Some(number_of(t, self.units[k]).map_err(at)?);
                 }
             }
         }

@@ -17,4 +17,5 @@ mod nc_programs;
 mod paths;
 mod pose_csv;
 mod pose_memory;
+mod probe_files;
 mod truth;

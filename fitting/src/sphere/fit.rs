@@ -178,19 +178,24 @@ fn solve(latches: &[Latch], fixed: Option<f64>) -> Result<Solved, SphereFitError
             condition: f64::INFINITY,
         });
     }
-    if fixed.is_none() {
-        let m = DMatrix::from_fn(n, 3, |i, j| q[i][j]);
-        let sv = m.singular_values();
-        let out_of_plane = sv.min() / (n as f64).sqrt();
-        if out_of_plane < COPLANAR_RELATIVE * extent {
-            return Err(SphereFitError::Coplanar {
-                out_of_plane_mm: out_of_plane,
-                extent_mm: extent,
-            });
-        }
+    let out_of_plane = if n >= 3 {
+        DMatrix::from_fn(n, 3, |i, j| q[i][j])
+            .singular_values()
+            .min()
+            / (n as f64).sqrt()
+    } else {
+        0.0
+    };
+    let coplanar = out_of_plane < COPLANAR_RELATIVE * extent;
+    if coplanar && fixed.is_none() {
+        return Err(SphereFitError::Coplanar {
+            out_of_plane_mm: out_of_plane,
+            extent_mm: extent,
+        });
     }
     let approach: Vec<Vector3<f64>> = latches.iter().map(|l| l.approach).collect();
-    let (c0, r0) = algebraic(&q, &approach, extent, fixed).ok_or(SphereFitError::Undetermined {
+    let start = algebraic(&q, &approach, extent, fixed, coplanar);
+    let (c0, r0) = start.ok_or(SphereFitError::Undetermined {
         condition: f64::INFINITY,
     })?;
     let (centre, radius, iterations) = gauss_newton(&q, c0, r0, fixed.is_none())?;
@@ -219,13 +224,16 @@ fn condition(sv: &DVector<f64>) -> f64 {
 }
 
 /// The algebraic fit `‖q‖² = 2·c·q + k` in coordinates divided by `scale` (mm): centre and
-/// radius (mm). With a `fixed` radius and coplanar hits, the centre on the line of solutions
+/// radius (mm). With a `fixed` radius and `coplanar` hits (exactly, or within noise: then the
+/// plane's offset is set by noise, and the full solution's centre can be anywhere along the
+/// plane's normal), the centre on the line of solutions along the smallest singular direction
 /// at that radius, on the side the approaches point to. `None` when no sphere comes out.
 fn algebraic(
     q: &[Vector3<f64>],
     approach: &[Vector3<f64>],
     scale: f64,
     fixed: Option<f64>,
+    coplanar: bool,
 ) -> Option<(Vector3<f64>, f64)> {
     let n = q.len();
     let u: Vec<Vector3<f64>> = q.iter().map(|v| v / scale).collect();
@@ -241,7 +249,11 @@ fn algebraic(
     let svd = a.svd(true, true);
     let (u_m, v_t) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
     let sv = &svd.singular_values;
-    let cut = sv.max() * ALGEBRAIC_RANK_RELATIVE;
+    let cut = if coplanar && fixed.is_some() {
+        sv.min()
+    } else {
+        sv.max() * ALGEBRAIC_RANK_RELATIVE
+    };
     let utb = u_m.transpose() * &b;
     let mut x = DVector::<f64>::zeros(4);
     for k in 0..4 {

@@ -23,7 +23,8 @@
 //!
 //! Values are held as the files write them (mm, degrees): the writers write each as the
 //! shortest decimal that reads back to the same `f64` ([`model_spec::units::format_scaled`]),
-//! so write → read gives the same bits.
+//! so write → read gives the same bits. [`crate::poses::from_file_units`] gives the commands in
+//! mm and rad the computation takes.
 //!
 //! Files: `table` (the header and rows both CSVs share), `hits`, `centres`, `instrument`.
 
@@ -66,8 +67,8 @@ pub const UNIT_NORM_TOLERANCE: f64 = 1e-6;
 /// cycle does not turn the rotary axes during a pose.
 pub const ROTARY_CONSTANT_DEG: f64 = 1e-9;
 
-/// The file units of the axes of `m` in the order the writers write them
-/// ([`crate::csv::column_order`]), and the header of those columns.
+/// The axes of `m` in the order the writers write them ([`crate::csv::column_order`]: linear,
+/// then rotary, each in ISO order), and their names (the header of those columns).
 fn axis_header(m: &model_spec::Machine) -> (Vec<usize>, Vec<String>) {
     let order = crate::csv::column_order(m);
     let names = order.iter().map(|&a| m.axes[a].name.clone()).collect();

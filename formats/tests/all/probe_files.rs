@@ -78,7 +78,10 @@ fn a_hits_file_is_grouped_by_pose_and_written_back_bit_for_bit() {
     let spelled = hits_with(3, "a30c90, 1E-3 ,+0.10,-12.750,30.0,9e1,0,-0,-1.0,2");
     let again = parse_probe_hits("h.csv", &spelled, &m).unwrap();
     assert_eq!(again.poses[1].hits[0].axes, last.axes);
-    assert_eq!(again.poses[1].hits[0].direction[1].to_bits(), (-0.0f64).to_bits());
+    assert_eq!(
+        again.poses[1].hits[0].direction[1].to_bits(),
+        (-0.0f64).to_bits()
+    );
 }
 
 #[test]
@@ -477,4 +480,25 @@ proptest! {
             }
         }
     }
+}
+
+#[test]
+fn lines_too_long_or_not_utf8_are_refused_by_the_shared_line_reader() {
+    let long = format!("{HITS}# {}\n", "x".repeat(70_000));
+    assert_eq!(
+        hits_err(&long),
+        "h.csv:8: line longer than 65536 bytes: not a measurement CSV"
+    );
+    let dir = Scratch::new("probe-utf8");
+    let path = dir.0.join("c.csv");
+    let mut bytes = CENTRES.as_bytes().to_vec();
+    bytes.extend_from_slice(b"p\xff,0,0,0,0,0,1,2,3,1,1,1,1\n");
+    std::fs::write(&path, bytes).unwrap();
+    let e = read_sphere_centres(&path, &machine())
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        e,
+        format!("{}:5:2: not UTF-8 text (byte 0xff)", path.display())
+    );
 }

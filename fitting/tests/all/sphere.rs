@@ -197,6 +197,11 @@ fn a_dirty_hit_is_refused_at_every_position() {
                     other => panic!("hit {at}, {e} mm: {other:?}"),
                 }
             }
+            let message = dirty(&hits, at, e, &free_calibrated())
+                .unwrap_err()
+                .to_string();
+            assert!(message.contains("(residual)"), "{message}");
+            assert!(message.contains(&format!("hit {at} is ")), "{message}");
             // The radius rule alone: with a σ of 10 µm the residual limit is 40 µm.
             let mut loose = free_calibrated();
             loose.noise_mm = 0.01;

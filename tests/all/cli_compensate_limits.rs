@@ -10,16 +10,7 @@ use common::{fails, ok, read_json, words};
 
 /// `dir` with `k4.csv` (demo truth) and `id.json` (seed-ac's reduced model on K4).
 fn seed_identified(name: &str) -> common::TempDir {
-    let dir = temp_dir(name);
-    ok(
-        &dir,
-        &words("simulate --machine seed-ac --path K4 --truth seed-ac-demo -o k4.csv"),
-    );
-    ok(
-        &dir,
-        &words("identify --machine seed-ac --model reduced --data k4.csv --json id.json"),
-    );
-    dir
+    common::seed_ac_identified("cli", name, None)
 }
 
 /// A copy of the identification `from` with the value of parameter `name` set to `value` (its

@@ -9,18 +9,7 @@ use common::{TempDir, entries, fails, ok, words};
 /// A directory with `id.json`: seed-ac's reduced model with `ECC@harmonic:2`, on K4 of the demo
 /// truth.
 fn seed_ac(name: &str) -> TempDir {
-    let dir = common::temp_dir_tagged("cli-linuxcnc", name);
-    ok(
-        &dir,
-        &words("simulate --machine seed-ac --path K4 --truth seed-ac-demo -o k4.csv"),
-    );
-    ok(
-        &dir,
-        &words(
-            "identify --machine seed-ac --model reduced --terms ECC@harmonic:2 --data k4.csv --json id.json",
-        ),
-    );
-    dir
+    common::seed_ac_identified("cli-linuxcnc", name, Some("ECC@harmonic:2"))
 }
 
 /// The value of `setp COMPONENT.PIN VALUE` in a HAL file.

@@ -9,18 +9,11 @@ use common::{TempDir, entries, fails, ok, words};
 /// A directory with `id.json`: seed-ac's reduced model with `ECC@harmonic:2` and X's
 /// straightness `EYX` and positioning `EXX` (linear in X), on K4 of the demo truth.
 fn seed_ac(name: &str) -> TempDir {
-    let dir = common::temp_dir_tagged("cli-siemens", name);
-    ok(
-        &dir,
-        &words("simulate --machine seed-ac --path K4 --truth seed-ac-demo -o k4.csv"),
-    );
-    ok(
-        &dir,
-        &words(
-            "identify --machine seed-ac --model reduced --terms ECC@harmonic:2,EYX@poly:1,EXX@poly:1 --data k4.csv --json id.json",
-        ),
-    );
-    dir
+    common::seed_ac_identified(
+        "cli-siemens",
+        name,
+        Some("ECC@harmonic:2,EYX@poly:1,EXX@poly:1"),
+    )
 }
 
 /// The lines of `text` that are not comments.

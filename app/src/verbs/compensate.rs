@@ -93,16 +93,17 @@ pub struct CompensateArgs {
     #[arg(long, value_name = "DIR")]
     tables: Option<PathBuf>,
     /// Also write LinuxCNC's files into this directory: the pins of its xyzac-trt-kins or
-    /// xyzbc-trt-kins module (kinematics.hal) and joint compensation files (joint_N.comp).
+    /// xyzbc-trt-kins module (kinematics.hal, mm) and joint compensation files (joint_N.comp,
+    /// mm or degrees).
     #[arg(long, value_name = "DIR")]
     linuxcnc: Option<PathBuf>,
     /// Also write the errors as ISG-kernel's volumetric compensation file (Beckhoff TwinCAT
-    /// CNC, ISG_CSV) to FILE.
+    /// CNC, ISG_CSV; values in mm and rad, positions in mm and degrees) to FILE.
     #[arg(long, value_name = "FILE")]
     isg: Option<Target>,
     /// Also write a SINUMERIK's files into this directory: swivel data record --carrier
-    /// (TC_CARR_N.MPF), the five-axis transformation's machine data (TRAFO_1.INI) and
-    /// compensation tables (AX_EEC.INI, NC_CEC.INI).
+    /// (TC_CARR_N.MPF; vectors in mm), the five-axis transformation's machine data
+    /// (TRAFO_1.INI) and compensation tables (AX_EEC.INI, NC_CEC.INI; mm or degrees).
     #[arg(long, value_name = "DIR")]
     siemens: Option<PathBuf>,
     /// The number of the swivel data record --siemens sets (from 1).

@@ -41,13 +41,8 @@ pub fn isg_file(
         comments.push("Not held:".to_string());
         comments.extend(v.not_held.iter().map(|(t, why)| format!("  {t}: {why}")));
     }
-    let blocks: Vec<(Vec<String>, Vec<Vec<f64>>)> = v
-        .blocks
-        .iter()
-        .map(|b| (b.columns.clone(), b.rows.clone()))
-        .collect();
     let text =
-        isg_csv(&comments, &blocks).map_err(|e| Error::computation(format!("--isg: {e}")))?;
+        isg_csv(&comments, &v.blocks).map_err(|e| Error::computation(format!("--isg: {e}")))?;
     let mut summary = format!(
         "ISG volumetric compensation: {} block{} ({})\n",
         v.blocks.len(),

@@ -149,8 +149,7 @@ fn comp_points(t: &AxisTable, sign: f64, reversal: Option<f64>) -> Vec<CompPoint
     let rotary = t.kind == AxisKind::Rotary;
     let unit = |v: f64| if rotary { v.to_degrees() } else { v };
     // The deviation in the axis's own sense moves with the axis's signed direction.
-    let own = if t.direction.negative { -1.0 } else { 1.0 };
-    let r = own * reversal.unwrap_or(0.0);
+    let r = t.direction.sign() * reversal.unwrap_or(0.0);
     let mut points: Vec<CompPoint> = t
         .rows
         .iter()

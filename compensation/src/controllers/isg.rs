@@ -26,16 +26,8 @@
 
 use super::super::tables::{Pitch, axis_tables};
 use super::super::values::{CompensationError, MachineErrors};
-use model_spec::{AxisKind, ErrorKind, Machine, Side};
-
-/// One block of the file: a header of column names and its rows.
-#[derive(Clone, Debug, PartialEq)]
-pub struct IsgBlock {
-    /// The column names: arguments (axis letters) first, then parameters (`X0C`, `EXX`).
-    pub columns: Vec<String>,
-    /// The rows: arguments in mm or degrees, parameters in mm or rad.
-    pub rows: Vec<Vec<f64>>,
-}
+pub use formats::controllers::isg::IsgBlock;
+use model_spec::{AxisKind, ErrorKind, Machine};
 
 /// A machine's errors as ISG's volumetric compensation takes them.
 #[derive(Clone, Debug, PartialEq)]
@@ -174,20 +166,10 @@ pub fn isg_volumetric(
         ));
     }
     // The workpiece side from the workpiece towards the bed, then the tool side from the bed.
-    let work: Vec<&str> = m
-        .work
-        .axes()
-        .map(|a| m.axes[a].name.as_str())
-        .collect::<Vec<_>>()
-        .into_iter()
-        .rev()
-        .collect();
+    let mut work: Vec<&str> = m.work.axes().map(|a| m.axes[a].name.as_str()).collect();
+    work.reverse();
     let tool = m.tool.axes().map(|a| m.axes[a].name.as_str());
     let chain: String = work.iter().copied().chain(tool).collect();
-    debug_assert_eq!(
-        m.axes.iter().filter(|a| a.side == Side::Work).count(),
-        work.len()
-    );
     Ok(IsgVolumetric {
         blocks,
         chain,

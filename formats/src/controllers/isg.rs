@@ -8,6 +8,15 @@
 
 use model_spec::units::format_scaled;
 
+/// One block of the file: a header of column names and its rows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IsgBlock {
+    /// The column names: arguments (axis letters) first, then parameters (`X0C`, `EXX`).
+    pub columns: Vec<String>,
+    /// The rows: arguments in mm or degrees, parameters in mm or rad.
+    pub rows: Vec<Vec<f64>>,
+}
+
 /// Why a file cannot be written.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum IsgFileError {
@@ -25,15 +34,12 @@ pub enum IsgFileError {
     },
 }
 
-/// The file: `// ` comment lines, then the blocks (`columns`, `rows`) separated by `#` lines.
+/// The file: `// ` comment lines, then the blocks separated by `#` lines.
 ///
 /// # Errors
 /// [`IsgFileError::BadRow`] for a row of another length than its header, or a value that is
 /// not finite.
-pub fn isg_csv(
-    comments: &[String],
-    blocks: &[(Vec<String>, Vec<Vec<f64>>)],
-) -> Result<String, IsgFileError> {
+pub fn isg_csv(comments: &[String], blocks: &[IsgBlock]) -> Result<String, IsgFileError> {
     let mut out = String::new();
     for c in comments {
         for line in c.lines() {
@@ -42,7 +48,7 @@ pub fn isg_csv(
             out.push('\n');
         }
     }
-    for (b, (columns, rows)) in blocks.iter().enumerate() {
+    for (b, IsgBlock { columns, rows }) in blocks.iter().enumerate() {
         if b > 0 {
             out += "#\n";
         }
@@ -86,16 +92,20 @@ pub fn isg_csv(
 mod tests {
     use super::*;
 
+    fn block(columns: &[&str], rows: Vec<Vec<f64>>) -> IsgBlock {
+        IsgBlock {
+            columns: columns.iter().map(|c| c.to_string()).collect(),
+            rows,
+        }
+    }
+
     #[test]
     fn blocks_are_headers_and_rows_separated_by_a_hash_line() {
         let text = isg_csv(
             &["machine m".into()],
             &[
-                (vec!["X0C".into(), "A0C".into()], vec![vec![0.01, -2e-5]]),
-                (
-                    vec!["C".into(), "ECC".into()],
-                    vec![vec![0.0, 1e-6], vec![180.0, -0.5e-6]],
-                ),
+                block(&["X0C", "A0C"], vec![vec![0.01, -2e-5]]),
+                block(&["C", "ECC"], vec![vec![0.0, 1e-6], vec![180.0, -0.5e-6]]),
             ],
         )
         .unwrap();
@@ -107,12 +117,12 @@ mod tests {
 
     #[test]
     fn a_row_of_the_wrong_length_or_a_value_not_finite_is_refused() {
-        let e = isg_csv(&[], &[(vec!["X".into(), "EXX".into()], vec![vec![0.0]])]).unwrap_err();
+        let e = isg_csv(&[], &[block(&["X", "EXX"], vec![vec![0.0]])]).unwrap_err();
         assert_eq!(
             e.to_string(),
             "block 1 (X EXX): row 1: 1 values for 2 columns"
         );
-        let e = isg_csv(&[], &[(vec!["X".into()], vec![vec![f64::INFINITY]])]).unwrap_err();
+        let e = isg_csv(&[], &[block(&["X"], vec![vec![f64::INFINITY]])]).unwrap_err();
         assert!(e.to_string().contains("not finite"));
     }
 }

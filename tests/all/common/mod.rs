@@ -168,6 +168,24 @@ pub fn temp_dir(name: &str) -> TempDir {
     temp_dir_tagged("cli", name)
 }
 
+/// A fresh directory (`tag`, `name`) with `k4.csv` (K4 on seed-ac, the demo truth) and `id.json`
+/// (its identification with the reduced model, plus the terms `terms` when given, as `--terms`
+/// spells them).
+pub fn seed_ac_identified(tag: &str, name: &str, terms: Option<&str>) -> TempDir {
+    let dir = temp_dir_tagged(tag, name);
+    ok(
+        &dir,
+        &words("simulate --machine seed-ac --path K4 --truth seed-ac-demo -o k4.csv"),
+    );
+    let mut identify =
+        words("identify --machine seed-ac --model reduced --data k4.csv --json id.json");
+    if let Some(t) = terms {
+        identify.extend(["--terms", t]);
+    }
+    ok(&dir, &identify);
+    dir
+}
+
 /// The parameter `name` of a report's JSON (`parameters[].name`).
 pub fn param<'a>(json: &'a Value, name: &str) -> &'a Value {
     json["parameters"]

@@ -22,7 +22,6 @@ use devtools::{Session, base64, evaluate, file_url, open_tab, print};
 use serde_json::{Value, json};
 use std::collections::HashMap;
 use std::io::Write;
-use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -49,41 +48,21 @@ const CANDIDATES: [&str; 4] = [
 /// google-chrome-stable found on the `PATH`.
 pub fn find_browser() -> Option<PathBuf> {
     if let Some(b) = std::env::var_os("RTEST_BROWSER").filter(|b| !b.is_empty()) {
-        return Some(on_path(&b).unwrap_or_else(|| PathBuf::from(b)));
+        return Some(super::on_path(&b).unwrap_or_else(|| PathBuf::from(b)));
     }
-    CANDIDATES.iter().find_map(|c| on_path(c.as_ref()))
-}
-
-/// `name` found in a directory of the `PATH` (executable), or `name` itself when it is a path.
-fn on_path(name: &std::ffi::OsStr) -> Option<PathBuf> {
-    if Path::new(name).components().count() > 1 {
-        return Some(PathBuf::from(name));
-    }
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|d| d.join(name))
-        .find(|p| {
-            p.metadata()
-                .is_ok_and(|m| m.is_file() && m.mode() & 0o111 != 0)
-        })
-}
-
-/// Whether the tests must find a browser: set in continuous integration (`CI` non-empty and
-/// not `0` or `false`), where a missing browser is a failure rather than a skipped test.
-pub fn browser_required() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && v != "false")
+    CANDIDATES.iter().find_map(|c| super::on_path(c.as_ref()))
 }
 
 /// The browser for the test named `test`, with [`DEFAULT_TIMEOUT`]; when there is none, `None`
 /// after saying so on stderr (past the test harness's capture, so that a skip is seen), or,
-/// when [`browser_required`], a panic that says how to install one.
+/// when [`super::required_in_ci`], a panic that says how to install one.
 pub fn for_test(test: &str) -> Option<Browser> {
     match find_browser() {
         Some(path) => Some(Browser {
             path,
             timeout: DEFAULT_TIMEOUT,
         }),
-        None if browser_required() => panic!(
+        None if super::required_in_ci() => panic!(
             "{test}: no browser found and CI is set: install Chromium (Debian: \
              `apt-get install -y chromium`) or set RTEST_BROWSER to a Chromium or Chrome"
         ),

@@ -39,15 +39,8 @@ pub struct Config<'a> {
     pub hal: &'a str,
 }
 
-fn find(program: &str) -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .map(|d| d.join(program))
-        .find(|p| p.is_file())
-}
-
 fn usable() -> Result<PathBuf, String> {
-    let linuxcnc = find("linuxcnc").ok_or("no `linuxcnc` on PATH")?;
+    let linuxcnc = super::on_path("linuxcnc".as_ref()).ok_or("no `linuxcnc` on PATH")?;
     let module = Command::new(PYTHON)
         .args(["-c", "import linuxcnc"])
         .stdout(Stdio::null())
@@ -65,7 +58,7 @@ fn usable() -> Result<PathBuf, String> {
 pub fn for_test(test: &str) -> Option<LinuxCnc> {
     match usable() {
         Ok(linuxcnc) => Some(LinuxCnc { linuxcnc }),
-        Err(why) if std::env::var_os("CI").is_some() => panic!(
+        Err(why) if super::required_in_ci() => panic!(
             "{test}: LinuxCNC is needed and CI is set: {why}; install it (Debian: `apt-get install \
              --no-install-recommends linuxcnc-uspace`)"
         ),

@@ -7,7 +7,14 @@
 //! tip_radius_mm = 3               # the stylus tip's radius, mm (required)
 //! sphere_radius_mm = 12.5         # the calibration sphere's calibrated radius, mm (required)
 //! noise_um = 0.5                  # the probe's noise σ (repeatability), µm (optional)
+//! pre_travel_um = 1.2             # the constant pre-travel, µm (optional)
+//! lobing_um = [0.4, -0.3]         # the three-lobed pre-travel [cos 3φ, sin 3φ], µm (optional)
 //! ```
+//!
+//! The pre-travel keys declare the probe's trigger delay (`docs/probe-simulation.md`): the probe
+//! latches `δ = pre_travel + ρ·(L_c·cos 3φ + L_s·sin 3φ)` beyond the contact along the approach,
+//! with `φ` the approach's azimuth about the stylus and `ρ` its part across the stylus (both in
+//! the probe's frame). The simulator makes hits with it; a fit may remove it.
 //!
 //! It is a file of its own, not a table of the R-test instrument description
 //! ([`model_spec::instrument`]): that one describes a nest of displacement sensors around a
@@ -17,12 +24,20 @@ use crate::located::{Located, TomlText, in_order};
 use model_spec::instrument::{MAX_BALL_RADIUS_MM, MAX_NOISE_UM, MAX_TIP_RADIUS_MM};
 use model_spec::text::TextError;
 use std::path::Path;
+use toml::de::DeValue;
 
 /// The largest probe instrument file read, bytes (64 KiB).
 pub const MAX_PROBE_INSTRUMENT_BYTES: u64 = 64 << 10;
 
 /// The longest instrument name, characters (64).
 pub const MAX_NAME_CHARS: usize = 64;
+
+/// The largest constant pre-travel, µm (100): a probe that triggers later than 0.1 mm after
+/// the contact is broken, not calibrated.
+pub const MAX_PRE_TRAVEL_UM: f64 = 100.0;
+
+/// The largest magnitude of either lobing amplitude, µm (100).
+pub const MAX_LOBING_UM: f64 = 100.0;
 
 /// A touch probe and its calibration sphere.
 #[derive(Clone, Debug, PartialEq)]
@@ -37,6 +52,15 @@ pub struct ProbeInstrument {
     /// The probe's noise σ (the standard deviation of one hit along its approach direction),
     /// µm (above 0, at most [`MAX_NOISE_UM`]), when the file gives it.
     pub noise_um: Option<f64>,
+    /// The probe's constant pre-travel `δ0`, µm (at least 0, at most [`MAX_PRE_TRAVEL_UM`]),
+    /// when the file declares it: how far beyond the contact, along the approach, the tip
+    /// centre is when the probe latches.
+    pub pre_travel_um: Option<f64>,
+    /// The three-lobed part of the pre-travel `[L_c, L_s]`, µm (each at most
+    /// [`MAX_LOBING_UM`] in magnitude), when the file declares it: `ρ·(L_c·cos 3φ + L_s·sin 3φ)`
+    /// is added to `δ0` for an approach of azimuth `φ` about the stylus and part `ρ` across it
+    /// (probe frame).
+    pub lobing_um: Option<[f64; 2]>,
 }
 
 /// A problem with a probe instrument file.
@@ -51,19 +75,21 @@ pub enum ProbeInstrumentError {
 }
 
 /// The keys of the file, for messages.
-const KEYS: &str = "name, tip_radius_mm, sphere_radius_mm, noise_um";
+const KEYS: &str = "name, tip_radius_mm, sphere_radius_mm, noise_um, pre_travel_um, lobing_um";
 
 /// Reads the probe instrument TOML `text` (named `file` in messages).
 ///
 /// # Errors
 /// [`Located`] for the first problem: TOML syntax, an unknown key, a name that is not a string
-/// or is empty or longer than [`MAX_NAME_CHARS`], a radius or noise that is not a finite number
-/// or is out of its range, a required key missing.
+/// or is empty or longer than [`MAX_NAME_CHARS`], a radius, noise or pre-travel that is not a
+/// finite number or is out of its range, a lobing that is not two such numbers, a required key
+/// missing.
 pub fn parse_probe_instrument(file: &str, text: &str) -> Result<ProbeInstrument, Located> {
     let src = TomlText::new(file, text);
     let root = src.root()?;
     let mut name = None;
     let (mut tip, mut sphere, mut noise) = (None, None, None);
+    let (mut pre_travel, mut lobing) = (None, None);
     for (k, v) in in_order(root.get_ref()) {
         let key = k.get_ref().as_ref();
         let what = format!("`{key}`");
@@ -105,6 +131,19 @@ pub fn parse_probe_instrument(file: &str, text: &str) -> Result<ProbeInstrument,
                 )?)
             }
             "noise_um" => noise = Some(range(v, "µm", MAX_NOISE_UM, "the probe's noise σ")?),
+            "pre_travel_um" => {
+                let (x, t) = src.number(v, &what)?;
+                if !(0.0..=MAX_PRE_TRAVEL_UM).contains(&x) {
+                    return Err(src.at(
+                        v.span(),
+                        format!(
+                            "{what} is {t} µm; the probe's constant pre-travel must be at least 0 and at most {MAX_PRE_TRAVEL_UM} µm"
+                        ),
+                    ));
+                }
+                pre_travel = Some(x);
+            }
+            "lobing_um" => lobing = Some(lobing_pair(&src, v, &what)?),
             other => {
                 return Err(src.at(
                     k.span(),
@@ -132,7 +171,53 @@ pub fn parse_probe_instrument(file: &str, text: &str) -> Result<ProbeInstrument,
         tip_radius_mm,
         sphere_radius_mm,
         noise_um: noise,
+        pre_travel_um: pre_travel,
+        lobing_um: lobing,
     })
+}
+
+/// The lobing amplitudes `[L_c, L_s]` of `v` (µm): an array of two finite numbers, each at
+/// most [`MAX_LOBING_UM`] in magnitude.
+fn lobing_pair(
+    src: &TomlText<'_>,
+    v: &crate::located::Val<'_>,
+    what: &str,
+) -> Result<[f64; 2], Located> {
+    let items = match v.get_ref() {
+        DeValue::Array(a) if a.len() == 2 => a,
+        DeValue::Array(a) => {
+            return Err(src.at(
+                v.span(),
+                format!(
+                    "{what} needs two numbers [cos 3φ, sin 3φ] (µm), got an array of {}",
+                    a.len()
+                ),
+            ));
+        }
+        other => {
+            return Err(src.at(
+                v.span(),
+                format!(
+                    "{what} needs two numbers [cos 3φ, sin 3φ] (µm), not {}",
+                    other.type_str()
+                ),
+            ));
+        }
+    };
+    let mut out = [0.0; 2];
+    for (slot, x) in out.iter_mut().zip(items.iter()) {
+        let (value, text) = src.number(x, what)?;
+        if value.abs() > MAX_LOBING_UM {
+            return Err(src.at(
+                x.span(),
+                format!(
+                    "{what} has {text} µm; a lobing amplitude must be at most {MAX_LOBING_UM} µm in magnitude"
+                ),
+            ));
+        }
+        *slot = value;
+    }
+    Ok(out)
 }
 
 /// Reads the probe instrument file at `path` (at most [`MAX_PROBE_INSTRUMENT_BYTES`], UTF-8);
@@ -161,6 +246,12 @@ impl ProbeInstrument {
         s += &format!("sphere_radius_mm = {}\n", float(self.sphere_radius_mm));
         if let Some(x) = self.noise_um {
             s += &format!("noise_um = {}\n", float(x));
+        }
+        if let Some(x) = self.pre_travel_um {
+            s += &format!("pre_travel_um = {}\n", float(x));
+        }
+        if let Some([c, si]) = self.lobing_um {
+            s += &format!("lobing_um = [{}, {}]\n", float(c), float(si));
         }
         s
     }
@@ -205,11 +296,23 @@ mod tests {
                 tip_radius_mm: 0.1 + 0.2,
                 sphere_radius_mm: 1e-7,
                 noise_um: None,
+                pre_travel_um: None,
+                lobing_um: None,
+            },
+            ProbeInstrument {
+                name: Some("lobed \"3-point\"".into()),
+                tip_radius_mm: 1.5,
+                sphere_radius_mm: 12.5,
+                noise_um: Some(0.1 + 0.2),
+                pre_travel_um: Some(0.0),
+                lobing_um: Some([-0.0, 1.0 / 3.0]),
             },
         ] {
             let back = parse_probe_instrument("q.toml", &q.to_toml()).unwrap();
             assert_eq!(back, q);
             assert_eq!(back.tip_radius_mm.to_bits(), q.tip_radius_mm.to_bits());
+            let bits = |p: &ProbeInstrument| p.lobing_um.map(|l| l.map(f64::to_bits));
+            assert_eq!(bits(&back), bits(&q));
         }
     }
 
@@ -218,11 +321,11 @@ mod tests {
         let ok = "tip_radius_mm = 3\nsphere_radius_mm = 12.5\n";
         assert_eq!(
             err("tip_radius_mm = 3\n"),
-            "p.toml:1:1: missing `sphere_radius_mm`: the calibration sphere's calibrated radius, mm; a probe instrument file has name, tip_radius_mm, sphere_radius_mm, noise_um"
+            "p.toml:1:1: missing `sphere_radius_mm`: the calibration sphere's calibrated radius, mm; a probe instrument file has name, tip_radius_mm, sphere_radius_mm, noise_um, pre_travel_um, lobing_um"
         );
         assert_eq!(
             err("sphere_radius_mm = 3\n"),
-            "p.toml:1:1: missing `tip_radius_mm`: the stylus tip's radius, mm; a probe instrument file has name, tip_radius_mm, sphere_radius_mm, noise_um"
+            "p.toml:1:1: missing `tip_radius_mm`: the stylus tip's radius, mm; a probe instrument file has name, tip_radius_mm, sphere_radius_mm, noise_um, pre_travel_um, lobing_um"
         );
         assert_eq!(
             err(&format!("{ok}noise_um = 0\n")),
@@ -238,7 +341,7 @@ mod tests {
         );
         assert_eq!(
             err(&format!("{ok}radius = 1\n")),
-            "p.toml:3:1: unknown key `radius` (a probe instrument file has name, tip_radius_mm, sphere_radius_mm, noise_um)"
+            "p.toml:3:1: unknown key `radius` (a probe instrument file has name, tip_radius_mm, sphere_radius_mm, noise_um, pre_travel_um, lobing_um)"
         );
         assert_eq!(
             err(&format!("name = \"\"\n{ok}")),
@@ -253,6 +356,60 @@ mod tests {
             "p.toml:1:17: `tip_radius_mm` must be a finite number, not `nan`"
         );
         assert!(err("tip_radius_mm = \n").starts_with("p.toml:1:"));
+    }
+
+    #[test]
+    fn the_declared_pre_travel_is_read_and_bounded() {
+        let ok = "tip_radius_mm = 3\nsphere_radius_mm = 12.5\n";
+        let p = parse_probe_instrument(
+            "p.toml",
+            &format!("{ok}pre_travel_um = 1.25\nlobing_um = [0.5, -2]\n"),
+        )
+        .unwrap();
+        assert_eq!(
+            (p.pre_travel_um, p.lobing_um),
+            (Some(1.25), Some([0.5, -2.0]))
+        );
+        let p = parse_probe_instrument("p.toml", ok).unwrap();
+        assert_eq!((p.pre_travel_um, p.lobing_um), (None, None));
+        assert_eq!(
+            parse_probe_instrument("p.toml", &format!("{ok}pre_travel_um = 0\n"))
+                .unwrap()
+                .pre_travel_um,
+            Some(0.0)
+        );
+        assert_eq!(
+            err(&format!("{ok}pre_travel_um = -0.5\n")),
+            "p.toml:3:17: `pre_travel_um` is -0.5 µm; the probe's constant pre-travel must be at least 0 and at most 100 µm"
+        );
+        assert_eq!(
+            err(&format!("{ok}pre_travel_um = 100.5\n")),
+            "p.toml:3:17: `pre_travel_um` is 100.5 µm; the probe's constant pre-travel must be at least 0 and at most 100 µm"
+        );
+        assert_eq!(
+            err(&format!("{ok}pre_travel_um = inf\n")),
+            "p.toml:3:17: `pre_travel_um` must be a finite number, not `inf`"
+        );
+        assert_eq!(
+            err(&format!("{ok}lobing_um = 2\n")),
+            "p.toml:3:13: `lobing_um` needs two numbers [cos 3φ, sin 3φ] (µm), not integer"
+        );
+        assert_eq!(
+            err(&format!("{ok}lobing_um = [1, 2, 3]\n")),
+            "p.toml:3:13: `lobing_um` needs two numbers [cos 3φ, sin 3φ] (µm), got an array of 3"
+        );
+        assert_eq!(
+            err(&format!("{ok}lobing_um = [1, \"2\"]\n")),
+            "p.toml:3:17: `lobing_um` must be a number, not string"
+        );
+        assert_eq!(
+            err(&format!("{ok}lobing_um = [1, -101]\n")),
+            "p.toml:3:17: `lobing_um` has -101 µm; a lobing amplitude must be at most 100 µm in magnitude"
+        );
+        assert_eq!(
+            err(&format!("{ok}lobing_um = [nan, 0]\n")),
+            "p.toml:3:14: `lobing_um` must be a finite number, not `nan`"
+        );
     }
 
     #[test]

@@ -92,6 +92,7 @@ pub mod least_squares;
 pub mod noise;
 pub mod offsets;
 pub mod plan;
+pub mod probe;
 pub mod refine;
 pub mod sanity;
 pub mod sphere;

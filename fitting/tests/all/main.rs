@@ -18,6 +18,7 @@ mod noise_model;
 mod plan;
 mod plan_reversal;
 mod plan_update;
+mod probe_readings;
 mod sphere;
 mod streaming;
 mod templates;

@@ -1,0 +1,315 @@
+//! A probe hits file turned into a record: a sphere fit per pose, its centre as the pose's
+//! reading of the error vector.
+
+use super::pose::PoseGeometry;
+use super::pretravel::PreTravel;
+use crate::sphere::{Latch, RadiusMode, SphereFit, SphereFitError, SphereFitOptions, fit_sphere};
+use formats::csv::CsvError;
+use formats::probe::{ProbeHits, ProbeInstrument, ProbePose};
+use model_spec::Machine;
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use simulation::exact::VirtualMachine;
+use simulation::record::{Record, Sample};
+
+/// What reading a probe record needs besides its hits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeSettings {
+    /// The stylus tip's radius, mm.
+    pub tip_radius_mm: f64,
+    /// The calibration sphere's calibrated radius, mm.
+    pub sphere_radius_mm: f64,
+    /// The probe's noise σ along the approach, mm, when declared.
+    pub noise_mm: Option<f64>,
+    /// The pre-travel declared for the probe, removed from every hit before the fit.
+    pub declared: PreTravel,
+    /// The largest magnitude of a reading's component, mm (as for R-test records).
+    pub max_reading_mm: f64,
+    /// The largest distance of a latched tip centre from the nominal sphere (`R_eff` about the
+    /// nominal centre), mm: beyond it the hit is not on this sphere at this pose.
+    pub off_sphere_mm: f64,
+}
+
+impl ProbeSettings {
+    /// The settings of `probe`, with the reading limit `max_reading_mm` (mm); a hit may be
+    /// [`OFF_SPHERE_MM`] off the nominal sphere.
+    pub fn of(probe: &ProbeInstrument, max_reading_mm: f64) -> Self {
+        ProbeSettings {
+            tip_radius_mm: probe.tip_radius_mm,
+            sphere_radius_mm: probe.sphere_radius_mm,
+            noise_mm: probe.noise_um.map(|u| u * 1e-3),
+            declared: PreTravel::default(),
+            max_reading_mm,
+            off_sphere_mm: OFF_SPHERE_MM,
+        }
+    }
+
+    /// `R_eff = R_sphere + r_tip`, mm.
+    pub fn effective_radius_mm(&self) -> f64 {
+        self.sphere_radius_mm + self.tip_radius_mm
+    }
+}
+
+/// The default largest distance of a hit from the nominal sphere, mm (0.5 mm: far above any
+/// error of a machine worth calibrating, far below a wrong sphere, pose or parameter).
+pub const OFF_SPHERE_MM: f64 = 0.5;
+
+/// One pose of a probe record, fitted.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PoseFit {
+    /// The pose's label.
+    pub label: String,
+    /// The line of its first hit (1-based; 0 when not read from a file).
+    pub line: usize,
+    /// The sphere fit, bed frame, about the nominal sphere centre (mm).
+    pub fit: SphereFit,
+    /// The pose's reading `e = −R_tool0ᵀ·c`, tool frame, mm.
+    pub reading_mm: [f64; 3],
+    /// Its covariance, tool frame, mm².
+    pub covariance_mm2: [[f64; 3]; 3],
+    /// Per hit, the change of the reading per mm of that hit's pre-travel (tool frame, mm/mm):
+    /// the first-order response of the free sphere fit.
+    pub pretravel_gain: Vec<Vector3<f64>>,
+    /// Per hit, its approach direction in the probe's (tool) frame.
+    pub approach_tool: Vec<Vector3<f64>>,
+}
+
+/// A probe record: the record the pipeline fits, with the fit of every pose.
+#[derive(Clone, Debug)]
+pub struct ProbeRecord {
+    /// One sample per pose: nominal commands, the time of its first hit, the reading, its
+    /// covariance, the line of its first hit.
+    pub record: Record,
+    /// Per pose, its sphere fit, in record order.
+    pub poses: Vec<PoseFit>,
+    /// The probe's σ the covariances use, mm.
+    pub noise_mm: f64,
+    /// The σ the fits' residuals give, pooled over the poses (`√(Σ r² / Σ dof)`), mm, when
+    /// some pose has more hits than unknowns: the check of the declared σ.
+    pub sigma_posterior_mm: Option<f64>,
+    /// The constant pre-travel the fitted radii show beyond the declared one, `R_eff − R_fit`
+    /// weighted over the poses, with its standard uncertainty (mm).
+    pub pre_travel_mm: (f64, f64),
+}
+
+/// Reads `hits` (from `file`) of a probe on machine `m` at kinematic parameters `params` (mm):
+/// one sphere fit per pose (free radius, checked against the calibrated one), its centre the
+/// pose's reading (module documentation).
+///
+/// # Errors
+/// [`CsvError::Format`] naming `file`, the line of the hit or pose and why: no declared σ, a
+/// pose the nominal inverse kinematics cannot reach, a hit off the nominal sphere, a refused
+/// sphere fit (with the rule and the hit), a reading beyond the limit.
+pub fn probe_record(
+    file: &str,
+    m: &Machine,
+    params: &[f64],
+    hits: &ProbeHits,
+    settings: &ProbeSettings,
+) -> Result<ProbeRecord, CsvError> {
+    let at = |line: usize, message: String| CsvError::Format {
+        file: file.to_string(),
+        line,
+        column: None,
+        message,
+    };
+    let first_line = hits
+        .poses
+        .first()
+        .and_then(|p| p.hits.first())
+        .map_or(0, |h| h.line);
+    let Some(noise_mm) = settings.noise_mm else {
+        return Err(at(
+            first_line,
+            "the probe instrument declares no noise_um: the sphere fits' refusal rule (largest residual above max(4σ, 5 µm)) and the centres' covariances need the probe's σ along the approach (its repeatability, µm)".into(),
+        ));
+    };
+    let vm = VirtualMachine::new(m);
+    let mut poses = Vec::with_capacity(hits.poses.len());
+    let mut record = Record::default();
+    for pose in &hits.poses {
+        let fitted = fit_pose(&vm, params, pose, settings, noise_mm)
+            .map_err(|(l, msg)| at(l, format!("pose `{}`: {msg}", pose.label)))?;
+        let first = &pose.hits[0];
+        if let Some(k) = (0..3).find(|&k| fitted.reading_mm[k].abs() > settings.max_reading_mm) {
+            return Err(at(
+                first.line,
+                format!(
+                    "pose `{}`: the fitted centre gives a reading of {:.3} µm along {}, beyond the limit of {} µm: not a small error of the machine (a wrong sphere position, kinematic parameter or pose)",
+                    pose.label,
+                    fitted.reading_mm[k] * 1e3,
+                    ["x", "y", "z"][k],
+                    settings.max_reading_mm * 1e3
+                ),
+            ));
+        }
+        let geometry = PoseGeometry::at(&vm, &first.axes, params)
+            .map_err(|e| at(first.line, e.to_string()))?;
+        record.samples.push(Sample {
+            commands: geometry.commands,
+            t: first.t_s,
+            motion: vec![1; m.axes.len()],
+            timed: true,
+        });
+        record.measured.push(fitted.reading_mm);
+        record.covariance.push(fitted.covariance_mm2);
+        record.lines.push(first.line);
+        poses.push(fitted);
+    }
+    let (rss, dof) = poses.iter().fold((0.0, 0usize), |(s, d), p| {
+        (
+            s + p.fit.residuals_mm.iter().map(|r| r * r).sum::<f64>(),
+            d + p.fit.dof,
+        )
+    });
+    let sigma_posterior_mm = (dof > 0).then(|| (rss / dof as f64).sqrt());
+    Ok(ProbeRecord {
+        record,
+        pre_travel_mm: pre_travel(&poses, settings),
+        poses,
+        noise_mm,
+        sigma_posterior_mm,
+    })
+}
+
+/// The constant pre-travel the radii show: per pose `R_eff − R_fit` with the fit's radius
+/// uncertainty, weighted (mm, and its standard uncertainty).
+fn pre_travel(poses: &[PoseFit], settings: &ProbeSettings) -> (f64, f64) {
+    let (mut sw, mut swx) = (0.0, 0.0);
+    for p in poses {
+        let s = p.fit.radius_std_mm.unwrap_or(f64::INFINITY);
+        let w = 1.0 / (s * s);
+        sw += w;
+        swx += w * (settings.effective_radius_mm() - p.fit.effective_radius_mm);
+    }
+    if sw > 0.0 {
+        (swx / sw, 1.0 / sw.sqrt())
+    } else {
+        (0.0, f64::INFINITY)
+    }
+}
+
+/// The fit of one pose, or the line and why it is refused.
+fn fit_pose(
+    vm: &VirtualMachine<'_>,
+    params: &[f64],
+    pose: &ProbePose,
+    settings: &ProbeSettings,
+    noise_mm: f64,
+) -> Result<PoseFit, (usize, String)> {
+    let first = &pose.hits[0];
+    let geometry =
+        PoseGeometry::at(vm, &first.axes, params).map_err(|e| (first.line, e.to_string()))?;
+    let r_eff = settings.effective_radius_mm();
+    let mut latches = Vec::with_capacity(pose.hits.len());
+    let mut approach_tool = Vec::with_capacity(pose.hits.len());
+    for h in &pose.hits {
+        let n = Vector3::from(h.direction);
+        let n_tool = geometry.to_tool(&n);
+        let g = geometry.gap(vm, &h.axes, params);
+        let off = g.norm() - r_eff;
+        if off.abs() > settings.off_sphere_mm {
+            return Err((
+                h.line,
+                format!(
+                    "the hit's tip centre is {:.3} mm from the nominal sphere centre, {:.3} mm off the sphere of radius R_sphere + r_tip = {} mm (limit {} mm): not a hit on this sphere at this pose (the sphere's position, the kinematic parameters, the probe's length or the radii are wrong)",
+                    g.norm(),
+                    off,
+                    r_eff,
+                    settings.off_sphere_mm
+                ),
+            ));
+        }
+        // A hit that pre-travelled by δ latched δ·n beyond the contact.
+        let delta = settings.declared.along(&n_tool);
+        latches.push(Latch {
+            tip_mm: g - delta * n,
+            approach: n,
+        });
+        approach_tool.push(n_tool);
+    }
+    let options = SphereFitOptions {
+        radius: RadiusMode::Free {
+            calibrated_mm: Some(settings.sphere_radius_mm),
+        },
+        tip_radius_mm: settings.tip_radius_mm,
+        noise_mm,
+    };
+    let fit = fit_sphere(&latches, &options).map_err(|e| refusal(pose, &e))?;
+    let c = fit.centre_mm;
+    let reading = -geometry.to_tool(&c);
+    let r = geometry.tool_rotation.matrix();
+    let cov: Matrix3<f64> = r.transpose() * fit.covariance_mm2 * r;
+    let pretravel_gain = pretravel_gains(&latches, &fit)
+        .into_iter()
+        .map(|dc| -geometry.to_tool(&dc))
+        .collect();
+    Ok(PoseFit {
+        label: pose.label.clone(),
+        line: first.line,
+        reading_mm: [reading.x, reading.y, reading.z],
+        covariance_mm2: [
+            [cov[(0, 0)], cov[(0, 1)], cov[(0, 2)]],
+            [cov[(1, 0)], cov[(1, 1)], cov[(1, 2)]],
+            [cov[(2, 0)], cov[(2, 1)], cov[(2, 2)]],
+        ],
+        fit,
+        pretravel_gain,
+        approach_tool,
+    })
+}
+
+/// A refused fit as the line of the hit it names (else the pose's first) and why.
+fn refusal(pose: &ProbePose, e: &SphereFitError) -> (usize, String) {
+    let hit = match e {
+        SphereFitError::Residual { hit, .. } => Some(*hit),
+        SphereFitError::Radius { suspect, .. } => *suspect,
+        _ => None,
+    };
+    let line = hit
+        .and_then(|i| pose.hits.get(i))
+        .map_or(pose.hits[0].line, |h| h.line);
+    let which = hit
+        .and_then(|i| pose.hits.get(i))
+        .map(|h| {
+            format!(
+                " (hit {} of the pose, line {})",
+                hit.unwrap_or(0) + 1,
+                h.line
+            )
+        })
+        .unwrap_or_default();
+    (line, format!("{e}{which}"))
+}
+
+/// Per hit, the fitted centre's first-order change (bed frame, mm per mm) when that hit
+/// latches 1 mm farther along its approach (a pre-travel), the radius free: `Δx = −(JᵀJ)⁻¹Jᵀ·Δr`
+/// with the Jacobian rows `[−u_iᵀ, −1]` of the residuals `‖p_i − c‖ − R` at the fit and `Δr`
+/// the hit's residual change.
+fn pretravel_gains(latches: &[Latch], fit: &SphereFit) -> Vec<Vector3<f64>> {
+    let n = latches.len();
+    let mut j = DMatrix::zeros(n, 4);
+    for (i, l) in latches.iter().enumerate() {
+        let u = (l.tip_mm - fit.centre_mm).normalize();
+        for k in 0..3 {
+            j[(i, k)] = -u[k];
+        }
+        j[(i, 3)] = -1.0;
+    }
+    let jtj = j.transpose() * &j;
+    let Some(inv) = jtj.try_inverse() else {
+        return vec![Vector3::zeros(); n];
+    };
+    let pinv = inv * j.transpose();
+    (0..n)
+        .map(|i| {
+            // A pre-travel δ moves the hit by δ·n: its residual changes by δ·(u·n), −δ for a
+            // hit aimed at the centre (n = −u); the exact projection is kept.
+            let u = (latches[i].tip_mm - fit.centre_mm).normalize();
+            let dr = u.dot(&latches[i].approach.normalize());
+            let mut e = DVector::zeros(n);
+            e[i] = dr;
+            let dx = -(&pinv * e);
+            Vector3::new(dx[0], dx[1], dx[2])
+        })
+        .collect()
+}

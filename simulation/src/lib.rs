@@ -18,6 +18,7 @@
 //! - [`paths`]: the built-in test paths, the linear axes following the ball;
 //! - [`truth`]: what a virtual machine's errors really are (read from TOML files by `formats`);
 //! - [`readings`]: simulated R-test readings of a truth along a path, with noise and zeroing;
+//! - [`probe`]: simulated touch-probe hits on a calibration sphere, exact contacts;
 //! - [`rng`]: the platform-independent noise generator;
 //! - [`pose`]: one pose from the axis positions a person gives, checked against the machine.
 //!
@@ -37,6 +38,7 @@ pub mod fd;
 pub mod generator;
 pub mod paths;
 pub mod pose;
+pub mod probe;
 pub mod readings;
 pub mod rng;
 pub mod truth;

@@ -10,3 +10,4 @@ mod generator_orders;
 mod instrument_description;
 mod instrument_geometry;
 mod simulate;
+mod probe;

@@ -1,0 +1,135 @@
+//! What a simulated probe cycle does at each pose: the hit pattern (approach directions in the
+//! bed frame), the clearance it starts from, its clock and the pre-travel of its trigger.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// The hits of the pattern at every pose (9).
+pub const PATTERN_HITS: usize = 9;
+
+/// How far outside the nominal sphere (of radius `R_eff`) the tip centre starts each approach,
+/// mm (2): the machine's errors must be smaller than this, or the probe would start inside the
+/// sphere.
+pub const CLEARANCE_MM: f64 = 2.0;
+
+/// The probing feed, mm/s (2 mm/s, 120 mm/min): the speed of the tip centre along the approach
+/// (for the truth's `velocity` terms, and the clock).
+pub const PROBING_FEED_MM_PER_S: f64 = 2.0;
+
+/// The time of one hit's cycle, s (4): the approach from the start point at the probing feed
+/// (1 s over [`CLEARANCE_MM`]), the retract to the start point and the move to the next start
+/// point.
+pub const HIT_CYCLE_S: f64 = 4.0;
+
+/// The time of a pose change, s (6): the rotary axes turn and the probe comes to the new
+/// pose's first start point; added once before every pose but the first.
+pub const POSE_CHANGE_S: f64 = 6.0;
+
+/// The time from the start of an approach to its (nominal) latch, s: [`CLEARANCE_MM`] at
+/// [`PROBING_FEED_MM_PER_S`].
+pub const APPROACH_S: f64 = CLEARANCE_MM / PROBING_FEED_MM_PER_S;
+
+/// The approach directions of the pattern (unit vectors, bed frame), in hit order: the
+/// directions of `fitting::sphere::default_pattern` (computed with the same operations, so
+/// bit for bit the same):
+///
+/// - 0–3: at the centre's height, approaching along −X, −Y, +X, +Y (the hits on the sphere at
+///   +X, +Y, −X, −Y);
+/// - 4–7: from the height `R/2` above the centre, at azimuths 45°, 135°, 225°, 315° (of the
+///   point hit), pointing down and in;
+/// - 8: the pole, approached along −Z.
+///
+/// They are fixed in the bed frame: they do not turn with the tool or the table.
+pub fn approach_directions() -> [Vector3<f64>; PATTERN_HITS] {
+    let quarter = std::f64::consts::FRAC_PI_2;
+    let h: f64 = 0.5; // z / R
+    let rho = (1.0 - h * h).sqrt();
+    let equator = (0..4).map(|k: i32| {
+        let a = f64::from(k) * quarter;
+        Vector3::new(a.cos(), a.sin(), 0.0)
+    });
+    let upper = (0..4).map(|k: i32| {
+        let a = std::f64::consts::FRAC_PI_4 + f64::from(k) * quarter;
+        Vector3::new(rho * a.cos(), rho * a.sin(), h)
+    });
+    let mut out = [Vector3::zeros(); PATTERN_HITS];
+    for (slot, point) in out
+        .iter_mut()
+        .zip(equator.chain(upper).chain([Vector3::z()]))
+    {
+        *slot = -point;
+    }
+    out
+}
+
+/// The time of the latch of hit `hit` (0-based over the whole run) of pose `pose` (0-based), s:
+/// `pose·`[`POSE_CHANGE_S`]` + hit·`[`HIT_CYCLE_S`]` + `[`APPROACH_S`] (the clock starts when
+/// the first approach starts). It is the nominal latch time: the actual contact comes earlier
+/// or later by the machine's error along the approach over the feed (a few µs).
+pub fn latch_time_s(pose: usize, hit: usize) -> f64 {
+    pose as f64 * POSE_CHANGE_S + hit as f64 * HIT_CYCLE_S + APPROACH_S
+}
+
+/// The time of a whole run of `poses` poses and `hits` hits in all, s: from the start of the
+/// first approach to the end of the last hit's cycle.
+pub fn run_time_s(poses: usize, hits: usize) -> f64 {
+    poses.saturating_sub(1) as f64 * POSE_CHANGE_S + hits as f64 * HIT_CYCLE_S
+}
+
+/// The probe's pre-travel: how far beyond the contact, along the approach, its tip centre is
+/// when it latches (mm), constant and three-lobed.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PreTravel {
+    /// The constant part `δ0`, mm.
+    pub constant_mm: f64,
+    /// The three-lobed part's amplitudes `[L_c, L_s]`, mm.
+    pub lobing_mm: [f64; 2],
+}
+
+impl PreTravel {
+    /// The pre-travel of an approach `approach` (unit, bed frame) of a probe whose frame is
+    /// turned by `tool_rotation` (bed ← tool): `δ = δ0 + ρ·(L_c·cos 3φ + L_s·sin 3φ)` (mm),
+    /// with `n_t = tool_rotationᵀ·approach`, `ρ = √(n_t.x² + n_t.y²)` its part across the
+    /// stylus and `φ = atan2(n_t.y, n_t.x)` its azimuth about the stylus (0 when `ρ` is 0).
+    pub fn along(&self, tool_rotation: &Matrix3<f64>, approach: &Vector3<f64>) -> f64 {
+        let n = tool_rotation.transpose() * approach;
+        let rho = n.x.hypot(n.y);
+        let phi = if rho > 0.0 { n.y.atan2(n.x) } else { 0.0 };
+        let [c, s] = self.lobing_mm;
+        self.constant_mm + rho * (c * (3.0 * phi).cos() + s * (3.0 * phi).sin())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_directions_are_unit_and_point_in() {
+        let d = approach_directions();
+        for n in &d {
+            assert!((n.norm() - 1.0).abs() < 1e-15);
+        }
+        assert_eq!(d[0], Vector3::new(-1.0, -0.0, -0.0));
+        assert_eq!(d[8], Vector3::new(-0.0, -0.0, -1.0));
+        assert!(d[4..8].iter().all(|n| (n.z + 0.5).abs() < 1e-15));
+    }
+
+    #[test]
+    fn lobing_vanishes_along_the_stylus_and_has_three_lobes_across_it() {
+        let p = PreTravel {
+            constant_mm: 0.001,
+            lobing_mm: [0.002, 0.0],
+        };
+        let id = Matrix3::identity();
+        assert_eq!(p.along(&id, &Vector3::new(0.0, 0.0, -1.0)), 0.001);
+        assert!((p.along(&id, &Vector3::new(1.0, 0.0, 0.0)) - 0.003).abs() < 1e-15);
+        assert!((p.along(&id, &Vector3::new(-1.0, 0.0, 0.0)) + 0.001).abs() < 1e-15);
+        // 120° apart: the same lobe.
+        let a = 120f64.to_radians();
+        let n = Vector3::new(a.cos(), a.sin(), 0.0);
+        assert!((p.along(&id, &n) - 0.003).abs() < 1e-15);
+        // A tool turned 90° about Z sees +Y of the bed as its +X.
+        let turn = Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+        assert!((p.along(&turn, &Vector3::new(0.0, 1.0, 0.0)) - 0.003).abs() < 1e-15);
+    }
+}

@@ -55,14 +55,26 @@ impl NoiseArgs {
     ) -> VerbResult<(NoiseChoice, Option<super::ReadFile>)> {
         let Some(path) = &self.noise_record else {
             let declared = self.declared()?;
-            if instrument.is_some() && matches!(declared, NoiseChoice::Model(_)) {
-                return Err(Error::usage(
-                    "--noise: the records are read through --instrument, whose sensors' σ give each reading's covariance: a declared noise model would declare the noise a second time; leave --noise out (estimated over time from the rows whitened by the covariances) or give --noise white (the covariances' shape, the residual's scale)",
-                ));
+            if instrument.declares_noise() && matches!(declared, NoiseChoice::Model(_)) {
+                let what = match instrument {
+                    super::campaign::Through::Probe(_) => {
+                        "--probe, whose σ gives each pose's reading its covariance through the sphere fit"
+                    }
+                    _ => "--instrument, whose sensors' σ give each reading's covariance",
+                };
+                return Err(Error::usage(format!(
+                    "--noise: the records are read through {what}: a declared noise model would declare the noise a second time; leave --noise out (estimated over time from the rows whitened by the covariances) or give --noise white (the covariances' shape, the residual's scale)"
+                )));
             }
             return Ok((declared, None));
         };
-        let (still, digest) = super::read_record(
+        if let super::campaign::Through::Probe(_) = instrument {
+            return Err(Error::usage(format!(
+                "--noise-record {}: a record of the machine standing still is an R-test's; a probe's noise is its σ in the --probe file (noise_um), which the sphere fits check against their residuals",
+                path.display()
+            )));
+        }
+        let (still, digest, _) = super::read_record(
             "--noise-record",
             m,
             path,

@@ -24,10 +24,57 @@ pub struct Loaded {
     /// The files as read: the campaign file (when there is one), then each record's file, with
     /// the digests of the bytes read.
     pub read: Vec<ReadFile>,
+    /// Per record, what its sphere fits say when it was read through a touch probe.
+    pub probe: Vec<Option<fitting::probe::ProbeSummary>>,
 }
 
-/// The instrument the records are read through (sensor readings), if any.
-pub type Through<'a> = Option<(&'a Instrument, ReadingsFrame)>;
+/// What the records' files hold and what turns them into error vectors.
+#[derive(Clone, Copy, Debug)]
+pub enum Through<'a> {
+    /// Error vectors (`dx_um,dy_um,dz_um`): measurement CSVs read as they are.
+    Errors,
+    /// An R-test's sensor readings, turned into error vectors by its geometry, in the frame
+    /// of its displacements.
+    Sensors(&'a Instrument, ReadingsFrame),
+    /// A touch probe's hits (or sphere centres), turned into error vectors by sphere fits.
+    Probe(&'a formats::probe::ProbeInstrument),
+}
+
+impl<'a> Through<'a> {
+    /// The records' reader from the loaded R-test instrument or probe (at most one is given:
+    /// the flags conflict).
+    pub fn of(
+        instrument: &'a Option<super::args::Loaded>,
+        probe: &'a Option<formats::probe::ProbeInstrument>,
+    ) -> Through<'a> {
+        match (instrument, probe) {
+            (Some((i, f)), _) => Through::Sensors(i, *f),
+            (None, Some(p)) => Through::Probe(p),
+            (None, None) => Through::Errors,
+        }
+    }
+
+    /// The R-test instrument, for the measurement CSV readers.
+    pub fn sensors(self) -> Option<(&'a Instrument, ReadingsFrame)> {
+        match self {
+            Through::Sensors(i, f) => Some((i, f)),
+            _ => None,
+        }
+    }
+
+    /// `true` when an instrument declares the readings' noise (the sensors' σ, the probe's).
+    pub fn declares_noise(self) -> bool {
+        !matches!(self, Through::Errors)
+    }
+
+    /// The flag of the instrument, for messages (`--instrument`, `--probe`).
+    pub fn flag(self) -> &'static str {
+        match self {
+            Through::Probe(_) => "--probe",
+            _ => "--instrument",
+        }
+    }
+}
 
 /// The records of `files` (given by `flag`), each on a set-up of its own labelled by the
 /// file's stem (made unique), at kinematic parameters `params` (mm), zeroed or not, read
@@ -45,8 +92,10 @@ pub fn from_files(
     let labels = labels_from_files(files);
     let mut records = Vec::with_capacity(files.len());
     let mut read_files = Vec::with_capacity(files.len());
+    let mut probe = Vec::with_capacity(files.len());
     for (f, label) in files.iter().zip(&labels) {
-        let (record, digest) = super::read_record(flag, m, f, read, instrument, params)?;
+        let (record, digest, summary) = super::read_record(flag, m, f, read, instrument, params)?;
+        probe.push(summary);
         read_files.push(ReadFile::new(flag, f, digest));
         records.push(CampaignRecord::new(
             label.clone(),
@@ -62,6 +111,7 @@ pub fn from_files(
         files: files.iter().map(|f| f.display().to_string()).collect(),
         source: None,
         read: read_files,
+        probe,
     })
 }
 
@@ -93,8 +143,14 @@ pub fn from_file(
     read: &ReadOptions,
     instrument: Through,
 ) -> VerbResult<Loaded> {
+    let mut probe = Vec::with_capacity(file.records.len());
     let (campaign, digests) = file
-        .load(m, read, instrument)
+        .load_with(m, |e| {
+            let (record, digest, summary) =
+                super::read_record_file(&e.path, m, &e.params, read, instrument)?;
+            probe.push(summary);
+            Ok((record, digest))
+        })
         .map_err(|e| Error::input(format!("{flag}: {e}")))?;
     let mut read_files = vec![source];
     read_files.extend(
@@ -112,6 +168,7 @@ pub fn from_file(
             .collect(),
         source: Some(path.to_path_buf()),
         read: read_files,
+        probe,
     })
 }
 

@@ -131,6 +131,8 @@ pub struct DiagnoseArgs {
     #[command(flatten)]
     instrument: args::InstrumentArgs,
     #[command(flatten)]
+    probe: super::probe_records::ProbeArgs,
+    #[command(flatten)]
     bounds: ValueBounds,
 }
 
@@ -178,6 +180,7 @@ pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
     );
     given.extend(args.noise.input());
     given.extend(args.instrument.input());
+    given.extend(args.probe.input());
     given.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     check_outputs(&given, &outputs, &dirs)?;
     if let Some(dir) = &args.plot {
@@ -185,7 +188,8 @@ pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
     }
 
     let (instrument, instrument_read) = args.instrument.load_read()?;
-    let through = instrument.as_ref().map(|(i, f)| (i, *f));
+    let (probe, probe_read) = args.probe.load_read()?;
+    let through = campaign::Through::of(&instrument, &probe);
     // Progress bars on a terminal's standard error, unless the JSON report takes standard output.
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
     let reader = Reader {
@@ -206,6 +210,7 @@ pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
     inputs.extend(held_inputs.iter().map(|p| ("--validate", p.as_path())));
     inputs.extend(args.noise.input());
     inputs.extend(args.instrument.input());
+    inputs.extend(args.probe.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     if args.campaign.is_some() || args.validate_campaign.is_some() {
         check_outputs(&inputs, &outputs, &dirs)?;
@@ -227,6 +232,7 @@ pub fn run(args: &DiagnoseArgs) -> VerbResult<Done> {
     read_files.extend(held.read.iter().cloned());
     read_files.extend(noise_read);
     read_files.extend(instrument_read);
+    read_files.extend(probe_read);
     read_files.extend(ReadFile::machine(&args.machine, machine.digest));
     let bar = super::progress::Bar::new(shown, false);
     let d = diagnose(&m, &model, &fitted.campaign, &held.campaign, &opts, &bar);
@@ -388,6 +394,9 @@ fn data_arguments(args: &DiagnoseArgs, data: &str) -> Vec<String> {
     }
     if let Some(f) = &args.instrument.readings_frame {
         out.extend(["--readings-frame".to_string(), f.clone()]);
+    }
+    if let Some(p) = &args.probe.probe {
+        out.extend(["--probe".to_string(), p.display().to_string()]);
     }
     out
 }

@@ -8,6 +8,9 @@ use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::record::Record;
 use std::path::PathBuf;
 
+/// The files as read, and per record what a probe's sphere fits say.
+type Read = (Vec<ReadFile>, Vec<Option<fitting::probe::ProbeSummary>>);
+
 /// How `rtest diagnose` reads its records: on the machine `m`, at the kinematic parameters of
 /// `--param` (mm), as the record flags say, through the instrument when one is given, each with
 /// a progress bar while it is read (`shown`).
@@ -21,19 +24,22 @@ pub(super) struct Reader<'a> {
 }
 
 impl Reader<'_> {
-    /// The records of `files` (given by `flag`), and the files as read.
-    fn records(&self, flag: &str, files: &[PathBuf]) -> VerbResult<(Vec<Record>, Vec<ReadFile>)> {
+    /// The records of `files` (given by `flag`), and the files as read (with what a probe's
+    /// sphere fits say).
+    fn records(&self, flag: &str, files: &[PathBuf]) -> VerbResult<(Vec<Record>, Read)> {
         campaign::record_count(flag, files)?;
         let mut records = Vec::with_capacity(files.len());
         let mut read_files = Vec::with_capacity(files.len());
+        let mut probe = Vec::with_capacity(files.len());
         for f in files {
             let (_bar, read) = super::progress::reading(self.shown, f, &self.read);
-            let (record, digest) =
+            let (record, digest, summary) =
                 super::read_record(flag, self.m, f, &read, self.through, &self.params)?;
             records.push(record);
             read_files.push(ReadFile::new(flag, f, digest));
+            probe.push(summary);
         }
-        Ok((records, read_files))
+        Ok((records, (read_files, probe)))
     }
 
     /// The fitted records: the `--campaign` file, or the `--data` `files`, each on a set-up of
@@ -108,7 +114,7 @@ impl Reader<'_> {
 fn loaded(
     records: Vec<CampaignRecord>,
     files: &[PathBuf],
-    read: Vec<ReadFile>,
+    (read, probe): Read,
 ) -> VerbResult<campaign::Loaded> {
     let campaign = if records.is_empty() {
         Campaign {
@@ -122,5 +128,6 @@ fn loaded(
         files: files.iter().map(|f| f.display().to_string()).collect(),
         source: None,
         read,
+        probe,
     })
 }

@@ -116,6 +116,8 @@ pub struct IdentifyArgs {
     #[command(flatten)]
     instrument: args::InstrumentArgs,
     #[command(flatten)]
+    probe: super::probe_records::ProbeArgs,
+    #[command(flatten)]
     bounds: ValueBounds,
     #[command(flatten)]
     history: record::RecordArgs,
@@ -146,7 +148,8 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
     // JSON report takes standard output.
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
     let (instrument, instrument_read) = args.instrument.load_read()?;
-    let through = instrument.as_ref().map(|(i, f)| (i, *f));
+    let (probe, probe_read) = args.probe.load_read()?;
+    let through = campaign::Through::of(&instrument, &probe);
     // The records' files: those of --data now; a campaign file's once it is read.
     let campaign_file = match &args.campaign {
         Some(path) => {
@@ -167,6 +170,7 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
     inputs.extend(file_list.iter().map(|p| (flag, p.as_path())));
     inputs.extend(args.noise.input());
     inputs.extend(args.instrument.input());
+    inputs.extend(args.probe.input());
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
     outputs.extend(args.report.iter().map(|t| ("--report", t)));
@@ -228,6 +232,7 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
     };
     read_files.extend(noise_read);
     read_files.extend(instrument_read);
+    read_files.extend(probe_read);
     read_files.extend(ReadFile::machine(&args.machine, machine.digest));
     campaign::check_campaign_values(&m, &ident.layout, &ident.fit.values, &args.bounds.values())
         .map_err(|e| implausible(&e))?;
@@ -243,6 +248,16 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
     let mut report = IdentificationReport::of_campaign(&m, source, &ident, refinement.as_ref())
         .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
     report.streaming = streaming;
+    if let (Some(p), Some(l)) = (&probe, &loaded) {
+        report.probe = Some(report::json::probe::ProbeReport::of(
+            &m,
+            p,
+            &l.campaign,
+            &l.files,
+            &l.probe,
+            &ident,
+        ));
+    }
     if args.param.is_some() {
         report.notes.push(format!(
             "kinematic parameters (--param): {}",
@@ -250,6 +265,9 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
         ));
     }
     let mut text = identification(&report);
+    if let Some(p) = &report.probe {
+        text.push_str(&report::text::probe::probe(p));
+    }
     if args.param.is_some() {
         text.push_str(&format!(
             "Kinematic parameters (--param): {}\n",

@@ -26,6 +26,7 @@ pub mod path;
 pub mod path_nc;
 pub mod plan;
 pub mod pose_args;
+pub mod probe_records;
 pub mod progress;
 pub mod record;
 pub mod report;
@@ -107,13 +108,30 @@ pub fn read_record(
     options: &ReadOptions,
     instrument: campaign::Through,
     params: &[f64],
-) -> VerbResult<(Record, Digest)> {
-    formats::campaign::read_record_at(path, m, params, options, instrument).map_err(|e| {
+) -> VerbResult<(Record, Digest, Option<fitting::probe::ProbeSummary>)> {
+    read_record_file(path, m, params, options, instrument).map_err(|e| {
         Error::input(format!(
             "{flag}: {e}{}",
             formats::campaign::parameters_note(m, params)
         ))
     })
+}
+
+/// The record of the file at `path` at kinematic parameters `params` (mm) as `through` reads
+/// it, with the digest of the bytes read and, for a probe's, what its sphere fits say.
+pub fn read_record_file(
+    path: &Path,
+    m: &Machine,
+    params: &[f64],
+    options: &ReadOptions,
+    through: campaign::Through,
+) -> Result<(Record, Digest, Option<fitting::probe::ProbeSummary>), formats::csv::CsvError> {
+    match through {
+        campaign::Through::Probe(p) => probe_records::read_probe_record(path, m, params, p, options)
+            .map(|(r, d, s)| (r, d, Some(s))),
+        other => formats::campaign::read_record_at(path, m, params, options, other.sensors())
+            .map(|(r, d)| (r, d, None)),
+    }
 }
 
 /// Refuses `record` (read from `path`, given by `flag`) for `model` when a term needs the real

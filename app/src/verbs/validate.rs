@@ -117,6 +117,8 @@ pub struct ValidateArgs {
     #[command(flatten)]
     instrument: super::args::InstrumentArgs,
     #[command(flatten)]
+    probe: super::probe_records::ProbeArgs,
+    #[command(flatten)]
     bounds: ValueBounds,
 }
 
@@ -138,6 +140,7 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
     inputs.extend(args.campaign.iter().map(|f| ("--campaign", f.as_path())));
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     inputs.extend(args.instrument.input());
+    inputs.extend(args.probe.input());
     inputs.extend(args.tolerance.iter().map(|f| ("--tolerance", f.as_path())));
     inputs.extend(
         args.noise_record
@@ -164,7 +167,8 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
     let read = args.records.read_options();
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
     let instrument = args.instrument.load()?;
-    let through = instrument.as_ref().map(|(i, f)| (i, *f));
+    let (probe, _) = args.probe.load_read()?;
+    let through = campaign::Through::of(&instrument, &probe);
     let campaign_file = match &args.campaign {
         Some(path) => Some(campaign::read_file("--campaign", &m, path)?),
         None => None,
@@ -352,7 +356,7 @@ fn reading_noise(
         });
     }
     if let Some(path) = &args.noise_record {
-        let (still, _) = super::read_record(
+        let (still, _, _) = super::read_record(
             "--noise-record",
             m,
             path,

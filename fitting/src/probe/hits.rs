@@ -30,14 +30,18 @@ pub struct ProbeSettings {
 }
 
 impl ProbeSettings {
-    /// The settings of `probe`, with the reading limit `max_reading_mm` (mm); a hit may be
-    /// [`OFF_SPHERE_MM`] off the nominal sphere.
+    /// The settings of `probe` (its radii, σ and declared pre-travel), with the reading limit
+    /// `max_reading_mm` (mm); a hit may be [`OFF_SPHERE_MM`] off the nominal sphere.
     pub fn of(probe: &ProbeInstrument, max_reading_mm: f64) -> Self {
+        let lobing = probe.lobing_um.unwrap_or([0.0, 0.0]);
         ProbeSettings {
             tip_radius_mm: probe.tip_radius_mm,
             sphere_radius_mm: probe.sphere_radius_mm,
             noise_mm: probe.noise_um.map(|u| u * 1e-3),
-            declared: PreTravel::default(),
+            declared: PreTravel {
+                constant_mm: probe.pre_travel_um.unwrap_or(0.0) * 1e-3,
+                lobing_mm: [lobing[0] * 1e-3, lobing[1] * 1e-3],
+            },
             max_reading_mm,
             off_sphere_mm: OFF_SPHERE_MM,
         }

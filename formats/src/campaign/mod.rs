@@ -271,17 +271,32 @@ impl CampaignFile {
         opts: &ReadOptions,
         instrument: Option<(&Instrument, ReadingsFrame)>,
     ) -> Result<(Campaign, Vec<Digest>), CampaignFileError> {
+        self.load_with(m, |e| {
+            read_record_at(&e.path, m, &e.params, opts, instrument)
+        })
+    }
+
+    /// [`CampaignFile::load`] with each record's file read by `read` (a record and the
+    /// digest of the bytes read, or the reader's located error): for records that are not
+    /// measurement CSVs (a touch probe's hits, read through its sphere fits).
+    ///
+    /// # Errors
+    /// As [`CampaignFile::load`].
+    pub fn load_with(
+        &self,
+        m: &Machine,
+        mut read: impl FnMut(&CampaignEntry) -> Result<(simulation::record::Record, Digest), CsvError>,
+    ) -> Result<(Campaign, Vec<Digest>), CampaignFileError> {
         let mut records = Vec::with_capacity(self.records.len());
         let mut digests = Vec::with_capacity(self.records.len());
         for e in &self.records {
-            let (record, digest) = read_record_at(&e.path, m, &e.params, opts, instrument)
-                .map_err(|error| CampaignFileError::Record {
-                    at: parameters_note(m, &e.params),
-                    campaign: self.file.clone(),
-                    line: e.line,
-                    label: e.label.clone(),
-                    error: Box::new(error),
-                })?;
+            let (record, digest) = read(e).map_err(|error| CampaignFileError::Record {
+                at: parameters_note(m, &e.params),
+                campaign: self.file.clone(),
+                line: e.line,
+                label: e.label.clone(),
+                error: Box::new(error),
+            })?;
             if e.start_s.is_some() && !record.has_times() {
                 return Err(CampaignFileError::Invalid {
                     file: self.file.clone(),

@@ -81,6 +81,15 @@ pub fn read_sphere_centres(path: &Path, m: &Machine) -> Result<SphereCentres, Cs
     read_centres(&file, f, m, MAX_PROBE_POSES)
 }
 
+/// [`read_sphere_centres`] of the bytes of `reader` (named `file` in messages).
+pub(super) fn read_centres_from(
+    file: &str,
+    reader: impl Read,
+    m: &Machine,
+) -> Result<SphereCentres, CsvError> {
+    read_centres(file, reader, m, MAX_PROBE_POSES)
+}
+
 /// The reader, with at most `max_poses` rows.
 fn read_centres<R: Read>(
     file: &str,

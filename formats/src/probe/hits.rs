@@ -98,6 +98,15 @@ pub fn read_probe_hits(path: &Path, m: &Machine) -> Result<ProbeHits, CsvError> 
     read_hits(&file, f, m, MAX_HITS, MAX_PROBE_POSES)
 }
 
+/// [`read_probe_hits`] of the bytes of `reader` (named `file` in messages).
+pub(super) fn read_hits_from(
+    file: &str,
+    reader: impl Read,
+    m: &Machine,
+) -> Result<ProbeHits, CsvError> {
+    read_hits(file, reader, m, MAX_HITS, MAX_PROBE_POSES)
+}
+
 /// The reader, with at most `max_hits` rows and `max_poses` poses.
 fn read_hits<R: Read>(
     file: &str,

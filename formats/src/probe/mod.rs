@@ -26,9 +26,12 @@
 //! so write → read gives the same bits. [`crate::poses::from_file_units`] gives the commands in
 //! mm and rad the computation takes.
 //!
-//! Files: `table` (the header and rows both CSVs share), `hits`, `centres`, `instrument`.
+//! [`file`] reads either CSV, told apart by its header ([`read_probe_file`]).
+//!
+//! Files: `table` (the header and rows both CSVs share), `hits`, `centres`, `file`, `instrument`.
 
 pub mod centres;
+pub mod file;
 pub mod hits;
 pub mod instrument;
 mod table;
@@ -37,6 +40,7 @@ pub use centres::{
     CENTRE_COLUMNS, SphereCentre, SphereCentres, format_sphere_centres, parse_sphere_centres,
     read_sphere_centres,
 };
+pub use file::{ProbeFile, read_probe_file};
 pub use hits::{
     HIT_COLUMNS, ProbeHit, ProbeHits, ProbePose, format_probe_hits, parse_probe_hits,
     read_probe_hits,

@@ -312,6 +312,10 @@ pub struct IdentificationReport {
     /// How a long record was read in blocks (`--stream`); absent when it was read whole.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub streaming: Option<StreamingReport>,
+    /// The touch probe's sphere fits and the dispersion per rotary axis, when the records
+    /// were read through a probe (`--probe`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe: Option<super::probe::ProbeReport>,
     /// Statements for people (what was swallowed, what has no value and why, non-convergence,
     /// set-up errors the records cannot tell from the machine's).
     pub notes: Vec<String>,

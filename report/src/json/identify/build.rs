@@ -173,6 +173,7 @@ impl IdentificationReport {
             refinement,
             noise_model: Some(noise_report(&ident.noise, ident.whitened_sigma)?),
             streaming: None,
+            probe: None,
             notes: all_notes,
         })
     }

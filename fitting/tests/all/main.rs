@@ -19,6 +19,7 @@ mod plan;
 mod plan_reversal;
 mod plan_update;
 mod probe_readings;
+mod probe_simulation;
 mod sphere;
 mod streaming;
 mod templates;

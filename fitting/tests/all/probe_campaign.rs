@@ -1,0 +1,293 @@
+//! A touch-probe campaign on the exact virtual machine identifies the machine's location
+//! errors: probe hits simulated with `simulation::probe`, fitted into readings by
+//! `fitting::probe`, identified as any campaign. The uncertainties hold over seeds.
+
+use crate::common::builtin;
+use fitting::campaign::CampaignIdentification;
+use fitting::probe::{PreTravel as DeclaredPreTravel, ProbeSettings, probe_record};
+use fitting::{Constraint, IdentifyOptions, identify};
+use formats::probe::{ProbeHit, ProbeHits, ProbePose};
+use model_spec::{AxisKind, Machine};
+use simulation::campaign::Campaign;
+use simulation::model::Model;
+use simulation::probe::{self as sim, PreTravel, ProbeRun, simulate_probe};
+use simulation::truth::Truth;
+
+const SPHERE_MM: f64 = 12.5;
+const TIP_MM: f64 = 1.5;
+const NOISE_MM: f64 = 0.5e-3;
+
+/// A machine, its truth (location and set-up errors), the model fitted and its constraint.
+pub struct Case {
+    pub m: Machine,
+    pub truth: Truth,
+    pub model: Model,
+    pub constraint: Constraint,
+}
+
+fn truth(m: &Machine, errors: &str) -> Truth {
+    formats::truth::parse_truth(
+        "t.toml",
+        &format!("machine = \"{}\"\n[errors]\n{errors}", m.name),
+        m,
+    )
+    .unwrap()
+}
+
+/// The cases of the acceptance: seed-ac's reduced model; on table-table-bc and head-table-bc
+/// the location errors of B and C and the sphere's set-up errors (the squareness of the
+/// linear axes needs the sphere at several positions), head-table-bc with XOC and ZOW held at
+/// zero (a sphere at one position does not separate them from the others).
+pub fn case(name: &str) -> Case {
+    let m = builtin(name);
+    let (errors, model, constraint) = match name {
+        "seed-ac" => (
+            "XOW = 12\nYOW = -18\nZOW = 15\nYOA = 20\nZOA = -15\nBOA = 25\nCOA = -18\nXOC = 10\nYOC = -22\nAOC = 30\nBOC = -12\n",
+            "reduced",
+            Constraint::None,
+        ),
+        "table-table-bc" => (
+            "XOW = -8\nYOW = 14\nZOW = 6\nXOB = 15\nZOB = -12\nAOB = 20\nCOB = -25\nXOC = 9\nYOC = -11\nAOC = 18\nBOC = 22\n",
+            "XOW YOW ZOW XOB ZOB AOB COB XOC YOC AOC BOC",
+            Constraint::None,
+        ),
+        _ => (
+            "YOW = 5\nXOW = 10\nXOB = -14\nZOB = 9\nAOB = 16\nCOB = -21\nYOC = 8\nAOC = -15\nBOC = 19\n",
+            "XOW YOW ZOW XOB ZOB AOB COB XOC YOC AOC BOC",
+            Constraint::Zero(vec!["XOC".into(), "ZOW".into()]),
+        ),
+    };
+    let model = Model::of(&m, model).unwrap_or_else(|| {
+        let ids: Vec<usize> = model
+            .split(' ')
+            .map(|e| m.error_by_name(e).unwrap())
+            .collect();
+        Model::constant(&ids)
+    });
+    Case {
+        truth: truth(&m, errors),
+        model,
+        m,
+        constraint,
+    }
+}
+
+/// `n` equally spaced positions of each rotary axis over its range (a full turn: `n` steps of
+/// 360°/n), the others at 0; the pose with every rotary axis at 0 once.
+pub fn sweep(m: &Machine, n: usize) -> Vec<Vec<f64>> {
+    let mut poses: Vec<Vec<f64>> = Vec::new();
+    for k in m.rotary_axes() {
+        let [lo, hi] = m.axes[k].limits;
+        for i in 0..n {
+            let deg = if lo.is_finite() && hi.is_finite() && hi - lo < 360.0 {
+                lo + (hi - lo) * i as f64 / (n - 1) as f64
+            } else {
+                360.0 * i as f64 / n as f64
+            };
+            let mut q = vec![0.0; m.axes.len()];
+            q[k] = deg.to_radians();
+            if !poses.iter().any(|p| p == &q) {
+                poses.push(q);
+            }
+        }
+    }
+    poses
+}
+
+/// The hits of `run` as the probe hits file gives them (rotary axes in degrees).
+pub fn hits_of(m: &Machine, run: &ProbeRun) -> ProbeHits {
+    let mut line = 1;
+    ProbeHits {
+        poses: run
+            .poses
+            .iter()
+            .enumerate()
+            .map(|(i, p)| ProbePose {
+                label: sim::pose_label(i),
+                hits: p
+                    .hits
+                    .iter()
+                    .map(|h| {
+                        line += 1;
+                        ProbeHit {
+                            line,
+                            axes: m
+                                .axes
+                                .iter()
+                                .zip(&h.latched)
+                                .map(|(a, &x)| match a.kind {
+                                    AxisKind::Linear => x,
+                                    AxisKind::Rotary => x.to_degrees(),
+                                })
+                                .collect(),
+                            direction: [h.approach.x, h.approach.y, h.approach.z],
+                            t_s: h.t_s,
+                        }
+                    })
+                    .collect(),
+            })
+            .collect(),
+    }
+}
+
+/// The probe campaign of `case` at `poses` with noise seed `seed` and pre-travel `pre`,
+/// declared to the reader as `declared`, identified.
+pub fn identified(
+    case: &Case,
+    poses: &[Vec<f64>],
+    seed: u64,
+    pre: PreTravel,
+    declared: DeclaredPreTravel,
+) -> CampaignIdentification {
+    let m = &case.m;
+    let params = m.default_parameters();
+    let run = simulate_probe(
+        m,
+        &params,
+        &case.truth,
+        poses,
+        &sim::ProbeSettings {
+            tip_radius_mm: TIP_MM,
+            sphere_radius_mm: SPHERE_MM,
+            pre_travel: pre,
+            noise_mm: NOISE_MM,
+            seed,
+        },
+    )
+    .unwrap();
+    let settings = ProbeSettings {
+        tip_radius_mm: TIP_MM,
+        sphere_radius_mm: SPHERE_MM,
+        noise_mm: Some(NOISE_MM),
+        declared,
+        max_reading_mm: 1.0,
+        off_sphere_mm: 0.5,
+    };
+    let read = probe_record("h.csv", m, &params, &hits_of(m, &run), &settings).unwrap();
+    let campaign = Campaign::of_record(read.record, params, false);
+    let opts = IdentifyOptions::new().constraint(case.constraint.clone());
+    identify(m, &case.model, &campaign, &opts).unwrap()
+}
+
+/// Per determined parameter, `(name, z = (value − truth)/std)`; panics when a parameter of the
+/// model that the constraint does not fix is undetermined.
+pub fn z_scores(case: &Case, ident: &CampaignIdentification) -> Vec<(String, f64)> {
+    let fit = &ident.fit;
+    let mut out = Vec::new();
+    for (k, name) in fit.names.iter().enumerate() {
+        if fit.fixed[k] {
+            continue;
+        }
+        let (Some(v), Some(s)) = (fit.values[k], fit.std[k]) else {
+            panic!("{}: {name} is not determined: {:?}", case.m.name, fit.names);
+        };
+        let column = &ident.layout.columns[k];
+        let t = case
+            .truth
+            .coefficient(&column.term)
+            .map_or(0.0, |c| c[column.component]);
+        out.push((name.clone(), (v - t) / s));
+    }
+    out
+}
+
+#[test]
+fn a_probe_campaign_identifies_the_location_errors_within_four_std() {
+    for name in ["seed-ac", "table-table-bc", "head-table-bc"] {
+        let case = case(name);
+        let poses = sweep(&case.m, 6);
+        let ident = identified(&case, &poses, 11, PreTravel::default(), Default::default());
+        let z = z_scores(&case, &ident);
+        assert!(!z.is_empty());
+        for (n, z) in &z {
+            assert!(z.abs() < 4.0, "{name}: {n} is {z:.2} std off the truth");
+        }
+    }
+}
+
+/// The mean z² over the determined parameters of `case` over `seeds` noise seeds.
+pub fn mean_z2(case: &Case, poses: &[Vec<f64>], seeds: std::ops::Range<u64>) -> f64 {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for seed in seeds {
+        let ident = identified(case, poses, seed, PreTravel::default(), Default::default());
+        for (_, z) in z_scores(case, &ident) {
+            sum += z * z;
+            n += 1;
+        }
+    }
+    sum / n as f64
+}
+
+#[test]
+fn the_uncertainties_hold_over_seeds() {
+    // 40 seeds per machine here; the 200-seed study is `probe_uncertainty_study` (ignored).
+    for name in ["seed-ac", "table-table-bc", "head-table-bc"] {
+        let case = case(name);
+        let z2 = mean_z2(&case, &sweep(&case.m, 6), 0..40);
+        assert!(
+            (0.75..1.3).contains(&z2),
+            "{name}: mean z² {z2:.3} over 40 seeds"
+        );
+    }
+}
+
+#[test]
+#[ignore = "study: 200 seeds per machine, about a minute; `cargo test --release -p fitting --test all probe_uncertainty_study -- --ignored --nocapture`"]
+fn probe_uncertainty_study() {
+    for name in ["seed-ac", "table-table-bc", "head-table-bc"] {
+        let case = case(name);
+        let z2 = mean_z2(&case, &sweep(&case.m, 6), 0..200);
+        println!("{name}: mean z² {z2:.3} over 200 seeds");
+        assert!((0.8..1.25).contains(&z2), "{name}: mean z² {z2:.3}");
+    }
+}
+
+#[test]
+fn a_declared_lobing_is_removed_and_an_undeclared_one_is_seen_on_a_head() {
+    // 2 µm of three-lobed pre-travel. On head-table-bc the probe turns with B, so the lobing
+    // moves each pose's centre differently: undeclared, it pulls the fit off the truth (the
+    // same noise seed both times: the difference is the lobing's bias alone); declared, it is
+    // removed before the sphere fits.
+    let case = case("head-table-bc");
+    let poses = sweep(&case.m, 6);
+    let lobing = PreTravel {
+        constant_mm: 0.0,
+        lobing_mm: [2e-3, 0.0],
+    };
+    let declared = DeclaredPreTravel {
+        constant_mm: 0.0,
+        lobing_mm: [2e-3, 0.0],
+    };
+    let clean = identified(&case, &poses, 5, lobing, declared);
+    for (n, z) in z_scores(&case, &clean) {
+        assert!(z.abs() < 4.0, "declared: {n} is {z:.2} std off");
+    }
+    let blind = identified(&case, &poses, 5, lobing, Default::default());
+    // The same noise: the difference is the lobing's bias alone, in std of the fit.
+    let bias: Vec<(String, f64)> = clean
+        .fit
+        .names
+        .iter()
+        .enumerate()
+        .filter_map(|(k, n)| {
+            let (a, b, s) = (
+                blind.fit.values[k]?,
+                clean.fit.values[k]?,
+                clean.fit.std[k]?,
+            );
+            Some((n.clone(), (a - b) / s))
+        })
+        .collect();
+    println!("the undeclared lobing's bias, in std of the fit: {bias:?}");
+    // Measured: XOB −1.5 std, XOW[record] −0.8 std, the rest below 0.01 std: a bias a single
+    // campaign cannot tell from its noise, which is why a lobing is declared (the probe
+    // calibrated) rather than left in the data.
+    let (name, worst) = bias
+        .iter()
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .unwrap();
+    assert!(
+        name == "XOB" && worst.abs() > 1.0,
+        "undeclared lobing: worst bias {worst:.2} std on {name}"
+    );
+}

@@ -9,5 +9,5 @@ mod fd;
 mod generator_orders;
 mod instrument_description;
 mod instrument_geometry;
-mod simulate;
 mod probe;
+mod simulate;

@@ -196,9 +196,16 @@ fn pre_travel_latches_beyond_the_contact_along_the_approach() {
             // The nominal gap moves by δ·n: inwards, towards the centre.
             let moved = nominal_gap(&m, &hl.latched) - nominal_gap(&m, &he.latched);
             assert!((moved - hl.approach * delta).norm() < 1e-11, "{moved:?}");
-            // On the actual machine the tip is δ closer to the sphere's centre, up to the
-            // errors' change over δ (δ times their gradient along the approach, a product of
-            // small quantities: 34 pm here, 1e-5 of δ).
+            // On the actual machine the tip moves δ·n too, up to the errors' change over δ (δ
+            // times their gradient along the approach, µm/m: 1e-5 of δ at most).
+            let actual = actual_gap(&m, &t, hl, &hl.latched) - actual_gap(&m, &t, he, &he.contact);
+            assert!(
+                (actual - hl.approach * delta).norm() < 1e-4 * delta,
+                "{actual:?}"
+            );
+            // So it is δ closer to the actual sphere's centre, up to δ·(1 − cos θ), θ ≈ |e|/R_eff
+            // the angle at which an approach aimed at the nominal centre meets the sphere about
+            // −e (34 pm here).
             let d = actual_gap(&m, &t, hl, &hl.latched).norm();
             assert!(
                 (d - (R_EFF - delta)).abs() < 5e-5 * delta,

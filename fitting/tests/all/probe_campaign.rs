@@ -219,26 +219,13 @@ pub fn mean_z2(case: &Case, poses: &[Vec<f64>], seeds: std::ops::Range<u64>) -> 
 }
 
 #[test]
-fn the_uncertainties_hold_over_seeds() {
-    // 40 seeds per machine here; the 200-seed study is `probe_uncertainty_study` (ignored).
-    for name in ["seed-ac", "table-table-bc", "head-table-bc"] {
-        let case = case(name);
-        let z2 = mean_z2(&case, &sweep(&case.m, 6), 0..40);
-        assert!(
-            (0.75..1.3).contains(&z2),
-            "{name}: mean z² {z2:.3} over 40 seeds"
-        );
-    }
-}
-
-#[test]
-#[ignore = "study: 200 seeds per machine, about a minute; `cargo test --release -p fitting --test all probe_uncertainty_study -- --ignored --nocapture`"]
-fn probe_uncertainty_study() {
+fn the_uncertainties_hold_over_200_seeds() {
+    // Measured: mean z² 1.114 (seed-ac), 1.053 (table-table-bc), 1.036 (head-table-bc).
     for name in ["seed-ac", "table-table-bc", "head-table-bc"] {
         let case = case(name);
         let z2 = mean_z2(&case, &sweep(&case.m, 6), 0..200);
         println!("{name}: mean z² {z2:.3} over 200 seeds");
-        assert!((0.8..1.25).contains(&z2), "{name}: mean z² {z2:.3}");
+        assert!((0.8..1.25).contains(&z2), "{name}: mean z² {z2:.3} over 200 seeds");
     }
 }
 

@@ -1,6 +1,6 @@
 //! The exact contact of one approach: the distance along the approach at which the tip
-//! centre, on the actual machine with the truth's errors evaluated where the axes are, is
-//! `R_eff` from the actual sphere centre.
+//! centre, on the actual machine with the truth's errors and zero offsets evaluated where the
+//! axes are, is `R_eff` from the actual sphere centre.
 
 use crate::exact::VirtualMachine;
 use crate::model::BasisContext;
@@ -58,8 +58,8 @@ impl Approach<'_, '_> {
         }
     }
 
-    /// The actual gap `P_tool − P_work` (bed frame, mm) at `s`, the truth's errors evaluated
-    /// at the commands there.
+    /// The actual gap `P_tip − P_work` (bed frame, mm) at `s`, the truth's errors and zero
+    /// offsets evaluated at the commands there: `P_tip = P_tool + R_tool·(dx0, dy0, dz0)`.
     fn gap(&self, s: f64, q: &mut [f64], errors: &mut [f64]) -> Vector3<f64> {
         self.commands_at(s, q);
         let m = self.vm.machine();
@@ -78,7 +78,9 @@ impl Approach<'_, '_> {
         let params = &self.truth.params;
         let tool = self.vm.transform_with(Side::Tool, q, params, &value);
         let work = self.vm.transform_with(Side::Work, q, params, &value);
-        tool.translation.vector - work.translation.vector
+        // The truth's zero offsets: the tip centre off the tool point, tool frame.
+        let tip = tool.translation.vector + tool.rotation * Vector3::from(offsets);
+        tip - work.translation.vector
     }
 
     /// The distance `s` (mm) along the approach of the exact contact, `‖gap(s)‖ = R_eff`, and

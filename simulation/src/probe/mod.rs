@@ -17,8 +17,9 @@
 //! the bed frame) the probe starts where the nominal gap is `−n·(R_eff + CLEARANCE_MM)` and
 //! moves so that the nominal gap changes by `s·n`: the linear commands change by `s·A⁻¹·n`.
 //! The contact is the `s` where the actual gap, with the truth's errors evaluated at the
-//! commands there (and the motion, times and velocities of the approach), has the norm `R_eff`
-//! ([`contact`]). The probe latches `δ + ε` later along the approach: `δ` its pre-travel
+//! commands there (and the motion, times and velocities of the approach) and the tip centre
+//! off the tool point by the truth's zero offsets (below), has the norm `R_eff`
+//! (a safeguarded Newton iteration). The probe latches `δ + ε` later along the approach: `δ` its pre-travel
 //! ([`PreTravel`], in the probe's frame), `ε` Gaussian noise of σ `noise_mm` (one standard
 //! normal draw of [`Rng::new`]`(seed)` per hit, in hit order; none when σ is 0). The latched
 //! commands are those at `s + δ + ε` on the same line of commands: the nominal gap moved by
@@ -39,9 +40,13 @@
 //! [`POSE_CHANGE_S`], a latch comes [`APPROACH_S`] after its approach starts. `τ` of the
 //! truth's `time:K` terms runs from −1 at the first latch to 1 at the last.
 //!
-//! **What a truth holds that a probe has not.** The R-test's sensor offsets `dx0 dy0 dz0`, its
-//! instrument terms (`SXX` …) and its reading noise (σ, φ, zeroing) are the R-test's; the
-//! simulation does not use them ([`r_test_terms`] names them for a note).
+//! **The truth's zero offsets and instrument terms.** The truth's `dx0 dy0 dz0` (a probe's
+//! `px0 py0 pz0`) put the tip centre off the tool point by `(dx0, dy0, dz0)` in the actual
+//! tool frame, `P_tip = P_tool + R_tool·o`: the probe's length and centring errors. A sphere
+//! fit then reads `e + o`, as an R-test reads its zero offsets. The R-test's instrument terms
+//! (`SXX` …) act on sensor readings a probe has not, and its reading noise (σ, φ, zeroing) is
+//! not the probe's: the simulation does not use them ([`unused_terms`] names the terms for a
+//! note).
 
 mod contact;
 mod pattern;

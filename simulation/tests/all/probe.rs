@@ -69,7 +69,7 @@ fn case(name: &str) -> (Machine, Truth, Vec<Vec<f64>>) {
         "table-table-bc" => {
             let t = truth(
                 &m,
-                "[parameters]\nZc = 60.05\n[errors]\nXOW = -8\nYOW = 14\nZOW = 6\nXOB = 15\nZOB = -12\nAOB = 20\nCOB = -25\nXOC = 9\nYOC = -11\nAOC = 18\nBOC = 22\nCOY = 12\nAOZ = -9\nBOZ = 7\nEYY = { reversal = 3 }\nEBB = { \"harmonic:1\" = [10, -5] }\n",
+                "[parameters]\nZc = 60.05\n[errors]\ndy0 = -5\nXOW = -8\nYOW = 14\nZOW = 6\nXOB = 15\nZOB = -12\nAOB = 20\nCOB = -25\nXOC = 9\nYOC = -11\nAOC = 18\nBOC = 22\nCOY = 12\nAOZ = -9\nBOZ = 7\nEYY = { reversal = 3 }\nEBB = { \"harmonic:1\" = [10, -5] }\n",
             );
             let p = poses(
                 &m,
@@ -85,7 +85,7 @@ fn case(name: &str) -> (Machine, Truth, Vec<Vec<f64>>) {
         _ => {
             let t = truth(
                 &m,
-                "[parameters]\nZt = -250.1\n[errors]\nXOW = 10\nYOW = 5\nZOW = -20\nXOB = -14\nZOB = 9\nAOB = 16\nCOB = -21\nXOC = 12\nYOC = 8\nAOC = -15\nBOC = 19\nCOY = -6\nAOZ = 11\nBOZ = 5\nEZZ = { reversal = 2 }\nEBB = 12\n",
+                "[parameters]\nZt = -250.1\n[errors]\ndx0 = 7\ndy0 = -4\ndz0 = 9\nXOW = 10\nYOW = 5\nZOW = -20\nXOB = -14\nZOB = 9\nAOB = 16\nCOB = -21\nXOC = 12\nYOC = 8\nAOC = -15\nBOC = 19\nCOY = -6\nAOZ = 11\nBOZ = 5\nEZZ = { reversal = 2 }\nEBB = 12\n",
             );
             let p = poses(
                 &m,
@@ -101,14 +101,17 @@ fn case(name: &str) -> (Machine, Truth, Vec<Vec<f64>>) {
     }
 }
 
-/// The actual gap `P_tool − P_work` (bed frame, mm) at `commands`, the truth's errors
-/// evaluated there with the hit's motion, times and velocities.
+/// The actual gap `P_tip − P_work` (bed frame, mm) at `commands`, the truth's errors
+/// evaluated there with the hit's motion, times and velocities, the tip centre off the tool
+/// point by the truth's zero offsets in the actual tool frame.
 fn actual_gap(m: &Machine, t: &Truth, hit: &SimulatedHit, commands: &[f64]) -> Vector3<f64> {
-    let errors = t.error_values(m, &hit.context(commands));
+    let cx = hit.context(commands);
+    let errors = t.error_values(m, &cx);
+    let offsets = Vector3::from(t.sensor_offsets(m, &cx));
     let vm = VirtualMachine::new(m);
     let tool = vm.chain_transform(Side::Tool, commands, &t.params, &errors);
     let work = vm.chain_transform(Side::Work, commands, &t.params, &errors);
-    tool.translation.vector - work.translation.vector
+    tool.translation.vector + tool.rotation * offsets - work.translation.vector
 }
 
 /// The nominal gap (bed frame, mm) at `commands`: the tip centre from the nominal sphere

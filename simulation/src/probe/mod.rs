@@ -238,19 +238,15 @@ fn direction(n: &Vector3<f64>) -> String {
     format!("({}, {}, {})", c(n.x), c(n.y), c(n.z))
 }
 
-/// The R-test terms of `truth` a probe simulation does not use: its sensor offsets and
-/// instrument terms, by name (empty when it has none).
-pub fn r_test_terms(m: &Machine, truth: &Truth) -> Vec<String> {
+/// The terms of `truth` a probe simulation does not use, by name (empty when it has none):
+/// every term that is neither a machine error nor a zero offset (the R-test's instrument
+/// terms).
+pub fn unused_terms(m: &Machine, truth: &Truth) -> Vec<String> {
     truth
         .model
         .terms
         .iter()
-        .filter(|t| {
-            matches!(
-                t.effect,
-                Effect::SensorOffset(_) | Effect::Instrument { .. }
-            )
-        })
+        .filter(|t| !matches!(t.effect, Effect::Error(_) | Effect::SensorOffset(_)))
         .map(|t| t.effect.name(m))
         .collect()
 }

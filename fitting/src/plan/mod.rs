@@ -18,13 +18,17 @@
 //!   the reason;
 //! - [`choose`]: the criterion and the ranking of the candidates, best first;
 //! - [`separate`]: a position term of an axis and a time term the plan does not separate, and
-//!   the reversed or there-and-back test that separates them.
+//!   the reversed or there-and-back test that separates them;
+//! - [`mod@probe`]: a touch-probe campaign: the probing poses per rotary axis, their readings'
+//!   covariances from the sphere fit, their prediction and the valuation numbers
+//!   (`docs/probe-plan.md`).
 //!
 //! `docs/plan.md` describes the method, the criterion and `rtest plan`.
 
 pub mod candidates;
 pub mod choose;
 pub mod predict;
+pub mod probe;
 pub mod separate;
 pub mod update;
 

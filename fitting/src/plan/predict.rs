@@ -23,6 +23,15 @@
 //! determined are those of the ordinary `H` (the poses' geometry; [`least_squares`] with the
 //! default tolerances); the whitened system must agree on them. A parameter the plan cannot
 //! determine gets no uncertainty.
+//!
+//! A campaign whose readings carry their own covariance `Σ_i` (one 3 × 3 per sample,
+//! [`simulation::record::Record::covariance`]: a touch-probe campaign, whose readings are
+//! sphere centres fitted from the probe's hits) is predicted by [`predict_with_covariances`]:
+//! each sample's three rows are whitened by `L_i⁻¹` (`Σ_i = L_i·L_iᵀ`), the weighting the
+//! campaign fit applies to such records ([`crate::campaign::whitening`]), and the covariances
+//! declare the noise, so `Cov(p̂) = (Hᵀ·Σ⁻¹·H)⁻¹` on the determined parameters, optionally under
+//! a [`Constraint::Zero`] (the named parameters fixed to 0, as the fit fixes them; they get no
+//! uncertainty and count as not determined).
 
 use crate::campaign::Owner;
 use crate::campaign::design::Solved;
@@ -33,7 +42,7 @@ use crate::identify::check_readings;
 use crate::least_squares::{
     Constraint, EstimateError, Tolerances, least_squares, least_squares_reduced,
 };
-use crate::noise::{NoiseError, NoiseModel};
+use crate::noise::{NoiseChoice, NoiseError, NoiseModel, NoiseSource, SampleWhitening};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector};
 use simulation::campaign::Campaign;
@@ -56,7 +65,7 @@ pub struct Prediction {
     pub singular_values: Vec<f64>,
     /// `σ_max / σ_r` of the column-scaled H; `None` when the rank is 0.
     pub condition: Option<f64>,
-    /// Whether the plan determines each column.
+    /// Whether the plan determines each column (not a column a constraint fixes to 0).
     pub determined: Vec<bool>,
     /// Groups of columns the plan cannot separate (indices), each ascending.
     pub confounded: Vec<Vec<usize>>,
@@ -111,18 +120,58 @@ pub fn predict_design(
     noise: &NoiseModel,
     tol: &Tolerances,
 ) -> Result<Prediction, EstimateError> {
+    predict_rows(design, None, noise, &Constraint::None, tol)
+}
+
+/// The prediction of `campaign` from its `design` matrix when every record carries the
+/// covariance of each reading (module documentation): `Cov(p̂) = (Hᵀ·Σ⁻¹·H)⁻¹` on what is
+/// determined, under `constraint` (`Zero` names as the campaign's columns or, for a campaign of
+/// one record, the record's own: `ZOW` for `ZOW[probe]`). The [`Prediction::noise`] is white
+/// with σ the root mean variance of one component of the readings (the scale of the
+/// per-sample whitening).
+///
+/// # Errors
+/// As [`predict`]; [`EstimateError::Noise`] when a record carries no covariances or one is not
+/// positive definite; an unknown name in the constraint.
+pub fn predict_with_covariances(
+    design: &Design,
+    campaign: &Campaign,
+    constraint: &Constraint,
+    tol: &Tolerances,
+) -> Result<Prediction, EstimateError> {
+    let Some(weights) = crate::campaign::whitening(campaign, &NoiseChoice::Ordinary)? else {
+        return Err(NoiseError::Whitening(
+            "the campaign's records carry no covariance of their readings: predict it under a noise model (predict_design)".into(),
+        )
+        .into());
+    };
+    let noise = NoiseModel::white(weights.scale_mm, NoiseSource::Declared);
+    predict_rows(design, Some(&weights), &noise, constraint, tol)
+}
+
+/// The prediction of `design`: rows whitened by the per-sample `weights` when given, then by
+/// `noise`, under `constraint`.
+fn predict_rows(
+    design: &Design,
+    weights: Option<&SampleWhitening>,
+    noise: &NoiseModel,
+    constraint: &Constraint,
+    tol: &Tolerances,
+) -> Result<Prediction, EstimateError> {
     noise.check()?;
     let samples: usize = design.rows.iter().sum();
     check_readings(samples, design.names.len())?;
     let Solved { h, names, order } = Solved::copied(design);
     let rows = h.nrows();
     let zero = DVector::zeros(rows);
-    let ordinary = least_squares(&h, &zero, &names, &Constraint::None, tol)?;
+    let ordinary = least_squares(&h, &zero, &names, constraint, tol)?;
     let mut hw = h;
+    if let Some(w) = weights {
+        w.whiten_matrix(&mut hw)?;
+    }
     noise.whiten_matrix(&design.rows, &mut hw)?;
     let dof = ordinary.dof;
-    let white =
-        least_squares_reduced(&hw, &zero, &names, &Constraint::None, tol, rows, dof as f64)?;
+    let white = least_squares_reduced(&hw, &zero, &names, constraint, tol, rows, dof as f64)?;
     if white.rank != ordinary.rank
         || white.identifiability.determined != ordinary.identifiability.determined
     {
@@ -138,7 +187,17 @@ pub fn predict_design(
     fit.covariance = white.covariance;
     fit.correlation = white.correlation;
     fit.identifiability.near_confounded = white.identifiability.near_confounded;
-    let fit = to_layout_order(fit, &order);
+    let mut fit = to_layout_order(fit, &order);
+    // A parameter fixed by the constraint is no estimate of the plan: not determined, no
+    // uncertainty.
+    for j in (0..fit.names.len()).filter(|&j| fit.fixed[j]) {
+        fit.identifiability.determined[j] = false;
+        fit.std[j] = None;
+        for k in 0..fit.names.len() {
+            fit.covariance[(j, k)] = f64::NAN;
+            fit.covariance[(k, j)] = f64::NAN;
+        }
+    }
     if let Some(j) = (0..fit.names.len())
         .find(|&j| fit.identifiability.determined[j] && fit.std[j].is_none_or(|s| !s.is_finite()))
     {

@@ -33,6 +33,7 @@ mod cli_reversal;
 mod cli_segment;
 mod cli_sensor_campaign;
 mod cli_siemens;
+mod cli_simulate_probe;
 mod cli_stream;
 mod cli_templates;
 mod cli_timebases;

@@ -33,6 +33,7 @@ pub mod report;
 mod report_files;
 pub mod segment;
 pub mod simulate;
+pub mod simulate_probe;
 pub mod validate;
 pub mod volumetric;
 

@@ -37,6 +37,11 @@ workpiece, tool frame, µm) and t_s (s). It is read back first: readings `identi
 (beyond --max-reading-um) are an error (exit code 3) and nothing is written. `-o -` writes it to \
 standard output. Prints the samples and the RMS of the readings (µm).
 
+With --probe FILE (a probe instrument file, docs/probe.md) it simulates a touch probe instead: \
+9 hits on the calibration sphere at each pose of the path, exact contacts with the truth's \
+errors, the probe's pre-travel and noise (--noise-um overrides the file's noise_um), written as a \
+probe hits CSV (docs/probe-simulation.md).
+
 Details (paths, truths, the CSV, --commanded, --instrument): docs/truth.md.";
 
 /// Flags of `rtest simulate`.
@@ -83,6 +88,12 @@ pub struct SimulateArgs {
     /// compensates reports the program's positions, not the corrected ones.
     #[arg(long, value_name = "FILE")]
     commanded: Option<std::path::PathBuf>,
+    /// A probe instrument file (TOML, docs/probe.md): simulate touch-probe hits on the
+    /// calibration sphere at every pose of --path instead of R-test readings, and write a probe
+    /// hits CSV (docs/probe-simulation.md); --noise-um is then the probe's noise.
+    #[arg(long, value_name = "FILE",
+          conflicts_with_all = ["zeroed", "noise_phi", "commanded", "instrument"])]
+    probe: Option<std::path::PathBuf>,
     /// The measurement CSV to write (`-`: standard output).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     output: Target,
@@ -176,6 +187,9 @@ pub fn run(args: &SimulateArgs) -> VerbResult<Done> {
         inputs.push(("--commanded", c.as_path()));
     }
     inputs.extend(args.instrument.input());
+    if let Some(p) = &args.probe {
+        inputs.push(("--probe", p.as_path()));
+    }
     check_outputs(&inputs, &[("-o", &args.output)], &[])?;
     let mut truth = truth(&m, args.truth.as_deref())?;
     // A ball position on the command line: the machine as planned there, the truth's real
@@ -193,6 +207,18 @@ pub fn run(args: &SimulateArgs) -> VerbResult<Done> {
         }
         other => Error::input(format!("--path: {other}")),
     })?;
+    if let Some(probe_file) = &args.probe {
+        return super::simulate_probe::run(&super::simulate_probe::ProbeRequest {
+            machine: &m,
+            path_name: &args.path,
+            path: &path,
+            truth: &truth,
+            probe_file,
+            noise_mm: noise,
+            seed: args.seed,
+            output: &args.output,
+        });
+    }
     if let Some(n) = noise {
         truth.noise_mm = n;
     }

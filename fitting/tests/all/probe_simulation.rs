@@ -47,12 +47,12 @@ fn poses(m: &Machine, angles: &[[(&str, f64); 2]]) -> Vec<Vec<f64>> {
 }
 
 /// Per machine: errors that are constant within a pose (set-up, location and rotary-axis
-/// errors, kinematic parameters off the plan) and four poses.
+/// errors, kinematic parameters off the plan, the probe's zero offsets) and four poses.
 fn case(name: &str) -> (Machine, String, Vec<Vec<f64>>) {
     let m = builtin(name);
     let (constant, angles) = match name {
         "seed-ac" => (
-            "[parameters]\nZw = 211.6\n[errors]\nXOW = 12\nYOW = -18\nZOW = 15\nYOA = 20\nZOA = -15\nBOA = 25\nCOA = -18\nXOC = 10\nYOC = -22\nAOC = 30\nBOC = -12\nECC = { \"harmonic:2\" = [8, 6] }\n",
+            "[parameters]\nZw = 211.6\n[errors]\ndx0 = 3\ndz0 = -5\nXOW = 12\nYOW = -18\nZOW = 15\nYOA = 20\nZOA = -15\nBOA = 25\nCOA = -18\nXOC = 10\nYOC = -22\nAOC = 30\nBOC = -12\nECC = { \"harmonic:2\" = [8, 6] }\n",
             [
                 [("A", 0.0), ("C", 0.0)],
                 [("A", -30.0), ("C", 90.0)],
@@ -61,7 +61,7 @@ fn case(name: &str) -> (Machine, String, Vec<Vec<f64>>) {
             ],
         ),
         "table-table-bc" => (
-            "[parameters]\nZc = 60.05\n[errors]\nXOW = -8\nYOW = 14\nZOW = 6\nXOB = 15\nZOB = -12\nAOB = 20\nCOB = -25\nXOC = 9\nYOC = -11\nAOC = 18\nBOC = 22\nEBB = { \"harmonic:1\" = [10, -5] }\n",
+            "[parameters]\nZc = 60.05\n[errors]\ndy0 = 4\nXOW = -8\nYOW = 14\nZOW = 6\nXOB = 15\nZOB = -12\nAOB = 20\nCOB = -25\nXOC = 9\nYOC = -11\nAOC = 18\nBOC = 22\nEBB = { \"harmonic:1\" = [10, -5] }\n",
             [
                 [("B", 0.0), ("C", 0.0)],
                 [("B", 45.0), ("C", 30.0)],
@@ -70,7 +70,7 @@ fn case(name: &str) -> (Machine, String, Vec<Vec<f64>>) {
             ],
         ),
         _ => (
-            "[parameters]\nZt = -250.1\n[errors]\nXOW = 10\nYOW = 5\nZOW = -20\nXOB = -14\nZOB = 9\nAOB = 16\nCOB = -21\nXOC = 12\nYOC = 8\nAOC = -15\nBOC = 19\nEBB = 12\n",
+            "[parameters]\nZt = -250.1\n[errors]\ndx0 = 7\ndy0 = -4\ndz0 = 9\nXOW = 10\nYOW = 5\nZOW = -20\nXOB = -14\nZOB = 9\nAOB = 16\nCOB = -21\nXOC = 12\nYOC = 8\nAOC = -15\nBOC = 19\nEBB = 12\n",
             [
                 [("C", 0.0), ("B", 0.0)],
                 [("C", 30.0), ("B", 45.0)],
@@ -114,8 +114,9 @@ fn fit(m: &Machine, pose: &SimulatedPose) -> SphereFit {
     fit_sphere(&latches, &options).unwrap()
 }
 
-/// The exact error vector's position part at the pose (tool frame, tool minus workpiece),
-/// rotated into the bed frame with the actual tool rotation.
+/// The exact error vector's position part at the pose (tool frame, tool minus workpiece) plus
+/// the truth's zero offsets (what an R-test would read there), rotated into the bed frame with
+/// the actual tool rotation.
 fn error_in_bed_frame(m: &Machine, t: &Truth, pose: &SimulatedPose) -> Vector3<f64> {
     let q = &pose.commands;
     let motion = vec![1i8; m.axes.len()];
@@ -129,9 +130,10 @@ fn error_in_bed_frame(m: &Machine, t: &Truth, pose: &SimulatedPose) -> Vector3<f
         reading: [0.0; 3],
     };
     let errors = t.error_values(m, &cx);
+    let offsets = Vector3::from(t.sensor_offsets(m, &cx));
     let e = simulation::error_vector(m, q, &t.params, &errors);
     let tool = VirtualMachine::new(m).chain_transform(Side::Tool, q, &t.params, &errors);
-    tool.rotation * e.position
+    tool.rotation * (e.position + offsets)
 }
 
 fn run(m: &Machine, t: &Truth, p: &[Vec<f64>], pre: PreTravel) -> ProbeRun {
@@ -166,7 +168,8 @@ fn centre_minus_error(name: &str, errors: &str) -> Vec<(Vector3<f64>, Vector3<f6
 #[test]
 fn the_fitted_centre_is_minus_the_error_vector_in_the_bed_frame() {
     for name in ["seed-ac", "table-table-bc", "head-table-bc"] {
-        // Errors constant within a pose: the hits lie on a sphere about −e, exactly.
+        // Errors constant within a pose: the hits lie on a sphere about −e, exactly; the
+        // probe's zero offsets add to e as an R-test's do.
         let (_, constant, _) = case(name);
         for (d, e) in centre_minus_error(name, &constant) {
             assert!(e.norm() > 0.02, "{name}: the error vector is {e:?} mm");

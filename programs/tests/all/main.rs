@@ -8,5 +8,7 @@ mod common;
 mod one_record;
 
 mod nc_measure;
+mod probe_log;
+mod probe_program;
 mod segment;
 mod sequence;

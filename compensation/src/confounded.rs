@@ -68,7 +68,7 @@ pub const ANGLES: usize = 9;
 /// Whether a term is a function of the pose alone (no time, no direction of motion, no
 /// reading).
 fn of_the_pose(t: &Term) -> bool {
-    !matches!(t.effect, Effect::Instrument { .. })
+    !matches!(t.effect, Effect::Instrument { .. } | Effect::PreTravel)
         && matches!(
             t.basis,
             Basis::Const | Basis::Harmonic(_) | Basis::Poly(_) | Basis::Period(_) | Basis::Step(_)

@@ -245,6 +245,9 @@ fn left_out_reason(m: &Machine, term: &Term) -> Option<String> {
         (Effect::SensorOffset(_), _) => {
             "a zero offset of the R-test's reading, not an error of the machine"
         }
+        (Effect::PreTravel, _) => {
+            "the touch probe's pre-travel (its lobing in the approach azimuth), not an error of the machine"
+        }
         (Effect::Instrument { .. }, _) => {
             "an instrument term of the R-test (a sensor's gain or cross-talk), not an error of the machine"
         }

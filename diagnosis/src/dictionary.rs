@@ -101,6 +101,8 @@ fn bases(m: &Machine, effect: Effect, o: &DictionaryOptions) -> Vec<Basis> {
                 .collect();
         }
         Effect::Instrument { .. } | Effect::KinematicOffset(_) => return vec![Basis::Const],
+        // A three-point probe's lobing.
+        Effect::PreTravel => return vec![Basis::Harmonic(3)],
         Effect::Error(e) => &m.catalogue[e],
     };
     match e.kind {

@@ -68,6 +68,7 @@ pub fn hidden_terms(
             measured,
             covariance: fitted.covariance.clone(),
             lines: fitted.lines.clone(),
+            probe: fitted.probe.clone(),
         };
         let campaign = Campaign::of_record(alone, m.default_parameters(), false);
         let ident = identify(m, model, &campaign, &IdentifyOptions::default())?;

@@ -37,6 +37,13 @@ pub enum Effect {
         /// The direction of the displacement it takes.
         displacement: Dir,
     },
+    /// A touch probe's pre-travel (`PRE`), in the approach azimuth about the stylus: with
+    /// `PRE@harmonic:K` the pre-travel of a hit is `ρ·(a·cos Kφ + b·sin Kφ)` (mm; `φ` the
+    /// approach's azimuth about the stylus, `ρ` its part across it, probe frame), and the
+    /// term's columns are what that does to each pose's sphere-fit centre, per record of probe
+    /// hits (`fitting::probe`). A constant pre-travel moves no centre of a free-radius sphere
+    /// fit (the radii show it): harmonics only.
+    PreTravel,
     /// A kinematic offset of the machine description: the symbol (index into
     /// `Machine::symbols`) whose value the identification changes. Its coefficient is the
     /// change from the value the record is modelled with (mm inside, µm for people); its gain is
@@ -49,7 +56,8 @@ pub enum Effect {
 /// The effect names that are no machine error (`dx0 dy0 dz0`, `SXX` … `SZY`): reserved, so a
 /// machine description may not give them to a kinematic symbol.
 pub const MEASUREMENT_EFFECTS: &[&str] = &[
-    "dx0", "dy0", "dz0", "SXX", "SXY", "SXZ", "SYX", "SYY", "SYZ", "SZX", "SZY", "SZZ",
+    "dx0", "dy0", "dz0", "px0", "py0", "pz0", "PRE", "SXX", "SXY", "SXZ", "SYX", "SYY", "SYZ",
+    "SZX", "SZY", "SZZ",
 ];
 
 impl Effect {
@@ -77,6 +85,9 @@ impl Effect {
     /// The effect of the measurement (not of the machine) called `name`: a sensor offset
     /// (`dx0 dy0 dz0`, any case) or an instrument term (`SXX` … `SZY`, upper case), or `None`.
     pub fn parse_measurement(name: &str) -> Option<Effect> {
+        if name.trim() == "PRE" {
+            return Some(Effect::PreTravel);
+        }
         Effect::parse_offset(name).or_else(|| Effect::parse_instrument(name))
     }
 
@@ -109,12 +120,13 @@ impl Effect {
         })
     }
 
-    /// The sensor offset called `name` (`dx0 dy0 dz0`, any case), or `None`.
+    /// The sensor offset called `name` (`dx0 dy0 dz0`, any case; `px0 py0 pz0`, a touch
+    /// probe's zero, are the same offsets of the reading in the tool frame), or `None`.
     pub fn parse_offset(name: &str) -> Option<Effect> {
         match name.trim().to_ascii_lowercase().as_str() {
-            "dx0" => Some(Effect::SensorOffset(Dir::X)),
-            "dy0" => Some(Effect::SensorOffset(Dir::Y)),
-            "dz0" => Some(Effect::SensorOffset(Dir::Z)),
+            "dx0" | "px0" => Some(Effect::SensorOffset(Dir::X)),
+            "dy0" | "py0" => Some(Effect::SensorOffset(Dir::Y)),
+            "dz0" | "pz0" => Some(Effect::SensorOffset(Dir::Z)),
             _ => None,
         }
     }
@@ -125,6 +137,7 @@ impl Effect {
             Effect::Error(e) => m.catalogue[e].name.clone(),
             Effect::KinematicOffset(s) => m.symbols[s].name.clone(),
             Effect::SensorOffset(d) => format!("d{d}0"),
+            Effect::PreTravel => "PRE".into(),
             Effect::Instrument {
                 reading,
                 displacement,
@@ -194,9 +207,10 @@ impl Effect {
                 crate::ErrorKind::Component { axis, .. } => Carrier::Axis(axis),
                 _ => Carrier::None,
             },
-            Effect::SensorOffset(_) | Effect::Instrument { .. } | Effect::KinematicOffset(_) => {
-                Carrier::None
-            }
+            Effect::SensorOffset(_)
+            | Effect::Instrument { .. }
+            | Effect::PreTravel
+            | Effect::KinematicOffset(_) => Carrier::None,
         }
     }
 
@@ -247,6 +261,17 @@ impl Term {
                 )));
             }
             return Ok(());
+        }
+        if self.effect == Effect::PreTravel {
+            return match self.basis {
+                Basis::Harmonic(_) => Ok(()),
+                Basis::Const => Err(BasisError(
+                    "`PRE` alone is a constant pre-travel of the probe: it moves no centre of a free-radius sphere fit (every hit pre-travels alike, and the fitted radius takes it), so the centres cannot determine it; the sphere fits' radii give it (the probe's part of the identification). Its lobing in the approach azimuth is `PRE@harmonic:K` (K = 3 for a three-point kinematic probe)".into(),
+                )),
+                other => Err(BasisError(format!(
+                    "`PRE` (a touch probe's pre-travel) varies with the approach azimuth about the stylus: `PRE@harmonic:K` only, not `{other}`"
+                ))),
+            };
         }
         if matches!(self.effect, Effect::Instrument { .. }) && self.basis != Basis::Const {
             return Err(BasisError(format!(
@@ -344,9 +369,10 @@ pub fn errors_of(terms: &[Term]) -> Vec<ErrorId> {
         .iter()
         .filter_map(|t| match t.effect {
             Effect::Error(e) => Some(e),
-            Effect::SensorOffset(_) | Effect::Instrument { .. } | Effect::KinematicOffset(_) => {
-                None
-            }
+            Effect::SensorOffset(_)
+            | Effect::Instrument { .. }
+            | Effect::PreTravel
+            | Effect::KinematicOffset(_) => None,
         })
         .collect();
     errors.sort_unstable();
@@ -379,6 +405,9 @@ pub fn describe_effect(m: &Machine, effect: Effect) -> String {
             );
         }
         Effect::SensorOffset(d) => return format!("R-test zero offset in {d}"),
+        Effect::PreTravel => {
+            return "touch probe pre-travel in the approach azimuth about the stylus".into();
+        }
         Effect::Instrument {
             reading,
             displacement,

@@ -48,6 +48,46 @@ pub struct Record {
     /// The 1-based line of its file each sample was read from; empty when the record was not
     /// read from a file (simulated, or built in memory).
     pub lines: Vec<usize>,
+    /// Per sample of a touch probe's record (one pose, read through its sphere fit), how the
+    /// reading responds to each hit's pre-travel ([`PreTravelResponse`]); empty for every other
+    /// record.
+    pub probe: Vec<Vec<PreTravelResponse>>,
+}
+
+/// How a probe pose's reading responds to one hit's pre-travel: what the term `PRE@harmonic:K`
+/// of a model is made of.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreTravelResponse {
+    /// The change of the pose's reading (tool frame, mm) per mm of this hit's pre-travel: the
+    /// first-order response of its sphere fit.
+    pub gain: [f64; 3],
+    /// The part of the hit's approach direction across the stylus, `ρ = √(n_x² + n_y²)` of the
+    /// approach in the probe's (tool) frame, 0 to 1.
+    pub across: f64,
+    /// The approach's azimuth about the stylus, `φ = atan2(n_y, n_x)` in the probe's frame, rad.
+    pub azimuth_rad: f64,
+}
+
+impl PreTravelResponse {
+    /// The reading's response (tool frame, mm per mm of amplitude) to the `component` (0:
+    /// cos, 1: sin) of a pre-travel `ρ·(a·cos Kφ + b·sin Kφ)` of order `order` (K), summed over
+    /// the hits `hits` of one pose.
+    pub fn harmonic(hits: &[PreTravelResponse], order: u32, component: usize) -> [f64; 3] {
+        let mut v = [0.0; 3];
+        for h in hits {
+            let angle = f64::from(order) * h.azimuth_rad;
+            let w = h.across
+                * if component == 0 {
+                    angle.cos()
+                } else {
+                    angle.sin()
+                };
+            for (x, g) in v.iter_mut().zip(h.gain) {
+                *x += w * g;
+            }
+        }
+        v
+    }
 }
 
 impl PartialEq for Record {
@@ -87,6 +127,10 @@ impl Record {
             lines: (0..self.lines.len())
                 .filter(keep)
                 .map(|i| self.lines[i])
+                .collect(),
+            probe: (0..self.probe.len())
+                .filter(keep)
+                .map(|i| self.probe[i].clone())
                 .collect(),
         }
     }

@@ -130,7 +130,7 @@ impl Truth {
             let w = t.basis.width();
             let c = &self.coefficients[at..at + w];
             at += w;
-            if matches!(t.effect, Effect::Instrument { .. }) {
+            if matches!(t.effect, Effect::Instrument { .. } | Effect::PreTravel) {
                 continue;
             }
             let b = t.basis.values(m, t.effect.carrier(m), cx);
@@ -139,7 +139,7 @@ impl Truth {
                 Effect::Error(e) => errors[e] += v,
                 Effect::SensorOffset(d) => offsets[d.index()] += v,
                 // The real lengths are `params`: a truth never has a kinematic offset term.
-                Effect::Instrument { .. } | Effect::KinematicOffset(_) => {}
+                Effect::Instrument { .. } | Effect::PreTravel | Effect::KinematicOffset(_) => {}
             }
         }
     }

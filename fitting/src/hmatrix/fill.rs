@@ -6,7 +6,7 @@ use super::{Gain, GainSource, HMatrixError, check_sample, parameter_name};
 use crate::offsets::OffsetGains;
 use model_spec::{Machine, parallel};
 use simulation::model::{Basis, BasisContext, Carrier, Model};
-use simulation::record::Record;
+use simulation::record::{PreTravelResponse, Record};
 
 /// Samples per thread at least: a shorter record is filled on the calling thread alone (a
 /// thread costs more than the rows it would fill).
@@ -128,13 +128,20 @@ impl Rows<'_> {
                 reading: record.measured.get(i).copied().unwrap_or([0.0; 3]),
             };
             for (c, &(gain, carrier, basis, k)) in self.cols.iter().enumerate() {
-                let b = basis.values(m, carrier, &cx)[k];
                 let mut v = [0.0; 3];
+                let b = match gain {
+                    Gain::PreTravel(order) => {
+                        v = PreTravelResponse::harmonic(&record.probe[i], order, k);
+                        1.0
+                    }
+                    _ => basis.values(m, carrier, &cx)[k],
+                };
                 match gain {
                     Gain::Slot(slot) => v = g[slot],
                     Gain::Unit(d) => v[d] = 1.0,
                     Gain::Reading(d, j) => v[d] = cx.reading[j],
                     Gain::Symbol(s) => v = symbol_gains[s],
+                    Gain::PreTravel(_) => {}
                 }
                 for d in 0..3 {
                     let x = v[d] * b;

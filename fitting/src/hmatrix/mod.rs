@@ -18,6 +18,9 @@
 //!   (σ_noise / displacement)² relative, negligible when the noise is much smaller than the
 //!   displacements; the refinement against the exact machine (which applies `(I + S)` to the
 //!   displacement exactly) removes the first-order part.
+//! - A touch probe's pre-travel `PRE@harmonic:K` (mm of amplitude): per pose, the sphere fit's
+//!   response to the hits' pre-travel `ρ·cos Kφ` and `ρ·sin Kφ` (probe records only:
+//!   [`Record::probe`]).
 //! - Kinematic offsets (a symbol of the description, `Zt`): the exact derivative of the
 //!   tool-minus-workpiece vector with respect to the symbol, mm/mm
 //!   ([`crate::offsets`]); their coefficient is the symbol's change, mm.
@@ -467,6 +470,9 @@ enum Gain {
     Reading(usize, usize),
     /// A kinematic offset: the gain of this symbol.
     Symbol(usize),
+    /// A probe's pre-travel of this harmonic order: the sphere fits' response
+    /// ([`simulation::record::PreTravelResponse::harmonic`]); its basis value is 1.
+    PreTravel(u32),
 }
 
 /// The axis velocities of `record` (sample-major, mm/ms or rad/ms) when `model` has a
@@ -606,6 +612,21 @@ fn h_matrix_on(
                 Gain::Reading(reading.index(), displacement.index())
             }
             Effect::KinematicOffset(s) => Gain::Symbol(s),
+            Effect::PreTravel => {
+                let Basis::Harmonic(order) = term.basis else {
+                    return Err(HMatrixError::Term {
+                        term: term.spelling(m),
+                        message: "a touch probe's pre-travel is a harmonic of the approach azimuth (PRE@harmonic:K)".into(),
+                    });
+                };
+                if record.probe.len() != record.samples.len() {
+                    return Err(HMatrixError::Term {
+                        term: term.spelling(m),
+                        message: "a touch probe's pre-travel needs records of probe hits (read through --probe): its columns are what each pose's sphere fit makes of the hits' pre-travel".into(),
+                    });
+                }
+                Gain::PreTravel(order)
+            }
         };
         cols.push((gain, term.effect.carrier(m), term.basis, k));
     }

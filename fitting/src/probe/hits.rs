@@ -2,14 +2,14 @@
 //! reading of the error vector.
 
 use super::pose::PoseGeometry;
-use super::pretravel::PreTravel;
+use super::pretravel::{PreTravel, approach_in_probe_frame};
 use crate::sphere::{Latch, RadiusMode, SphereFit, SphereFitError, SphereFitOptions, fit_sphere};
 use formats::csv::CsvError;
 use formats::probe::{ProbeHits, ProbeInstrument, ProbePose};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use simulation::exact::VirtualMachine;
-use simulation::record::{Record, Sample};
+use simulation::record::{PreTravelResponse, Record, Sample};
 
 /// What reading a probe record needs besides its hits.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,7 +77,8 @@ pub struct PoseFit {
     pub approach_tool: Vec<Vector3<f64>>,
 }
 
-/// A probe record: the record the pipeline fits, with the fit of every pose.
+/// A probe record: the record the pipeline fits (with each pose's response to its hits'
+/// pre-travel, [`Record::probe`]), with the fit of every pose.
 #[derive(Clone, Debug)]
 pub struct ProbeRecord {
     /// One sample per pose: nominal commands, the time of its first hit, the reading, its
@@ -157,6 +158,21 @@ pub fn probe_record(
         record.measured.push(fitted.reading_mm);
         record.covariance.push(fitted.covariance_mm2);
         record.lines.push(first.line);
+        record.probe.push(
+            fitted
+                .pretravel_gain
+                .iter()
+                .zip(&fitted.approach_tool)
+                .map(|(g, n)| {
+                    let (across, azimuth_rad) = approach_in_probe_frame(n);
+                    PreTravelResponse {
+                        gain: [g.x, g.y, g.z],
+                        across,
+                        azimuth_rad,
+                    }
+                })
+                .collect(),
+        );
         poses.push(fitted);
     }
     let (rss, dof) = poses.iter().fold((0.0, 0usize), |(s, d), p| {
@@ -243,7 +259,7 @@ fn fit_pose(
     let reading = -geometry.to_tool(&c);
     let r = geometry.tool_rotation.matrix();
     let cov: Matrix3<f64> = r.transpose() * fit.covariance_mm2 * r;
-    let pretravel_gain = pretravel_gains(&latches, &fit)
+    let pretravel_gain = pretravel_gains(&latches)
         .into_iter()
         .map(|dc| -geometry.to_tool(&dc))
         .collect();
@@ -286,14 +302,18 @@ fn refusal(pose: &ProbePose, e: &SphereFitError) -> (usize, String) {
 }
 
 /// Per hit, the fitted centre's first-order change (bed frame, mm per mm) when that hit
-/// latches 1 mm farther along its approach (a pre-travel), the radius free: `Δx = −(JᵀJ)⁻¹Jᵀ·Δr`
-/// with the Jacobian rows `[−u_iᵀ, −1]` of the residuals `‖p_i − c‖ − R` at the fit and `Δr`
-/// the hit's residual change.
-fn pretravel_gains(latches: &[Latch], fit: &SphereFit) -> Vec<Vector3<f64>> {
+/// latches 1 mm farther along its approach (a pre-travel), the radius free: `Δx = (JᵀJ)⁻¹Jᵀ·e_i`
+/// with the Jacobian rows `[n_iᵀ, −1]` of the residuals `‖p_i − c‖ − R` for hits aimed at the
+/// centre (outward normal `u_i = −n_i`), whose residual a pre-travel δ changes by `−δ`.
+/// Evaluated at the pattern as aimed (not at the latched points, which the machine's errors
+/// move by microns): a response of the pattern alone, so two poses whose approaches are the
+/// same in the tool frame get the same response to the digit, and what a pose set cannot
+/// separate stays exactly confounded.
+fn pretravel_gains(latches: &[Latch]) -> Vec<Vector3<f64>> {
     let n = latches.len();
     let mut j = DMatrix::zeros(n, 4);
     for (i, l) in latches.iter().enumerate() {
-        let u = (l.tip_mm - fit.centre_mm).normalize();
+        let u = -l.approach.normalize();
         for k in 0..3 {
             j[(i, k)] = -u[k];
         }
@@ -306,13 +326,9 @@ fn pretravel_gains(latches: &[Latch], fit: &SphereFit) -> Vec<Vector3<f64>> {
     let pinv = inv * j.transpose();
     (0..n)
         .map(|i| {
-            // A pre-travel δ moves the hit by δ·n: its residual changes by δ·(u·n), −δ for a
-            // hit aimed at the centre (n = −u); the exact projection is kept.
-            let u = (latches[i].tip_mm - fit.centre_mm).normalize();
-            let dr = u.dot(&latches[i].approach.normalize());
-            let mut e = DVector::zeros(n);
-            e[i] = dr;
-            let dx = -(&pinv * e);
+            let mut dr = DVector::zeros(n);
+            dr[i] = -1.0;
+            let dx = -(&pinv * dr);
             Vector3::new(dx[0], dx[1], dx[2])
         })
         .collect()

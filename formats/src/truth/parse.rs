@@ -214,6 +214,12 @@ impl Parser<'_> {
                     ),
                 ));
             };
+            if effect == Effect::PreTravel {
+                return Err(self.err(
+                    k.span(),
+                    "`PRE` is a touch probe's pre-travel, not an error of the machine: a simulated probe's pre-travel is its probe file's pre_travel_um and lobing_um (rtest simulate --probe)".to_string(),
+                ));
+            }
             let unit = effect.unit(m).replace('u', "µ");
             match v.get_ref() {
                 DeValue::Table(table) => {

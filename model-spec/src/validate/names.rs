@@ -152,7 +152,7 @@ impl Validator<'_> {
                 return self.err(
                     k.span(),
                     format!(
-                        "symbol `{}` has a name reserved for an effect of the R-test measurement ({}): rename the symbol",
+                        "symbol `{}` has a name reserved for an effect of the measurement (R-test or touch probe: {}): rename the symbol",
                         k.get_ref(),
                         MEASUREMENT_EFFECTS.join(" ")
                     ),

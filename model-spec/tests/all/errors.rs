@@ -1022,12 +1022,12 @@ fn submodel_term_errors_are_located() {
 
 #[test]
 fn measurement_effect_names_are_refused_as_symbols() {
-    for name in ["SXY", "SZZ", "dx0", "DZ0"] {
+    for name in ["SXY", "SZZ", "dx0", "DZ0", "px0", "PRE"] {
         let e = err(&edit("Zc = 30.0\n", &format!("Zc = 30.0\n{name} = 1.0\n")));
         assert_eq!(
             e,
             format!(
-                "m.toml:6:1: symbol `{name}` has a name reserved for an effect of the R-test measurement (dx0 dy0 dz0 SXX SXY SXZ SYX SYY SYZ SZX SZY SZZ): rename the symbol"
+                "m.toml:6:1: symbol `{name}` has a name reserved for an effect of the measurement (R-test or touch probe: dx0 dy0 dz0 px0 py0 pz0 PRE SXX SXY SXZ SYX SYY SYZ SZX SZY SZZ): rename the symbol"
             )
         );
     }

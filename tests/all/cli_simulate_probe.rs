@@ -140,7 +140,7 @@ fn a_bad_probe_file_is_named_at_its_line_and_column_and_nothing_is_written() {
 }
 
 #[test]
-fn hits_beyond_a_stroke_are_a_failed_computation_and_nothing_is_written() {
+fn hits_beyond_a_stroke_or_the_clearance_are_a_failed_computation_and_nothing_is_written() {
     let dir = setup("stroke");
     let before = entries(&dir);
     // The ball 495 mm out along x: the pose is within X's stroke, the +X approach's start
@@ -151,6 +151,21 @@ fn hits_beyond_a_stroke_are_a_failed_computation_and_nothing_is_written() {
         3,
         &[
             "--path poses.csv: pose p1, hit 3 (approach (1, 0, 0)): the start point X = 511 mm outside its stroke -500 .. 500 mm; nothing is written",
+        ],
+    );
+    // A ball set up 20 mm off: the probe would start inside it.
+    std::fs::write(
+        dir.join("far.toml"),
+        "machine = \"seed-ac\"\n[errors]\nXOW = 20000\n",
+    )
+    .unwrap();
+    let before = entries(&dir);
+    fails(
+        &dir,
+        &words(&format!("{SIM} --truth far.toml -o hits.csv")),
+        3,
+        &[
+            "--truth far.toml: pose p1, hit 1 (approach (-1, 0, 0)): the start point, 2 mm outside the nominal sphere, is 10000 µm inside the actual sphere: the machine's errors move the sphere by more than the clearance; nothing is written",
         ],
     );
     assert_eq!(entries(&dir), before);

@@ -54,6 +54,10 @@ pub fn run(r: &ProbeRequest<'_>) -> VerbResult<Done> {
                 Error::input(format!("--probe {}: {e}", r.probe_file.display()))
             }
             e @ ProbeError::Truth { .. } => Error::computation(format!("--truth: {e}")),
+            e @ ProbeError::Contact { .. } => Error::computation(format!(
+                "--truth {}: {e}; nothing is written",
+                r.truth.source
+            )),
             e => Error::computation(format!("--path {}: {e}; nothing is written", r.path_name)),
         },
     )?;

@@ -410,7 +410,7 @@ fn failure(e: ContactFailure) -> String {
     match e {
         ContactFailure::StartsInside(d) => format!(
             "the start point, {CLEARANCE_MM} mm outside the nominal sphere, is {} µm inside the actual sphere: the machine's errors move the sphere by more than the clearance",
-            um(d)
+            um(d + 0.0)
         ),
         ContactFailure::NeverTouches(d) => format!(
             "the probe reaches the nominal sphere centre without touching: the tip centre is {d} mm from the actual sphere centre there, beyond R_eff; the machine's errors move the sphere by more than its radius"

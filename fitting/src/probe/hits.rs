@@ -278,27 +278,53 @@ fn fit_pose(
     })
 }
 
-/// A refused fit as the line of the hit it names (else the pose's first) and why.
+/// A refused fit as the line of the hit it names (else the pose's first) and why, the hit
+/// counted from 1 within the pose.
 fn refusal(pose: &ProbePose, e: &SphereFitError) -> (usize, String) {
-    let hit = match e {
-        SphereFitError::Residual { hit, .. } => Some(*hit),
-        SphereFitError::Radius { suspect, .. } => *suspect,
-        _ => None,
-    };
-    let line = hit
-        .and_then(|i| pose.hits.get(i))
-        .map_or(pose.hits[0].line, |h| h.line);
-    let which = hit
-        .and_then(|i| pose.hits.get(i))
-        .map(|h| {
-            format!(
-                " (hit {} of the pose, line {})",
-                hit.unwrap_or(0) + 1,
-                h.line
-            )
+    let hit_at = |i: usize| {
+        pose.hits.get(i).map_or(String::new(), |h| {
+            format!("hit {} of the pose (line {})", i + 1, h.line)
         })
-        .unwrap_or_default();
-    (line, format!("{e}{which}"))
+    };
+    match e {
+        SphereFitError::Residual {
+            hit,
+            residual_mm,
+            limit_mm,
+        } => {
+            return (
+                pose.hits.get(*hit).map_or(pose.hits[0].line, |h| h.line),
+                format!(
+                    "sphere fit refused (residual): {} is {:.3} µm off the fitted sphere (limit {:.3} µm = max(4σ, 5 µm)): a dirty hit (a chip or coolant on the sphere or the stylus), or a probe that latched on the way",
+                    hit_at(*hit),
+                    residual_mm * 1e3,
+                    limit_mm * 1e3
+                ),
+            );
+        }
+        SphereFitError::Radius {
+            fitted_mm,
+            calibrated_mm,
+            suspect,
+        } => {
+            return (
+                suspect
+                    .and_then(|i| pose.hits.get(i))
+                    .map_or(pose.hits[0].line, |h| h.line),
+                format!(
+                    "sphere fit refused (radius): fitted sphere radius {fitted_mm:.6} mm, calibrated {calibrated_mm:.6} mm, {:.3} µm apart (limit {:.3} µm){}",
+                    (fitted_mm - calibrated_mm) * 1e3,
+                    crate::sphere::RADIUS_LIMIT_MM * 1e3,
+                    suspect.map_or(
+                        "; no single hit explains it: the tip's or the sphere's radius, or every hit, is off".to_string(),
+                        |i| format!("; without {} the fit agrees", hit_at(i))
+                    )
+                ),
+            );
+        }
+        _ => {}
+    }
+    (pose.hits[0].line, e.to_string())
 }
 
 /// Per hit, the fitted centre's first-order change (bed frame, mm per mm) when that hit

@@ -270,7 +270,7 @@ fn refusals_name_the_file_the_line_and_the_rule() {
         e.starts_with("h.csv:6: pose `p1`: sphere fit refused (residual)"),
         "{e}"
     );
-    assert!(e.contains("hit 3 of the pose, line 6"), "{e}");
+    assert!(e.contains("hit 3 of the pose (line 6) is "), "{e}");
     // No declared σ.
     let e = read(
         &clean,

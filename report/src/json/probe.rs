@@ -174,8 +174,8 @@ fn axes(
             }
             let mut mean = [0.0; 3];
             for &i in &sweep {
-                for d in 0..3 {
-                    mean[d] += record.measured[i][d] / sweep.len() as f64;
+                for (m, e) in mean.iter_mut().zip(record.measured[i]) {
+                    *m += e / sweep.len() as f64;
                 }
             }
             for &i in &sweep {

@@ -2,13 +2,13 @@
 //! reading of the error vector.
 
 use super::pose::PoseGeometry;
-use super::pretravel::{PreTravel, approach_in_probe_frame};
 use crate::sphere::{Latch, RadiusMode, SphereFit, SphereFitError, SphereFitOptions, fit_sphere};
 use formats::csv::CsvError;
 use formats::probe::{ProbeHits, ProbeInstrument, ProbePose};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use simulation::exact::VirtualMachine;
+use simulation::probe::{PreTravel, approach_in_probe_frame};
 use simulation::record::{PreTravelResponse, Record, Sample};
 
 /// What reading a probe record needs besides its hits.
@@ -240,7 +240,7 @@ fn fit_pose(
             ));
         }
         // A hit that pre-travelled by δ latched δ·n beyond the contact.
-        let delta = settings.declared.along(&n_tool);
+        let delta = settings.declared.along(geometry.tool_rotation.matrix(), &n);
         latches.push(Latch {
             tip_mm: g - delta * n,
             approach: n,

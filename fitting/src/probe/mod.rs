@@ -29,11 +29,10 @@
 mod centres;
 mod hits;
 mod pose;
-mod pretravel;
 mod summary;
 
 pub use centres::centre_record;
 pub use hits::{PoseFit, ProbeRecord, ProbeSettings, probe_record};
 pub use pose::PoseGeometry;
-pub use pretravel::{PreTravel, approach_in_probe_frame};
+pub use simulation::probe::{PreTravel, approach_in_probe_frame};
 pub use summary::ProbeSummary;

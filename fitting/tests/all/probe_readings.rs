@@ -169,7 +169,7 @@ fn pretravel_gains_predict_the_centre_shift_and_a_declared_pretravel_is_removed(
         constant_mm: 0.0,
         lobing_mm: [2e-3, -1e-3],
     };
-    let pre = |n: &Vector3<f64>| lobing.along(&tool.inverse_transform_vector(n));
+    let pre = |n: &Vector3<f64>| lobing.along(tool.matrix(), n);
     let mut line = 1;
     let clean = pose_hits(&vm, "p", &q, &params, Vector3::zeros(), &|_| 0.0, &mut line);
     let lobed = pose_hits(&vm, "p", &q, &params, Vector3::zeros(), &pre, &mut line);
@@ -193,7 +193,7 @@ fn pretravel_gains_predict_the_centre_shift_and_a_declared_pretravel_is_removed(
         .pretravel_gain
         .iter()
         .zip(&base.poses[0].approach_tool)
-        .map(|(gain, n)| gain * lobing.along(n))
+        .map(|(gain, n)| gain * lobing.along(&nalgebra::Matrix3::identity(), n))
         .sum();
     assert!(
         shift.norm() > 0.3e-3,

@@ -30,6 +30,19 @@ fn r_test_and_probe_agree_within_three_combined_std() {
             })
             .collect();
         assert!(!records.is_empty(), "{name}: no R-test");
+        let samples: usize = records.iter().map(|r| r.record.samples.len()).sum();
+        let seconds: f64 = records
+            .iter()
+            .map(|r| r.record.samples.last().map_or(0.0, |s| s.t))
+            .sum();
+        let poses = sweep(m, 6);
+        println!(
+            "{name}: R-test {} records, {samples} samples, {seconds:.0} s of paths; probe {} poses, {} hits, {:.0} s",
+            records.len(),
+            poses.len(),
+            9 * poses.len(),
+            simulation::probe::run_time_s(poses.len(), 9 * poses.len())
+        );
         // The same constraint, its set-up errors named as a campaign of several records names
         // them (`ZOW[ball]`).
         let constraint = match &case.constraint {

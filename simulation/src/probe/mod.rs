@@ -54,7 +54,7 @@ mod pattern;
 pub use contact::{CONTACT_TOLERANCE_MM, MAX_CONTACT_ITERATIONS};
 pub use pattern::{
     APPROACH_S, CLEARANCE_MM, HIT_CYCLE_S, PATTERN_HITS, POSE_CHANGE_S, PROBING_FEED_MM_PER_S,
-    PreTravel, approach_directions, latch_time_s, run_time_s,
+    PreTravel, approach_directions, approach_in_probe_frame, latch_time_s, run_time_s,
 };
 
 use crate::exact::{ExactError, VirtualMachine};

@@ -91,12 +91,24 @@ impl PreTravel {
     /// with `n_t = tool_rotationᵀ·approach`, `ρ = √(n_t.x² + n_t.y²)` its part across the
     /// stylus and `φ = atan2(n_t.y, n_t.x)` its azimuth about the stylus (0 when `ρ` is 0).
     pub fn along(&self, tool_rotation: &Matrix3<f64>, approach: &Vector3<f64>) -> f64 {
-        let n = tool_rotation.transpose() * approach;
-        let rho = n.x.hypot(n.y);
-        let phi = if rho > 0.0 { n.y.atan2(n.x) } else { 0.0 };
+        let (rho, phi) = approach_in_probe_frame(&(tool_rotation.transpose() * approach));
         let [c, s] = self.lobing_mm;
         self.constant_mm + rho * (c * (3.0 * phi).cos() + s * (3.0 * phi).sin())
     }
+
+    /// `true` when every part is zero.
+    pub fn is_zero(&self) -> bool {
+        self.constant_mm == 0.0 && self.lobing_mm == [0.0, 0.0]
+    }
+}
+
+/// `(ρ, φ)` of an approach direction `n_t` in the probe's (tool) frame (unit vector): its part
+/// across the stylus `√(n_t.x² + n_t.y²)` and its azimuth about it `atan2(n_t.y, n_t.x)` (rad;
+/// 0 when `ρ` is 0).
+pub fn approach_in_probe_frame(n_t: &Vector3<f64>) -> (f64, f64) {
+    let rho = n_t.x.hypot(n_t.y);
+    let phi = if rho > 0.0 { n_t.y.atan2(n_t.x) } else { 0.0 };
+    (rho, phi)
 }
 
 #[cfg(test)]

@@ -55,7 +55,8 @@ use simulation::record::{Record, Sample};
 
 /// The fewest positions per rotary axis (three points fix a circle).
 pub const MIN_PER_AXIS: usize = 3;
-/// The most positions per rotary axis (Heidenhain's cycle 451 takes at most 12).
+/// The most positions per rotary axis: the bound of [`choose_per_axis`]'s search (a
+/// controller's calibration cycle measures a handful of positions per axis).
 pub const MAX_PER_AXIS: usize = 12;
 /// The valuation number the controllers need at least.
 pub const NEEDED_VALUATION: f64 = 2.0;
@@ -90,7 +91,7 @@ pub enum ProbePlanError {
     Probe(String),
     /// The number of positions per rotary axis is out of its bounds.
     #[error(
-        "{0} positions per rotary axis: from {MIN_PER_AXIS} to {MAX_PER_AXIS} (three fix a circle; cycle 451 takes at most 12)"
+        "{0} positions per rotary axis: from {MIN_PER_AXIS} to {MAX_PER_AXIS} (three fix a circle; more than 12 is beyond what this planner searches)"
     )]
     PerAxis(usize),
     /// The machine has no rotary axis to step.
@@ -472,11 +473,13 @@ pub struct AxisValuation {
     pub least: Option<(usize, f64)>,
 }
 
-/// Per rotary axis of `m` (axis order), the least valuation among the parameters of interest
+/// Per rotary axis of `m` (ISO order: A, B, C, then by letter), the least valuation among the parameters of interest
 /// of `p` that belong to it (`values` from [`valuations`]).
 pub fn axis_valuations(m: &Machine, p: &Prediction, values: &[Option<f64>]) -> Vec<AxisValuation> {
     let wanted = interest(p);
-    m.rotary_axes()
+    let mut axes: Vec<AxisId> = m.rotary_axes().collect();
+    axes.sort_by_key(|&a| model_spec::catalogue::iso_rank(&m.axes[a].name));
+    axes.into_iter()
         .map(|axis| {
             let columns: Vec<usize> = wanted
                 .iter()

@@ -26,6 +26,7 @@ pub mod fit_summary;
 pub mod gains;
 pub mod identify;
 pub mod plan;
+pub mod plan_probe;
 pub mod probe;
 pub mod read;
 pub mod tolerance;

@@ -7,6 +7,7 @@ pub mod diagnose;
 pub mod gains;
 pub mod identify;
 pub mod plan;
+pub mod plan_probe;
 pub mod probe;
 pub mod simulate;
 pub mod tolerance;

@@ -26,6 +26,7 @@ mod cli_noise;
 mod cli_offsets;
 mod cli_path;
 mod cli_plan;
+mod cli_plan_probe;
 mod cli_probe;
 mod cli_progress;
 mod cli_report;

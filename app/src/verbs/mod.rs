@@ -25,6 +25,7 @@ pub mod machines;
 pub mod path;
 pub mod path_nc;
 pub mod plan;
+pub mod plan_probe;
 pub mod pose_args;
 pub mod probe_records;
 pub mod progress;

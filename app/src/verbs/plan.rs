@@ -41,7 +41,13 @@ machine's) newly determined, then the largest std/target (--target-um, --target-
 and a time term correlate by 0.9 or more, it names the reversed (T-rev) or there-and-back (T-back) \
 test that separates them.
 
---json FILE writes the report (`-`: standard output; `null` where the plan determines no value).";
+--json FILE writes the report (`-`: standard output; `null` where the plan determines no value).
+
+--probe FILE plans a touch-probe calibration instead (the probe instrument file, docs/probe.md): \
+each rotary axis stepped over its interval at --per-axis N positions (3 to 12; `auto`: the least \
+that gives every determined parameter of the machine a valuation number, target / predicted std, \
+of --min-valuation or more, default 2), the others at rest; --constraint zero:NAME,... holds \
+parameters at 0; --poses-out FILE writes the poses as a path CSV. Details: docs/probe-plan.md.";
 
 /// Flags of `rtest plan`.
 #[derive(Debug, clap::Args)]
@@ -62,8 +68,8 @@ pub struct PlanArgs {
     terms: Option<String>,
     /// The planned tests, in order: comma list of TEST (at the `base` ball position) or
     /// TEST:NAME (at the ball position NAME of --ball), e.g. `K4,K1,K4:high`.
-    #[arg(long, value_name = "LIST")]
-    paths: String,
+    #[arg(long, value_name = "LIST", required_unless_present = "probe")]
+    paths: Option<String>,
     /// Kinematic parameters (mm) of the `base` ball position, overriding the machine's
     /// defaults (`Xw=-200,Zw=180`).
     #[arg(long, value_name = "SYMBOL=VALUE,...")]
@@ -106,6 +112,8 @@ pub struct PlanArgs {
     /// Also write the report as JSON to FILE (`-`: standard output).
     #[arg(long, value_name = "FILE")]
     json: Option<Target>,
+    #[command(flatten)]
+    probe: super::plan_probe::ProbeFlags,
 }
 
 /// A lag-1 autocorrelation: a number from 0 up to, not including, 0.99.
@@ -164,7 +172,8 @@ fn plan_of(m: &Machine, args: &PlanArgs) -> VerbResult<Plan> {
     let mut tests = Vec::new();
     let example = "expected a comma list of TEST or TEST:BALL, e.g. K4,K1,K4:high";
     // The number of tests is checked with the plan's shape (`Plan::check`), before any work.
-    for item in items("--paths", &args.paths, example)? {
+    let paths = args.paths.as_deref().unwrap_or_default();
+    for item in items("--paths", paths, example)? {
         let (test, name) = item.split_once(':').unwrap_or((item, BASE_BALL));
         let (test, name) = (test.trim(), name.trim());
         let Some(b) = balls.iter().position(|b| b.name == name) else {
@@ -252,8 +261,25 @@ fn plan_error(e: PlanError, args: &PlanArgs) -> Error {
     }
 }
 
-/// Runs `rtest plan`.
+/// Runs `rtest plan` (`--probe`: a touch-probe plan, [`super::plan_probe`]).
 pub fn run(args: &PlanArgs) -> VerbResult<Done> {
+    if let Some(file) = &args.probe.probe {
+        let common = super::plan_probe::Common {
+            machine: &args.machine,
+            model: args.model.as_deref(),
+            terms: args.terms.as_deref(),
+            param: args.param.as_deref(),
+            targets: Targets {
+                um: args.target_um,
+                urad: args.target_urad,
+                ms: args.target_ms,
+            },
+            json: args.json.as_ref(),
+            generator: &args.generator,
+        };
+        return super::plan_probe::run(&common, file, &args.probe);
+    }
+    args.probe.refuse_without_probe()?;
     let m = super::load_machine(&args.machine)?;
     let (label, model) = args::model(&m, args.model.as_deref(), args.terms.as_deref())?;
     plan::check_model(&m, &model).map_err(|e| {

@@ -69,8 +69,8 @@ pub struct ProbeFlags {
     /// position cannot separate.
     #[arg(long, value_name = "zero:NAME,...", requires = "probe")]
     pub constraint: Option<String>,
-    /// With --probe: also write the planned poses as a path CSV (`rtest simulate --path FILE`,
-    /// `rtest path --probe`); `-`: standard output.
+    /// With --probe: also write the planned poses as a path CSV (docs/paths.md), which
+    /// `rtest simulate --path FILE [--probe PROBE]` takes; `-`: standard output.
     #[arg(long, value_name = "FILE", requires = "probe")]
     pub poses_out: Option<Target>,
 }

@@ -356,7 +356,7 @@ fn pose_at(
 
 /// The record of `poses`: one sample per pose (its commands, `t` its index in s, timed), no
 /// readings, the poses' covariances.
-pub fn probe_record(poses: &ProbePoses, axes: usize) -> Record {
+pub fn planned_record(poses: &ProbePoses, axes: usize) -> Record {
     let mut r = Record::default();
     for (i, p) in poses.poses.iter().enumerate() {
         r.samples.push(Sample {
@@ -426,7 +426,7 @@ impl ProbePlanInputs<'_> {
             self.probe.effective_radius_mm(),
             &bed,
         )?;
-        let record = probe_record(&poses, m.axes.len());
+        let record = planned_record(&poses, m.axes.len());
         let campaign = Campaign::new(vec![CampaignRecord::new(
             PROBE_RECORD,
             record,

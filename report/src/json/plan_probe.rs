@@ -447,9 +447,4 @@ impl PlanProbeReport {
             auto: auto.transpose()?,
         })
     }
-
-    /// The parameters of interest (the machine's) among [`PlanProbeReport::parameters`].
-    pub fn of_interest(&self) -> impl Iterator<Item = &ProbeParameterReport> {
-        self.parameters.iter().filter(|p| p.owner == "shared")
-    }
 }

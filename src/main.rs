@@ -47,13 +47,14 @@ enum Verb {
     Path(cli::path::PathArgs),
     Instrument(cli::instrument::InstrumentVerb),
     Segment(cli::segment::SegmentArgs),
+    ProbeLog(cli::probe_log::ProbeLogArgs),
     Plan(cli::plan::PlanArgs),
     History(cli::history::HistoryArgs),
     Report(cli::report::ReportArgs),
 }
 
 /// The verbs, for the hint of a usage error.
-const VERBS: [&str; 17] = [
+const VERBS: [&str; 18] = [
     "machines",
     "gains",
     "generate",
@@ -68,6 +69,7 @@ const VERBS: [&str; 17] = [
     "path",
     "instrument",
     "segment",
+    "probe-log",
     "plan",
     "history",
     "report",
@@ -130,6 +132,7 @@ fn main() -> ExitCode {
         Verb::Path(a) => cli::path::run(a),
         Verb::Instrument(a) => cli::instrument::run(a),
         Verb::Segment(a) => cli::segment::run(a),
+        Verb::ProbeLog(a) => cli::probe_log::run(a),
         Verb::Plan(a) => cli::plan::run(a),
         Verb::History(a) => cli::history::run(a),
         Verb::Report(a) => cli::report::run(a),

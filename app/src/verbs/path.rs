@@ -40,7 +40,8 @@ log with (docs/measurement-programs.md). In machine coordinates (iso: G53 and a 
 linuxcnc: G53; heidenhain: M91) it goes to --clearance-mm, turns the rotary axes there, M19, \
 approaches the first pose along the tool axis (--approach-mm), stops (M0) for the nest check, \
 measures, retracts; its header lists the checks in that order. `rtest simulate --path NAME` takes \
-the same test names. `-o -` writes to standard output.";
+the same test names. `-o -` writes to standard output. --probe PROBE.toml: a touch-probe program \
+and its probe plan instead (docs/probe-programs.md).";
 
 /// Flags of `rtest path`.
 #[derive(Debug, clap::Args)]
@@ -78,6 +79,8 @@ pub struct PathArgs {
     output: Option<Target>,
     #[command(flatten)]
     nc: super::path_nc::NcArgs,
+    #[command(flatten)]
+    probe: super::path_probe::ProbeArgs,
 }
 
 /// A generator error as a verb's error, naming the flag at fault: a usage error for what the
@@ -261,6 +264,15 @@ fn extents(m: &Machine, record: &Record) -> String {
 /// Runs `rtest path`.
 pub fn run(args: &PathArgs) -> VerbResult<Done> {
     let m = super::load_machine(&args.machine)?;
+    if args.probe.probe.is_some() {
+        let parts = super::path_probe::PathParts {
+            machine_arg: &args.machine,
+            param: args.param.as_deref(),
+            generator: &args.generator,
+            output: args.output.as_ref(),
+        };
+        return super::path_probe::run(args, &m, parts, &args.probe, &args.nc);
+    }
     let mut inputs = Vec::new();
     inputs.extend(super::machine_file(&args.machine).map(|p| ("--machine", p)));
     let dialect = args.nc.dialect()?;

@@ -324,3 +324,39 @@ impl LinuxCnc {
 pub fn number(x: f64) -> String {
     format!("{}", x + 0.0)
 }
+
+/// The HAL of a calibration sphere of radius `radius` (mm; the sphere's plus the tip's) about
+/// `centre` (joints 0–2, mm), made of stock components: `sum2` for the tip's offsets from the
+/// centre (`sphere-dx`, `sphere-dy`, `sphere-dz`: `in0` the joint, `offset` minus the centre),
+/// `hypot` for their length, `wcomp` for "inside", which drives `motion.probe-input`. The
+/// simulation must be loaded without its own `hypot` (`basic_sim.tcl -no_make_ddts`, as
+/// [`Config`]'s INI does). [`sphere_centre_setp`] moves it between blocks.
+pub fn sphere_hal(centre: [f64; 3], radius: f64) -> String {
+    let mut h = String::from(
+        "loadrt sum2 names=sphere-dx,sphere-dy,sphere-dz\nloadrt hypot names=sphere-distance\n\
+         loadrt wcomp names=sphere-inside\n\
+         addf sphere-dx servo-thread\naddf sphere-dy servo-thread\naddf sphere-dz servo-thread\n\
+         addf sphere-distance servo-thread\naddf sphere-inside servo-thread\n",
+    );
+    for (j, (c, d)) in centre.iter().zip(["dx", "dy", "dz"]).enumerate() {
+        h += &format!(
+            "net J{j}:pos-fb => sphere-{d}.in0\nsetp sphere-{d}.gain0 1\nsetp sphere-{d}.gain1 0\nsetp sphere-{d}.offset {}\nnet sphere-{d} sphere-{d}.out => sphere-distance.in{j}\n",
+            number(-c)
+        );
+    }
+    h += &format!(
+        "net sphere-distance sphere-distance.out => sphere-inside.in\nsetp sphere-inside.min -1\nsetp sphere-inside.max {}\nnet sphere-probe sphere-inside.out => motion.probe-input\n",
+        number(radius)
+    );
+    h
+}
+
+/// The `setp` lines (blocks of [`LinuxCnc::run_probing`]) that move the sphere of
+/// [`sphere_hal`] to `centre` (joints 0–2, mm).
+pub fn sphere_centre_setp(centre: [f64; 3]) -> Vec<String> {
+    centre
+        .iter()
+        .zip(["dx", "dy", "dz"])
+        .map(|(c, d)| format!("setp sphere-{d}.offset {}", number(-c)))
+        .collect()
+}

@@ -588,6 +588,9 @@ fn h_matrix_on(
     let mut cols = Vec::with_capacity(model.width());
     for (t, k) in model.columns() {
         let term = model.terms[t];
+        if !record.probe.is_empty() {
+            probe_term(m, &term)?;
+        }
         let gain = match term.effect {
             Effect::Error(e) => match source.slot(e) {
                 Some(s) if source.machine == m.name => Gain::Slot(s),
@@ -647,6 +650,27 @@ fn h_matrix_on(
     };
     rows.fill(h.as_mut_slice(), source, threads)?;
     Ok(h)
+}
+
+/// Refuses a term a touch probe's readings cannot carry: a linear axis's reversal (the hits of a
+/// pose approach along both directions of every linear axis, so its backlash moves the hits and
+/// the sphere's radius, not the centre) and the servo lag (the probe stands still at a hit).
+fn probe_term(m: &Machine, term: &Term) -> Result<(), HMatrixError> {
+    let why = match (term.basis, term.effect.carrier(m)) {
+        (Basis::Reversal, model_spec::basis::Carrier::Axis(a))
+            if m.axes[a].kind == model_spec::AxisKind::Linear =>
+        {
+            "a touch probe's pose approaches the sphere along both directions of every linear axis: a linear axis's backlash moves the hits (and the fitted radius), not the centre, so probe readings do not carry it; the reversal of rotary axes they do (poses approached from either side)"
+        }
+        (Basis::Velocity, _) => {
+            "a touch probe stands still at every hit: its readings carry no servo lag"
+        }
+        _ => return Ok(()),
+    };
+    Err(HMatrixError::Term {
+        term: term.spelling(m),
+        message: why.into(),
+    })
 }
 
 /// [`h_matrix`] with the best [`GainSource`] for the model's errors at kinematic parameters

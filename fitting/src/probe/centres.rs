@@ -96,5 +96,6 @@ pub fn centre_record(
         record.measured.push([e.x, e.y, e.z]);
         record.lines.push(p.line);
     }
+    super::hits::set_rotary_motion(m, &mut record);
     Ok(record)
 }

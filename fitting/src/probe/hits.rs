@@ -181,6 +181,7 @@ pub fn probe_record(
             d + p.fit.dof,
         )
     });
+    set_rotary_motion(m, &mut record);
     let sigma_posterior_mm = (dof > 0).then(|| (rss / dof as f64).sqrt());
     Ok(ProbeRecord {
         record,
@@ -189,6 +190,26 @@ pub fn probe_record(
         noise_mm,
         sigma_posterior_mm,
     })
+}
+
+/// The direction of motion of every rotary axis at each pose: that of its last move between
+/// poses (an axis at rest keeps it; before its first move, the direction of that move), so
+/// that a rotary axis's reversal (backlash) term sees the poses approached from either side.
+/// Linear axes get +1: the hits of a pose approach the sphere along both directions of every
+/// linear axis, so a linear axis's backlash moves the hits, not the centre (the H matrix
+/// refuses a linear axis's reversal on probe records).
+pub(super) fn set_rotary_motion(m: &Machine, record: &mut Record) {
+    let commands: Vec<Vec<f64>> = record.samples.iter().map(|s| s.commands.clone()).collect();
+    let motion = simulation::record::motion_directions(&commands);
+    for (s, dirs) in record.samples.iter_mut().zip(motion) {
+        for (a, d) in dirs.into_iter().enumerate() {
+            s.motion[a] = if m.axes[a].kind == model_spec::AxisKind::Rotary {
+                d
+            } else {
+                1
+            };
+        }
+    }
 }
 
 /// The constant pre-travel the radii show: per pose `R_eff − R_fit` with the fit's radius

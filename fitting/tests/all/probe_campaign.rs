@@ -152,6 +152,21 @@ pub fn identified_as(
     pre: PreTravel,
     declared: DeclaredPreTravel,
 ) -> CampaignIdentification {
+    let campaign = probe_campaign(case, zeroed, poses, seed, pre, declared);
+    let opts = IdentifyOptions::new().constraint(case.constraint.clone());
+    identify(&case.m, model, &campaign, &opts).unwrap()
+}
+
+/// The campaign of one record of `case`'s probe hits at `poses` (noise seed `seed`, pre-travel
+/// `pre`, declared to the reader as `declared`), zeroed or not.
+pub fn probe_campaign(
+    case: &Case,
+    zeroed: bool,
+    poses: &[Vec<f64>],
+    seed: u64,
+    pre: PreTravel,
+    declared: DeclaredPreTravel,
+) -> Campaign {
     let m = &case.m;
     let params = m.default_parameters();
     let run = simulate_probe(
@@ -177,9 +192,7 @@ pub fn identified_as(
         off_sphere_mm: 0.5,
     };
     let read = probe_record("h.csv", m, &params, &hits_of(m, &run), &settings).unwrap();
-    let campaign = Campaign::of_record(read.record, params, zeroed);
-    let opts = IdentifyOptions::new().constraint(case.constraint.clone());
-    identify(m, model, &campaign, &opts).unwrap()
+    Campaign::of_record(read.record, params, zeroed)
 }
 
 /// Per determined parameter, `(name, z = (value − truth)/std)`; panics when a parameter of the
@@ -376,5 +389,73 @@ fn a_lobing_is_identified_on_a_head_and_not_on_a_table_table_machine() {
             ident.fit.values[j].is_none(),
             "{k} is determined on table-table-bc"
         );
+    }
+}
+
+#[test]
+fn a_rotary_axis_backlash_is_identified_from_poses_approached_from_both_sides() {
+    // seed-ac's C with 15 µrad of reversal (30 µrad of lost motion): C stepped up 0…300° and
+    // back down 240…60°, so that each angle but the ends is approached from both sides.
+    let mut case = case("seed-ac");
+    case.truth = truth(
+        &case.m,
+        "XOW = 12\nYOW = -18\nZOW = 15\nYOA = 20\nZOA = -15\nBOA = 25\nCOA = -18\nXOC = 10\nYOC = -22\nAOC = 30\nBOC = -12\nECC = { reversal = 15 }\n",
+    );
+    case.model
+        .terms
+        .push(simulation::model::Term::parse(&case.m, "ECC@reversal").unwrap());
+    let mut poses = sweep(&case.m, 6);
+    let c = case.m.axis_by_name("C").unwrap();
+    for deg in [240.0f64, 180.0, 120.0, 60.0] {
+        let mut q = vec![0.0; case.m.axes.len()];
+        q[c] = deg.to_radians();
+        poses.push(q);
+    }
+    let ident = identified(&case, &poses, 4, PreTravel::default(), Default::default());
+    let z = z_scores(&case, &ident);
+    let (_, zr) = z.iter().find(|(n, _)| n.starts_with("ECC")).unwrap();
+    let j = ident
+        .fit
+        .names
+        .iter()
+        .position(|n| n.starts_with("ECC"))
+        .unwrap();
+    println!(
+        "ECC@reversal: {:.2} ± {:.2} µrad (truth 15)",
+        ident.fit.values[j].unwrap() * 1e6,
+        ident.fit.std[j].unwrap() * 1e6
+    );
+    assert!(zr.abs() < 4.0, "ECC@reversal {zr:.2} std off");
+    assert!(ident.fit.std[j].unwrap() < 5e-6, "ECC@reversal std");
+    for (n, z) in &z {
+        assert!(z.abs() < 4.0, "{n} is {z:.2} std off");
+    }
+}
+
+#[test]
+fn a_linear_axis_backlash_or_a_servo_lag_is_refused_on_probe_records() {
+    let case = case("seed-ac");
+    let poses = sweep(&case.m, 4);
+    for (term, why) in [
+        ("EXX@reversal", "both directions of every linear axis"),
+        ("EXX@velocity", "stands still at every hit"),
+    ] {
+        let mut model = case.model.clone();
+        model
+            .terms
+            .push(simulation::model::Term::parse(&case.m, term).unwrap());
+        let campaign = probe_campaign(
+            &case,
+            false,
+            &poses,
+            1,
+            PreTravel::default(),
+            Default::default(),
+        );
+        let m = &case.m;
+        let e = identify(m, &model, &campaign, &IdentifyOptions::new())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(term) && e.contains(why), "{term}: {e}");
     }
 }

@@ -115,7 +115,10 @@ pub(crate) fn lines(
     h.push("5 sphere: its centre at the ball position of the kinematic".into());
     h.push(format!(
         "  parameters, within {} mm; clean; its stem along the table",
-        short(0.5 * o.pretouch_mm.min(o.overtravel_mm))
+        short(
+            super::LogOptions::DEFAULT_MAX_DEVIATION_MM
+                .min(0.5 * o.pretouch_mm.min(o.overtravel_mm))
+        )
     ));
     h.push(format!(
         "  normal (no hit within {} deg of it)",

@@ -75,7 +75,7 @@ pub fn run(args: &ProbeLogArgs) -> VerbResult<Done> {
     }
     let log_name = args.log.display().to_string();
     let hits = hits_from_log(&m, &plan, &trips, &log_name, &o).map_err(|e| match e {
-        CsvError::Record(why) => Error::usage(why),
+        CsvError::Record(why) => Error::usage(format!("--max-deviation-mm: {why}")),
         e => Error::input(format!("--log: {e}")),
     })?;
     // The largest distance of a latch from its planned contact, mm, and its hit.

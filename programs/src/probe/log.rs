@@ -16,6 +16,7 @@
 use formats::csv::{CsvError, Ctx, Lines, ReadOptions, column_order};
 use formats::nc::Dialect;
 use formats::poses::axis_words;
+use formats::probe::MAX_HITS;
 use model_spec::units::parse_scaled;
 use model_spec::{AxisKind, Machine};
 use std::io::Read;
@@ -55,7 +56,8 @@ pub fn parse_probe_log(
 /// # Errors
 /// [`CsvError::Format`] naming the line: not nine numbers (LinuxCNC), not the letters of the
 /// linear axes each with a number (ISO, Heidenhain), a number that cannot be read, a line too
-/// long or not UTF-8; a log without a trip; [`CsvError::Io`] when the file cannot be read.
+/// long or not UTF-8; a log without a trip or with more than [`MAX_HITS`]; [`CsvError::Io`]
+/// when the file cannot be read.
 pub fn read_probe_log(
     path: &Path,
     dialect: Dialect,
@@ -87,6 +89,13 @@ fn read_log<R: Read>(
         let t = text.trim();
         if t.is_empty() || (dialect != Dialect::LinuxCnc && t == "%") {
             continue;
+        }
+        if trips.len() >= MAX_HITS {
+            return Err(cx.err(
+                line,
+                None,
+                format!("more than {MAX_HITS} trips: no probe plan has that many hits"),
+            ));
         }
         let axes = match dialect {
             Dialect::LinuxCnc => linuxcnc_line(&cx, line, t, &letters)?,

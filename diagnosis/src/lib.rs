@@ -274,6 +274,20 @@ pub fn diagnose(
         &joined(fitted),
         &o.dictionary,
     ));
+    // A touch probe's records: no candidate they cannot carry (a linear axis's reversal, a
+    // servo lag), and the probe's lobing among the candidates when every record is a probe's.
+    if fitted.records.iter().any(|r| !r.record.probe.is_empty()) {
+        candidates.retain(|t| fitting::hmatrix::probe_term(m, t).is_ok());
+        let lobing = Term {
+            effect: simulation::model::Effect::PreTravel,
+            basis: simulation::model::Basis::Harmonic(3),
+        };
+        if fitted.records.iter().all(|r| !r.record.probe.is_empty())
+            && !base_terms.terms.contains(&lobing)
+        {
+            candidates.push(lobing);
+        }
+    }
     // A jump in time where one record is fitted (`dictionary::jumps`).
     if let [one] = fitted.records.as_slice() {
         let times: Vec<f64> = one.record.samples.iter().map(|s| s.t).collect();

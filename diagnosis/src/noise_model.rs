@@ -40,6 +40,15 @@ pub(super) fn choose(
     match choice {
         NoiseChoice::Model(model) => (model.clone(), false),
         NoiseChoice::Ordinary => (NoiseModel::residual(sigma, "ordinary least squares"), false),
+        // The diagnosis weighs the rows by the covariances' shape and takes the scale from
+        // the base fit's residual, which the lack-of-fit test then judges.
+        NoiseChoice::Instrument => (
+            NoiseModel::residual(
+                sigma,
+                "ordinary least squares of the rows whitened by the instrument's covariances",
+            ),
+            false,
+        ),
         NoiseChoice::Estimate => match adequacy::estimate_records(series) {
             Ok(model) => (model, true),
             Err(e) => (

@@ -224,6 +224,10 @@ pub fn choose_noise(choice: &NoiseChoice, residual: &[f64], sigma: Option<f64>) 
     let sigma = sigma.unwrap_or(0.0);
     match choice {
         NoiseChoice::Ordinary => NoiseModel::residual(sigma, "ordinary least squares"),
+        NoiseChoice::Instrument => NoiseModel::residual(
+            sigma,
+            "ordinary least squares: the record declares no covariances",
+        ),
         NoiseChoice::Model(m) => m.clone(),
         NoiseChoice::Estimate => {
             let rows: Vec<[f64; 3]> = residual

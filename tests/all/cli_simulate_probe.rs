@@ -153,6 +153,7 @@ fn hits_beyond_a_stroke_or_the_clearance_are_a_failed_computation_and_nothing_is
             "--path poses.csv: pose p1, hit 3 (approach (1, 0, 0)): the start point X = 511 mm outside its stroke -500 .. 500 mm; nothing is written",
         ],
     );
+    assert_eq!(entries(&dir), before);
     // A ball set up 20 mm off: the probe would start inside it.
     std::fs::write(
         dir.join("far.toml"),

@@ -54,6 +54,11 @@ impl NoiseArgs {
         instrument: super::campaign::Through,
     ) -> VerbResult<(NoiseChoice, Option<super::ReadFile>)> {
         let Some(path) = &self.noise_record else {
+            // A probe's σ declares its readings' covariances, scale included (its sphere
+            // fits check it): taken as declared unless --noise says otherwise.
+            if self.noise.is_none() && matches!(instrument, super::campaign::Through::Probe(_)) {
+                return Ok((NoiseChoice::Instrument, None));
+            }
             let declared = self.declared()?;
             if instrument.declares_noise() && matches!(declared, NoiseChoice::Model(_)) {
                 let what = match instrument {

@@ -131,8 +131,10 @@ pub fn read_record_file(
     through: campaign::Through,
 ) -> Result<(Record, Digest, Option<fitting::probe::ProbeSummary>), formats::csv::CsvError> {
     match through {
-        campaign::Through::Probe(p) => probe_records::read_probe_record(path, m, params, p, options)
-            .map(|(r, d, s)| (r, d, Some(s))),
+        campaign::Through::Probe(p) => {
+            probe_records::read_probe_record(path, m, params, p, options)
+                .map(|(r, d, s)| (r, d, Some(s)))
+        }
         other => formats::campaign::read_record_at(path, m, params, options, other.sensors())
             .map(|(r, d)| (r, d, None)),
     }

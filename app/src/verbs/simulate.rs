@@ -37,12 +37,11 @@ workpiece, tool frame, µm) and t_s (s). It is read back first: readings `identi
 (beyond --max-reading-um) are an error (exit code 3) and nothing is written. `-o -` writes it to \
 standard output. Prints the samples and the RMS of the readings (µm).
 
-With --probe FILE (a probe instrument file, docs/probe.md) it simulates a touch probe instead: \
-9 hits on the calibration sphere at each pose of the path, exact contacts with the truth's \
-errors, the probe's pre-travel and noise (--noise-um overrides the file's noise_um), written as a \
-probe hits CSV (docs/probe-simulation.md).
+With --probe FILE (docs/probe.md) it simulates a touch probe instead: 9 hits on the sphere at \
+each pose of the path, with the probe's pre-travel and noise, as a probe hits CSV.
 
-Details (paths, truths, the CSV, --commanded, --instrument): docs/truth.md.";
+Details: docs/truth.md (paths, truths, the CSV, --commanded, --instrument), \
+docs/probe-simulation.md (--probe).";
 
 /// Flags of `rtest simulate`.
 #[derive(Debug, clap::Args)]

@@ -13,7 +13,7 @@ use crate::hmatrix::Backend;
 use crate::identifiability::{NearPair, Swallowed, swallowed_by_offsets};
 use crate::identify::check_readings;
 use crate::least_squares::{EstimateError, Fit};
-use crate::noise::{NoiseChoice, NoiseModel, SampleWhitening};
+use crate::noise::{NoiseChoice, NoiseModel, NoiseSource, SampleWhitening};
 use crate::refine::{IdentifyError, Refinement};
 use crate::{Identification, IdentifyOptions};
 use model_spec::Machine;
@@ -165,6 +165,10 @@ pub fn choose_campaign_noise(
     let sigma = sigma.unwrap_or(0.0);
     match choice {
         NoiseChoice::Ordinary => NoiseModel::residual(sigma, "ordinary least squares"),
+        NoiseChoice::Instrument => NoiseModel::residual(
+            sigma,
+            "ordinary least squares: the records declare no covariances",
+        ),
         NoiseChoice::Model(m) => m.clone(),
         NoiseChoice::Estimate => {
             let mut series: Vec<Vec<[f64; 3]>> = Vec::with_capacity(rows.len());
@@ -198,6 +202,9 @@ pub fn choose_campaign_noise_weighted(
     rows: &[usize],
     weights: Option<&SampleWhitening>,
 ) -> Result<NoiseModel, EstimateError> {
+    if let (NoiseChoice::Instrument, Some(w)) = (choice, weights) {
+        return Ok(NoiseModel::white(w.scale_mm, NoiseSource::Instrument));
+    }
     let Some(w) = weights else {
         return Ok(choose_campaign_noise(
             choice,
@@ -303,7 +310,45 @@ fn fit_system(
     let mut ident = CampaignIdentification::new(m, model, design, to_layout_order(fit, order));
     ident.noise = chosen;
     ident.whitened_sigma = whitened_sigma;
+    at_declared_scale(&mut ident);
     Ok(ident)
+}
+
+/// The p-value below which a fit's residual refutes the instrument's declared noise
+/// ([`at_declared_scale`]): 1 %.
+pub const DECLARED_REFUTED: f64 = 0.01;
+
+/// Under the instrument's declared noise ([`NoiseChoice::Instrument`]): the uncertainties at the
+/// declared scale (the fit's own scale the σ̂ of its whitened residual, about 1 when the declared
+/// σ is right), unless the residual refutes it (`χ² = σ̂_w²·dof`, upper tail below
+/// [`DECLARED_REFUTED`]): the model then misses something or the σ is optimistic, and the
+/// uncertainties keep the residual's scale, the noise model saying why.
+pub(crate) fn at_declared_scale(ident: &mut CampaignIdentification) {
+    if ident.noise.source != NoiseSource::Instrument {
+        return;
+    }
+    let dof = ident.fit.dof;
+    let Some(ws) = ident.whitened_sigma.filter(|w| *w > 0.0 && w.is_finite()) else {
+        return;
+    };
+    if dof == 0 {
+        return;
+    }
+    let p = crate::distributions::chi2_upper_tail(ws * ws * dof as f64, dof as f64);
+    if p < DECLARED_REFUTED {
+        let sigma = ident.noise.sigma_mm[0] * ws;
+        ident.noise = NoiseModel::residual(
+            sigma,
+            format!(
+                "the instrument's declared σ is refuted by the residual: σ̂ of the whitened residual {ws:.3} over {dof} degrees of freedom, χ² upper tail {p:.1e} < {DECLARED_REFUTED}; the model misses something or the σ is optimistic (rtest diagnose)"
+            ),
+        );
+        return;
+    }
+    for s in ident.fit.std.iter_mut().flatten() {
+        *s /= ws;
+    }
+    ident.fit.covariance /= ws * ws;
 }
 
 /// The ordinary identification of `model` on the campaign of `design` from `fit`, the fit of

@@ -234,6 +234,7 @@ pub(crate) fn identify_refined(
     let r = run.refine(&mut ident, Some(&chosen), Some(&under))?;
     ident.noise = chosen;
     r.converged()?;
+    super::fit::at_declared_scale(&mut ident);
     ident.refinement = Some(ordinary.followed_by(&r));
     Ok(ident)
 }

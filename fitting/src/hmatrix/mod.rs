@@ -655,7 +655,7 @@ fn h_matrix_on(
 /// Refuses a term a touch probe's readings cannot carry: a linear axis's reversal (the hits of a
 /// pose approach along both directions of every linear axis, so its backlash moves the hits and
 /// the sphere's radius, not the centre) and the servo lag (the probe stands still at a hit).
-fn probe_term(m: &Machine, term: &Term) -> Result<(), HMatrixError> {
+pub fn probe_term(m: &Machine, term: &Term) -> Result<(), HMatrixError> {
     let why = match (term.basis, term.effect.carrier(m)) {
         (Basis::Reversal, model_spec::basis::Carrier::Axis(a))
             if m.axes[a].kind == model_spec::AxisKind::Linear =>

@@ -75,6 +75,10 @@ pub enum NoiseSource {
         /// Samples over all records.
         samples: usize,
     },
+    /// The instrument's own: the records' per-sample covariances taken as declared (white
+    /// after whitening, its scale theirs), as a touch probe's σ, which its sphere fits check,
+    /// declares them.
+    Instrument,
     /// White, one σ for every direction: the σ̂ of an ordinary fit's residual (ordinary least
     /// squares, as without a noise model). `why` says why no other model is used.
     Residual {
@@ -90,6 +94,7 @@ impl NoiseSource {
             NoiseSource::Declared => "declared",
             NoiseSource::StaticRecord { .. } => "static-record",
             NoiseSource::Estimated { .. } => "estimated",
+            NoiseSource::Instrument => "instrument",
             NoiseSource::Residual { .. } => "residual",
         }
     }
@@ -120,6 +125,11 @@ pub enum NoiseChoice {
     Estimate,
     /// This model (declared or from a static record), then a generalized least-squares fit.
     Model(NoiseModel),
+    /// The records' covariances as their instrument declares them, scale included (a touch
+    /// probe's σ, checked by its sphere fits): the generalized least-squares fit of the rows
+    /// whitened by them, with no scale estimated from the residual; ordinary least squares for
+    /// records without covariances.
+    Instrument,
 }
 
 /// A noise specification, a static record or a whitening that cannot be used.
@@ -381,6 +391,12 @@ impl fmt::Display for NoiseModel {
                 if *records == 1 { "" } else { "s" }
             ),
             NoiseSource::Residual { why } => write!(f, "the σ̂ of the residual ({why})"),
+            NoiseSource::Instrument => {
+                write!(
+                    f,
+                    "declared by the instrument (the readings' covariances as they are)"
+                )
+            }
         }
     }
 }

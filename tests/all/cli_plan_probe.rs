@@ -50,14 +50,14 @@ fn a_probe_plan_prints_its_poses_and_valuations_and_writes_the_json_and_the_pose
         ],
     );
     for needle in [
-        "Probe plan on machine seed-ac, model reduced (11 parameters): 3 positions per rotary axis (auto",
-        "A: -90° .. 90°, both ends: -90, 0, 90°",
-        "C: a full turn from 0° in 3 equal steps: 0, 120, 240°",
-        "A-90 ",
-        "C240 ",
+        "Probe plan on machine seed-ac, model reduced (11 parameters): 5 positions per rotary axis (auto",
+        "A: -60° .. 60°, both ends: -60, -30, 0, 30, 60°",
+        "C: a full turn from 0° in 5 equal steps: 0, 72, 144, 216, 288°",
+        "A-60 ",
+        "C288 ",
         "predicted std",
         "valuation per rotary axis",
-        "auto: 3 positions per rotary axis give every determined parameter of interest a valuation of 2 or more",
+        "auto: 5 positions per rotary axis give every determined parameter of interest a valuation of 2 or more",
         "Wrote plan.json",
         "Wrote poses.csv",
     ] {
@@ -65,11 +65,11 @@ fn a_probe_plan_prints_its_poses_and_valuations_and_writes_the_json_and_the_pose
     }
     let j = read_json(&dir.join("plan.json"));
     assert_eq!(j["machine"], "seed-ac");
-    assert_eq!(j["per_axis"], 3);
+    assert_eq!(j["per_axis"], 5);
     assert_eq!(j["mode"], "auto");
     assert_eq!(j["auto"]["met"], true);
-    assert_eq!(j["samples"], 6);
-    assert_eq!(j["poses"].as_array().unwrap().len(), 6);
+    assert_eq!(j["samples"], 10);
+    assert_eq!(j["poses"].as_array().unwrap().len(), 10);
     assert_eq!(j["rank"], 11);
     assert!(j["skipped"].as_array().unwrap().is_empty());
     // The valuation is the target over the std: 1 µm and 5 µrad.
@@ -93,12 +93,12 @@ fn a_probe_plan_prints_its_poses_and_valuations_and_writes_the_json_and_the_pose
     // The poses CSV: a path the other verbs read, one sample per pose in the plan's order.
     let csv = std::fs::read_to_string(dir.join("poses.csv")).unwrap();
     assert!(
-        csv.contains("# poses, in order: A-90, A0, A90, C0, C120, C240"),
+        csv.contains("# poses, in order: A-60, A-30, A0, A30, A60, C0, C72, C144, C216, C288"),
         "{csv}"
     );
     assert_eq!(
         csv.lines().filter(|l| !l.starts_with('#')).count(),
-        7,
+        11,
         "{csv}"
     );
     ok(

@@ -161,6 +161,38 @@ fn a_probe_campaign_goes_through_the_pipeline() {
     );
     let h = ok(&dir, &["history"]);
     assert!(h.contains("M-1"), "{h}");
+    // The poses a plan chooses make the probing program.
+    ok(
+        &dir,
+        &[
+            "plan",
+            "--machine",
+            "seed-ac",
+            "--model",
+            "reduced",
+            "--probe",
+            "probe.toml",
+            "--poses-out",
+            "planned.csv",
+        ],
+    );
+    let p = ok(
+        &dir,
+        &[
+            "path",
+            "--machine",
+            "seed-ac",
+            "--test",
+            "planned.csv",
+            "--probe",
+            "probe.toml",
+            "--nc",
+            "linuxcnc",
+            "-o",
+            "probe.ngc",
+        ],
+    );
+    assert!(p.contains("Wrote probe.ngc"), "{p}");
 }
 
 #[test]

@@ -57,14 +57,15 @@ pub struct PathArgs {
     /// List the machine's tests instead of writing one.
     #[arg(long, conflicts_with_all = ["test", "output", "step_deg", "period_s"])]
     list: bool,
-    /// The test to write (`turn-C`, `pair-A-C`, `K4`; see --list), any case.
+    /// The test to write (`turn-C`, `pair-A-C`, `K4`; see --list), any case; with --probe also
+    /// a path CSV of poses (as `rtest plan --probe --poses-out` writes them).
     #[arg(
         long,
-        value_name = "NAME",
+        value_name = "NAME|FILE",
         required_unless_present = "list",
         requires = "output"
     )]
-    test: Option<String>,
+    pub(super) test: Option<String>,
     /// Kinematic parameters (mm) overriding the machine's defaults, the ball position among
     /// them (`Xw=-200,Zw=180`).
     #[arg(long, value_name = "SYMBOL=VALUE,...")]

@@ -148,7 +148,18 @@ pub fn run(
         read_probe_instrument(file).map_err(|e| Error::input(format!("--probe: {e}")))?;
     let params = pose_args::params(m, parts.param)?;
     let gen_opts = parts.generator.options()?;
-    let (spec, record) = super::path::poses(args, m, &params, &gen_opts)?;
+    let (test_name, record) = match args.test.as_deref() {
+        // A path CSV of poses (`rtest plan --probe --poses-out`): a file that is no test name.
+        Some(f) if Path::new(f).is_file() && simulation::paths::builtin_path(m, f).is_none() => {
+            let record = formats::paths::load_path(m, f, &formats::csv::ReadOptions::default())
+                .map_err(|e| Error::input(format!("--test: {e}")))?;
+            (f.to_string(), record)
+        }
+        _ => {
+            let (spec, record) = super::path::poses(args, m, &params, &gen_opts)?;
+            (spec.name, record)
+        }
+    };
     let mut o = ProbeOptions::new(
         m,
         dialect,
@@ -157,7 +168,7 @@ pub fn run(
         instrument.tip_radius_mm,
     );
     o.params = params.clone();
-    o.test_name = spec.name.clone();
+    o.test_name = test_name;
     o.log_name = name.clone();
     o.clearance_mm = nc.clearance_mm;
     if let Some(d) = super::args::nc_decimals(nc.decimals)? {
@@ -194,7 +205,7 @@ pub fn run(
             "probe plan written by rtest {} for machine {}, test {}: {} poses probed, {} hits, {} program",
             env!("CARGO_PKG_VERSION"),
             m.name,
-            spec.name,
+            o.test_name,
             p.passes,
             p.plan.rows.len(),
             dialect.name()
@@ -228,7 +239,7 @@ pub fn run(
     let text = format!(
         "Probing program ({}) of test {} of machine {}: {} poses probed, {} hits, nominal duration {} s.\n  Sphere {} mm, tip {} mm; the control logs to {log}.\n  Then: rtest probe-log --machine {} --plan {} --log LOG --nc {} -o hits.csv\n",
         dialect.name(),
-        spec.name,
+        o.test_name,
         m.name,
         p.passes,
         p.plan.rows.len(),

@@ -43,11 +43,8 @@ test that separates them.
 
 --json FILE writes the report (`-`: standard output; `null` where the plan determines no value).
 
---probe FILE plans a touch-probe calibration instead (the probe instrument file, docs/probe.md): \
-each rotary axis stepped over its interval at --per-axis N positions (3 to 12; `auto`: the least \
-that gives every determined parameter of the machine a valuation number, target / predicted std, \
-of --min-valuation or more, default 2), the others at rest; --constraint zero:NAME,... holds \
-parameters at 0; --poses-out FILE writes the poses as a path CSV. Details: docs/probe-plan.md.";
+--probe FILE plans a touch-probe calibration: each rotary axis at --per-axis N|auto positions, \
+valuation numbers (target / std), --poses-out FILE for `path --probe`. Details: docs/probe-plan.md.";
 
 /// Flags of `rtest plan`.
 #[derive(Debug, clap::Args)]

@@ -19,9 +19,9 @@ use std::path::{Path, PathBuf};
 pub struct ProbeArgs {
     /// The touch probe of the records: a probe instrument file (TOML: tip_radius_mm,
     /// sphere_radius_mm, noise_um; docs/probe.md). The records are then probe hits CSVs (pose,
-    /// the axes, nx,ny,nz, t_s) or sphere centres CSVs (pose, the axes, cx,cy,cz[,u_cx,u_cy,
-    /// u_cz][,r]), told apart by their headers; each pose's sphere fit gives one reading of the
-    /// error vector, its covariance from the probe's σ.
+    /// the axes, nx, ny, nz, t_s) or sphere centres CSVs (pose, the axes, cx, cy, cz, optionally
+    /// u_cx, u_cy, u_cz and r), told apart by their headers; each pose's sphere fit gives one
+    /// reading of the error vector, its covariance from the probe's σ.
     #[arg(long, value_name = "FILE", conflicts_with = "instrument")]
     pub probe: Option<PathBuf>,
 }

@@ -314,7 +314,11 @@ pub fn probe_poses(
 }
 
 /// The pose whose rotary axes stand at `axes` (degrees), or why it is skipped: the inverse
-/// kinematics, or an axis out of its stroke or range at the centre or at a hit of `pattern`.
+/// kinematics, an axis out of its stroke or range at the centre or at a hit of `pattern`, or a
+/// hit nearer the sphere's stem than the probing programs allow
+/// ([`simulation::probe::near_stem`]). The programs' other rule, no hit below the sphere's
+/// equator seen along the tool axis ([`simulation::probe::below_equator`]), is not applied:
+/// on a tilting head it would leave no tilted pose of the bed-frame pattern (`docs/probe-plan.md`).
 fn pose_at(
     vm: &VirtualMachine<'_>,
     params: &[f64],
@@ -342,6 +346,13 @@ fn pose_at(
         .flatten()
         .ok_or_else(|| "the linear axes do not move the probe in three directions".to_string())?;
     for (h, hit) in pattern.iter().enumerate() {
+        if let Some(why) = simulation::probe::near_stem(
+            &hit.point_mm,
+            &geometry.table_normal,
+            simulation::probe::STEM_CLEARANCE_DEG,
+        ) {
+            return Err(format!("hit {} of the default pattern: {why}", h + 1));
+        }
         let dq: Vector3<f64> = inverse * (hit.point_mm - base);
         let mut q = geometry.commands.clone();
         for (k, &i) in linear.iter().enumerate() {
@@ -417,7 +428,16 @@ impl ProbePlanInputs<'_> {
             return Err(ProbePlanError::PerAxis(per_axis));
         }
         let bed = pattern_covariance(self.probe)?;
-        let sweeps = sweeps(m, self.clearance)?;
+        // The bed-frame pattern's equator hits come within 90° − tilt of the sphere's stem:
+        // tilts beyond 90° − the stem clearance would skip every end pose.
+        let clearance = Clearance {
+            max_tilt_deg: self
+                .clearance
+                .max_tilt_deg
+                .min(90.0 - simulation::probe::STEM_CLEARANCE_DEG),
+            ..*self.clearance
+        };
+        let sweeps = sweeps(m, &clearance)?;
         let poses = probe_poses(
             m,
             self.params,
@@ -581,8 +601,8 @@ pub fn below(
 }
 
 /// The least number of positions per rotary axis, from [`MIN_PER_AXIS`] to [`MAX_PER_AXIS`],
-/// whose every determined parameter of interest has a valuation of at least `min_valuation`
-/// against `targets`; [`MAX_PER_AXIS`] with `met` false when none has. A number whose
+/// that leaves no parameter of interest confounded and gives every determined one a valuation
+/// of at least `min_valuation` against `targets`; [`MAX_PER_AXIS`] with `met` false when none has. A number whose
 /// campaign has too few readings for the model's parameters does not meet it.
 ///
 /// # Errors
@@ -609,7 +629,16 @@ pub fn choose_per_axis(
             Ok(plan) => {
                 let (low, least) = below(m, &plan.prediction, targets, min_valuation);
                 tried.push(Tried { per_axis: n, least });
-                let met = low.is_empty() && least.is_some();
+                // A parameter of interest the poses leave confounded is not met either (more
+                // positions may separate it: a pose skipped at a range's end, say).
+                let wanted = super::choose::interest(&plan.prediction);
+                let confounded = plan
+                    .prediction
+                    .confounded
+                    .iter()
+                    .flatten()
+                    .any(|j| wanted.contains(j));
+                let met = low.is_empty() && least.is_some() && !confounded;
                 if met || n >= MAX_PER_AXIS {
                     return Ok(Choice {
                         plan,

@@ -14,6 +14,9 @@ pub struct PoseGeometry {
     pub commands: Vec<f64>,
     /// The nominal tool frame's rotation (bed frame ← tool frame) at the pose.
     pub tool_rotation: Rotation3<f64>,
+    /// The nominal table normal (unit, bed frame): the workpiece chain's z axis at the pose,
+    /// along the sphere's stem from its foot to the sphere.
+    pub table_normal: Vector3<f64>,
 }
 
 impl PoseGeometry {
@@ -35,9 +38,11 @@ impl PoseGeometry {
             .collect();
         vm.tool_centre_point_ik(&mut commands, params)?;
         let tool = vm.transform_with(Side::Tool, &commands, params, &|_| 0.0);
+        let work = vm.transform_with(Side::Work, &commands, params, &|_| 0.0);
         Ok(PoseGeometry {
             commands,
             tool_rotation: tool.rotation,
+            table_normal: work.rotation.matrix().column(2).into_owned(),
         })
     }
 
@@ -62,6 +67,11 @@ impl PoseGeometry {
                 AxisKind::Rotary => own,
             })
             .collect()
+    }
+
+    /// The nominal tool axis (unit, bed frame): from the tip towards the spindle.
+    pub fn tool_axis(&self) -> Vector3<f64> {
+        self.tool_rotation.matrix().column(2).into_owned()
     }
 
     /// A bed-frame vector expressed in the tool frame.

@@ -44,11 +44,6 @@ fn norm(a: &V3) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// The angle between two unit vectors, degrees (from the sine and the cosine).
-fn angle_deg(a: &V3, b: &V3) -> f64 {
-    norm(&cross(a, b)).atan2(dot(a, b)).to_degrees()
-}
-
 /// The frame of one pose.
 pub(crate) struct Frame {
     /// The three linear axes (indices into [`Machine::axes`]), in the machine's order.
@@ -200,24 +195,18 @@ pub(crate) fn hit_points(
         short(p[1]),
         short(p[2])
     );
-    if dot(&p, &t) < -1e-9 {
-        return Err(format!(
-            "{described} lies below the sphere's equator seen along the tool axis ({}, {}, {}): the stylus would meet the sphere",
-            short(t[0]),
-            short(t[1]),
-            short(t[2])
-        ));
-    }
-    let from_stem = angle_deg(&p, &f.stem);
-    if from_stem < o.stem_clearance_deg {
-        return Err(format!(
-            "{described} is {}° from the sphere's stem (the table normal reversed: ({}, {}, {})), nearer than the {}° allowed (rtest path --stem-clearance-deg)",
-            short(from_stem),
-            short(f.stem[0]),
-            short(f.stem[1]),
-            short(f.stem[2]),
-            short(o.stem_clearance_deg)
-        ));
+    let v = |x: &V3| nalgebra::Vector3::new(x[0], x[1], x[2]);
+    if let Some(why) = simulation::probe::unreachable(
+        &v(&p),
+        &v(&t),
+        &v(&scale(&f.stem, -1.0)),
+        o.stem_clearance_deg,
+    ) {
+        return Err(if why.contains("stem") {
+            format!("{why} (rtest path --stem-clearance-deg)")
+        } else {
+            why
+        });
     }
     let (approach, axis) = if o.dialect == Dialect::Heidenhain {
         let mut best: Option<(usize, f64, f64)> = None;

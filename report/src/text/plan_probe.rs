@@ -22,7 +22,7 @@ pub fn plan_probe(r: &PlanProbeReport) -> String {
 fn intro(r: &PlanProbeReport) -> String {
     let how = match &r.auto {
         Some(_) => format!(
-            " (auto: the least number from 3 to 12 that gives every determined parameter of interest a valuation of {} or more)",
+            " (auto: the least number from 3 to 12 that leaves no parameter of interest confounded and gives each a valuation of {} or more)",
             short(r.min_valuation)
         ),
         None => String::new(),

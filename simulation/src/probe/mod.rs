@@ -50,12 +50,14 @@
 
 mod contact;
 mod pattern;
+mod reach;
 
 pub use contact::{CONTACT_TOLERANCE_MM, MAX_CONTACT_ITERATIONS};
 pub use pattern::{
     APPROACH_S, CLEARANCE_MM, HIT_CYCLE_S, PATTERN_HITS, POSE_CHANGE_S, PROBING_FEED_MM_PER_S,
     PreTravel, approach_directions, approach_in_probe_frame, latch_time_s, run_time_s,
 };
+pub use reach::{STEM_CLEARANCE_DEG, below_equator, near_stem, unreachable};
 
 use crate::exact::{ExactError, VirtualMachine};
 use crate::model::{BasisContext, Effect};

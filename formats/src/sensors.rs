@@ -132,11 +132,7 @@ pub fn read_sensor_measurement(
     frame: ReadingsFrame,
     opts: &ReadOptions,
 ) -> Result<Record, CsvError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let (file, f) = crate::csv::open(path)?;
     read_sensor_measurement_from(&file, f, m, instrument, frame, opts)
 }
 
@@ -449,11 +445,7 @@ pub fn read_calibration_file(
     instrument: &Instrument,
     opts: &ReadOptions,
 ) -> Result<CalibrationRecord, CsvError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let (file, f) = crate::csv::open(path)?;
     let mut r = read_calibration(&file, f, instrument, opts)?;
     r.file = file;
     Ok(r)

@@ -24,7 +24,7 @@
 //!    then exactly zero), as R-test software does.
 
 use crate::exact::VirtualMachine;
-use crate::model::{Basis, BasisContext, Effect};
+use crate::model::{Basis, BasisContext};
 use crate::record::Record;
 use crate::rng::Rng;
 use crate::truth::Truth;
@@ -190,34 +190,7 @@ fn check(m: &Machine, truth: &Truth, path: &Record) -> Result<(), SimulateError>
             crate::truth::MAX_NOISE_PHI
         )));
     }
-    if truth.params.len() != m.symbols.len() {
-        return Err(bad(format!(
-            "it has {} kinematic parameters, the machine {}",
-            truth.params.len(),
-            m.symbols.len()
-        )));
-    }
-    if truth.coefficients.len() != truth.model.width() {
-        return Err(bad(format!(
-            "it has {} coefficients for {} model columns",
-            truth.coefficients.len(),
-            truth.model.width()
-        )));
-    }
-    for t in &truth.model.terms {
-        if let Effect::Error(e) = t.effect
-            && e >= m.catalogue.len()
-        {
-            return Err(bad(format!(
-                "it names error #{e}, the catalogue has {} errors",
-                m.catalogue.len()
-            )));
-        }
-        if let Err(e) = t.check(m) {
-            return Err(bad(format!("term {}: {}", t.effect.name(m), e.0)));
-        }
-    }
-    Ok(())
+    truth.fits(m).map_err(bad)
 }
 
 /// Comment lines for the CSV of a simulation (`formats::csv::format_record`): what produced

@@ -144,6 +144,42 @@ impl Truth {
         }
     }
 
+    /// Checks that the truth fits machine `m`: one kinematic parameter per symbol, one
+    /// coefficient per model column, errors of its catalogue, terms valid on it.
+    ///
+    /// # Errors
+    /// What does not fit, for a message that names the truth.
+    pub fn fits(&self, m: &Machine) -> Result<(), String> {
+        if self.params.len() != m.symbols.len() {
+            return Err(format!(
+                "it has {} kinematic parameters, the machine {}",
+                self.params.len(),
+                m.symbols.len()
+            ));
+        }
+        if self.coefficients.len() != self.model.width() {
+            return Err(format!(
+                "it has {} coefficients for {} model columns",
+                self.coefficients.len(),
+                self.model.width()
+            ));
+        }
+        for t in &self.model.terms {
+            if let Effect::Error(e) = t.effect
+                && e >= m.catalogue.len()
+            {
+                return Err(format!(
+                    "it names error #{e}, the catalogue has {} errors",
+                    m.catalogue.len()
+                ));
+            }
+            if let Err(e) = t.check(m) {
+                return Err(format!("term {}: {}", t.effect.name(m), e.0));
+            }
+        }
+        Ok(())
+    }
+
     /// Every catalogue error's value at the sample `cx` (catalogue order; mm or rad).
     pub fn error_values(&self, m: &Machine, cx: &BasisContext<'_>) -> Vec<f64> {
         let mut e = vec![0.0; m.catalogue.len()];

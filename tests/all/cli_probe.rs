@@ -65,6 +65,8 @@ fn a_probe_campaign_goes_through_the_pipeline() {
             "probe.toml",
             "--json",
             "id.json",
+            "--report",
+            "id.html",
             "--record",
             "--machine-id",
             "M-1",
@@ -161,6 +163,26 @@ fn a_probe_campaign_goes_through_the_pipeline() {
     );
     let h = ok(&dir, &["history"]);
     assert!(h.contains("M-1"), "{h}");
+    // The HTML reports: identify's and rtest report's of the JSON, with the probe's part.
+    let html = std::fs::read_to_string(dir.join("id.html")).unwrap();
+    assert!(html.contains("Dispersion of the sphere centres per rotary axis"));
+    ok(
+        &dir,
+        &[
+            "report",
+            "--machine",
+            "seed-ac",
+            "id.json",
+            "-o",
+            "rep.html",
+        ],
+    );
+    let html = std::fs::read_to_string(dir.join("rep.html")).unwrap();
+    assert!(html.contains("Dispersion of the sphere centres per rotary axis"));
+    assert!(
+        html.contains("the records are a touch probe"),
+        "paths not drawn, and why"
+    );
     // The poses a plan chooses make the probing program.
     ok(
         &dir,

@@ -158,6 +158,12 @@ fn draw_paths(
         }
         return Ok(());
     };
+    if id.probe.is_some() {
+        inputs.prediction_not_drawn.push(
+            "No path is drawn: the records are a touch probe's (hits or sphere centres, each pose one reading through its sphere fit), which the report does not draw as paths; section 3 gives their sphere fits and the centres' dispersion per rotary axis.".into(),
+        );
+        return Ok(());
+    }
     let m = match machine.map_or_else(|| model_spec::load_machine(&id.machine), Ok) {
         Ok(m) => m,
         Err(_) => {

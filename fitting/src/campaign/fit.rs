@@ -315,7 +315,7 @@ fn fit_system(
 }
 
 /// The p-value below which a fit's residual refutes the instrument's declared noise
-/// ([`at_declared_scale`]): 1 %.
+/// (the uncertainties of an identification under [`NoiseChoice::Instrument`]): 1 %.
 pub const DECLARED_REFUTED: f64 = 0.01;
 
 /// Under the instrument's declared noise ([`NoiseChoice::Instrument`]): the uncertainties at the

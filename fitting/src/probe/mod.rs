@@ -32,7 +32,7 @@ mod pose;
 mod summary;
 
 pub use centres::centre_record;
-pub use hits::{PoseFit, ProbeRecord, ProbeSettings, probe_record};
+pub use hits::{OFF_SPHERE_MM, PoseFit, ProbeRecord, ProbeSettings, probe_record};
 pub use pose::PoseGeometry;
 pub use simulation::probe::{PreTravel, approach_in_probe_frame};
 pub use summary::ProbeSummary;

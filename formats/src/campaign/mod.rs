@@ -189,11 +189,7 @@ pub fn read_record_at(
     opts: &ReadOptions,
     instrument: Option<(&Instrument, ReadingsFrame)>,
 ) -> Result<(simulation::record::Record, Digest), CsvError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let (file, f) = crate::csv::open(path)?;
     let mut source = HashingReader::new(f);
     let record = parse_record_at(&file, &mut source, m, params, opts, instrument)?;
     Ok((record, source.digest()))

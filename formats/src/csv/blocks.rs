@@ -54,11 +54,7 @@ impl<'m> MeasurementBlocks<'m, std::fs::File> {
         block: usize,
         opts: &ReadOptions,
     ) -> Result<Self, CsvError> {
-        let file = path.display().to_string();
-        let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-            file: file.clone(),
-            source,
-        })?;
+        let (file, f) = crate::csv::open(path)?;
         MeasurementBlocks::new(file, f, m, block, opts)
     }
 }

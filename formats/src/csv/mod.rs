@@ -108,6 +108,19 @@ impl ReadOptions {
     }
 }
 
+/// Opens `path` for one of the CSV readers: its name as messages give it (`path.display()`)
+/// and the file, or [`CsvError::Io`] naming it.
+///
+/// # Errors
+/// [`CsvError::Io`] when the file cannot be opened.
+pub fn open(path: &std::path::Path) -> Result<(String, std::fs::File), CsvError> {
+    let file = path.display().to_string();
+    match std::fs::File::open(path) {
+        Ok(f) => Ok((file, f)),
+        Err(source) => Err(CsvError::Io { file, source }),
+    }
+}
+
 /// A problem with a CSV file.
 #[derive(Debug, thiserror::Error)]
 pub enum CsvError {
@@ -234,11 +247,7 @@ pub fn parse_measurement(
 /// # Errors
 /// As [`parse_measurement`]; [`CsvError::Io`] when the file cannot be opened or read.
 pub fn read_measurement(path: &Path, m: &Machine, opts: &ReadOptions) -> Result<Record, CsvError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let (file, f) = crate::csv::open(path)?;
     read_csv(&file, f, m, Need::Measured, opts)
 }
 

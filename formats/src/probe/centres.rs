@@ -73,11 +73,7 @@ pub fn parse_sphere_centres(
 /// radius not above 0, more than [`MAX_PROBE_POSES`] rows, no row; a line too long or not
 /// UTF-8; [`CsvError::Io`] when the file cannot be read.
 pub fn read_sphere_centres(path: &Path, m: &Machine) -> Result<SphereCentres, CsvError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let (file, f) = crate::csv::open(path)?;
     read_centres(&file, f, m, MAX_PROBE_POSES)
 }
 

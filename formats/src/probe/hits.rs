@@ -90,11 +90,7 @@ pub fn parse_probe_hits(file: &str, text: &str, m: &Machine) -> Result<ProbeHits
 /// poses, no row; a line too long or not UTF-8; [`CsvError::Io`] when the file cannot be
 /// read.
 pub fn read_probe_hits(path: &Path, m: &Machine) -> Result<ProbeHits, CsvError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let (file, f) = crate::csv::open(path)?;
     read_hits(&file, f, m, MAX_HITS, MAX_PROBE_POSES)
 }
 

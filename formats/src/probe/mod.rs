@@ -26,7 +26,7 @@
 //! so write → read gives the same bits. [`crate::poses::from_file_units`] gives the commands in
 //! mm and rad the computation takes.
 //!
-//! [`file`] reads either CSV, told apart by its header ([`read_probe_file`]).
+//! [`mod@file`] reads either CSV, told apart by its header ([`read_probe_file`]).
 //!
 //! Files: `table` (the header and rows both CSVs share), `hits`, `centres`, `file`, `instrument`.
 

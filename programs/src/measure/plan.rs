@@ -230,11 +230,7 @@ pub fn parse_plan(file: &str, text: &str, m: &Machine) -> Result<TimingPlan, Csv
 /// strokes and ranges, a row of the other kind, a file without a row; [`CsvError::Io`] when the
 /// file cannot be read.
 pub fn read_plan(path: &Path, m: &Machine) -> Result<TimingPlan, CsvError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let (file, f) = formats::csv::open(path)?;
     read_plan_from(&file, f, m)
 }
 

@@ -63,11 +63,7 @@ pub fn read_probe_log(
     dialect: Dialect,
     m: &Machine,
 ) -> Result<Vec<LoggedTrip>, CsvError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let (file, f) = formats::csv::open(path)?;
     read_log(&file, f, dialect, m)
 }
 

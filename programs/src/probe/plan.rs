@@ -137,11 +137,7 @@ pub fn parse_probe_plan(file: &str, text: &str, m: &Machine) -> Result<ProbePlan
 /// time going backwards, lines not increasing, more than [`MAX_HITS`] rows, no row;
 /// [`CsvError::Io`] when the file cannot be read.
 pub fn read_probe_plan(path: &Path, m: &Machine) -> Result<ProbePlan, CsvError> {
-    let file = path.display().to_string();
-    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let (file, f) = formats::csv::open(path)?;
     read_plan(&file, f, m)
 }
 

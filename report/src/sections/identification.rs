@@ -180,6 +180,9 @@ pub fn write(b: &mut Body, inputs: &Inputs) {
         b.subheading("What the zero offsets swallow");
         b.list(&lines);
     }
+    if let Some(p) = &r.probe {
+        super::probe::write(b, p);
+    }
     if !r.notes.is_empty() {
         b.subheading("Notes of the identification");
         b.list(&r.notes);

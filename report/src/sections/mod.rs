@@ -6,6 +6,7 @@ pub mod data;
 pub mod diagnosis;
 pub mod identification;
 pub mod machine;
+pub mod probe;
 pub mod validation;
 
 use model_spec::units::{fixed, readable};

@@ -544,32 +544,5 @@ fn check_truth(m: &Machine, truth: &Truth) -> Result<(), ProbeError> {
         machine: m.name.clone(),
         why,
     };
-    if truth.params.len() != m.symbols.len() {
-        return Err(bad(format!(
-            "it has {} kinematic parameters, the machine {}",
-            truth.params.len(),
-            m.symbols.len()
-        )));
-    }
-    if truth.coefficients.len() != truth.model.width() {
-        return Err(bad(format!(
-            "it has {} coefficients for {} model columns",
-            truth.coefficients.len(),
-            truth.model.width()
-        )));
-    }
-    for t in &truth.model.terms {
-        if let Effect::Error(e) = t.effect
-            && e >= m.catalogue.len()
-        {
-            return Err(bad(format!(
-                "it names error #{e}, the catalogue has {} errors",
-                m.catalogue.len()
-            )));
-        }
-        if let Err(e) = t.check(m) {
-            return Err(bad(format!("term {}: {}", t.effect.name(m), e.0)));
-        }
-    }
-    Ok(())
+    truth.fits(m).map_err(bad)
 }

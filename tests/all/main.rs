@@ -50,7 +50,6 @@ mod golden;
 mod inclined_axes;
 mod inclined_directions;
 mod linuxcnc_oracle;
-mod linuxcnc_probe;
 mod linuxcnc_probe_program;
 mod readers_fuzz;
 mod report_browser;

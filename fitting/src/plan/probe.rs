@@ -330,17 +330,9 @@ fn pose_at(
     if let Some(o) = m.outside_limits(&geometry.commands).first() {
         return Err(format!("{o} at the sphere's centre"));
     }
-    // The bed-frame move of the tip centre per mm of each linear axis.
     let linear: Vec<usize> = m.linear_axes().collect();
-    // `gap` takes the linear commands of its argument and the pose's own rotary ones.
-    let at_centre = geometry.commands.clone();
-    let base = geometry.gap(vm, &at_centre, params);
-    let mut a = Matrix3::zeros();
-    for (k, &i) in linear.iter().enumerate().take(3) {
-        let mut moved = at_centre.clone();
-        moved[i] += 1.0;
-        a.set_column(k, &(geometry.gap(vm, &moved, params) - base));
-    }
+    let base = geometry.gap(vm, &geometry.commands, params);
+    let a = geometry.linear_map(vm, params);
     let inverse = (linear.len() == 3)
         .then(|| a.try_inverse())
         .flatten()

@@ -64,22 +64,12 @@ pub fn centre_record(
         }
         let c = geometry.gap(&vm, &at_centre, params);
         let e = -geometry.to_tool(&c);
-        if let Some(k) = (0..3).find(|&k| e[k].abs() > settings.max_reading_mm) {
-            return Err(bad(format!(
-                "the centre gives a reading of {:.3} µm along {}, beyond the limit of {} µm: not a small error of the machine (a wrong sphere position, kinematic parameter or pose)",
-                e[k] * 1e3,
-                ["x", "y", "z"][k],
-                settings.max_reading_mm * 1e3
-            )));
+        if let Some(why) = super::hits::reading_beyond("centre", [e.x, e.y, e.z], settings) {
+            return Err(bad(why));
         }
         if let Some(u) = p.uncertainty_mm {
-            // The linear map from machine coordinates to the bed frame, column by column.
-            let mut a = Matrix3::zeros();
-            for (k, &i) in linear.iter().enumerate() {
-                let mut moved = at_centre.clone();
-                moved[i] += 1.0;
-                a.set_column(k, &(geometry.gap(&vm, &moved, params) - c));
-            }
+            // The linear map from machine coordinates to the bed frame.
+            let a = geometry.linear_map(&vm, params);
             let d = Matrix3::from_diagonal(&Vector3::new(u[0] * u[0], u[1] * u[1], u[2] * u[2]));
             let r = geometry.tool_rotation.matrix();
             let cov = r.transpose() * a * d * a.transpose() * r;

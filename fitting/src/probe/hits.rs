@@ -62,6 +62,9 @@ pub const OFF_SPHERE_MM: f64 = 0.5;
 pub struct PoseFit {
     /// The pose's label.
     pub label: String,
+    /// Its nominal commands (`Machine::axes` order; mm, rad): the rotary axes as probed, the
+    /// linear axes putting the tip centre on the sphere's centre.
+    pub commands: Vec<f64>,
     /// The line of its first hit (1-based; 0 when not read from a file).
     pub line: usize,
     /// The sphere fit, bed frame, about the nominal sphere centre (mm).
@@ -135,22 +138,11 @@ pub fn probe_record(
         let fitted = fit_pose(&vm, params, pose, settings, noise_mm)
             .map_err(|(l, msg)| at(l, format!("pose `{}`: {msg}", pose.label)))?;
         let first = &pose.hits[0];
-        if let Some(k) = (0..3).find(|&k| fitted.reading_mm[k].abs() > settings.max_reading_mm) {
-            return Err(at(
-                first.line,
-                format!(
-                    "pose `{}`: the fitted centre gives a reading of {:.3} µm along {}, beyond the limit of {} µm: not a small error of the machine (a wrong sphere position, kinematic parameter or pose)",
-                    pose.label,
-                    fitted.reading_mm[k] * 1e3,
-                    ["x", "y", "z"][k],
-                    settings.max_reading_mm * 1e3
-                ),
-            ));
+        if let Some(why) = reading_beyond("fitted centre", fitted.reading_mm, settings) {
+            return Err(at(first.line, format!("pose `{}`: {why}", pose.label)));
         }
-        let geometry = PoseGeometry::at(&vm, &first.axes, params)
-            .map_err(|e| at(first.line, e.to_string()))?;
         record.samples.push(Sample {
-            commands: geometry.commands,
+            commands: fitted.commands.clone(),
             t: first.t_s,
             motion: vec![1; m.axes.len()],
             timed: true,
@@ -210,6 +202,19 @@ pub(super) fn set_rotary_motion(m: &Machine, record: &mut Record) {
             };
         }
     }
+}
+
+/// Why a pose's reading `e` (tool frame, mm), from its `what` (`fitted centre`, `centre`), is
+/// beyond the settings' limit in some direction: not a small error of the machine; `None`
+/// within it.
+pub(super) fn reading_beyond(what: &str, e: [f64; 3], settings: &ProbeSettings) -> Option<String> {
+    let k = (0..3).find(|&k| e[k].abs() > settings.max_reading_mm)?;
+    Some(format!(
+        "the {what} gives a reading of {:.3} µm along {}, beyond the limit of {} µm: not a small error of the machine (a wrong sphere position, kinematic parameter or pose)",
+        e[k] * 1e3,
+        ["x", "y", "z"][k],
+        settings.max_reading_mm * 1e3
+    ))
 }
 
 /// The constant pre-travel the radii show: per pose `R_eff − R_fit` with the fit's radius
@@ -286,6 +291,7 @@ fn fit_pose(
         .collect();
     Ok(PoseFit {
         label: pose.label.clone(),
+        commands: geometry.commands.clone(),
         line: first.line,
         reading_mm: [reading.x, reading.y, reading.z],
         covariance_mm2: [

@@ -2,7 +2,7 @@
 //! centre relative to the sphere's centre, and how the probe's (tool) frame stands.
 
 use model_spec::{AxisKind, Machine, Side};
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::{Matrix3, Rotation3, Vector3};
 use simulation::exact::{ExactError, VirtualMachine};
 
 /// The nominal geometry of a pose: its rotary commands, the nominal linear commands that put
@@ -55,6 +55,22 @@ impl PoseGeometry {
         let tool = vm.transform_with(Side::Tool, &commands, params, &|_| 0.0);
         let work = vm.transform_with(Side::Work, &commands, params, &|_| 0.0);
         tool.translation.vector - work.translation.vector
+    }
+
+    /// The bed-frame move of the tip centre relative to the sphere per mm of each linear axis
+    /// (columns in the machine's order of its linear axes, the first three): the nominal gap is
+    /// affine in the linear commands at the pose's rotary ones, so one difference per axis
+    /// gives it exactly.
+    pub fn linear_map(&self, vm: &VirtualMachine<'_>, params: &[f64]) -> Matrix3<f64> {
+        let m = vm.machine();
+        let base = self.gap(vm, &self.commands, params);
+        let mut a = Matrix3::zeros();
+        for (k, i) in m.linear_axes().enumerate().take(3) {
+            let mut moved = self.commands.clone();
+            moved[i] += 1.0;
+            a.set_column(k, &(self.gap(vm, &moved, params) - base));
+        }
+        a
     }
 
     /// The pose's commands with the linear axes replaced by those of `axes` (mm).

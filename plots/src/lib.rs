@@ -1,4 +1,5 @@
-//! SVG figures of R-test records, model predictions and residual spectra.
+//! SVG figures of R-test records, model predictions and residual spectra, and of a touch
+//! probe's readings per pose.
 //!
 //! This crate has one job: turn plain numbers into self-describing SVG figures. It knows nothing
 //! about machines, models or fits (it does not depend on the other rtest crates); callers convert
@@ -533,9 +534,11 @@ fn draw_path_panel(
     Ok(())
 }
 
+mod poses;
 mod spectrum;
 mod trend;
 
+pub use poses::{PoseFigure, PosePanel, probe_poses};
 pub use spectrum::spectrum;
 pub use trend::{TrendFigure, TrendPoint, trend};
 

@@ -70,6 +70,7 @@ pub fn path_figures(figures: &Figures) -> Result<Vec<Figure>, PlotError> {
                     labels.join(" and the "),
                     f.x_label
                 ),
+                data: Vec::new(),
             })
         })
         .collect()
@@ -108,6 +109,7 @@ pub fn validation_figure(
         id: "fig-validation".into(),
         svg,
         caption: "Residual RMS (µm, the bar length) on each validation record, per direction x, y, z of the tool frame and over all three: on the nominal machine (the measured error itself) and with the identified model (measured minus predicted). One row per record and direction.".into(),
+        data: Vec::new(),
     }))
 }
 
@@ -147,6 +149,7 @@ pub fn spectrum_figure(d: &DiagnosisReport) -> Result<Option<Figure>, PlotError>
             "The largest components of the residual on {} (what each shape alone explains, RMS in µm, the bar length): of the base model {} and of the extended model {}. A row is what the residual follows (an axis, or time), its shape (harmonic:k of a rotary angle, poly:k of a linear position, time:k, reversal) and its direction in the tool frame.",
             d.data, d.base_model, d.extended_model.label
         ),
+        data: Vec::new(),
     }))
 }
 

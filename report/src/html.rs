@@ -159,9 +159,25 @@ impl Body {
     /// A `<figure>` with `id`, the SVG markup `svg` (made by [`crate::svg::embed`]) and a
     /// caption `caption` (text).
     pub fn figure(&mut self, id: &str, svg: &str, caption: &str) {
+        self.figure_with_data(id, svg, caption, &[]);
+    }
+
+    /// A `<figure>` as [`Body::figure`], with `data-NAME="value"` attributes (`data`: the
+    /// names after `data-`, the values escaped).
+    pub fn figure_with_data(
+        &mut self,
+        id: &str,
+        svg: &str,
+        caption: &str,
+        data: &[(String, String)],
+    ) {
+        let attributes: String = data
+            .iter()
+            .map(|(k, v)| format!(" data-{}=\"{}\"", escape(k), escape(v)))
+            .collect();
         let _ = writeln!(
             self.html,
-            "<figure id=\"{}\">\n{svg}\n<figcaption>{}</figcaption>\n</figure>",
+            "<figure id=\"{}\"{attributes}>\n{svg}\n<figcaption>{}</figcaption>\n</figure>",
             escape(id),
             escape(caption)
         );

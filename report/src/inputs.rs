@@ -190,6 +190,9 @@ pub struct Figure {
     pub svg: String,
     /// What it shows and what its abscissa is.
     pub caption: String,
+    /// The numbers it draws, for programs, as `data-*` attributes of its `<figure>`: (name
+    /// after `data-`, of lower-case letters, digits and `-`; value). Empty for most figures.
+    pub data: Vec<(String, String)>,
 }
 
 /// An input file of the check: its role, its path and, when it was read, the size and SHA-256

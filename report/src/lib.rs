@@ -6,7 +6,8 @@
 //!   and the gain tables as serde types, written as JSON; an identification read back;
 //! - [`text`]: the same results as text for a terminal;
 //! - the HTML report, below: [`inputs`] (the JSON reports it is built from), [`sections`],
-//!   [`html`], [`figures`] and [`svg`], [`style`] (with the embedded font, encoded by
+//!   [`html`], [`figures`] (and [`probe_figure`], a touch probe's readings per pose) and
+//!   [`svg`], [`style`] (with the embedded font, encoded by
 //!   [`base64`]).
 //!
 //! The report is built from the reports rtest writes ([`inputs`]: the JSON of `identify`,
@@ -37,6 +38,7 @@ pub mod figures;
 pub mod html;
 pub mod inputs;
 pub mod json;
+pub mod probe_figure;
 pub mod sections;
 pub mod style;
 pub mod svg;
@@ -72,7 +74,7 @@ pub enum RenderError {
 /// [`RenderError::Svg`].
 pub fn place_figure(b: &mut Body, f: &Figure) -> Result<(), RenderError> {
     let svg = svg::embed(&f.id, &f.svg)?;
-    b.figure(&f.id, &svg, &f.caption);
+    b.figure_with_data(&f.id, &svg, &f.caption, &f.data);
     Ok(())
 }
 

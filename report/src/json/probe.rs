@@ -9,13 +9,21 @@
 //!                "largest_residual_at": "p.csv:57 (pose a30c90)",
 //!                "largest_radius_deviation_um": 0.6, "pre_travel_um": 0.1,
 //!                "pre_travel_std_um": 0.07}],
-//!   "axes": [{"axis": "C", "poses": 8, "measured_um": 31.2, "after_um": 0.6}]}
+//!   "axes": [{"axis": "C", "poses": 8, "measured_um": 31.2, "after_um": 0.6}],
+//!   "file": "probe.toml", "sha256": "3f0c…", "bytes": 84}
 //! ```
+//!
+//! `file` is the probe instrument file as `--probe` named it, `sha256` and `bytes` the digest
+//! and size of the bytes `identify` read from it: `rtest report` reads the same file (relative
+//! to the report's directory, as it reads the records) to read the records again through the
+//! same sphere fits, and refuses one whose bytes differ. Reports written before these fields
+//! existed have none of them (they are read all the same; their records are not drawn).
 
 use fitting::campaign::CampaignIdentification;
 use fitting::probe::ProbeSummary;
 use formats::probe::ProbeInstrument;
 use model_spec::Machine;
+use model_spec::sha256::Digest;
 use serde::{Deserialize, Serialize};
 use simulation::campaign::Campaign;
 
@@ -35,6 +43,16 @@ pub struct ProbeReport {
     pub records: Vec<ProbeRecordReport>,
     /// Per rotary axis swept by some record, the centres' dispersion before and after the fit.
     pub axes: Vec<ProbeAxisReport>,
+    /// The probe instrument file, as `--probe` named it; absent in reports written before it
+    /// was given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// The SHA-256 of the bytes read from `file` (64 lower-case hex digits).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sha256: Option<String>,
+    /// How many bytes were read from `file`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bytes: Option<u64>,
 }
 
 /// One probe record's sphere fits.
@@ -102,7 +120,19 @@ impl ProbeReport {
             noise_um: probe.noise_um,
             records,
             axes: axes(m, campaign, summaries, ident),
+            file: None,
+            sha256: None,
+            bytes: None,
         }
+    }
+
+    /// The report naming the probe instrument `file` (as `--probe` named it) and the `digest`
+    /// of the bytes read from it.
+    pub fn read_from(mut self, file: &str, digest: &Digest) -> ProbeReport {
+        self.file = Some(file.to_string());
+        self.sha256 = Some(digest.sha256.clone());
+        self.bytes = Some(digest.bytes);
+        self
     }
 }
 

@@ -2,7 +2,8 @@
 //! on the nominal machine and with the identified model, µm, and their figure; for each record
 //! its set-up (fitted, or new: its set-up errors refitted on it, the machine's values held) and
 //! what was refitted; the verdicts against a tolerance file, before and after (ISO 14253-1);
-//! the measured error against the identified model's prediction along each path.
+//! the measured error against the identified model's prediction along each path, or at each
+//! pose of a touch probe's records.
 
 use super::{num, unit, value_std};
 use crate::html::{Body, Cell};
@@ -92,13 +93,24 @@ pub fn write(
     Ok(())
 }
 
-/// The measured error against the identified model's prediction along each path, and the
-/// records not drawn with why.
+/// The measured error against the identified model's prediction along each path (at each pose,
+/// for a touch probe's records), and the records not drawn with why.
 fn paths(b: &mut Body, inputs: &Inputs) -> Result<(), crate::RenderError> {
     if inputs.prediction_figures.is_empty() && inputs.prediction_not_drawn.is_empty() {
         return Ok(());
     }
-    b.subheading("Measured against predicted along the paths");
+    let probe = inputs
+        .identification
+        .as_ref()
+        .is_some_and(|(_, id)| id.probe.is_some());
+    if probe {
+        b.subheading("Measured against predicted at the probe's poses");
+        b.paragraph(
+            "Per pose, not along a path: the records are a touch probe's, each pose one reading of the error vector through its sphere fit (section 3 gives the fits and the centres' dispersion per rotary axis).",
+        );
+    } else {
+        b.subheading("Measured against predicted along the paths");
+    }
     if !inputs.prediction_not_drawn.is_empty() {
         b.list(&inputs.prediction_not_drawn);
     }

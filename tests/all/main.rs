@@ -32,6 +32,7 @@ mod cli_probe;
 mod cli_progress;
 mod cli_report;
 mod cli_report_inputs;
+mod cli_report_probe;
 mod cli_reversal;
 mod cli_segment;
 mod cli_sensor_campaign;

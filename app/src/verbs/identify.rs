@@ -232,6 +232,9 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
     };
     read_files.extend(noise_read);
     read_files.extend(instrument_read);
+    let probe_file = probe_read
+        .as_ref()
+        .map(|f| (f.path.clone(), f.digest.clone()));
     read_files.extend(probe_read);
     read_files.extend(ReadFile::machine(&args.machine, machine.digest));
     campaign::check_campaign_values(&m, &ident.layout, &ident.fit.values, &args.bounds.values())
@@ -249,14 +252,13 @@ pub fn run(args: &IdentifyArgs) -> VerbResult<Done> {
         .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
     report.streaming = streaming;
     if let (Some(p), Some(l)) = (&probe, &loaded) {
-        report.probe = Some(report::json::probe::ProbeReport::of(
-            &m,
-            p,
-            &l.campaign,
-            &l.files,
-            &l.probe,
-            &ident,
-        ));
+        let mut fits =
+            report::json::probe::ProbeReport::of(&m, p, &l.campaign, &l.files, &l.probe, &ident);
+        // Named with its digest, so that `rtest report` reads the records through it again.
+        if let Some((file, digest)) = &probe_file {
+            fits = fits.read_from(file, digest);
+        }
+        report.probe = Some(fits);
     }
     if args.param.is_some() {
         report.notes.push(format!(
@@ -392,8 +394,14 @@ fn html_report(
                     record: r,
                 })
                 .collect();
+            // A probe's records: per pose, not along a path.
+            let draw = if report.probe.is_some() {
+                super::report::probe_figures
+            } else {
+                super::report::path_figures
+            };
             (i.prediction_figures, i.prediction_not_drawn) =
-                super::report::path_figures("--report", m, &values, label, &records)?;
+                draw("--report", m, &values, label, &records)?;
         }
     }
     super::report::render("--report", &i)

@@ -140,10 +140,12 @@ pub fn run(args: &ReportArgs) -> VerbResult<Done> {
 }
 
 /// The identified model's prediction along the path of every record of the identification and
-/// of every validation, when the machine is known (`--machine`, or the built-in the reports
-/// name) and the records were read (`records`); otherwise one line says why not. A validated
-/// record on a set-up the identification did not fit has its set-up errors refitted on it, as
-/// `rtest validate` did.
+/// of every validation (for a touch probe's records, at each pose), when the machine is known
+/// (`--machine`, or the built-in the reports name) and the records were read (`records`);
+/// otherwise one line says why not. A validated record on a set-up the identification did not
+/// fit has its set-up errors refitted on it, as `rtest validate` did. A probe's records are read
+/// again through the probe file the identification names, once its bytes are those identify
+/// read.
 fn draw_paths(
     inputs: &mut Inputs,
     machine: Option<model_spec::Machine>,
@@ -158,17 +160,28 @@ fn draw_paths(
         }
         return Ok(());
     };
-    if id.probe.is_some() {
-        inputs.prediction_not_drawn.push(
-            "No path is drawn: the records are a touch probe's (hits or sphere centres, each pose one reading through its sphere fit), which the report does not draw as paths; section 3 gives their sphere fits and the centres' dispersion per rotary axis.".into(),
-        );
-        return Ok(());
-    }
+    let probe = match &id.probe {
+        None => None,
+        Some(p) => match probe_of(id_file, p, records) {
+            Ok(probe) => Some(probe),
+            Err(why) => {
+                inputs
+                    .prediction_not_drawn
+                    .push(format!("No pose is drawn: {why}"));
+                return Ok(());
+            }
+        },
+    };
+    let nothing = if probe.is_some() {
+        "No pose is drawn"
+    } else {
+        "No path is drawn"
+    };
     let m = match machine.map_or_else(|| model_spec::load_machine(&id.machine), Ok) {
         Ok(m) => m,
         Err(_) => {
             inputs.prediction_not_drawn.push(format!(
-                "No path is drawn: machine {} is no built-in; give its description with --machine.",
+                "{nothing}: machine {} is no built-in; give its description with --machine.",
                 id.machine
             ));
             return Ok(());
@@ -181,9 +194,7 @@ fn draw_paths(
     let values = match report::json::read::parse_identification(id_file, id_text, &m) {
         Ok(v) => v.values,
         Err(e) => {
-            inputs
-                .prediction_not_drawn
-                .push(format!("No path is drawn: {e}"));
+            inputs.prediction_not_drawn.push(format!("{nothing}: {e}"));
             return Ok(());
         }
     };
@@ -237,6 +248,7 @@ fn draw_paths(
     }
     let mut read = Vec::new();
     let mut not_drawn = Vec::new();
+    let opts = formats::csv::ReadOptions::default();
     for (json, name, role, spec) in named {
         let bytes = match records.get(&(json.to_string(), name.to_string())) {
             Some(Ok(bytes)) => bytes,
@@ -249,14 +261,21 @@ fn draw_paths(
                 continue;
             }
         };
-        match formats::campaign::parse_record_at(
-            name,
-            bytes.as_slice(),
-            &m,
-            &spec.params,
-            &formats::csv::ReadOptions::default(),
-            None,
-        ) {
+        let record = match &probe {
+            Some(p) => {
+                super::probe_records::probe_record_of_bytes(name, bytes, &m, &spec.params, p, &opts)
+                    .map(|(r, _)| r)
+            }
+            None => formats::campaign::parse_record_at(
+                name,
+                bytes.as_slice(),
+                &m,
+                &spec.params,
+                &opts,
+                None,
+            ),
+        };
+        match record {
             Ok(record) => {
                 let mut r = simulation::campaign::CampaignRecord::new(
                     spec.label,
@@ -275,11 +294,48 @@ fn draw_paths(
         .iter()
         .map(|(name, role, record)| PathRecord { name, role, record })
         .collect();
-    let (figures, unpredicted) = path_figures("-o", &m, &values, &id.model, &records)?;
+    let (figures, unpredicted) = if probe.is_some() {
+        probe_figures("-o", &m, &values, &id.model, &records)?
+    } else {
+        path_figures("-o", &m, &values, &id.model, &records)?
+    };
     not_drawn.extend(unpredicted);
     inputs.prediction_figures = figures;
     inputs.prediction_not_drawn = not_drawn;
     Ok(())
+}
+
+/// The probe instrument the identification `p` (of report `id_file`) read its records
+/// through: its file as `rtest report` read it (`records`), when its bytes are those identify
+/// read; otherwise why not (one line).
+fn probe_of(
+    id_file: &str,
+    p: &report::json::probe::ProbeReport,
+    records: &Records,
+) -> Result<formats::probe::ProbeInstrument, String> {
+    let Some(file) = &p.file else {
+        return Err(format!(
+            "{id_file} does not name the probe file its records were read through (`probe.file`, which identify --json writes since rtest reads the records again); identify again with --json to draw them"
+        ));
+    };
+    let bytes = match records.get(&(id_file.to_string(), file.clone())) {
+        Some(Ok(bytes)) => bytes,
+        Some(Err(why)) => return Err(format!("the probe file {why}")),
+        None => return Err(format!("the probe file {file} was not read")),
+    };
+    let digest = model_spec::sha256::Digest::of(bytes);
+    if let Some(sha) = &p.sha256
+        && *sha != digest.sha256
+    {
+        return Err(format!(
+            "the probe file {file} is not the one identify read (SHA-256 {} here, {sha} in {id_file}): through another probe's radii and σ the records would not be read as they were identified",
+            digest.sha256
+        ));
+    }
+    let text = std::str::from_utf8(bytes)
+        .map_err(|e| format!("the probe file {file} is not UTF-8 text ({e})"))?;
+    formats::probe::parse_probe_instrument(file, text)
+        .map_err(|e| format!("the probe file cannot be read ({e})"))
 }
 
 /// What a record of the reports is, besides its samples: its label, set-up, kinematic
@@ -343,4 +399,68 @@ pub fn path_figures(
     let drawn = report::figures::path_figures(&figures)
         .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
     Ok((drawn, not_drawn))
+}
+
+/// The identified model's prediction at each pose of each probe record (the exact virtual
+/// machine at the identified `values`, model labelled `label`, each record on its set-up as
+/// [`path_figures`] has it) beside the measured readings with their ±1σ bars, one figure per
+/// record. A record that cannot be predicted is not drawn: the second list says which and why.
+///
+/// # Errors
+/// A figure that cannot be drawn (exit code 3).
+pub fn probe_figures(
+    flag: &str,
+    m: &model_spec::Machine,
+    values: &fitting::campaign::CampaignValues,
+    label: &str,
+    records: &[PathRecord<'_>],
+) -> VerbResult<(Vec<report::Figure>, Vec<String>)> {
+    use fitting::ValidateOptions;
+    use fitting::campaign::validate_record;
+    let opts = ValidateOptions::new().exact(true);
+    let mut figures = Vec::new();
+    let mut not_drawn = Vec::new();
+    let mut taken = Vec::new();
+    for r in records {
+        let v = match validate_record(m, values, r.record, &opts) {
+            Ok(v) => v.validation,
+            Err(e) => {
+                not_drawn.push(format!("{} is not drawn: {e}", r.name));
+                continue;
+            }
+        };
+        let record = &r.record.record;
+        let measured: Vec<[f64; 3]> = v
+            .prediction
+            .iter()
+            .zip(&v.residual)
+            .map(|(p, e)| [p[0] + e[0], p[1] + e[1], p[2] + e[2]])
+            .collect();
+        let rotary = m
+            .rotary_axes()
+            .map(|a| {
+                let q = record
+                    .samples
+                    .iter()
+                    .map(|s| s.commands[a].to_degrees())
+                    .collect();
+                (m.axes[a].name.clone(), q)
+            })
+            .collect();
+        let poses = report::probe_figure::ProbePoses {
+            name: r.name,
+            role: r.role,
+            model: label,
+            rotary,
+            measured_mm: &measured,
+            covariance: &record.covariance,
+            prediction_mm: &v.prediction,
+        };
+        figures.push(
+            report::probe_figure::probe_figure(&poses, &mut taken).map_err(|e| {
+                Error::computation(format!("{flag}: a figure cannot be drawn: {e}"))
+            })?,
+        );
+    }
+    Ok((figures, not_drawn))
 }

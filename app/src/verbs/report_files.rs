@@ -8,9 +8,12 @@ use report::{InputFile, Inputs};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The bytes of the records `rtest report` read, by (JSON report, name the report gives), or
-/// why a record was not read.
+/// The bytes of the records `rtest report` read (and of the identification's probe file), by
+/// (JSON report, name the report gives), or why a file was not read.
 pub(super) type Records = BTreeMap<(String, String), Result<Vec<u8>, String>>;
+
+/// The field of an identification report that names its probe file.
+pub(super) const PROBE_FIELD: &str = "probe.file";
 
 /// A file a report names: the report (its file as given), the field, the role in the check,
 /// the name, where it is looked for, and the most bytes a file of its kind may have.
@@ -32,12 +35,16 @@ pub(super) struct Named {
 /// leaves the directory (`..`).
 pub(super) fn named_files(inputs: &Inputs, data_dir: Option<&Path>) -> VerbResult<Vec<Named>> {
     use formats::poses::MAX_FILE_BYTES as RECORD;
+    use formats::probe::instrument::MAX_PROBE_INSTRUMENT_BYTES as PROBE;
     use report::json::read::MAX_REPORT_BYTES as VALUES;
     let mut raw: Vec<(&str, String, &'static str, &str, u64)> = Vec::new();
     if let Some((f, r)) = &inputs.identification {
         for (i, x) in r.records.iter().enumerate() {
             let field = format!("records[{i}].data");
             raw.push((f, field, "identification: fitted record", &x.data, RECORD));
+        }
+        if let Some(file) = r.probe.as_ref().and_then(|p| p.file.as_ref()) {
+            raw.push((f, PROBE_FIELD.into(), "identification: probe", file, PROBE));
         }
     }
     for (f, v) in &inputs.validations {
@@ -139,7 +146,7 @@ fn resolve(json: &str, field: &str, name: &str, data_dir: Option<&Path>) -> Verb
 /// Reads every regular file of `named` (at most its kind's bytes), hashed as read, and lists
 /// it in `files` (once: a file two reports name, or that is given itself, is listed once);
 /// anything else (a pipe, a device, a directory, a missing file) is listed as not hashed, and
-/// never opened. The records' bytes are kept for the figures.
+/// never opened. The records' bytes (and the probe file's) are kept for the figures.
 pub(super) fn read_named(named: &[Named], files: &mut Vec<InputFile>) -> Records {
     let mut records = Records::new();
     for n in named {
@@ -151,7 +158,9 @@ pub(super) fn read_named(named: &[Named], files: &mut Vec<InputFile>) -> Records
                 Err(why) => InputFile::not_hashed(n.role, &shown, Some(&n.at), why),
             });
         }
-        if n.field.starts_with("records[") && !n.role.starts_with("diagnosis") {
+        let kept = (n.field.starts_with("records[") && !n.role.starts_with("diagnosis"))
+            || n.field == PROBE_FIELD;
+        if kept {
             let at = n.at.display();
             records.insert(
                 (n.json.clone(), n.name.clone()),

@@ -275,6 +275,12 @@ enum Glyph {
     Dot(RGBColor),
     Line(RGBColor, Option<(u32, u32)>),
     Swatch(RGBColor),
+    /// A dot with a vertical bar (a value ± its uncertainty).
+    DotBar(RGBColor),
+    /// An open diamond.
+    Diamond(RGBColor),
+    /// A small filled square.
+    Square(RGBColor),
 }
 
 const LEGEND_PX: f64 = 14.0;
@@ -335,6 +341,45 @@ fn draw_glyph(
         Glyph::Swatch(c) => {
             area.draw(&Rectangle::new(
                 [(x + 4, cy - 6), (x + GLYPH_W - 4, cy + 6)],
+                c.filled(),
+            ))
+            .map_err(render_err)?;
+        }
+        Glyph::DotBar(c) => {
+            let mx = x + GLYPH_W / 2;
+            area.draw(&PathElement::new(
+                vec![(mx, cy - 7), (mx, cy + 7)],
+                c.stroke_width(1),
+            ))
+            .map_err(render_err)?;
+            for y in [cy - 7, cy + 7] {
+                area.draw(&PathElement::new(
+                    vec![(mx - 4, y), (mx + 4, y)],
+                    c.stroke_width(1),
+                ))
+                .map_err(render_err)?;
+            }
+            area.draw(&Circle::new((mx, cy), 3, c.filled()))
+                .map_err(render_err)?;
+        }
+        Glyph::Diamond(c) => {
+            let mx = x + GLYPH_W / 2;
+            area.draw(&PathElement::new(
+                vec![
+                    (mx, cy - 6),
+                    (mx + 6, cy),
+                    (mx, cy + 6),
+                    (mx - 6, cy),
+                    (mx, cy - 6),
+                ],
+                c.stroke_width(2),
+            ))
+            .map_err(render_err)?;
+        }
+        Glyph::Square(c) => {
+            let mx = x + GLYPH_W / 2;
+            area.draw(&Rectangle::new(
+                [(mx - 3, cy - 3), (mx + 3, cy + 3)],
                 c.filled(),
             ))
             .map_err(render_err)?;

@@ -114,7 +114,11 @@ pub fn probe_poses(fig: &PoseFigure<'_>) -> Result<String, PlotError> {
         let bars = fig.panels.iter().any(|p| !p.std.is_empty());
         let entries = vec![
             (
-                Glyph::Dot(INK),
+                if bars {
+                    Glyph::DotBar(INK)
+                } else {
+                    Glyph::Dot(INK)
+                },
                 if bars {
                     "measured ± σ".to_string()
                 } else {
@@ -122,11 +126,11 @@ pub fn probe_poses(fig: &PoseFigure<'_>) -> Result<String, PlotError> {
                 },
             ),
             (
-                Glyph::Swatch(PREDICTED),
+                Glyph::Diamond(PREDICTED),
                 format!("predicted: {}", fig.predicted_label),
             ),
             (
-                Glyph::Swatch(RESIDUAL),
+                Glyph::Square(RESIDUAL),
                 "residual (measured − predicted)".to_string(),
             ),
         ];

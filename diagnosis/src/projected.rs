@@ -147,29 +147,26 @@ impl Model<'_> {
         self.residual.as_ref().unwrap_or(&self.state.residual)
     }
 
-    /// The columns of candidate `c` (unit norm, the model projected out) written into `out`
-    /// (its width times the rows, column after column); its width (0 for a candidate not
-    /// held).
-    fn projected_into(&self, c: usize, out: &mut [f64]) -> usize {
-        let n = self.state.span.rows();
-        let (start, width) = self.state.at[c];
-        let out = &mut out[..n * width];
-        out.copy_from_slice(&self.state.columns.as_slice()[n * start..n * (start + width)]);
-        if let Some(w) = &self.removed {
-            let unit = &self.state.unit.as_slice()[n * start..n * (start + width)];
-            for (from, to) in unit.chunks_exact(n).zip(out.chunks_exact_mut(n)) {
-                add_projection(w, from, to);
-            }
-        }
-        width
-    }
-
     /// The columns of candidate `c`: unit norm, the model projected out (a column of zero norm
     /// stays zero).
     pub fn projected(&self, c: usize) -> DMatrix<f64> {
         let n = self.state.span.rows();
-        let mut out = DMatrix::zeros(n, self.state.at[c].1);
-        self.projected_into(c, out.as_mut_slice());
+        let (start, width) = self.state.at[c];
+        // Copied from where they are held (not zeroed first, then copied over).
+        let mut out = DMatrix::from_column_slice(
+            n,
+            width,
+            &self.state.columns.as_slice()[n * start..n * (start + width)],
+        );
+        if let Some(w) = &self.removed {
+            let unit = &self.state.unit.as_slice()[n * start..n * (start + width)];
+            for (from, to) in unit
+                .chunks_exact(n)
+                .zip(out.as_mut_slice().chunks_exact_mut(n))
+            {
+                add_projection(w, from, to);
+            }
+        }
         out
     }
 
@@ -243,11 +240,15 @@ impl Model<'_> {
 /// The columns of `g` scaled to unit norm; a column of zero or non-finite norm is zero (it adds
 /// no direction, as in [`Span::new_directions`]).
 pub fn unit_columns(g: &DMatrix<f64>) -> DMatrix<f64> {
-    let mut unit = DMatrix::zeros(g.nrows(), g.ncols());
-    for (k, col) in g.column_iter().enumerate() {
+    let mut unit = g.clone();
+    // Each column divided by its norm in place (the same quotients as `col / norm`, without a
+    // column of its own for each).
+    for mut col in unit.column_iter_mut() {
         let norm = col.norm();
         if norm > 0.0 && norm.is_finite() {
-            unit.column_mut(k).copy_from(&(col / norm));
+            col.iter_mut().for_each(|x| *x /= norm);
+        } else {
+            col.fill(0.0);
         }
     }
     unit

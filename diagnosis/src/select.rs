@@ -179,6 +179,20 @@ impl<'a> Scored<'a> {
         }
     }
 
+    /// Its directions (n × q, as [`Scored::directions`]) appended to `out`, column after
+    /// column: directions made already are copied; the others are made for this and not kept
+    /// (the same directions, to the bit: a step appends every candidate's, and looks again at
+    /// the directions of a few).
+    fn append_directions(&self, out: &mut Vec<f64>) {
+        match &self.directions {
+            Directions::Given(d) => out.extend_from_slice(d.as_slice()),
+            Directions::Made(make, cell) => match cell.get() {
+                Some(d) => out.extend_from_slice(d.as_slice()),
+                None => out.extend_from_slice(make(self.index).as_slice()),
+            },
+        }
+    }
+
     /// `Q_g`, its directions (n × q).
     pub fn directions(&self) -> DMatrixView<'_, f64> {
         let d = match &self.directions {
@@ -290,7 +304,7 @@ fn monte_carlo_p_stopping(
     }
     let mut all = Vec::with_capacity(n * total);
     for s in scored {
-        all.extend(s.directions().iter());
+        s.append_directions(&mut all);
     }
     let all = DMatrix::from_vec(n, total, all);
     let mut rng = Rng::new(seed);

@@ -331,3 +331,45 @@ fn a_probe_file_or_record_that_no_longer_reads_as_identified_is_named_not_drawn(
         "{html}"
     );
 }
+
+#[test]
+fn the_probe_report_reads_in_a_browser() {
+    use crate::support::browser;
+    let Some(b) = browser::for_test("the_probe_report_reads_in_a_browser") else {
+        return;
+    };
+    let dir = temp_dir("report-probe-browser");
+    check(&dir);
+    ok(
+        &dir,
+        &[
+            "report",
+            "id.json",
+            "v.json",
+            "--machine",
+            "seed-ac",
+            "-o",
+            "rep.html",
+        ],
+    );
+    let scratch = dir.join("browser");
+    std::fs::create_dir_all(&scratch).unwrap();
+    let run = b
+        .open(&dir.join("rep.html"), &scratch)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(run.problems(), Vec::<String>::new(), "{run:#?}");
+    // The validation bars and the poses of low.csv, high.csv and sweep.csv, each drawn.
+    let drawn: Vec<&str> = run
+        .figures
+        .iter()
+        .filter(|f| f.element.starts_with("figure") && f.width > 0.0 && f.height > 0.0)
+        .map(|f| f.label.as_str())
+        .collect();
+    assert!(drawn.len() >= 4, "{:#?}", run.figures);
+    assert!(
+        run.fonts.iter().any(|f| f.status == "loaded"),
+        "{:?}",
+        run.fonts
+    );
+    assert!(run.pdf_pages >= 2, "{} PDF pages", run.pdf_pages);
+}

@@ -28,7 +28,8 @@ and the identification's model and records.
 The records the reports name are read relative to the directory of the report that names them (or \
 to --data-dir DIR; an absolute name, or one that leaves that directory, is refused), hashed, and \
 drawn: the measured error against the identified model's prediction (µm) along each path, against \
-the axis that moves most (mm or degrees). The document makes no request of any kind: figures are \
+the axis that moves most (mm or degrees); a touch probe's records per pose, each reading with its \
+±1σ bar, read again through the probe file the identification names (its SHA-256 checked). The document makes no request of any kind: figures are \
 inline SVG, their font (DejaVu Sans, about 1 MB) is embedded, a Content-Security-Policy forbids \
 every other source, and there is no script. `identify`, `diagnose` and `compensate` write the same \
 report with --report FILE. `-o -` writes it to standard output.";

@@ -384,3 +384,168 @@ fn bad_flags_files_and_logs_are_refused_and_nothing_is_written() {
     fails(&dir, &args, 2, &["good.log"]);
     assert!(!dir.join("hits.csv").exists());
 }
+
+#[test]
+fn a_tilting_heads_planned_poses_are_programmed_in_every_dialect_simulated_and_identified() {
+    // head-table-bc's B tilts the probe: the pattern turns with it (and 22.5° about the stylus
+    // pose after pose), so every pose the plan chooses, B from −60° to 60°, is written in
+    // every dialect and read back; the same poses simulated and identified give the truth.
+    let dir = temp_dir_tagged("cli-path-probe", "head");
+    std::fs::write(dir.join("probe.toml"), format!("{PROBE}noise_um = 0.5\n")).unwrap();
+    let terms = "XOW,YOW,ZOW,XOB,ZOB,AOB,COB,XOC,YOC,AOC,BOC";
+    ok(
+        &dir,
+        &[
+            "plan",
+            "--machine",
+            "head-table-bc",
+            "--probe",
+            "probe.toml",
+            "--terms",
+            terms,
+            "--constraint",
+            "zero:XOC,ZOW",
+            "--poses-out",
+            "poses.csv",
+        ],
+    );
+    let m = model_spec::builtin("head-table-bc").unwrap().unwrap();
+    let poses = formats::paths::load_path(
+        &m,
+        &dir.join("poses.csv").to_string_lossy(),
+        &formats::csv::ReadOptions::default(),
+    )
+    .unwrap();
+    let b = m.axis_by_name("B").unwrap();
+    let n = poses.samples.len();
+    assert!(
+        poses
+            .samples
+            .iter()
+            .any(|s| s.commands[b].to_degrees().abs() > 45.0),
+        "the plan tilts the head"
+    );
+    let vm = simulation::VirtualMachine::new(&m);
+    let params = m.default_parameters();
+    let pattern = simulation::probe::approach_directions();
+    for (name, dialect, file) in [
+        ("linuxcnc", Dialect::LinuxCnc, "h.ngc"),
+        ("iso", Dialect::Iso, "h.nc"),
+        ("heidenhain", Dialect::Heidenhain, "h.h"),
+    ] {
+        let out = ok(
+            &dir,
+            &[
+                "path",
+                "--machine",
+                "head-table-bc",
+                "--test",
+                "poses.csv",
+                "--probe",
+                "probe.toml",
+                "--nc",
+                name,
+                "-o",
+                file,
+            ],
+        );
+        assert!(
+            out.contains(&format!("{n} poses probed, {} hits", 9 * n)),
+            "{out}"
+        );
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        let read = read_program(file, &text, dialect, &axis_words(&m)).unwrap();
+        check_order(&read, dialect).unwrap();
+        let plan = read_probe_plan(&dir.join("h.plan.csv"), &m).unwrap();
+        assert_eq!(plan.rows.len(), 9 * n, "{name}");
+        if dialect == Dialect::Heidenhain {
+            continue;
+        }
+        // Every direction is the pattern's turned by the pose's nominal tool rotation and
+        // 0°, 22.5°, 45°, 67.5° about the stylus.
+        for (i, s) in poses.samples.iter().enumerate() {
+            let r = *vm
+                .nominal_chain_transform(model_spec::Side::Tool, &s.commands, &params)
+                .rotation
+                .matrix();
+            let phi = [0.0f64, 22.5, 45.0, 67.5][i % 4].to_radians();
+            for (k, d) in pattern.iter().enumerate() {
+                let turned = Vector3::new(
+                    d.x * phi.cos() - d.y * phi.sin(),
+                    d.x * phi.sin() + d.y * phi.cos(),
+                    d.z,
+                );
+                let got = Vector3::from(plan.rows[9 * i + k].direction);
+                assert!(
+                    (got - r * turned).norm() < 1e-9,
+                    "{name}: pose {i}, hit {k}"
+                );
+            }
+        }
+    }
+    std::fs::write(
+        dir.join("t.toml"),
+        "machine = \"head-table-bc\"\n[errors]\nYOW = 5\nXOW = 10\nXOB = -14\nZOB = 9\nAOB = 16\nCOB = -21\nYOC = 8\nAOC = -15\nBOC = 19\n",
+    )
+    .unwrap();
+    ok(
+        &dir,
+        &[
+            "simulate",
+            "--machine",
+            "head-table-bc",
+            "--path",
+            "poses.csv",
+            "--probe",
+            "probe.toml",
+            "--truth",
+            "t.toml",
+            "-o",
+            "hits.csv",
+        ],
+    );
+    ok(
+        &dir,
+        &[
+            "identify",
+            "--machine",
+            "head-table-bc",
+            "--terms",
+            terms,
+            "--constraint",
+            "zero:XOC,ZOW",
+            "--data",
+            "hits.csv",
+            "--probe",
+            "probe.toml",
+            "--json",
+            "id.json",
+        ],
+    );
+    let id = crate::common::read_json(&dir.join("id.json"));
+    let truth = [
+        ("XOW", 10.0),
+        ("YOW", 5.0),
+        ("XOB", -14.0),
+        ("ZOB", 9.0),
+        ("AOB", 16.0),
+        ("COB", -21.0),
+        ("YOC", 8.0),
+        ("AOC", -15.0),
+        ("BOC", 19.0),
+    ];
+    let mut seen = 0;
+    for p in id["parameters"].as_array().unwrap() {
+        let Some((_, t)) = truth.iter().find(|(n, _)| p["name"] == *n) else {
+            continue;
+        };
+        let (v, s) = (p["value"].as_f64().unwrap(), p["std"].as_f64().unwrap());
+        assert!(
+            ((v - t) / s).abs() < 4.0,
+            "{}: {v} ± {s}, truth {t}",
+            p["name"]
+        );
+        seen += 1;
+    }
+    assert_eq!(seen, truth.len());
+}

@@ -49,10 +49,13 @@ fn a_probe_run_writes_hits_the_probe_readers_read() {
     assert_eq!(labels, ["p1", "p2", "p3"]);
     assert_eq!(hits.hit_count(), 27);
     let (a, c) = (m.axis_by_name("A").unwrap(), m.axis_by_name("C").unwrap());
-    for (pose, [want_a, want_c]) in
-        hits.poses
-            .iter()
-            .zip([[0.0, 0.0], [-30.0, 90.0], [-60.0, 200.0]])
+    // seed-ac's probe does not turn: the pattern stands in the bed frame, turned about the
+    // stylus (z) by 0°, 22.5°, 45° pose after pose; the pole along −z at every pose.
+    for ((pose, [want_a, want_c]), phi) in hits
+        .poses
+        .iter()
+        .zip([[0.0, 0.0], [-30.0, 90.0], [-60.0, 200.0]])
+        .zip([0.0f64, 22.5, 45.0])
     {
         for h in &pose.hits {
             // The rotary axes as the path gives them, written as the path wrote them.
@@ -62,8 +65,12 @@ fn a_probe_run_writes_hits_the_probe_readers_read() {
             let d = nominal_distance(&m, &h.axes) - 14.0;
             assert!(d.abs() < 0.2 && d.abs() > 1e-7, "{d} mm");
         }
-        let n = &pose.hits[0].direction;
-        assert_eq!(*n, [-1.0, 0.0, 0.0]);
+        let n = pose.hits[0].direction;
+        let phi = phi.to_radians();
+        assert!(
+            (n[0] + phi.cos()).abs() < 1e-15 && (n[1] + phi.sin()).abs() < 1e-15 && n[2] == 0.0,
+            "{n:?}"
+        );
         assert_eq!(pose.hits[8].direction, [0.0, 0.0, -1.0]);
     }
     let text = std::fs::read_to_string(dir.join("hits.csv")).unwrap();
@@ -71,6 +78,7 @@ fn a_probe_run_writes_hits_the_probe_readers_read() {
         "# machine: seed-ac",
         "# path: poses.csv (3 poses, labelled p1 to p3 in the path's order)",
         "# probe: TS 460: tip radius 1.5 mm, sphere radius 12.5 mm (R_eff 14 mm), pre-travel 1 µm, lobing [0.5, 0] µm, noise σ 0.3 µm along the approach from seed 1",
+        "# pattern: 9 hits per pose about the nominal sphere centre (+x, +y, -x, -y of the probe at its height, four at R/2 above, the pole), defined in the probe's frame and turned by each pose's nominal tool rotation and by 0, 22.5, 45, 67.5° about the stylus pose after pose, each from 2 mm outside the sphere at 120 mm/min",
         "pose,X,Y,Z,A,C,nx,ny,nz,t_s",
     ] {
         assert!(text.lines().any(|l| l == line), "{line} not in:\n{text}");

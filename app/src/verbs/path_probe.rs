@@ -11,7 +11,9 @@ use formats::probe::read_probe_instrument;
 use model_spec::Machine;
 use model_spec::units::short;
 use output::{Outputs, Target};
-use programs::probe::{PatternHit, ProbeError, ProbeOptions, format_probe_plan, probe_program};
+use programs::probe::{
+    ProbeError, ProbeOptions, default_pattern, format_probe_plan, probe_program,
+};
 use std::path::{Path, PathBuf};
 
 /// Flags of the probing program (with `--probe`).
@@ -20,7 +22,8 @@ pub struct ProbeArgs {
     /// With --nc: write a touch-probe calibration program instead of an R-test program; FILE
     /// is the probe instrument (TOML: tip_radius_mm, sphere_radius_mm; docs/probe.md). The
     /// sphere's centre is the ball of the machine description and the probe's tip centre its
-    /// tool point (--param); every pose of the test is probed with the default 9-hit pattern.
+    /// tool point (--param); every pose of the test is probed with the default 9-hit pattern,
+    /// which turns with the probe and, pose after pose, 22.5° about the stylus.
     #[arg(
         long,
         value_name = "FILE",
@@ -57,17 +60,6 @@ pub struct ProbeArgs {
     /// degrees (default 30).
     #[arg(long, value_name = "DEG", requires = "probe", value_parser = super::args::between(0.0, 90.0))]
     pub stem_clearance_deg: Option<f64>,
-}
-
-/// The default pattern of `fitting::sphere` as unit vectors (bed frame).
-fn pattern() -> Vec<PatternHit> {
-    fitting::sphere::default_pattern(1.0)
-        .iter()
-        .map(|h| PatternHit {
-            point: [h.point_mm.x, h.point_mm.y, h.point_mm.z],
-            approach: [h.approach.x, h.approach.y, h.approach.z],
-        })
-        .collect()
 }
 
 /// The log's name on the control from the program's file: its stem, letters, digits, `-` and
@@ -163,7 +155,7 @@ pub fn run(
     let mut o = ProbeOptions::new(
         m,
         dialect,
-        pattern(),
+        default_pattern(),
         instrument.sphere_radius_mm,
         instrument.tip_radius_mm,
     );
@@ -218,6 +210,7 @@ pub fn run(
             short(o.effective_radius_mm())
         ),
         "axes: the planned contact in mm and degrees (machine coordinates); nx,ny,nz: the probing move's direction, bed frame".into(),
+        "pattern: 9 hits defined in the probe's frame, turned by each pose's nominal tool rotation and by 0, 22.5, 45, 67.5° about the stylus, pose after pose".into(),
         "t_s: the nominal time of the contact from the resume after the stop, s; line: the program's probing block".into(),
         "rtest probe-log turns the control's log into the probe hits CSV with this plan (docs/probe-programs.md)".into(),
     ];

@@ -11,8 +11,9 @@ use model_spec::units::{degrees_for, format_scaled, short};
 use model_spec::{AxisKind, Machine};
 use output::{Outputs, Target};
 use simulation::probe::{
-    CLEARANCE_MM, HIT_CYCLE_S, PATTERN_HITS, POSE_CHANGE_S, PROBING_FEED_MM_PER_S, PreTravel,
-    ProbeError, ProbeRun, ProbeSettings, pose_label, simulate_probe, unused_terms,
+    AZIMUTH_CYCLE_DEG, CLEARANCE_MM, HIT_CYCLE_S, PATTERN_HITS, POSE_CHANGE_S,
+    PROBING_FEED_MM_PER_S, PatternAzimuth, PreTravel, ProbeError, ProbeRun, ProbeSettings,
+    pose_label, simulate_probe, unused_terms,
 };
 use simulation::record::Record;
 use simulation::truth::Truth;
@@ -123,6 +124,7 @@ fn settings(p: &ProbeInstrument, r: &ProbeRequest<'_>) -> ProbeSettings {
         },
         noise_mm: r.noise_mm.unwrap_or_else(|| mm(p.noise_um.unwrap_or(0.0))),
         seed: r.seed.unwrap_or(r.truth.seed),
+        azimuth: PatternAzimuth::default(),
     }
 }
 
@@ -238,7 +240,8 @@ fn provenance(
             p.seed
         ),
         format!(
-            "pattern: {PATTERN_HITS} hits per pose about the nominal sphere centre (+X, +Y, -X, -Y at its height, four at R/2 above, the pole), approach directions fixed in the machine frame, each from {CLEARANCE_MM} mm outside the sphere at {} mm/min",
+            "pattern: {PATTERN_HITS} hits per pose about the nominal sphere centre (+x, +y, -x, -y of the probe at its height, four at R/2 above, the pole), defined in the probe's frame and turned by each pose's nominal tool rotation and by {}° about the stylus pose after pose, each from {CLEARANCE_MM} mm outside the sphere at {} mm/min",
+            AZIMUTH_CYCLE_DEG.map(short).join(", "),
             PROBING_FEED_MM_PER_S * 60.0
         ),
         format!(

@@ -11,19 +11,29 @@
 //! (`from + k·(to − from)/(N − 1)`). The linear axes put the nominal tip centre on the nominal
 //! sphere centre (nominal inverse kinematics at the plan's kinematic parameters).
 //!
-//! **Strokes and ranges.** A pose is kept when its commands and the commands of each of the
-//! nine hits of the default pattern ([`crate::sphere::default_pattern`] at
-//! `R_sphere + r_tip`, the tip centres at the latch) are within every axis's stroke and range;
-//! otherwise it is **skipped**, with the reason (the hit and the axis), and the plan goes on
-//! with the others. A plan with no pose left is refused.
+//! **The pattern** is the one the probing programs and the simulation use
+//! ([`simulation::probe::approach_directions`], defined in the probe's frame): at the `i`-th
+//! pose kept it is turned into the bed frame by the pose's nominal tool rotation and the
+//! azimuth offset [`PatternAzimuth::Cycled`] gives pose `i` ([`PatternTurn`]), so the plan's
+//! poses, written as a path and probed in that order (`rtest path --probe`,
+//! `rtest simulate --probe`), are probed with the hits planned here.
+//!
+//! **Strokes, ranges and reach.** A pose is kept when its commands and the commands of each of
+//! the nine hits of the pattern at the pose (at `R_sphere + r_tip`, the tip centres at the
+//! latch) are within every axis's stroke and range and every hit can be probed
+//! ([`simulation::probe::unreachable`]: none below the sphere's equator seen along the tool
+//! axis, which the pattern turning with the probe never is, none within
+//! [`simulation::probe::STEM_CLEARANCE_DEG`] of the sphere's stem); otherwise it is
+//! **skipped**, with the reason (the hit and the axis or the rule), and the plan goes on with
+//! the others. A plan with no pose left is refused.
 //!
 //! **The readings.** Each pose is one reading of the error vector `e` (tool frame, mm), as a
 //! probe record gives it ([`crate::probe`]): the centre of the sphere fit of the pose's hits.
-//! The hits of the default pattern have their approach directions fixed in the bed frame, so
-//! the centre's covariance `C` is the same at every pose: the free-radius fit's
-//! ([`RadiusMode::Free`] with the calibrated radius) of the nine exact hits under the probe's
-//! σ. The reading's covariance is `R_tool0ᵀ·C·R_tool0` (`R_tool0` the nominal tool frame's
-//! rotation at the pose).
+//! The pattern turns with the probe, so the centre's covariance in the tool frame is the
+//! pattern's own, `C` (the free-radius fit's, [`RadiusMode::Free`] with the calibrated radius,
+//! of the nine exact hits under the probe's σ, in the probe's frame), turned by the pose's
+//! azimuth offset about the stylus: `R_z(φ₀)·C·R_z(φ₀)ᵀ`, the same at every pose to rounding
+//! (the pattern is four-fold symmetric about the stylus).
 //!
 //! **The prediction** is that of the campaign of one record (label [`PROBE_RECORD`], its own
 //! sphere set-up, not zeroed) whose samples are the poses with those covariances, by
@@ -42,15 +52,15 @@ use super::predict::{Prediction, predict_with_covariances};
 use crate::campaign::design::{Design, design_matrix};
 use crate::campaign::names::single_record_names;
 use crate::least_squares::{Constraint, EstimateError, Tolerances};
-use crate::probe::PoseGeometry;
-use crate::sphere::{Latch, RadiusMode, SphereFitOptions, default_pattern, fit_sphere};
+use crate::sphere::{Latch, RadiusMode, SphereFitOptions, fit_sphere};
 use model_spec::units::short;
 use model_spec::{AxisId, Machine};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Matrix3;
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::exact::VirtualMachine;
 use simulation::generator::{self, Clearance, TestKind};
 use simulation::model::{Effect, Model};
+use simulation::probe::{PatternAzimuth, PatternTurn, PoseFrame, approach_directions};
 use simulation::record::{Record, Sample};
 
 /// The fewest positions per rotary axis (three points fix a circle).
@@ -175,17 +185,19 @@ pub fn sweeps(m: &Machine, clearance: &Clearance) -> Result<Vec<AxisSweep>, Prob
     Ok(out)
 }
 
-/// The covariance of the fitted centre of the default pattern's nine exact hits (bed frame,
-/// mm²): free radius, checked against the calibrated one, under the probe's σ.
+/// The covariance of the fitted centre of the pattern's nine exact hits in the probe's frame
+/// (at azimuth 0; on a table-table machine the bed frame), mm²: free radius, checked against
+/// the calibrated one, under the probe's σ.
 ///
 /// # Errors
 /// [`ProbePlanError::Probe`] when the fit refuses (a radius or σ not above 0).
 pub fn pattern_covariance(probe: &ProbeSetup) -> Result<Matrix3<f64>, ProbePlanError> {
-    let latches: Vec<Latch> = default_pattern(probe.effective_radius_mm())
+    let r = probe.effective_radius_mm();
+    let latches: Vec<Latch> = approach_directions()
         .into_iter()
-        .map(|h| Latch {
-            tip_mm: h.point_mm,
-            approach: h.approach,
+        .map(|n| Latch {
+            tip_mm: -n * r,
+            approach: n,
         })
         .collect();
     let options = SphereFitOptions {
@@ -250,8 +262,9 @@ pub struct ProbePoses {
 }
 
 /// The poses of `per_axis` positions on each of `sweeps` of `m` at the kinematic parameters
-/// `params` (mm), with the pattern covariance `bed_covariance` (bed frame, mm²) of a probe of
-/// effective radius `effective_radius_mm` (module documentation: kept or skipped).
+/// `params` (mm), with the pattern covariance `pattern_covariance` ([`pattern_covariance`],
+/// probe frame, mm²) of a probe of effective radius `effective_radius_mm` (module
+/// documentation: kept or skipped, the pattern turned pose by pose).
 ///
 /// # Errors
 /// [`ProbePlanError::PerAxis`] out of bounds; [`ProbePlanError::NoPose`] when every pose is
@@ -262,23 +275,24 @@ pub fn probe_poses(
     sweeps: &[AxisSweep],
     per_axis: usize,
     effective_radius_mm: f64,
-    bed_covariance: &Matrix3<f64>,
+    pattern_covariance: &Matrix3<f64>,
 ) -> Result<ProbePoses, ProbePlanError> {
     if !(MIN_PER_AXIS..=MAX_PER_AXIS).contains(&per_axis) {
         return Err(ProbePlanError::PerAxis(per_axis));
     }
     let vm = VirtualMachine::new(m);
-    let pattern = default_pattern(effective_radius_mm);
     let (mut poses, mut skipped) = (Vec::new(), Vec::new());
     for s in sweeps {
         for angle in s.angles_deg(per_axis) {
             let label = format!("{}{}", m.axes[s.axis].name, short(angle));
             let mut axes = s.fixed_deg.clone();
             axes[s.axis] = angle;
-            match pose_at(&vm, params, &axes, &pattern) {
+            let azimuth_rad = PatternAzimuth::Cycled.offset_rad(poses.len());
+            match pose_at(&vm, params, &axes, azimuth_rad, effective_radius_mm) {
                 Ok(geometry) => {
-                    let r = geometry.tool_rotation.matrix();
-                    let c = r.transpose() * bed_covariance * r;
+                    let (sin, cos) = azimuth_rad.sin_cos();
+                    let turn = Matrix3::new(cos, -sin, 0.0, sin, cos, 0.0, 0.0, 0.0, 1.0);
+                    let c = turn * pattern_covariance * turn.transpose();
                     poses.push(PlannedPose {
                         label,
                         axis: s.axis,
@@ -313,48 +327,40 @@ pub fn probe_poses(
     })
 }
 
-/// The pose whose rotary axes stand at `axes` (degrees), or why it is skipped: the inverse
-/// kinematics, an axis out of its stroke or range at the centre or at a hit of `pattern`, or a
-/// hit nearer the sphere's stem than the probing programs allow
-/// ([`simulation::probe::near_stem`]). The programs' other rule, no hit below the sphere's
-/// equator seen along the tool axis ([`simulation::probe::below_equator`]), is not applied:
-/// on a tilting head it would leave no tilted pose of the bed-frame pattern (`docs/probe-plan.md`).
+/// The pose whose rotary axes stand at `axes` (degrees), probed with the pattern turned by
+/// its nominal tool rotation and `azimuth_rad` (rad) about the stylus at `R_eff` =
+/// `effective_radius_mm`, or why it is skipped: the inverse kinematics, an axis out of its
+/// stroke or range at the centre or at a hit, a hit the probe cannot reach
+/// ([`simulation::probe::unreachable`] at [`simulation::probe::STEM_CLEARANCE_DEG`]).
 fn pose_at(
     vm: &VirtualMachine<'_>,
     params: &[f64],
     axes: &[f64],
-    pattern: &[crate::sphere::Hit],
-) -> Result<PoseGeometry, String> {
+    azimuth_rad: f64,
+    effective_radius_mm: f64,
+) -> Result<PoseFrame, String> {
     let m = vm.machine();
-    let geometry = PoseGeometry::at(vm, axes, params).map_err(|e| e.to_string())?;
-    if let Some(o) = m.outside_limits(&geometry.commands).first() {
+    let frame = crate::probe::pose_frame(vm, axes, params).map_err(|e| e.to_string())?;
+    if let Some(o) = m.outside_limits(&frame.commands).first() {
         return Err(format!("{o} at the sphere's centre"));
     }
-    let linear: Vec<usize> = m.linear_axes().collect();
-    let base = geometry.gap(vm, &geometry.commands, params);
-    let a = geometry.linear_map(vm, params);
-    let inverse = (linear.len() == 3)
-        .then(|| a.try_inverse())
-        .flatten()
-        .ok_or_else(|| "the linear axes do not move the probe in three directions".to_string())?;
-    for (h, hit) in pattern.iter().enumerate() {
-        if let Some(why) = simulation::probe::near_stem(
-            &hit.point_mm,
-            &geometry.table_normal,
+    let turn = PatternTurn::new(frame.tool_rotation.matrix(), azimuth_rad);
+    for (h, n) in turn.approach_directions().iter().enumerate() {
+        let point = -n;
+        if let Some(why) = simulation::probe::unreachable(
+            &point,
+            &frame.tool_axis(),
+            &frame.table_normal,
             simulation::probe::STEM_CLEARANCE_DEG,
         ) {
-            return Err(format!("hit {} of the default pattern: {why}", h + 1));
+            return Err(format!("hit {} of the pattern: {why}", h + 1));
         }
-        let dq: Vector3<f64> = inverse * (hit.point_mm - base);
-        let mut q = geometry.commands.clone();
-        for (k, &i) in linear.iter().enumerate() {
-            q[i] += dq[k];
-        }
+        let q = frame.commands_at(&(point * effective_radius_mm));
         if let Some(o) = m.outside_limits(&q).first() {
-            return Err(format!("{o} at hit {} of the default pattern", h + 1));
+            return Err(format!("{o} at hit {} of the pattern", h + 1));
         }
     }
-    Ok(geometry)
+    Ok(frame)
 }
 
 /// The record of `poses`: one sample per pose (its commands, `t` its index in s, timed), no
@@ -419,9 +425,10 @@ impl ProbePlanInputs<'_> {
         if !(MIN_PER_AXIS..=MAX_PER_AXIS).contains(&per_axis) {
             return Err(ProbePlanError::PerAxis(per_axis));
         }
-        let bed = pattern_covariance(self.probe)?;
-        // The bed-frame pattern's equator hits come within 90° − tilt of the sphere's stem:
-        // tilts beyond 90° − the stem clearance would skip every end pose.
+        let covariance = pattern_covariance(self.probe)?;
+        // The pattern's equator hits (across the stylus) come within 90° − tilt of the
+        // sphere's stem when the tool or the table tilts: tilts beyond 90° − the stem
+        // clearance would skip the end poses.
         let clearance = Clearance {
             max_tilt_deg: self
                 .clearance
@@ -436,7 +443,7 @@ impl ProbePlanInputs<'_> {
             &sweeps,
             per_axis,
             self.probe.effective_radius_mm(),
-            &bed,
+            &covariance,
         )?;
         let record = planned_record(&poses, m.axes.len());
         let campaign = Campaign::new(vec![CampaignRecord::new(

@@ -1,7 +1,7 @@
 //! A sphere centres file (centres another device fitted, one per pose) turned into a record.
 
 use super::hits::ProbeSettings;
-use super::pose::PoseGeometry;
+use super::pose::pose_frame;
 use crate::sphere::RADIUS_LIMIT_MM;
 use formats::csv::CsvError;
 use formats::probe::SphereCentres;
@@ -39,7 +39,7 @@ pub fn centre_record(
     let mut record = Record::default();
     for p in &centres.poses {
         let bad = |message: String| at(p.line, &p.label, message);
-        let geometry = PoseGeometry::at(&vm, &p.axes, params).map_err(|e| bad(e.to_string()))?;
+        let geometry = pose_frame(&vm, &p.axes, params).map_err(|e| bad(e.to_string()))?;
         let commanded = geometry.gap(&vm, &p.axes, params).norm();
         if commanded > settings.off_sphere_mm {
             return Err(bad(format!(
@@ -69,7 +69,7 @@ pub fn centre_record(
         }
         if let Some(u) = p.uncertainty_mm {
             // The linear map from machine coordinates to the bed frame.
-            let a = geometry.linear_map(&vm, params);
+            let a = geometry.linear_map;
             let d = Matrix3::from_diagonal(&Vector3::new(u[0] * u[0], u[1] * u[1], u[2] * u[2]));
             let r = geometry.tool_rotation.matrix();
             let cov = r.transpose() * a * d * a.transpose() * r;

@@ -1,7 +1,7 @@
 //! A probe hits file turned into a record: a sphere fit per pose, its centre as the pose's
 //! reading of the error vector.
 
-use super::pose::PoseGeometry;
+use super::pose::pose_frame;
 use crate::sphere::{Latch, RadiusMode, SphereFit, SphereFitError, SphereFitOptions, fit_sphere};
 use formats::csv::CsvError;
 use formats::probe::{ProbeHits, ProbeInstrument, ProbePose};
@@ -243,8 +243,7 @@ fn fit_pose(
     noise_mm: f64,
 ) -> Result<PoseFit, (usize, String)> {
     let first = &pose.hits[0];
-    let geometry =
-        PoseGeometry::at(vm, &first.axes, params).map_err(|e| (first.line, e.to_string()))?;
+    let geometry = pose_frame(vm, &first.axes, params).map_err(|e| (first.line, e.to_string()))?;
     let r_eff = settings.effective_radius_mm();
     let mut latches = Vec::with_capacity(pose.hits.len());
     let mut approach_tool = Vec::with_capacity(pose.hits.len());

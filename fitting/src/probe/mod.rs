@@ -33,6 +33,6 @@ mod summary;
 
 pub use centres::centre_record;
 pub use hits::{OFF_SPHERE_MM, PoseFit, ProbeRecord, ProbeSettings, probe_record};
-pub use pose::PoseGeometry;
-pub use simulation::probe::{PreTravel, approach_in_probe_frame};
+pub use pose::pose_frame;
+pub use simulation::probe::{PoseFrame, PreTravel, approach_in_probe_frame};
 pub use summary::ProbeSummary;

@@ -25,6 +25,7 @@ fn probe(pre_travel: PreTravel) -> ProbeSettings {
         pre_travel,
         noise_mm: 0.0,
         seed: 0,
+        azimuth: simulation::probe::PatternAzimuth::Cycled,
     }
 }
 
@@ -118,7 +119,7 @@ fn fit(m: &Machine, pose: &SimulatedPose) -> SphereFit {
 /// the truth's zero offsets (what an R-test would read there), rotated into the bed frame with
 /// the actual tool rotation.
 fn error_in_bed_frame(m: &Machine, t: &Truth, pose: &SimulatedPose) -> Vector3<f64> {
-    let q = &pose.commands;
+    let q = &pose.frame.commands;
     let motion = vec![1i8; m.axes.len()];
     let cx = simulation::model::BasisContext {
         commands: q,
@@ -182,7 +183,11 @@ fn the_fitted_centre_is_minus_the_error_vector_in_the_bed_frame() {
 fn the_linear_axes_travel_across_the_pattern_deforms_the_sphere() {
     // The pattern spans ±R_eff of axis travel: an error that changes along it (a squareness,
     // a scale error) deforms the sphere the hits see, and the fitted centre differs from −e by
-    // a fraction of (the change per mm) × R_eff, that fraction a property of the pattern.
+    // a fraction of (the change per mm) × R_eff, that fraction a property of the pattern as
+    // it stands in the bed frame. It turns with the probe: on the table-table machines and at
+    // head-table-bc's B = 0 (its first pose) it stands upright, the fractions below; at a
+    // tilted head's poses the change of the error is seen at another angle, and the centre
+    // differs from −e by less than (the change per mm) × R_eff.
     for name in ["seed-ac", "table-table-bc", "head-table-bc"] {
         let (m, constant, _) = case(name);
         let [lo, hi] = m.axes[m.axis_by_name("Z").unwrap()].limits;
@@ -193,18 +198,33 @@ fn the_linear_axes_travel_across_the_pattern_deforms_the_sphere() {
             ("EZZ = { \"poly:1\" = 10 }", scale, 2, 0.833),
         ];
         for (error, gradient, along, fraction) in cases {
-            for (d, _) in centre_minus_error(name, &format!("{constant}{error}\n")) {
+            for (i, (d, _)) in centre_minus_error(name, &format!("{constant}{error}\n"))
+                .into_iter()
+                .enumerate()
+            {
+                if name == "head-table-bc" && i > 0 {
+                    assert!(d.norm() < gradient * R_EFF, "{name} {error}: {d:?}");
+                    continue;
+                }
                 let ratio = d[along].abs() / (gradient * R_EFF);
                 assert!((ratio - fraction).abs() < 0.003, "{name} {error}: {ratio}");
                 let across = (d.norm_squared() - d[along] * d[along]).sqrt();
                 assert!(across < 1e-6, "{name} {error}: {d:?}");
             }
         }
-        // A squareness in the XY plane: the pattern is symmetric there, the effect 100 times
-        // smaller.
+        // A squareness in the XY plane: the upright pattern is symmetric there, the effect 100
+        // times smaller.
         let error = if name == "seed-ac" { "COX" } else { "COY" };
-        for (d, _) in centre_minus_error(name, &format!("{constant}{error} = 10\n")) {
-            assert!(d.norm() / (1e-5 * R_EFF) < 0.006, "{name}: {d:?}");
+        for (i, (d, _)) in centre_minus_error(name, &format!("{constant}{error} = 10\n"))
+            .into_iter()
+            .enumerate()
+        {
+            let bound = if name == "head-table-bc" && i > 0 {
+                1.0
+            } else {
+                0.006
+            };
+            assert!(d.norm() / (1e-5 * R_EFF) < bound, "{name}: {d:?}");
         }
     }
 }
@@ -229,10 +249,13 @@ fn constant_pre_travel_shrinks_the_fitted_radius_and_leaves_the_centre() {
             let (fe, fl) = (fit(&m, pe), fit(&m, pl));
             assert!((fe.effective_radius_mm - R_EFF).abs() < 1e-9);
             // Latched δ beyond the contact, towards the centre: R_fit = R_eff − δ, up to
-            // δ·(1 − cos θ), θ ≈ |e|/R_eff the angle at which an approach aimed at the
-            // nominal centre meets the sphere about −e: below 0.1 nm here.
+            // terms of the order δ·(1 − cos θ) ≈ δ·θ²/2, θ ≈ |e|/R_eff the angle at which an
+            // approach aimed at the nominal centre meets the sphere about −e. On head-table-bc
+            // e is mostly its probe's length error, 0.1 mm along the stylus (δ·θ²/2 = 0.08 nm),
+            // which the pattern turning with the probe sees across every ring hit at every
+            // pose: 0.12 nm measured on the radius; the other machines below 0.1 nm.
             let dr = fl.effective_radius_mm - (R_EFF - delta);
-            assert!(dr.abs() < 1e-7, "{name}: {dr} mm");
+            assert!(dr.abs() < 2e-7, "{name}: {dr} mm");
             let dc = (fl.centre_mm - fe.centre_mm).norm();
             assert!(dc < 1e-7, "{name}: {dc} mm");
         }
@@ -243,11 +266,20 @@ fn constant_pre_travel_shrinks_the_fitted_radius_and_leaves_the_centre() {
 fn two_microns_of_lobing_move_the_centre_by_two_sevenths_of_a_micron() {
     // seed-ac: the probe's frame is the bed's at every pose. The three lobes do not fit a
     // sphere: over the pattern they leave the radius and move the centre across the stylus by
-    // (L_c, −L_s)/7, to second order (L²/R_eff: 0.03 nm here).
+    // (L_c·cos 4φ₀ + L_s·sin 4φ₀, L_c·sin 4φ₀ − L_s·cos 4φ₀)/7, φ₀ the pattern's azimuth
+    // offset (0°, 22.5°, 45°, 67.5° pose after pose), to second order (L²/R_eff: 0.03 nm
+    // here): at φ₀ = 0 (L_c, −L_s)/7, turned by 90° from one pose to the next. A pattern
+    // fixed in the probe's frame would move every centre alike (the probe's zero takes it);
+    // the turning separates the lobing.
     let m = builtin("seed-ac");
     let p = poses(
         &m,
-        &[[("A", 0.0), ("C", 0.0)], [("A", -40.0), ("C", 130.0)]],
+        &[
+            [("A", 0.0), ("C", 0.0)],
+            [("A", -40.0), ("C", 130.0)],
+            [("A", 20.0), ("C", 45.0)],
+            [("A", 60.0), ("C", 300.0)],
+        ],
     );
     let t = Truth::nominal(&m);
     for lobes in [[0.002, 0.0], [0.0, 0.002], [0.0012, -0.0016]] {
@@ -255,9 +287,15 @@ fn two_microns_of_lobing_move_the_centre_by_two_sevenths_of_a_micron() {
             constant_mm: 0.0,
             lobing_mm: lobes,
         };
-        for pose in &run(&m, &t, &p, pre).poses {
+        for (i, pose) in run(&m, &t, &p, pre).poses.iter().enumerate() {
             let f = fit(&m, pose);
-            let want = Vector3::new(lobes[0], -lobes[1], 0.0) / 7.0;
+            let four = 4.0 * [0.0f64, 22.5, 45.0, 67.5][i].to_radians();
+            let [c, s] = lobes;
+            let want = Vector3::new(
+                c * four.cos() + s * four.sin(),
+                c * four.sin() - s * four.cos(),
+                0.0,
+            ) / 7.0;
             assert!((f.centre_mm - want).norm() < 1e-7, "{:?}", f.centre_mm);
             assert!((f.effective_radius_mm - R_EFF).abs() < 1e-7);
         }

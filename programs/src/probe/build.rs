@@ -1,6 +1,6 @@
 //! The probing program, its plan and its nominal times, from the poses of a record.
 
-use super::geometry::{Frame, HitPoints, V3, dot, hit_points};
+use super::geometry::{Frame, HitPoints, hit_points, turned};
 use super::text::Writer;
 use super::{MAX_DISTANCE_MM, MAX_OVERSHOOT_DEG, ProbeError, ProbeOptions, ProbeProgram};
 use formats::csv::column_order;
@@ -8,7 +8,9 @@ use formats::nc::MAX_DECIMALS;
 use formats::poses::axis_words;
 use model_spec::units::{short, significant};
 use model_spec::{AxisKind, Machine};
+use nalgebra::Vector3;
 use simulation::exact::VirtualMachine;
+use simulation::probe::PatternTurn;
 use simulation::record::Record;
 
 /// The operator's message at the stop.
@@ -37,9 +39,10 @@ fn check_options(m: &Machine, o: &ProbeOptions) -> Result<(), ProbeError> {
         return bad("a probing pattern without a hit".into());
     }
     for (i, h) in o.pattern.iter().enumerate() {
+        let (point, approach) = (Vector3::from(h.point), Vector3::from(h.approach));
         let unit =
-            |v: &V3| v.iter().all(|x| x.is_finite()) && (dot(v, v).sqrt() - 1.0).abs() <= 1e-9;
-        if !unit(&h.point) || !unit(&h.approach) || dot(&h.point, &h.approach) > -0.5 {
+            |v: &Vector3<f64>| v.iter().all(|x| x.is_finite()) && (v.norm() - 1.0).abs() <= 1e-9;
+        if !unit(&point) || !unit(&approach) || point.dot(&approach) > -0.5 {
             return bad(format!(
                 "hit {} of the pattern: its point and approach must be unit vectors, the approach into the sphere (within 60° of the inward normal)",
                 i + 1
@@ -310,16 +313,18 @@ pub fn probe_program(
                 err(e)
             }
         })?;
+        // The pattern turns with the probe and, pose after pose, about the stylus.
+        let turn = PatternTurn::new(frame.pose.tool_rotation.matrix(), o.azimuth.offset_rad(i));
         let hits = o
             .pattern
             .iter()
-            .map(|h| hit_points(&frame, h, o))
+            .map(|h| hit_points(&frame, &turned(&turn, h), o))
             .collect::<Result<Vec<_>, _>>()
             .map_err(err)?;
         written.push(frame.centre.clone());
         frames.push((frame, hits));
     }
-    check_log_axes(m, o, &frames[0].0.linear)?;
+    check_log_axes(m, o, &frames[0].0.linear())?;
     let passes = passes(m, &written, o, poses)?;
     let clearance = super::sequence::clearance(m, &vm, o, &frames)?;
     let sequence = super::sequence::Sequence {

@@ -6,8 +6,9 @@
 //! [`formats::probe`] with that plan.
 //!
 //! **The program.** At every pose the rotary axes turn at the clearance; then, for every hit
-//! of the pattern (`fitting::sphere::default_pattern`: directions in the bed frame), the probe
-//! moves over the hit at the safe height above the sphere, down to the **pre-touch point**
+//! of the pattern ([`default_pattern`], defined in the probe's frame and turned into the bed
+//! frame by the pose's nominal tool rotation and an azimuth offset about the stylus that
+//! changes from pose to pose, [`ProbeOptions::azimuth`]), the probe moves over the hit at the safe height above the sphere, down to the **pre-touch point**
 //! (the nominal tip centre [`ProbeOptions::pretouch_mm`] outside the sphere of radius
 //! `R_eff = sphere radius + tip radius`), probes towards the centre to
 //! [`ProbeOptions::overtravel_mm`] beyond the nominal contact (LinuxCNC `G38.2`, an error if it
@@ -54,8 +55,11 @@ pub use plan::{
 use crate::measure::AxisRates;
 use formats::nc::{Dialect, NcError};
 use model_spec::Machine;
+pub use simulation::probe::PatternAzimuth;
 
-/// One hit of a pattern, relative to the sphere's centre, in the bed frame.
+/// One hit of a pattern, relative to the sphere's centre, in the probe's (tool) frame: at every
+/// pose it is turned into the bed frame by the pose's nominal tool rotation and the azimuth
+/// offset [`ProbeOptions::azimuth`] gives the pose (`simulation::probe::PatternTurn`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PatternHit {
     /// The unit vector from the centre to the contact (the outward normal there).
@@ -63,6 +67,19 @@ pub struct PatternHit {
     /// The approach direction, unit: the inward normal, `-point`, for a hit aimed at the
     /// centre.
     pub approach: [f64; 3],
+}
+
+/// The default pattern as [`PatternHit`]s: the nine hits of
+/// `simulation::probe::approach_directions` (probe frame; the point hit is `−approach`), the
+/// pattern the simulation and the plans use.
+pub fn default_pattern() -> Vec<PatternHit> {
+    simulation::probe::approach_directions()
+        .iter()
+        .map(|n| PatternHit {
+            point: [-n.x, -n.y, -n.z],
+            approach: [n.x, n.y, n.z],
+        })
+        .collect()
 }
 
 /// The longest stroke a probing move may have beyond the contact, and the largest pre-touch
@@ -83,9 +100,14 @@ pub const MAX_OBLIQUE_DEG: f64 = 60.0;
 pub struct ProbeOptions {
     /// The program's language.
     pub dialect: Dialect,
-    /// The hits at every pose, in order (`fitting::sphere::default_pattern(1.0)` by default,
-    /// as unit vectors). At least one.
+    /// The hits at every pose, in order, in the probe's frame
+    /// ([`default_pattern`]: `simulation::probe::approach_directions`, the simulation's). At
+    /// least one.
     pub pattern: Vec<PatternHit>,
+    /// How the pattern turns about the stylus from pose to pose (by the pose's index in the
+    /// record; both passes of a pose with [`ProbeOptions::backlash_overshoot_deg`] alike).
+    /// Default [`PatternAzimuth::Cycled`].
+    pub azimuth: PatternAzimuth,
     /// The sphere's calibrated radius, mm, above 0.
     pub sphere_radius_mm: f64,
     /// The stylus tip's radius, mm, above 0: the tip centre touches the sphere at
@@ -149,6 +171,7 @@ impl ProbeOptions {
         ProbeOptions {
             dialect,
             pattern,
+            azimuth: PatternAzimuth::default(),
             sphere_radius_mm,
             tip_radius_mm,
             pretouch_mm: 2.0,

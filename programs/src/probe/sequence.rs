@@ -50,10 +50,10 @@ pub(crate) fn clearance(
     let at_zero = Frame::new(m, vm, &o.params, &level);
     let f = at_zero.as_ref().unwrap_or(&frames[0].0);
     let (k, along) = (0..3)
-        .map(|k| (k, f.axis_cos(k, &f.tool_axis)))
+        .map(|k| (k, f.axis_cos(k, &f.tool_axis())))
         .max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()))
         .unwrap_or((2, 1.0));
-    let axis = f.linear[k];
+    let axis = f.linear()[k];
     let ax = &m.axes[axis];
     let up = along >= 0.0;
     let [lo, hi] = ax.limits;
@@ -205,7 +205,7 @@ impl Sequence<'_> {
                     pose: pass.label.clone(),
                     hit: k + 1,
                     axes: contact,
-                    direction: h.approach,
+                    direction: [h.approach.x, h.approach.y, h.approach.z],
                     t_s: s.t_s,
                     line,
                 });
@@ -327,7 +327,7 @@ impl Sequence<'_> {
                 let line = w.probe(&text, &read, &f);
                 if w.dialect == formats::nc::Dialect::Iso {
                     let value = |a: usize| w.number(after[a], false);
-                    let [x, y, z] = frame.linear;
+                    let [x, y, z] = frame.linear();
                     let threshold = format!("{:.4}", (0.5 * o.overtravel_mm).min(0.01));
                     w.iso_latch(
                         [letters[x].letter, letters[y].letter, letters[z].letter],
@@ -344,7 +344,7 @@ impl Sequence<'_> {
                 w.cycle0(
                     &text,
                     &read,
-                    letters[frame.linear[k]].letter,
+                    letters[frame.linear()[k]].letter,
                     positive,
                     &format!("{name}.A"),
                     &format!("{name}.TXT"),
@@ -364,8 +364,8 @@ fn up_from(at: &[f64], axis: usize, position: f64) -> Vec<f64> {
 }
 
 /// The distance between two points, mm.
-fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+fn distance(a: &nalgebra::Vector3<f64>, b: &nalgebra::Vector3<f64>) -> f64 {
+    (a - b).norm()
 }
 
 /// The combined path of a move from `from` to `to` (file units) over the axes known in both,

@@ -11,7 +11,8 @@ use formats::nc::Dialect;
 use formats::poses::{axis_words, from_file_units};
 use model_spec::{AxisKind, Machine, Side};
 use programs::probe::{
-    PatternHit, ProbeError, ProbeOptions, ProbeProgram, check_order, hit_steps, probe_program,
+    PatternAzimuth, PatternHit, ProbeError, ProbeOptions, ProbeProgram, check_order,
+    default_pattern, hit_steps, probe_program,
 };
 use programs::reader::{ProbeKind, ReadProgram, Step, read_program};
 use simulation::exact::VirtualMachine;
@@ -24,15 +25,18 @@ pub(crate) const DIALECTS: [Dialect; 3] = [Dialect::Iso, Dialect::LinuxCnc, Dial
 pub(crate) const SPHERE_MM: f64 = 12.5;
 pub(crate) const TIP_MM: f64 = 1.5;
 
-/// The default pattern of `fitting::sphere`, as unit vectors.
+/// The default pattern (probe frame), checked bit for bit against `fitting::sphere`'s.
 pub(crate) fn pattern() -> Vec<PatternHit> {
-    fitting::sphere::default_pattern(1.0)
+    let p = default_pattern();
+    let fit: Vec<PatternHit> = fitting::sphere::default_pattern(1.0)
         .iter()
         .map(|h| PatternHit {
             point: [h.point_mm.x, h.point_mm.y, h.point_mm.z],
             approach: [h.approach.x, h.approach.y, h.approach.z],
         })
-        .collect()
+        .collect();
+    assert_eq!(p, fit);
+    p
 }
 
 /// Poses of `m` at the rotary angles `angles` (degrees, by axis name); linear axes 0.
@@ -56,6 +60,20 @@ pub(crate) fn seed_poses(m: &Machine) -> Record {
             &[],
             &[("A", 30.0), ("C", 90.0)],
             &[("A", -45.0), ("C", 200.0)],
+        ],
+    )
+}
+
+/// Five poses of `head-table-bc`, the head tilted both ways by up to 60°.
+pub(crate) fn head_poses(m: &Machine) -> Record {
+    poses(
+        m,
+        &[
+            &[],
+            &[("B", -60.0)],
+            &[("B", 30.0), ("C", 90.0)],
+            &[("B", 60.0), ("C", 200.0)],
+            &[("B", -45.0), ("C", 300.0)],
         ],
     )
 }
@@ -190,8 +208,16 @@ fn check_program(m: &Machine, p: &ProbeProgram, d: Dialect, o: &ProbeOptions, wh
                     .map(|(a, b)| a + u * (b - a))
                     .collect();
                 let dist = norm(&gap(m, &q));
+                // Heidenhain's cycle 0 probes along a machine axis: on a tilted head its
+                // pre-touch point may be below the equator seen along the tool axis, reached
+                // at least half the pre-touch distance outside the sphere.
+                let least = if d == Dialect::Heidenhain {
+                    r + 0.5 * o.pretouch_mm
+                } else {
+                    r + o.pretouch_mm
+                };
                 assert!(
-                    dist > r + o.pretouch_mm - 2e-4,
+                    dist > least - 2e-4,
                     "{what}: line {} comes {dist} mm from the centre",
                     x.line
                 );
@@ -207,12 +233,14 @@ fn check_program(m: &Machine, p: &ProbeProgram, d: Dialect, o: &ProbeOptions, wh
 fn every_dialect_reads_back_in_order_with_its_points_on_the_nominal_machine() {
     let seed = builtin("seed-ac");
     let nutating = builtin("nutating-table-bc");
+    let head = builtin("head-table-bc");
     let cases = [
         (&seed, seed_poses(&seed)),
         (
             &nutating,
             poses(&nutating, &[&[], &[("B", 40.0), ("C", 135.0)]]),
         ),
+        (&head, head_poses(&head)),
     ];
     for (m, poses) in &cases {
         for d in DIALECTS {
@@ -436,11 +464,26 @@ fn both_directions_probe_each_pose_arriving_from_below_then_above() {
 fn poses_and_options_that_cannot_be_probed_are_refused() {
     let m = builtin("seed-ac");
     let o = options(&m, Dialect::LinuxCnc);
-    // At A = 90° the table stands vertical: its stem points along +y, at the +Y hit.
+    // At A = 90° the table stands vertical: its stem points along +y, at the +Y hit (the
+    // second pose's pattern turned 22.5° about the stylus: 22.5° from the stem).
     let tilted = poses(&m, &[&[], &[("A", 90.0)]]);
     let e = probe_program(&m, &tilted, &o).unwrap_err().to_string();
     assert!(
-        e.starts_with("pose at sample 2: the hit at (0, 1, 0) from the centre (bed frame) is 0° from the sphere's stem"),
+        e.starts_with("pose at sample 2: the hit at (-0.382683, 0.92388, 0) from the centre (bed frame) is 22.5° from the sphere's stem"),
+        "{e}"
+    );
+    // head-table-bc at B = −90°: the spindle horizontal, the pattern turned with it; the
+    // equator hit below the sphere meets the stem (the table normal reversed).
+    let head = builtin("head-table-bc");
+    let e = probe_program(
+        &head,
+        &poses(&head, &[&[("B", -90.0)]]),
+        &options(&head, Dialect::LinuxCnc),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("pose at sample 1: the hit at (0, 0, -1) from the centre (bed frame) is 0° from the sphere's stem"),
         "{e}"
     );
     let one = poses(&m, &[&[]]);
@@ -533,4 +576,74 @@ fn the_reader_refuses_what_it_does_not_know_in_a_probing_program() {
     assert_eq!(r.blocks[0].statement.as_deref(), Some("log.txt"));
     let r = read_program("p.nc", "(PROBEOPEN log.txt)\n", Dialect::Iso, &axes).unwrap();
     assert!(r.blocks.is_empty());
+}
+
+#[test]
+fn the_pattern_turns_with_the_tilted_head_and_about_the_stylus_pose_after_pose() {
+    // head-table-bc's B tilts the probe: every hit's direction in the plan is the pattern's
+    // (probe frame) turned by the pose's nominal tool rotation, from the nominal tool chain
+    // here, and by 0°, 22.5°, 45°, 67.5°, 0° about the stylus; no hit is below the sphere's
+    // equator seen along the tool axis.
+    let m = builtin("head-table-bc");
+    let poses = head_poses(&m);
+    let vm = VirtualMachine::new(&m);
+    let params = m.default_parameters();
+    let pattern = pattern();
+    for d in DIALECTS {
+        let o = options(&m, d);
+        let p = probe_program(&m, &poses, &o).unwrap_or_else(|e| panic!("{d:?}: {e}"));
+        assert_eq!(p.plan.rows.len(), 9 * poses.samples.len());
+        for (i, sample) in poses.samples.iter().enumerate() {
+            let tool = vm.nominal_chain_transform(Side::Tool, &sample.commands, &params);
+            let r = tool.rotation.matrix();
+            let phi = [0.0f64, 22.5, 45.0, 67.5][i % 4].to_radians();
+            let axis = r.column(2);
+            for (k, h) in pattern.iter().enumerate() {
+                let row = &p.plan.rows[9 * i + k];
+                let a = h.approach;
+                let turned = nalgebra::Vector3::new(
+                    a[0] * phi.cos() - a[1] * phi.sin(),
+                    a[0] * phi.sin() + a[1] * phi.cos(),
+                    a[2],
+                );
+                let want = r * turned;
+                let got = nalgebra::Vector3::from(row.direction);
+                if d == Dialect::Heidenhain {
+                    // Cycle 0 probes along the machine axis nearest the hit's normal.
+                    assert!(got.dot(&want) > 60f64.to_radians().cos() - 1e-12, "{i} {k}");
+                } else {
+                    assert!((got - want).norm() < 1e-12, "{d:?} pose {i} hit {k}");
+                }
+                // The hit's point (−approach in the pattern) on the spindle's half.
+                assert!((-want).dot(&axis) > -1e-12, "pose {i} hit {k}");
+            }
+        }
+    }
+    // With the azimuth fixed, every pose is probed at azimuth 0.
+    let mut o = options(&m, Dialect::LinuxCnc);
+    o.azimuth = PatternAzimuth::Fixed;
+    let fixed = probe_program(&m, &poses, &o).unwrap();
+    let cycled = probe_program(&m, &poses, &options(&m, Dialect::LinuxCnc)).unwrap();
+    for (i, (f, c)) in fixed.plan.rows.iter().zip(&cycled.plan.rows).enumerate() {
+        // The pole lies on the stylus: no azimuth turns it.
+        let (pose, hit) = (i / 9, i % 9);
+        assert_eq!(
+            f.direction == c.direction,
+            pose % 4 == 0 || hit == 8,
+            "row {i}"
+        );
+    }
+}
+
+#[test]
+fn on_a_table_table_machine_the_fixed_pattern_writes_the_bed_frame_program() {
+    // seed-ac's tool does not turn: at azimuth 0 the pattern is the bed-frame one, so the
+    // first pose of a cycled program and every pose of a fixed one probe along ±X, ±Y, −Z.
+    let m = builtin("seed-ac");
+    let mut o = options(&m, Dialect::LinuxCnc);
+    o.azimuth = PatternAzimuth::Fixed;
+    let p = probe_program(&m, &seed_poses(&m), &o).unwrap();
+    for (i, row) in p.plan.rows.iter().enumerate() {
+        assert_eq!(row.direction, pattern()[i % 9].approach, "row {i}");
+    }
 }

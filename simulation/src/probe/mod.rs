@@ -11,10 +11,16 @@
 //! **A pose.** The rotary commands of a pose are kept; the linear ones come from the nominal
 //! tool-centre-point inverse kinematics (the nominal tip centre on the nominal sphere centre).
 //! With the rotary axes still, the nominal gap is affine in the linear commands, `A·q + b`,
-//! the columns of `A` (bed frame, mm/mm) from the exact chains.
+//! the columns of `A` (bed frame, mm/mm) from the exact chains ([`PoseFrame`], the nominal
+//! frame the programs, the plans and the reading of probe records share).
 //!
-//! **A hit.** For each approach direction `n` of the pattern ([`approach_directions`], fixed in
-//! the bed frame) the probe starts where the nominal gap is `−n·(R_eff + CLEARANCE_MM)` and
+//! **The pattern.** The nine approach directions of [`approach_directions`] are defined in the
+//! probe's (tool) frame and turned into the bed frame at every pose by its nominal tool
+//! rotation and an azimuth offset about the stylus ([`PatternTurn`]: `n = R_tool·R_z(φ₀)·d`,
+//! `φ₀` by [`ProbeSettings::azimuth`] and the pose's index); on a table-table machine at
+//! azimuth 0 they are the bed-frame directions bit for bit.
+//!
+//! **A hit.** For each approach direction `n` of the pattern at the pose the probe starts where the nominal gap is `−n·(R_eff + CLEARANCE_MM)` and
 //! moves so that the nominal gap changes by `s·n`: the linear commands change by `s·A⁻¹·n`.
 //! The contact is the `s` where the actual gap, with the truth's errors evaluated at the
 //! commands there (and the motion, times and velocities of the approach) and the tip centre
@@ -49,13 +55,16 @@
 //! note).
 
 mod contact;
+mod frame;
 mod pattern;
 mod reach;
 
 pub use contact::{CONTACT_TOLERANCE_MM, MAX_CONTACT_ITERATIONS};
+pub use frame::PoseFrame;
 pub use pattern::{
-    APPROACH_S, CLEARANCE_MM, HIT_CYCLE_S, PATTERN_HITS, POSE_CHANGE_S, PROBING_FEED_MM_PER_S,
-    PreTravel, approach_directions, approach_in_probe_frame, latch_time_s, run_time_s,
+    APPROACH_S, AZIMUTH_CYCLE_DEG, CLEARANCE_MM, HIT_CYCLE_S, PATTERN_HITS, POSE_CHANGE_S,
+    PROBING_FEED_MM_PER_S, PatternAzimuth, PatternTurn, PreTravel, approach_directions,
+    approach_in_probe_frame, latch_time_s, run_time_s,
 };
 pub use reach::{STEM_CLEARANCE_DEG, below_equator, near_stem, unreachable};
 
@@ -64,10 +73,10 @@ use crate::model::{BasisContext, Effect};
 use crate::rng::Rng;
 use crate::truth::Truth;
 use contact::{Approach, ContactFailure};
+use model_spec::Machine;
 use model_spec::pose::PoseError;
 use model_spec::units::short;
-use model_spec::{Machine, Side};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 /// A command change smaller than this (mm or rad) is no move, for the directions of motion.
 pub const MOVE_EPS: f64 = 1e-9;
@@ -85,6 +94,8 @@ pub struct ProbeSettings {
     pub noise_mm: f64,
     /// The seed of the noise generator.
     pub seed: u64,
+    /// How the pattern turns about the stylus from pose to pose.
+    pub azimuth: PatternAzimuth,
 }
 
 impl ProbeSettings {
@@ -145,14 +156,11 @@ impl SimulatedHit {
 /// The hits of one pose.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimulatedPose {
-    /// The pose's nominal commands (mm, rad): the nominal tip centre on the nominal sphere
-    /// centre.
-    pub commands: Vec<f64>,
-    /// The nominal tool rotation at the pose (bed ← tool).
-    pub tool_rotation: Matrix3<f64>,
-    /// `A`: the change of the nominal gap (bed frame) per unit change of each linear axis, in
-    /// the order of [`Machine::linear_axes`] (mm/mm).
-    pub linear_map: Matrix3<f64>,
+    /// The pose's nominal frame: its commands (the nominal tip centre on the nominal sphere
+    /// centre), tool rotation and linear map.
+    pub frame: PoseFrame,
+    /// The turn of the pattern into the bed frame at the pose.
+    pub turn: PatternTurn,
     /// The hits, in the pattern's order.
     pub hits: Vec<SimulatedHit>,
 }
@@ -272,36 +280,18 @@ pub fn simulate_probe(
 ) -> Result<ProbeRun, ProbeError> {
     check(m, nominal_params, truth, poses, probe)?;
     let vm = VirtualMachine::new(m);
-    let linear: Vec<usize> = m.linear_axes().collect();
-    let directions = approach_directions();
     let r = probe.effective_radius_mm();
-    // The nominal geometry of every pose and the start point and command step of every hit.
+    // The nominal frame, the pattern's turn and per hit the start point and command step of
+    // every pose.
     let mut geometry = Vec::with_capacity(poses.len());
     for (p, given) in poses.iter().enumerate() {
-        let mut q = given.clone();
-        vm.tool_centre_point_ik(&mut q, nominal_params)
+        let frame = PoseFrame::at(&vm, given, nominal_params)
             .map_err(|source| ProbeError::Kinematics { pose: p, source })?;
-        let gap0 = nominal_gap(&vm, &q, nominal_params);
-        let mut a = Matrix3::zeros();
-        for (j, &i) in linear.iter().enumerate() {
-            let mut e = q.clone();
-            e[i] += 1.0;
-            a.set_column(j, &(nominal_gap(&vm, &e, nominal_params) - gap0));
-        }
-        let lu = a.lu();
-        let to_commands = |d: &Vector3<f64>| -> Vec<f64> {
-            let x = lu.solve(d).unwrap_or_else(|| Vector3::repeat(f64::NAN));
-            let mut full = vec![0.0; m.axes.len()];
-            for (j, &i) in linear.iter().enumerate() {
-                full[i] = x[j];
-            }
-            full
-        };
+        let turn = PatternTurn::new(frame.tool_rotation.matrix(), probe.azimuth.offset_rad(p));
         let mut hits = Vec::with_capacity(PATTERN_HITS);
-        for (k, n) in directions.iter().enumerate() {
-            let d = to_commands(&(-n * (r + CLEARANCE_MM) - gap0));
-            let start: Vec<f64> = q.iter().zip(&d).map(|(a, b)| a + b).collect();
-            let step = to_commands(n);
+        for (k, n) in turn.approach_directions().iter().enumerate() {
+            let start = frame.commands_at(&(-n * (r + CLEARANCE_MM)));
+            let step = frame.command_change(n);
             let start_ok = m.check_pose(&start);
             if let Err(source) = start_ok {
                 return Err(ProbeError::Limits {
@@ -312,10 +302,9 @@ pub fn simulate_probe(
                     source,
                 });
             }
-            hits.push((start, step));
+            hits.push((*n, start, step));
         }
-        let tool = vm.transform_with(Side::Tool, &q, nominal_params, &|_| 0.0);
-        geometry.push((q, *tool.rotation.matrix(), a, hits));
+        geometry.push((frame, turn, hits));
     }
     let motion = directions_at_latches(m, &geometry);
     let total = poses.len() * PATTERN_HITS;
@@ -323,10 +312,9 @@ pub fn simulate_probe(
     let mut rng = Rng::new(probe.seed);
     let mut out = Vec::with_capacity(poses.len());
     let mut k_all = 0;
-    for (p, (q, rotation, a, starts)) in geometry.into_iter().enumerate() {
+    for (p, (frame, turn, starts)) in geometry.into_iter().enumerate() {
         let mut hits = Vec::with_capacity(PATTERN_HITS);
-        for (k, (start, step)) in starts.into_iter().enumerate() {
-            let n = directions[k];
+        for (k, (n, start, step)) in starts.into_iter().enumerate() {
             let t_s = latch_time_s(p, k_all);
             let tau = if t_last > t_first {
                 2.0 * (t_s - t_first) / (t_last - t_first) - 1.0
@@ -357,7 +345,7 @@ pub fn simulate_probe(
             let (s, iterations) = approach
                 .contact(r + CLEARANCE_MM)
                 .map_err(|e| fail(failure(e)))?;
-            let delta = probe.pre_travel.along(&rotation, &n);
+            let delta = probe.pre_travel.along(frame.tool_rotation.matrix(), &n);
             let noise = if probe.noise_mm > 0.0 {
                 probe.noise_mm * rng.normal()
             } else {
@@ -393,12 +381,7 @@ pub fn simulate_probe(
             });
             k_all += 1;
         }
-        out.push(SimulatedPose {
-            commands: q,
-            tool_rotation: rotation,
-            linear_map: a,
-            hits,
-        });
+        out.push(SimulatedPose { frame, turn, hits });
     }
     Ok(ProbeRun {
         poses: out,
@@ -423,20 +406,12 @@ fn failure(e: ContactFailure) -> String {
     }
 }
 
-/// `P_tool − P_work` of the nominal machine, bed frame (mm).
-fn nominal_gap(vm: &VirtualMachine<'_>, q: &[f64], params: &[f64]) -> Vector3<f64> {
-    let tool = vm.transform_with(Side::Tool, q, params, &|_| 0.0);
-    let work = vm.transform_with(Side::Work, q, params, &|_| 0.0);
-    tool.translation.vector - work.translation.vector
-}
-
-/// A pose's nominal geometry: its commands, tool rotation, linear map and per hit its start
-/// point and command step.
+/// A pose's nominal frame, the pattern's turn and per hit its approach direction (bed frame),
+/// start point and command step.
 type PoseGeometry = (
-    Vec<f64>,
-    Matrix3<f64>,
-    Matrix3<f64>,
-    Vec<(Vec<f64>, Vec<f64>)>,
+    PoseFrame,
+    PatternTurn,
+    Vec<(Vector3<f64>, Vec<f64>, Vec<f64>)>,
 );
 
 /// The direction of motion of every axis at every latch, in hit order over the run (see the
@@ -447,8 +422,8 @@ fn directions_at_latches(m: &Machine, geometry: &[PoseGeometry]) -> Vec<Vec<i8>>
     let mut moves: Vec<Vec<f64>> = Vec::new();
     let mut approaches = Vec::new();
     let mut previous: Option<(&[f64], &[f64])> = None;
-    for (_, _, _, hits) in geometry {
-        for (start, step) in hits {
+    for (_, _, hits) in geometry {
+        for (_, start, step) in hits {
             if let Some((s0, d0)) = previous {
                 moves.push(d0.iter().map(|d| -d * CLEARANCE_MM).collect());
                 moves.push(start.iter().zip(s0).map(|(a, b)| a - b).collect());

@@ -1,5 +1,7 @@
-//! What a simulated probe cycle does at each pose: the hit pattern (approach directions in the
-//! bed frame), the clearance it starts from, its clock and the pre-travel of its trigger.
+//! What a probe cycle does at each pose: the hit pattern (approach directions in the probe's
+//! frame, turned into the bed frame by the pose's nominal tool rotation and an azimuth about
+//! the stylus that changes from pose to pose), the clearance a simulated approach starts from,
+//! its clock and the pre-travel of the probe's trigger.
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -28,17 +30,19 @@ pub const POSE_CHANGE_S: f64 = 6.0;
 /// [`PROBING_FEED_MM_PER_S`].
 pub const APPROACH_S: f64 = CLEARANCE_MM / PROBING_FEED_MM_PER_S;
 
-/// The approach directions of the pattern (unit vectors, bed frame), in hit order: the
-/// directions of `fitting::sphere::default_pattern` (computed with the same operations, so
-/// bit for bit the same):
+/// The approach directions of the pattern in the probe's (tool) frame, at azimuth 0, in hit
+/// order: the directions of `fitting::sphere::default_pattern` (computed with the same
+/// operations, so bit for bit the same):
 ///
-/// - 0–3: at the centre's height, approaching along −X, −Y, +X, +Y (the hits on the sphere at
-///   +X, +Y, −X, −Y);
-/// - 4–7: from the height `R/2` above the centre, at azimuths 45°, 135°, 225°, 315° (of the
-///   point hit), pointing down and in;
-/// - 8: the pole, approached along −Z.
+/// - 0–3: at the centre's height (across the stylus), approaching along −x, −y, +x, +y of the
+///   tool frame (the hits on the sphere at +x, +y, −x, −y);
+/// - 4–7: from the height `R/2` above the centre (along the tool axis), at azimuths 45°, 135°,
+///   225°, 315° (of the point hit), pointing down and in;
+/// - 8: the pole, approached along −z of the tool frame (along the stylus).
 ///
-/// They are fixed in the bed frame: they do not turn with the tool or the table.
+/// Every hit lies on the sphere's half towards the spindle, so none is below the sphere's
+/// equator seen along the tool axis ([`crate::probe::below_equator`]) at any pose. At a pose
+/// the directions are [`PatternTurn::apply`]'d into the bed frame.
 pub fn approach_directions() -> [Vector3<f64>; PATTERN_HITS] {
     let quarter = std::f64::consts::FRAC_PI_2;
     let h: f64 = 0.5; // z / R
@@ -59,6 +63,101 @@ pub fn approach_directions() -> [Vector3<f64>; PATTERN_HITS] {
         *slot = -point;
     }
     out
+}
+
+/// The azimuth offsets of [`PatternAzimuth::Cycled`], degrees, pose after pose.
+pub const AZIMUTH_CYCLE_DEG: [f64; 4] = [0.0, 22.5, 45.0, 67.5];
+
+/// How the pattern turns about the stylus from pose to pose.
+///
+/// A three-lobed pre-travel ([`PreTravel`]) moves the centre a ring of four equally spaced
+/// hits gives across the stylus by a tool-frame vector proportional to
+/// `(L_c·cos 4φ₀ + L_s·sin 4φ₀, L_c·sin 4φ₀ − L_s·cos 4φ₀)`, `φ₀` the ring's azimuth in the
+/// probe's frame (the terms in 2φ₀ cancel over the ring). A pattern fixed in the probe's frame
+/// (`φ₀` the same at every pose) moves every centre by the same tool-frame vector, which the
+/// probe's zero (`dx0 dy0 dz0`) takes: the lobing is confounded with it. Turning the pattern
+/// by 22.5° from pose to pose turns that vector by 90°, so the lobing and the probe's zero
+/// separate; hence the default.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PatternAzimuth {
+    /// Pose `i` (0-based, in probing order) turned by [`AZIMUTH_CYCLE_DEG`]`[i mod 4]` about
+    /// the stylus (the default).
+    #[default]
+    Cycled,
+    /// Every pose at azimuth 0: on a machine whose tool does not turn (table-table), the
+    /// pattern fixed in the bed frame.
+    Fixed,
+}
+
+impl PatternAzimuth {
+    /// The names, as the command line takes them.
+    pub const NAMES: [&'static str; 2] = ["cycled", "fixed"];
+
+    /// The azimuth offset of pose `pose` (0-based, in probing order), rad.
+    pub fn offset_rad(self, pose: usize) -> f64 {
+        match self {
+            PatternAzimuth::Cycled => {
+                AZIMUTH_CYCLE_DEG[pose % AZIMUTH_CYCLE_DEG.len()].to_radians()
+            }
+            PatternAzimuth::Fixed => 0.0,
+        }
+    }
+
+    /// Its name: `cycled` or `fixed`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PatternAzimuth::Cycled => Self::NAMES[0],
+            PatternAzimuth::Fixed => Self::NAMES[1],
+        }
+    }
+
+    /// The choice named `name` (`cycled`, `fixed`), or `None`.
+    pub fn parse(name: &str) -> Option<Self> {
+        match name {
+            "cycled" => Some(PatternAzimuth::Cycled),
+            "fixed" => Some(PatternAzimuth::Fixed),
+            _ => None,
+        }
+    }
+}
+
+/// The turn of the pattern from the probe's frame into the bed frame at one pose:
+/// `R = R_tool · R_z(φ₀)`, `R_tool` the pose's nominal tool rotation (bed ← tool), `φ₀` its
+/// azimuth offset about the stylus.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatternTurn {
+    /// `R` (bed ← pattern).
+    pub rotation: Matrix3<f64>,
+    /// `φ₀`, rad.
+    pub azimuth_rad: f64,
+}
+
+impl PatternTurn {
+    /// The turn at a pose of nominal tool rotation `tool_rotation` (bed ← tool) and azimuth
+    /// offset `azimuth_rad` (rad).
+    pub fn new(tool_rotation: &Matrix3<f64>, azimuth_rad: f64) -> PatternTurn {
+        let (s, c) = azimuth_rad.sin_cos();
+        let about_stylus = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        PatternTurn {
+            rotation: tool_rotation * about_stylus,
+            azimuth_rad,
+        }
+    }
+
+    /// `R·d`, bed frame, for `d` in the pattern's frame; `d` itself, bit for bit, when `R` is
+    /// the identity (a table-table machine at azimuth 0: the bed-frame pattern as it was).
+    pub fn apply(&self, d: &Vector3<f64>) -> Vector3<f64> {
+        if self.rotation == Matrix3::identity() {
+            *d
+        } else {
+            self.rotation * d
+        }
+    }
+
+    /// The approach directions of the pattern at this pose (unit, bed frame), in hit order.
+    pub fn approach_directions(&self) -> [Vector3<f64>; PATTERN_HITS] {
+        approach_directions().map(|d| self.apply(&d))
+    }
 }
 
 /// The time of the latch of hit `hit` (0-based over the whole run) of pose `pose` (0-based), s:

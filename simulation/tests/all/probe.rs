@@ -7,8 +7,9 @@ use model_spec::{Machine, Side};
 use nalgebra::Vector3;
 use simulation::VirtualMachine;
 use simulation::probe::{
-    APPROACH_S, CLEARANCE_MM, HIT_CYCLE_S, PATTERN_HITS, POSE_CHANGE_S, PreTravel, ProbeError,
-    ProbeRun, ProbeSettings, SimulatedHit, approach_directions, simulate_probe,
+    APPROACH_S, AZIMUTH_CYCLE_DEG, CLEARANCE_MM, HIT_CYCLE_S, PATTERN_HITS, POSE_CHANGE_S,
+    PatternAzimuth, PreTravel, ProbeError, ProbeRun, ProbeSettings, SimulatedHit,
+    approach_directions, simulate_probe,
 };
 use simulation::truth::Truth;
 
@@ -23,6 +24,7 @@ fn probe() -> ProbeSettings {
         pre_travel: PreTravel::default(),
         noise_mm: 0.0,
         seed: 0,
+        azimuth: PatternAzimuth::Cycled,
     }
 }
 
@@ -150,7 +152,7 @@ fn exact_hits_touch_the_actual_sphere_on_three_machines() {
                 off_nominal = off_nominal.max((nominal - R_EFF).abs());
                 // The rotary axes stand at the pose's commands.
                 for i in m.rotary_axes() {
-                    assert_eq!(hit.latched[i], pose.commands[i]);
+                    assert_eq!(hit.latched[i], pose.frame.commands[i]);
                 }
             }
         }
@@ -164,10 +166,9 @@ fn with_the_nominal_truth_the_hits_lie_on_the_nominal_sphere() {
     for name in ["seed-ac", "table-table-bc", "head-table-bc"] {
         let (m, _, p) = case(name);
         let r = run(&m, &Truth::nominal(&m), &p, &probe());
-        let directions = approach_directions();
         for pose in &r.poses {
-            assert!(nominal_gap(&m, &pose.commands).norm() < 1e-9);
-            for (hit, n) in pose.hits.iter().zip(&directions) {
+            assert!(nominal_gap(&m, &pose.frame.commands).norm() < 1e-9);
+            for (hit, n) in pose.hits.iter().zip(&pose.turn.approach_directions()) {
                 assert_eq!(hit.approach, *n);
                 let g = nominal_gap(&m, &hit.latched);
                 assert!((g + n * R_EFF).norm() < 1e-9, "{name}: {g:?}");
@@ -234,21 +235,88 @@ fn lobing_follows_the_approach_in_the_probe_frame() {
     let r = run(&m, &t, &p, &settings);
     for pose in &r.poses {
         for hit in &pose.hits {
-            let n = pose.tool_rotation.transpose() * hit.approach;
+            let n = pose.frame.tool_rotation.matrix().transpose() * hit.approach;
             let (rho, phi) = (n.x.hypot(n.y), n.y.atan2(n.x));
             let want = rho * (lc * (3.0 * phi).cos() + ls * (3.0 * phi).sin());
             assert!((hit.pre_travel_mm - want).abs() < 1e-15);
         }
     }
-    // B = 0: the pole's approach is along the stylus (no lobing), the +X approach at φ = 0.
-    let first = &r.poses[0].hits;
-    assert!(first[8].pre_travel_mm.abs() < 1e-15);
-    assert!((first[2].pre_travel_mm - lc).abs() < 1e-15);
-    // B = 90°: the stylus along the bed's x, so the ±X approaches have no lobing and the pole
-    // has.
-    let turned = &r.poses[3].hits;
-    assert!(turned[0].pre_travel_mm.abs() < 1e-12 && turned[2].pre_travel_mm.abs() < 1e-12);
-    assert!(turned[8].pre_travel_mm.abs() > 1e-4);
+    // The pattern turns with the probe: at every pose the pole's approach is along the stylus
+    // (no lobing), and the third hit's (+x of the probe at azimuth 0) sees the lobing at the
+    // pose's azimuth offset φ₀: L_c·cos 3φ₀ + L_s·sin 3φ₀, whatever B is.
+    for (i, pose) in r.poses.iter().enumerate() {
+        let hits = &pose.hits;
+        assert!(hits[8].pre_travel_mm.abs() < 1e-15, "pose {i}");
+        let phi = AZIMUTH_CYCLE_DEG[i % 4].to_radians();
+        let want = lc * (3.0 * phi).cos() + ls * (3.0 * phi).sin();
+        assert!((hits[2].pre_travel_mm - want).abs() < 1e-15, "pose {i}");
+    }
+}
+
+#[test]
+fn the_pattern_turns_with_the_probe_and_about_the_stylus_from_pose_to_pose() {
+    // head-table-bc tilts the probe with B: the hits are the tool-frame pattern turned by the
+    // pose's nominal tool rotation and its azimuth offset (0, 22.5°, 45°, 67.5°, …), so none
+    // lies below the sphere's equator seen along the tool axis.
+    let (m, t, p) = case("head-table-bc");
+    let r = run(&m, &t, &p, &probe());
+    let d = approach_directions();
+    let mut tilted = false;
+    for (i, pose) in r.poses.iter().enumerate() {
+        let rot = pose.frame.tool_rotation.matrix();
+        tilted |= (pose.frame.tool_axis() - Vector3::z()).norm() > 0.5;
+        let phi = AZIMUTH_CYCLE_DEG[i % 4].to_radians();
+        assert_eq!(pose.turn.azimuth_rad, phi);
+        for (hit, dk) in pose.hits.iter().zip(&d) {
+            // In the probe's frame the approach is the pattern's turned by φ₀ about z.
+            let n = rot.transpose() * hit.approach;
+            let want = Vector3::new(
+                dk.x * phi.cos() - dk.y * phi.sin(),
+                dk.x * phi.sin() + dk.y * phi.cos(),
+                dk.z,
+            );
+            assert!((n - want).norm() < 1e-14, "pose {i}: {n:?} vs {want:?}");
+            // The point hit (−n) is on the spindle's half of the sphere.
+            assert!(
+                simulation::probe::below_equator(&-hit.approach, &pose.frame.tool_axis()).is_none()
+            );
+        }
+    }
+    assert!(tilted, "no pose of the case tilts the probe");
+}
+
+#[test]
+fn on_table_table_machines_the_fixed_pattern_is_the_bed_frame_pattern_bit_for_bit() {
+    // The tool does not turn: with the azimuth fixed every pose gets the bed-frame directions
+    // bit for bit; cycled, the first pose of every four does, the others are turned about z.
+    for name in ["seed-ac", "table-table-bc"] {
+        let (m, t, p) = case(name);
+        let fixed = run(
+            &m,
+            &t,
+            &p,
+            &ProbeSettings {
+                azimuth: PatternAzimuth::Fixed,
+                ..probe()
+            },
+        );
+        let cycled = run(&m, &t, &p, &probe());
+        let bed = approach_directions();
+        for (i, (f, c)) in fixed.poses.iter().zip(&cycled.poses).enumerate() {
+            assert_eq!(
+                f.frame.tool_rotation.matrix(),
+                &nalgebra::Matrix3::identity()
+            );
+            for (k, (hf, hc)) in f.hits.iter().zip(&c.hits).enumerate() {
+                assert_eq!(hf.approach, bed[k], "{name}: pose {i}, hit {k}");
+                if i % 4 == 0 {
+                    assert_eq!(hc, hf, "{name}: pose {i}, hit {k}");
+                } else if k < 8 {
+                    assert_ne!(hc.approach, bed[k], "{name}: pose {i}, hit {k}");
+                }
+            }
+        }
+    }
 }
 
 #[test]

@@ -4,8 +4,8 @@
 //! files.
 
 use formats::time::Timestamp;
-use report::json::IdentificationReport;
 use report::json::identify::ParameterReport;
+use report::json::{IdentificationReport, ValidationReport};
 use serde::Serialize;
 
 /// The longest machine id, test-path label, or text field of a check, in characters.
@@ -118,6 +118,10 @@ pub struct Check {
     pub rtest_version: String,
     /// One record or a campaign.
     pub kind: CheckKind,
+    /// A re-check (`rtest validate --refit NAMES --record`): a few poses measured again
+    /// refitted the named machine parameters (the pivot) and the records' new set-ups (the
+    /// preset), every other value held at a calibration's. Re-checks make their own series.
+    pub recheck: bool,
     /// Every input file, with its digest.
     pub inputs: Vec<InputFile>,
     /// Every parameter, in report order.
@@ -146,6 +150,29 @@ pub struct Check {
     pub refinement: String,
     /// The noise model the uncertainties assume, for people; `None` if the report had none.
     pub noise_model: Option<String>,
+}
+
+/// What a re-check's check takes from the calibration it re-checked: its machine description's
+/// fingerprint, its model's label, base model and terms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecheckedCalibration {
+    /// The machine description's fingerprint.
+    pub fingerprint: String,
+    /// The model's label.
+    pub model: String,
+    /// The base model, when the model extends one.
+    pub base_model: Option<String>,
+    /// The model's terms.
+    pub terms: Vec<String>,
+}
+
+/// `(effect, basis)` of a parameter's name (`ECC@harmonic:2:cos` → `ECC`, `harmonic:2:cos`;
+/// `XOB` → `XOB`, `const`).
+fn split_name(name: &str) -> (String, String) {
+    match name.split_once('@') {
+        Some((e, b)) => (e.to_string(), b.to_string()),
+        None => (name.to_string(), "const".to_string()),
+    }
 }
 
 /// What a check says besides its identification report.
@@ -222,6 +249,7 @@ impl Check {
             } else {
                 CheckKind::Record
             },
+            recheck: false,
             inputs: p.inputs,
             parameters: report
                 .parameters
@@ -247,6 +275,113 @@ impl Check {
             refinement: report.refinement.method.clone(),
             noise_model: report.noise_model.as_ref().map(|n| n.text.clone()),
         }
+    }
+
+    /// The check of a re-check ([`CheckKind::Recheck`]): the validation report `v` with its
+    /// `recheck` part, of the calibration `calibration` (its model's label and terms). Its
+    /// parameters are the pivot (owner `shared`) and every record's refits (the preset: owner
+    /// `setup`; a zero: owner `record`); the held values are not the re-check's and are not
+    /// stored. Its constraint says what was refitted (`recheck: XOB, ZOB`), so that only
+    /// re-checks of the same parameters make a series. `None` when `v` is no re-check.
+    pub fn from_recheck(
+        v: &ValidationReport,
+        calibration: &RecheckedCalibration,
+        p: Provenance,
+    ) -> Option<Check> {
+        let c = v.recheck.as_ref()?;
+        let paths = if p.paths.is_empty() {
+            v.records.iter().map(|r| r.label.clone()).collect()
+        } else {
+            p.paths
+        };
+        let mut parameters: Vec<Parameter> = c
+            .pivot
+            .iter()
+            .map(|q| {
+                let (error, basis) = split_name(&q.name);
+                Parameter {
+                    name: q.name.clone(),
+                    error,
+                    basis,
+                    owner: Some("shared".into()),
+                    of: None,
+                    value: q.value,
+                    std: q.std,
+                    unit: q.unit.clone(),
+                    determined: q.value.is_some(),
+                    fixed: false,
+                }
+            })
+            .collect();
+        for r in &v.records {
+            for q in &r.refitted {
+                let base = q.name.split('[').next().unwrap_or(&q.name);
+                let (error, basis) = split_name(base);
+                let setup = matches!(error.as_str(), "XOW" | "YOW" | "ZOW" | "Xw" | "Yw" | "Zw");
+                parameters.push(Parameter {
+                    name: q.name.clone(),
+                    error,
+                    basis,
+                    owner: Some(if setup { "setup" } else { "record" }.into()),
+                    of: Some(if setup {
+                        r.setup.clone()
+                    } else {
+                        r.label.clone()
+                    }),
+                    value: q.value,
+                    std: q.std,
+                    unit: q.unit.clone(),
+                    determined: q.value.is_some(),
+                    fixed: false,
+                });
+            }
+        }
+        let free = parameters.len();
+        let rank = parameters.iter().filter(|q| q.determined).count();
+        let unidentifiable: Vec<Vec<String>> = parameters
+            .iter()
+            .filter(|q| !q.determined)
+            .map(|q| vec![q.name.clone()])
+            .collect();
+        Some(Check {
+            machine_id: p.machine_id,
+            fingerprint: calibration.fingerprint.clone(),
+            machine: v.machine.clone(),
+            model: calibration.model.clone(),
+            base_model: calibration.base_model.clone(),
+            terms: calibration.terms.clone(),
+            paths,
+            measured_at: p.measured_at,
+            recorded_at: p.recorded_at,
+            rtest_version: p.rtest_version,
+            kind: if v.records.len() == 1 {
+                CheckKind::Record
+            } else {
+                CheckKind::Campaign
+            },
+            recheck: true,
+            inputs: p.inputs,
+            parameters,
+            rank,
+            free_parameters: free,
+            condition: None,
+            unidentifiable,
+            residual_rms_um: v.overall.residual_rms_um,
+            sigma_um: c.sigma_um,
+            samples: v.samples,
+            dof: c.dof,
+            zeroed: v.records.iter().any(|r| r.zeroed),
+            constraint: format!(
+                "recheck: {}",
+                c.pivot
+                    .iter()
+                    .map(|q| q.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            refinement: v.prediction.clone(),
+            noise_model: Some(c.scale_text()),
+        })
     }
 
     /// The parameter called `name` ([`same_name`]), if the check has it.

@@ -34,7 +34,7 @@ pub mod store;
 pub mod tolerance;
 pub mod trend;
 
-pub use check::{Check, CheckKind, InputFile, Parameter, Provenance};
+pub use check::{Check, CheckKind, InputFile, Parameter, Provenance, RecheckedCalibration};
 pub use error::HistoryError;
 pub use formats::time::Timestamp;
 pub use store::{DEFAULT_FILE, MachineSummary, RecordedCheck, Staged, Store};

@@ -10,7 +10,8 @@
 //! `check_inputs`, `parameters` and `unidentifiable` (one row per name of a group the data
 //! could not separate). Version 2 adds `checks.measured_at`, the time of the measurement beside
 //! the time it was recorded (filled with `recorded_at` in older checks), and an index on
-//! `(machine_id, measured_at)`.
+//! `(machine_id, measured_at)`. Version 3 adds `checks.recheck` (1 for a re-check: a few poses
+//! refitting the pivot and the preset with everything else held; 0 for every older check).
 
 /// `PRAGMA application_id` of an rtest history database: `rtst` in ASCII.
 pub const APPLICATION_ID: i32 = 0x7274_7374;
@@ -95,8 +96,15 @@ UPDATE checks SET measured_at = recorded_at;
 CREATE INDEX checks_by_time ON checks(machine_id, measured_at, id);
 ";
 
+/// Version 2 to 3: re-checks (`checks.recheck`, 1 for a re-check, 0 for every older check).
+/// `kind` keeps saying one record or several: a CHECK constraint of version 1 cannot change
+/// without rebuilding the table, which its children's foreign keys forbid inside a migration.
+pub const MIGRATION_3: &str = "
+ALTER TABLE checks ADD COLUMN recheck INTEGER NOT NULL DEFAULT 0 CHECK (recheck IN (0, 1));
+";
+
 /// The migrations, in order: `MIGRATIONS[k]` takes version `k` to `k + 1`.
-pub const MIGRATIONS: [&str; 2] = [SCHEMA_1, MIGRATION_2];
+pub const MIGRATIONS: [&str; 3] = [SCHEMA_1, MIGRATION_2, MIGRATION_3];
 
 /// The tables of the current version (a database at [`VERSION`] has exactly these).
 pub const TABLES: [&str; 6] = [

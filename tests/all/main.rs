@@ -29,6 +29,7 @@ mod cli_path_probe;
 mod cli_plan;
 mod cli_plan_probe;
 mod cli_probe;
+mod cli_recheck;
 mod cli_progress;
 mod cli_report;
 mod cli_report_inputs;

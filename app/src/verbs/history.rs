@@ -20,7 +20,8 @@ Without --machine-id: every machine id with its checks (id, measurement time, mo
 residual RMS in µm, rank). With --machine-id ID: that machine's checks and the errors it can \
 show. With --error NAME as well: that error's trend over the machine's comparable checks (same \
 machine description, model, test paths and constraint; the others are listed as left out, with \
-why) as a table with the flags of every check:
+why) as a table with the flags of every check; the calibrations' series, or with --rechecks the \
+re-checks' (rtest validate --refit --record):
 
 - tolerance: |value| > limit (µm or µrad; --tolerance NAME=LIMIT or --tolerances FILE);
 - baseline: the value changed against the baseline check (--baseline CHECK, default the first \
@@ -55,6 +56,10 @@ pub struct HistoryArgs {
     /// The baseline: a check id of the series (default: its first check).
     #[arg(long, value_name = "CHECK", requires = "error")]
     baseline: Option<i64>,
+    /// Trend the re-checks (rtest validate --refit --record: pivot and preset), a series of
+    /// their own, instead of the calibrations.
+    #[arg(long, requires = "error")]
+    rechecks: bool,
     /// Two-sided level of the change and trend tests (1e-6 to 0.2).
     #[arg(long, value_name = "ALPHA", default_value_t = trend::DEFAULT_ALPHA, requires = "error")]
     alpha: f64,
@@ -199,7 +204,8 @@ fn trend_outputs(
             }
         })?;
     }
-    let series = trend::select(all, id, error, args.baseline).map_err(trend_error)?;
+    let series =
+        trend::select(all, id, error, args.baseline, args.rechecks).map_err(trend_error)?;
     let (limit, from) = match &tolerances {
         Some((_, t)) => tolerance_of(t, &series.head.parameter),
         None => (None, None),

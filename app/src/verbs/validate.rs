@@ -3,45 +3,47 @@
 
 use super::args::{self, RecordLimits, ValueBounds};
 use super::campaign;
-use super::{EXIT_CODES, Error, VerbResult, check_outputs};
+use super::{EXIT_CODES, Error, ReadFile, VerbResult, check_outputs};
 use crate::Done;
 use fitting::validate;
 use fitting::validate::Extent;
 use fitting::validate::Unidentified;
 use fitting::{ValidateError, ValidateOptions};
 use formats::tolerance::{MAX_TOLERANCE_BYTES, TestTolerances};
+use history::{Check, RecheckedCalibration};
 use model_spec::units::UM_PER_MM;
 use output::{Outputs, Target};
 use report::json::read::{IdentifiedValues, MAX_REPORT_BYTES, ReportError, parse_identification};
+use report::json::recheck::RecheckReport;
 use report::json::tolerance::{JudgeError, NoiseReport, RecordExtents, ToleranceReport};
 use report::json::{ValidationReport, ValidationSource, to_json};
 use report::text::validate::validation;
 use std::path::{Path, PathBuf};
 
 const LONG_ABOUT: &str = "\
-Checks identified values on other measurements: the model and values of an `rtest identify` \
-JSON (--params: one record or a campaign of several) predict the readings of measurement CSVs \
-(--data FILE[,FILE...]: axes in mm and degrees, dx_um,dy_um,dz_um in µm; or the records of \
---campaign FILE), each record on its set-up, and the residual (measured minus predicted) is \
-reported per record, per direction x, y, z of the tool frame and overall: RMS and maximum in µm, \
-before (the nominal machine: prediction 0) and after (the identified model).
+Checks identified values on other measurements: the values of an `rtest identify` JSON \
+(--params) predict the readings of measurement CSVs (--data FILE[,FILE...], or --campaign FILE), \
+each record on its set-up; the residual (measured minus predicted) is reported per record, per \
+direction x, y, z of the tool frame and overall: RMS and max in µm, before (the nominal machine) \
+and after (the identified model).
 
-The values must belong to the machine (its name and fingerprint, base model and parameters; \
-values within --max-error-um / --max-error-urad). The prediction is the exact virtual machine at \
-the identified values; --first-order predicts with H·v (about 1e-3 µm apart for errors of tens \
-of µm and µrad).
+The values must belong to the machine (name, fingerprint, model; within --max-error-um / \
+--max-error-urad). The prediction is the exact machine at the values (--first-order: H·v).
 
-A record on a set-up the identification fitted uses that set-up's XOW YOW ZOW; on a new set-up \
-they are refitted on the record, everything else held. The --data records are on the \
-identification's set-up when it fitted one at their kinematic parameters, else each on its own \
-(--setup LABEL chooses). With --zeroed each record's zero dx0 dy0 dz0 is refitted on it. \
-Parameters the identification could not determine (value null) are set to 0 and named; \
---refuse-undetermined makes that an error instead.
+A record on a set-up the identification fitted uses its XOW YOW ZOW; on a new set-up they are \
+refitted on the record, everything else held (--setup LABEL chooses; default the fitted set-up \
+at the records' kinematic parameters). --zeroed refits each record's zero dx0 dy0 dz0. Values \
+the identification did not determine are set to 0 and named (--refuse-undetermined: an error).
 
---tolerance FILE: verdicts per test and direction, before and after, by ISO 14253-1 (pass, \
-fail, undecided; exit code 0 whatever they are): docs/tolerances.md.
+--tolerance FILE: verdicts per test and direction by ISO 14253-1 (docs/tolerances.md).
 
---json FILE (`-`: standard output) writes the report. Details: docs/campaigns.md §6 (set-ups), \
+A re-check (--refit XOB,ZOB: one sphere at a few poses after a head change, as a controller's \
+preset cycle) refits the named machine parameters (the pivot) over every record with each new \
+set-up (the preset), the rest held; a change beyond --max-change-um/-urad is refused; \
+--params-out FILE writes the calibration with the re-checked values (for compensate); --record \
+puts the re-check into the history as its own series (docs/probe.md).
+
+--json FILE (`-`: standard output) writes the report. Details: docs/campaigns.md §6, \
 docs/identification.md §9, §11, §16.";
 
 /// Flags of `rtest validate`.
@@ -118,14 +120,33 @@ pub struct ValidateArgs {
     instrument: super::args::InstrumentArgs,
     #[command(flatten)]
     probe: super::probe_records::ProbeArgs,
+    /// A re-check (as a controller's preset cycle, e.g. one sphere at a few poses after a head
+    /// change): refit these machine parameters (the pivot, e.g. XOB,ZOB) over every record,
+    /// with each record's new set-up (the preset) and zero, every other value held.
+    #[arg(long, value_name = "NAME[,NAME...]")]
+    refit: Option<String>,
+    /// With --refit: write the calibration's identification with the re-checked values in
+    /// place (what `rtest compensate --params` takes) to FILE.
+    #[arg(long, value_name = "FILE", requires = "refit")]
+    params_out: Option<Target>,
+    /// With --refit: refuse a re-check that moves a translational parameter by more than this,
+    /// µm (a controller's maxModification).
+    #[arg(long, value_name = "UM", default_value_t = 50.0, requires = "refit")]
+    max_change_um: f64,
+    /// With --refit: refuse a re-check that moves an angular parameter by more than this, µrad.
+    #[arg(long, value_name = "URAD", default_value_t = 200.0, requires = "refit")]
+    max_change_urad: f64,
     #[command(flatten)]
     bounds: ValueBounds,
+    #[command(flatten)]
+    history: super::record::RecordArgs,
 }
 
 /// Runs `rtest validate`: the identification's values (of one record or several) predict
 /// the records of `--data` or `--campaign`, each on its set-up.
 pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
-    let m = super::load_machine(&args.machine)?;
+    let machine = super::load_machine_read(&args.machine)?;
+    let m = machine.machine;
     let files = match &args.data {
         Some(list) => args::files("--data", list)?,
         None => Vec::new(),
@@ -147,8 +168,18 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
             .iter()
             .map(|f| ("--noise-record", f.as_path())),
     );
-    let outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
+    let mut outputs: Vec<(&str, &Target)> = args.json.iter().map(|t| ("--json", t)).collect();
+    outputs.extend(args.params_out.iter().map(|t| ("--params-out", t)));
+    let db = args.history.input();
+    inputs.extend(db.as_ref().map(|(f, p)| (*f, p.as_path())));
     check_outputs(&inputs, &outputs, &[])?;
+    let pivot = refit_names(args)?;
+    if args.history.record && pivot.is_none() {
+        return Err(Error::usage(
+            "--record records a re-check (--refit NAMES); a validation changes no value of the machine: record the identification (rtest identify --record)",
+        ));
+    }
+    let mut recorder = args.history.recorder()?;
     let tolerances = args.tolerance.as_deref().map(read_tolerances).transpose()?;
     let noise_um = match args.noise_um {
         Some(s) if s.is_finite() && s >= 0.0 => Some(s),
@@ -161,13 +192,22 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
     };
     let (id, params_text) =
         read_params(&args.params, &m).map_err(|e| Error::input(format!("--params: {e}")))?;
+    let params_read = ReadFile::new(
+        "--params",
+        &args.params,
+        model_spec::sha256::Digest::of(params_text.as_bytes()),
+    );
     let values = &id.values;
+    if let Some(names) = &pivot {
+        fitting::campaign::recheck::pivot_columns(&m, values, names)
+            .map_err(|e| Error::usage(format!("--refit: {e} ({})", args.params.display())))?;
+    }
     campaign::check_campaign_values(&m, &values.layout, &values.values, &args.bounds.values())
         .map_err(|e| implausible(args, &e))?;
     let read = args.records.read_options();
     let shown = super::progress::wanted(matches!(args.json, Some(Target::Stdout)));
-    let instrument = args.instrument.load()?;
-    let (probe, _) = args.probe.load_read()?;
+    let (instrument, instrument_read) = args.instrument.load_read()?;
+    let (probe, probe_read) = args.probe.load_read()?;
     let through = campaign::Through::of(&instrument, &probe);
     let campaign_file = match &args.campaign {
         Some(path) => Some(campaign::read_file("--campaign", &m, path)?),
@@ -196,6 +236,8 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
                     .map_err(|e| Error::usage(e.to_string()))?;
                 Some(setup.clone())
             }
+            // A re-check's records are on new set-ups (the preset is refitted).
+            None if pivot.is_some() => None,
             None => fitted_setup(values, &loaded.campaign),
         };
         if let Some(setup) = setup {
@@ -231,9 +273,24 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
     if args.refuse_undetermined {
         opts.unidentified = Unidentified::Refuse;
     }
-    let v = {
+    let (v, recheck) = {
         let bar = super::progress::counting(shown);
-        validate(&m, values, &loaded.campaign, &opts, &bar).map_err(|e| validate_error(args, e))?
+        match &pivot {
+            Some(names) => {
+                let r =
+                    fitting::campaign::recheck(&m, values, &loaded.campaign, names, &opts, &bar)
+                        .map_err(|e| validate_error(args, e))?;
+                let report = RecheckReport::new(&m, names, &r)
+                    .map_err(|e| Error::computation(format!("--refit: {e}")))?;
+                check_changes(args, &report)?;
+                (r.validation, Some(report))
+            }
+            None => (
+                validate(&m, values, &loaded.campaign, &opts, &bar)
+                    .map_err(|e| validate_error(args, e))?,
+                None,
+            ),
+        }
     };
     let params_file = args.params.display().to_string();
     let kinematics: Vec<Vec<f64>> = loaded
@@ -251,6 +308,7 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
     };
     let mut report = ValidationReport::new(&m, source, &v)
         .map_err(|e| Error::computation(format!("{flag}: {e}")))?;
+    report.recheck = recheck;
     if let (Some(t), Some(noise)) = (&tolerances, noise) {
         let extents = extents(&loaded.campaign, &v)?;
         report.tolerance = Some(ToleranceReport::new(t, &report, &extents, noise).map_err(
@@ -271,11 +329,95 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
         let json = to_json(&report).map_err(|e| Error::computation(format!("--json: {e}")))?;
         files.add("--json", target.clone(), json);
     }
-    Ok(Done::new(
-        text,
-        files,
-        matches!(args.json, Some(Target::Stdout)),
-    ))
+    if let (Some(target), Some(c)) = (&args.params_out, &report.recheck) {
+        let file = args.params.display().to_string();
+        let updated =
+            report::json::recheck::updated_identification(&file, &params_text, c, &loaded.files)
+                .map_err(|e| Error::input(format!("--params: {e}")))?;
+        files.add("--params-out", target.clone(), updated);
+    }
+    let stdout_taken = [&args.json, &args.params_out]
+        .iter()
+        .any(|t| matches!(t, Some(Target::Stdout)));
+    let done = Done::new(text, files, stdout_taken);
+    let Some(mut r) = recorder.take() else {
+        return Ok(done);
+    };
+    r.add_read(&loaded.read);
+    r.add_read(&[params_read]);
+    r.add_read(
+        &instrument_read
+            .into_iter()
+            .chain(probe_read)
+            .collect::<Vec<_>>(),
+    );
+    r.add_read(
+        &ReadFile::machine(&args.machine, machine.digest)
+            .into_iter()
+            .collect::<Vec<_>>(),
+    );
+    let calibration = RecheckedCalibration {
+        fingerprint: id.fingerprint.clone(),
+        model: id.model_name.clone(),
+        base_model: serde_json::from_str::<serde_json::Value>(&params_text)
+            .ok()
+            .and_then(|j| j.get("base_model")?.as_str().map(str::to_string)),
+        terms: values.model.terms.iter().map(|t| t.spelling(&m)).collect(),
+    };
+    let check = Check::from_recheck(&report, &calibration, r.provenance())
+        .ok_or_else(|| Error::computation("--record: the re-check has no report"))?;
+    Ok(done.recording(r, check))
+}
+
+/// The names of `--refit` (a re-check), or `None` (a validation).
+///
+/// # Errors
+/// A usage error for an empty name or list.
+fn refit_names(args: &ValidateArgs) -> VerbResult<Option<Vec<String>>> {
+    let Some(list) = &args.refit else {
+        return Ok(None);
+    };
+    let names: Vec<String> = list.split(',').map(|n| n.trim().to_string()).collect();
+    if names.iter().any(String::is_empty) {
+        return Err(Error::usage(format!(
+            "--refit `{list}`: give machine parameters separated by commas (XOB,ZOB)"
+        )));
+    }
+    for (limit, flag) in [
+        (args.max_change_um, "--max-change-um"),
+        (args.max_change_urad, "--max-change-urad"),
+    ] {
+        if !(limit.is_finite() && limit > 0.0) {
+            return Err(Error::usage(format!(
+                "{flag}: {limit} is not a limit (a finite number above 0)"
+            )));
+        }
+    }
+    Ok(Some(names))
+}
+
+/// Refuses a re-check whose pivot moved beyond `--max-change-um` / `--max-change-urad`: a
+/// change that large is a crash or a wrong set-up, not what a re-check corrects.
+fn check_changes(args: &ValidateArgs, r: &RecheckReport) -> VerbResult<()> {
+    for p in &r.pivot {
+        let (limit, flag) = if p.unit == "urad" {
+            (args.max_change_urad, "--max-change-urad")
+        } else {
+            (args.max_change_um, "--max-change-um")
+        };
+        if let Some(d) = p.change
+            && d.abs() > limit
+        {
+            return Err(Error::computation(format!(
+                "--refit: the re-check moves {} by {} {} from the calibration's value, beyond {flag} {}: a change that large is a crash, a wrong set-up or another head, not what a re-check corrects; calibrate again (or raise {flag} if it is real)",
+                p.name,
+                model_spec::units::significant(d),
+                model_spec::units::symbol(&p.unit),
+                model_spec::units::significant(limit)
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The set-up of `--data` records without `--setup`: the identification's, when it fitted one

@@ -22,7 +22,8 @@
 //! generalized least squares) and, when asked, refines the fit against the exact machine (each
 //! record with its own parameters and set-up values, [`refine`]), and
 //! [`validate::validate()`] predicts other records, refitting the set-up errors of a
-//! set-up that was not fitted (and a record's own zero) with the machine's errors held.
+//! set-up that was not fitted (and a record's own zero) with the machine's errors held;
+//! [`recheck()`] also refits named machine parameters (a re-check's pivot) over its records.
 //! [`names`] lets a constraint of a campaign of one record use the record's own names.
 //! `docs/campaigns.md` describes the campaign file and a worked campaign.
 //!
@@ -35,11 +36,13 @@ pub mod clock;
 pub mod design;
 pub mod fit;
 pub mod names;
+pub mod recheck;
 pub mod refine;
 pub mod validate;
 
 pub use design::{Column, Design, Layout, Owner, RecordColumns, RecordSpec, design_matrix};
 pub use fit::{CampaignIdentification, RecordFit, choose_campaign_noise, fit_design, identify};
+pub use recheck::{PivotRefit, Recheck, RecheckScale, recheck};
 pub use refine::{exact_campaign_prediction, refine_campaign};
 pub use validate::{
     CampaignValidation, CampaignValues, RecordPlan, RecordValidation, Refitted, record_plan,

@@ -45,7 +45,7 @@ use crate::validate::{
 };
 use formats::progress::Progress;
 use model_spec::Machine;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::model::{Model, Term};
 
@@ -264,28 +264,41 @@ pub fn record_plan(
     })
 }
 
-/// Validates `values` on one record `r` (see the module documentation).
+/// A validation record made ready for its refit: its plan, its columns' values from the
+/// identification (mm, rad: the refitted ones 0 until refitted), its H matrix and readings,
+/// and its samples' whitening when read through an instrument.
+pub(crate) struct Prepared<'a> {
+    /// The record.
+    pub r: &'a CampaignRecord,
+    /// Its plan.
+    pub plan: RecordPlan,
+    /// Per column its value (mm, rad).
+    pub v: Vec<f64>,
+    /// The identification's parameters without a value (set to 0), as its report names them.
+    pub defaulted: Vec<String>,
+    /// The record's H matrix (mm per unit of each column).
+    pub h: DMatrix<f64>,
+    /// Its readings (mm).
+    pub y: DVector<f64>,
+    /// The per-sample whitening of readings through an instrument.
+    pub weights: Option<SampleWhitening>,
+}
+
+/// Record `r` made ready under `values` (see [`Prepared`]).
 ///
 /// # Errors
 /// As [`record_plan`]; readings missing; parameters without a value under
-/// [`Unidentified::Refuse`]; a refit or an exact prediction that fails.
-pub fn validate_record(
+/// [`Unidentified::Refuse`].
+pub(crate) fn prepare<'a>(
     m: &Machine,
     values: &CampaignValues,
-    r: &CampaignRecord,
+    r: &'a CampaignRecord,
     opts: &ValidateOptions,
-) -> Result<RecordValidation, ValidateError> {
+) -> Result<Prepared<'a>, ValidateError> {
     let layout = &values.layout;
-    let RecordPlan {
-        model,
-        sources,
-        names,
-        setup,
-        fitted,
-        clock,
-    } = record_plan(m, values, r)?;
+    let plan = record_plan(m, values, r)?;
     let mut defaulted = Vec::new();
-    let mut v = vec![0.0; sources.len()];
+    let mut v = vec![0.0; plan.sources.len()];
     let nominal = layout.nominal_mm();
     // The identification's columns named as its report names them: a record's as a single fit
     // does (`XOW`), a campaign's with their owners (`XOW[k4]`).
@@ -297,7 +310,7 @@ pub fn validate_record(
             col.name.clone()
         }
     };
-    for (k, s) in sources.iter().enumerate() {
+    for (k, s) in plan.sources.iter().enumerate() {
         if let Some(c) = s {
             match values.values[*c] {
                 Some(x) => v[k] = x,
@@ -314,9 +327,6 @@ pub fn validate_record(
     if !defaulted.is_empty() && opts.unidentified == Unidentified::Refuse {
         return Err(ValidateError::Unidentified(defaulted));
     }
-    let refit: Vec<usize> = (0..sources.len())
-        .filter(|&k| sources[k].is_none())
-        .collect();
     let rec = &r.record;
     if rec.samples.is_empty() {
         return Err(ValidateError::Shape(format!(
@@ -325,84 +335,192 @@ pub fn validate_record(
         )));
     }
     let y = measurement_vector(rec)?;
-    let mut source = GainSource::new(m, &model.errors(), &r.params)?;
-    let h = block(m, &model, rec, &mut source, clock).map_err(ValidateError::Measurements)?;
-    // The prediction with every value at `x` (mm, one per reading).
-    let predict = |x: &[f64]| -> Result<DVector<f64>, IdentifyError> {
-        if !opts.exact {
-            return Ok(&h * DVector::from_column_slice(x));
+    let mut source = GainSource::new(m, &plan.model.errors(), &r.params)?;
+    let h =
+        block(m, &plan.model, rec, &mut source, plan.clock).map_err(ValidateError::Measurements)?;
+    // Readings through an instrument carry their covariances: a refit weights by them, as the
+    // identification does.
+    let weights = SampleWhitening::of(rec)
+        .map_err(|e| ValidateError::Shape(format!("record `{}`: {e}", r.label)))?;
+    Ok(Prepared {
+        r,
+        plan,
+        v,
+        defaulted,
+        h,
+        y,
+        weights,
+    })
+}
+
+impl Prepared<'_> {
+    /// The record's readings predicted with every column at `x` (mm, rad; one per reading):
+    /// the exact machine's, or `H·x` when `exact` is false.
+    ///
+    /// # Errors
+    /// An exact prediction that fails.
+    pub(crate) fn predict(
+        &self,
+        m: &Machine,
+        x: &[f64],
+        exact: bool,
+    ) -> Result<DVector<f64>, IdentifyError> {
+        if !exact {
+            return Ok(&self.h * DVector::from_column_slice(x));
         }
-        let p = match clock {
+        let (rec, model) = (&self.r.record, &self.plan.model);
+        let p = match self.plan.clock {
             Some((span, start)) => {
-                let (own, coef) = own_clock_terms(&model, x, rec, start, span);
+                let (own, coef) = own_clock_terms(model, x, rec, start, span);
                 let c: Vec<Option<f64>> = coef.into_iter().map(Some).collect();
-                exact_prediction(m, &own, &c, rec, &r.params)?
+                exact_prediction(m, &own, &c, rec, &self.r.params)?
             }
             None => {
                 let c: Vec<Option<f64>> = x.iter().copied().map(Some).collect();
-                exact_prediction(m, &model, &c, rec, &r.params)?
+                exact_prediction(m, model, &c, rec, &self.r.params)?
             }
         };
         Ok(DVector::from_iterator(
-            y.len(),
+            self.y.len(),
             p.iter().flat_map(|q| q.iter().copied()),
         ))
-    };
-    let failed = |e: IdentifyError| ValidateError::Shape(format!("record `{}`: {e}", r.label));
+    }
+
+    /// A failure of this record's refit or prediction, naming the record.
+    pub(crate) fn failed(&self, e: IdentifyError) -> ValidateError {
+        ValidateError::Shape(format!("record `{}`: {e}", self.r.label))
+    }
+
+    /// The largest coordinate of the record's parameters and commands (mm, at least 1): the
+    /// scale of the exact prediction's rounding.
+    pub(crate) fn coordinates(&self) -> f64 {
+        self.r
+            .params
+            .iter()
+            .chain(self.r.record.samples.iter().flat_map(|s| s.commands.iter()))
+            .fold(1.0f64, |a, x| a.max(x.abs()))
+    }
+
+    /// The parameter `k` refitted to `value ± std`.
+    pub(crate) fn refitted(&self, k: usize, value: Option<f64>, std: Option<f64>) -> Refitted {
+        let (ti, c) = self.plan.model.columns()[k];
+        Refitted {
+            name: self.plan.names[k].clone(),
+            term: self.plan.model.terms[ti],
+            component: c,
+            value,
+            std,
+        }
+    }
+
+    /// The record's validation with every column at `v` (mm, rad) and the parameters
+    /// `refitted` on it.
+    ///
+    /// # Errors
+    /// An exact prediction that fails.
+    pub(crate) fn finish(
+        &self,
+        m: &Machine,
+        v: &[f64],
+        refitted: Vec<Refitted>,
+        exact: bool,
+    ) -> Result<RecordValidation, ValidateError> {
+        let p = self.predict(m, v, exact).map_err(|e| self.failed(e))?;
+        let prediction: Vec<[f64; 3]> = p
+            .as_slice()
+            .chunks_exact(3)
+            .map(|q| [q[0], q[1], q[2]])
+            .collect();
+        let measured: Vec<[f64; 3]> = self.r.record.measured.clone();
+        let residual = measured
+            .iter()
+            .zip(&prediction)
+            .map(|(a, b)| std::array::from_fn(|d| a[d] - b[d]))
+            .collect();
+        let (per_direction, overall) = statistics(&measured, &prediction);
+        Ok(RecordValidation {
+            label: self.r.label.clone(),
+            setup: self.r.setup.clone(),
+            setup_fitted: self.plan.setup.is_some(),
+            record_fitted: self.plan.fitted.is_some(),
+            zeroed: self.r.zeroed,
+            refitted,
+            validation: Validation {
+                samples: self.r.record.samples.len(),
+                prediction,
+                residual,
+                per_direction,
+                overall,
+                defaulted: self.defaulted.clone(),
+                zeroed: false,
+            },
+        })
+    }
+}
+
+/// Validates `values` on one record `r` (see the module documentation).
+///
+/// # Errors
+/// As [`record_plan`]; readings missing; parameters without a value under
+/// [`Unidentified::Refuse`]; a refit or an exact prediction that fails.
+pub fn validate_record(
+    m: &Machine,
+    values: &CampaignValues,
+    r: &CampaignRecord,
+    opts: &ValidateOptions,
+) -> Result<RecordValidation, ValidateError> {
+    let p = prepare(m, values, r, opts)?;
+    let mut v = p.v.clone();
+    let refit: Vec<usize> = (0..v.len())
+        .filter(|&k| p.plan.sources[k].is_none())
+        .collect();
     let mut refitted = Vec::new();
     if !refit.is_empty() {
+        let rec = &r.record;
         check_readings(rec.samples.len(), refit.len())?;
-        let h_r = h.select_columns(&refit);
-        let refit_names: Vec<String> = refit.iter().map(|&k| names[k].clone()).collect();
+        let h_r = p.h.select_columns(&refit);
+        let refit_names: Vec<String> = refit.iter().map(|&k| p.plan.names[k].clone()).collect();
         let tol = Tolerances::default();
-        // Readings through an instrument carry their covariances: the refit weights by them,
-        // as the identification does.
-        let weights = SampleWhitening::of(rec)
-            .map_err(|e| ValidateError::Shape(format!("record `{}`: {e}", r.label)))?;
+        let y = &p.y;
+        let held = p.predict(m, &v, opts.exact).map_err(|e| p.failed(e))?;
         let (first, _) = fit_rows(
             &h_r,
-            &(&y - predict(&v).map_err(failed)?),
+            &(y - held),
             &refit_names,
             &Constraint::None,
             &tol,
             None,
             &[rec.samples.len()],
-            weights.as_ref(),
+            p.weights.as_ref(),
         )?;
         let fit = if opts.exact {
-            let coordinates = r
-                .params
-                .iter()
-                .chain(rec.samples.iter().flat_map(|s| s.commands.iter()))
-                .fold(1.0f64, |a, x| a.max(x.abs()));
             let problem = GaussNewton {
                 h: &h_r,
-                y: &y,
+                y,
                 layout: &[rec.samples.len()],
                 tolerances: &tol,
                 noise: None,
-                coordinates,
-                weights: weights.as_ref(),
+                coordinates: p.coordinates(),
+                weights: p.weights.as_ref(),
                 factored: None,
             };
-            let start = first;
             let base = v.clone();
             let mut predict_refit = |xr: &[f64]| -> Result<DVector<f64>, IdentifyError> {
                 let mut x = base.clone();
                 for (i, &k) in refit.iter().enumerate() {
                     x[k] = xr[i];
                 }
-                predict(&x)
+                p.predict(m, &x, true)
             };
             let (fit, _, refinement) = gauss_newton(
                 &problem,
-                &start,
+                &first,
                 &RefineOptions::default(),
                 &mut predict_refit,
             )
-            .map_err(failed)?;
+            .map_err(|e| p.failed(e))?;
             if !refinement.converged {
-                return Err(failed(IdentifyError::NotConverged {
+                return Err(p.failed(IdentifyError::NotConverged {
                     iterations: refinement.iterations,
                     last_step_mm: refinement.steps_mm.last().copied().unwrap_or(0.0),
                     tolerance_mm: refinement.tolerance_mm,
@@ -414,44 +532,8 @@ pub fn validate_record(
         };
         for (i, &k) in refit.iter().enumerate() {
             v[k] = fit.solution[i];
-            let (ti, c) = model.columns()[k];
-            refitted.push(Refitted {
-                name: names[k].clone(),
-                term: model.terms[ti],
-                component: c,
-                value: fit.values[i],
-                std: fit.std[i],
-            });
+            refitted.push(p.refitted(k, fit.values[i], fit.std[i]));
         }
     }
-    let p = predict(&v).map_err(failed)?;
-    let prediction: Vec<[f64; 3]> = p
-        .as_slice()
-        .chunks_exact(3)
-        .map(|q| [q[0], q[1], q[2]])
-        .collect();
-    let measured: Vec<[f64; 3]> = rec.measured.clone();
-    let residual = measured
-        .iter()
-        .zip(&prediction)
-        .map(|(a, b)| std::array::from_fn(|d| a[d] - b[d]))
-        .collect();
-    let (per_direction, overall) = statistics(&measured, &prediction);
-    Ok(RecordValidation {
-        label: r.label.clone(),
-        setup: r.setup.clone(),
-        setup_fitted: setup.is_some(),
-        record_fitted: fitted.is_some(),
-        zeroed: r.zeroed,
-        refitted,
-        validation: Validation {
-            samples: rec.samples.len(),
-            prediction,
-            residual,
-            per_direction,
-            overall,
-            defaulted,
-            zeroed: false,
-        },
-    })
+    p.finish(m, &v, refitted, opts.exact)
 }

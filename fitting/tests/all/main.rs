@@ -23,6 +23,7 @@ mod probe_campaign;
 mod probe_readings;
 mod probe_simulation;
 mod probe_vs_rtest;
+mod recheck;
 mod sphere;
 mod streaming;
 mod templates;

@@ -156,9 +156,9 @@ fn insert(tx: &Transaction<'_>, c: &Check) -> rusqlite::Result<i64> {
     tx.execute(
         "INSERT INTO checks (machine_id, fingerprint, machine, model, base_model, recorded_at,
              measured_at, rtest_version, kind, rank, free_parameters, condition, residual_rms_um,
-             sigma_um, samples, dof, zeroed, constraint_text, refinement, noise_model)
+             sigma_um, samples, dof, zeroed, constraint_text, refinement, noise_model, recheck)
          VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, ?18,
-                 ?19, ?20)",
+                 ?19, ?20, ?21)",
         params![
             c.machine_id,
             c.fingerprint,
@@ -180,6 +180,7 @@ fn insert(tx: &Transaction<'_>, c: &Check) -> rusqlite::Result<i64> {
             c.constraint,
             c.refinement,
             c.noise_model,
+            c.recheck,
         ],
     )?;
     let id = tx.last_insert_rowid();

@@ -58,7 +58,8 @@ impl Store {
                 "SELECT c.id, c.machine_id, c.fingerprint, c.machine, c.model, c.base_model,
                         c.recorded_at, c.measured_at, c.rtest_version, c.kind, c.rank,
                         c.free_parameters, c.condition, c.residual_rms_um, c.sigma_um, c.samples,
-                        c.dof, c.zeroed, c.constraint_text, c.refinement, c.noise_model
+                        c.dof, c.zeroed, c.constraint_text, c.refinement, c.noise_model,
+                        c.recheck
                  FROM checks c WHERE {filter} ORDER BY c.measured_at, c.id"
             ))
             .map_err(&sql)?;
@@ -243,6 +244,7 @@ fn check_row(r: &Row<'_>) -> rusqlite::Result<(i64, Check, String, String)> {
         } else {
             CheckKind::Record
         },
+        recheck: r.get(21)?,
         inputs: Vec::new(),
         parameters: Vec::new(),
         rank: usize_of(r.get(10)?),

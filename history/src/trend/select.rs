@@ -111,7 +111,9 @@ fn no_value(name: &str, p: &Parameter) -> Option<String> {
 
 /// The series of `parameter` for `machine_id` among `checks` (all checks of the database, or
 /// those of the machine), defined by the check `reference` when given, else by the latest
-/// check (by measurement time, then id) that determined it.
+/// check (by measurement time, then id) that determined it among the calibrations, or among
+/// the re-checks when `rechecks` ([`Check::recheck`]: a re-check and a calibration are
+/// never in one series).
 ///
 /// # Errors
 /// [`TrendError::EmptyHistory`], [`TrendError::UnknownMachine`] (with the known ids),
@@ -122,6 +124,7 @@ pub fn select(
     machine_id: &str,
     parameter: &str,
     reference: Option<i64>,
+    rechecks: bool,
 ) -> Result<Series, TrendError> {
     if checks.is_empty() {
         return Err(TrendError::EmptyHistory);
@@ -189,9 +192,10 @@ pub fn select(
             .iter()
             .rev()
             .find(|c| {
-                c.check
-                    .parameter(parameter)
-                    .is_some_and(|p| no_value(&p.name, p).is_none())
+                c.check.recheck == rechecks
+                    && c.check
+                        .parameter(parameter)
+                        .is_some_and(|p| no_value(&p.name, p).is_none())
             })
             .ok_or_else(|| TrendError::NeverDetermined {
                 machine_id: machine_id.to_string(),
@@ -207,7 +211,13 @@ pub fn select(
     let mut left_out = Vec::new();
     for c in &mine {
         let k = &c.check;
-        let reason = if k.fingerprint != r.fingerprint {
+        let reason = if k.recheck != r.recheck {
+            Some(if k.recheck {
+                "a re-check (its own series: rtest history --rechecks)".to_string()
+            } else {
+                "a calibration, not a re-check".to_string()
+            })
+        } else if k.fingerprint != r.fingerprint {
             Some(format!(
                 "another machine description (fingerprint {}, the series' is {})",
                 k.fingerprint, r.fingerprint

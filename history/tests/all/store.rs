@@ -86,7 +86,7 @@ fn a_new_database_is_versioned_and_in_wal_mode() {
         .pragma_query_value(None, "journal_mode", |r| r.get(0))
         .unwrap();
     assert_eq!((v, app, mode.as_str()), (VERSION, APPLICATION_ID, "wal"));
-    assert_eq!(VERSION, 2);
+    assert_eq!(VERSION, 3);
     drop(conn);
     // Opening a database that does not exist is an error naming it, and creates nothing.
     let missing = d.join("missing.sqlite");
@@ -146,9 +146,20 @@ fn a_version_1_file_is_migrated() {
     );
     assert_eq!(c.recorded_at, c.measured_at);
     assert_eq!(c.parameter("XOC").unwrap().value, Some(10.5));
-    // New checks go in beside the old one.
+    assert!(!c.recheck, "an older check is no re-check");
+    // New checks go in beside the old one, a re-check among them.
     store.record(&check("M123", 60, 11.0, 0.05)).unwrap();
-    assert_eq!(store.count().unwrap(), 2);
+    let mut recheck = check("M123", 61, 11.2, 0.2);
+    recheck.recheck = true;
+    store.record(&recheck).unwrap();
+    assert_eq!(store.count().unwrap(), 3);
+    let flags: Vec<bool> = store
+        .checks(None)
+        .unwrap()
+        .iter()
+        .map(|c| c.check.recheck)
+        .collect();
+    assert_eq!(flags, [false, false, true]);
     drop(store);
     let conn = Connection::open(&path).unwrap();
     let v: i32 = conn
@@ -157,7 +168,7 @@ fn a_version_1_file_is_migrated() {
     let mode: String = conn
         .pragma_query_value(None, "journal_mode", |r| r.get(0))
         .unwrap();
-    assert_eq!((v, mode.as_str()), (2, "wal"));
+    assert_eq!((v, mode.as_str()), (3, "wal"));
 }
 
 /// A database with `n` checks, closed; its bytes.

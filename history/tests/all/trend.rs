@@ -101,7 +101,7 @@ fn a_series_keeps_comparable_checks_and_says_why_it_leaves_the_others_out() {
     checks.push(recorded(9, same));
     checks.push(recorded(10, check("M123", 56, 10.8, 0.3)));
 
-    let s = select(&checks, "M123", "x0c", None).unwrap();
+    let s = select(&checks, "M123", "x0c", None, false).unwrap();
     assert_eq!(s.head.parameter, "XOC");
     assert_eq!(s.head.unit, "um");
     assert_eq!(s.reference, 10);
@@ -128,22 +128,22 @@ fn a_series_keeps_comparable_checks_and_says_why_it_leaves_the_others_out() {
         assert!(reason.contains(needle), "{id}: {reason}");
     }
     // A chosen baseline defines the series: check 4's model.
-    let s = select(&checks, "M123", "XOC", Some(4)).unwrap();
+    let s = select(&checks, "M123", "XOC", Some(4), false).unwrap();
     assert_eq!(s.points.iter().map(|p| p.id).collect::<Vec<_>>(), [4]);
     assert_eq!(s.head.model, "reduced + ECC@harmonic:2");
 
     // Errors, each with what is known.
-    match select(&checks, "M999", "XOC", None).unwrap_err() {
+    match select(&checks, "M999", "XOC", None, false).unwrap_err() {
         TrendError::UnknownMachine { known, .. } => assert_eq!(known, ["M123", "M124"]),
         e => panic!("{e}"),
     }
-    let e = select(&checks, "M123", "XOD", None).unwrap_err();
+    let e = select(&checks, "M123", "XOD", None, false).unwrap_err();
     assert_eq!(
         e.to_string(),
         "no check of machine `M123` identified `XOD` (its parameters: XOC, AOC)"
     );
     assert_eq!(
-        select(&[], "M123", "XOC", None).unwrap_err(),
+        select(&[], "M123", "XOC", None, false).unwrap_err(),
         TrendError::EmptyHistory
     );
     for (id, needle) in [
@@ -151,7 +151,7 @@ fn a_series_keeps_comparable_checks_and_says_why_it_leaves_the_others_out() {
         (7, "not determined"),
         (8, "no uncertainty"),
     ] {
-        let e = select(&checks, "M123", "XOC", Some(id))
+        let e = select(&checks, "M123", "XOC", Some(id), false)
             .unwrap_err()
             .to_string();
         assert!(
@@ -160,7 +160,7 @@ fn a_series_keeps_comparable_checks_and_says_why_it_leaves_the_others_out() {
         );
     }
     let only_undetermined = vec![recorded(7, checks[6].check.clone())];
-    let e = select(&only_undetermined, "M123", "XOC", None).unwrap_err();
+    let e = select(&only_undetermined, "M123", "XOC", None, false).unwrap_err();
     assert!(matches!(e, TrendError::NeverDetermined { .. }), "{e}");
 }
 
@@ -524,7 +524,7 @@ fn the_real_pipeline_flags_a_drifting_location_error() {
     let (_, crossing) = detectable();
     let (mut zs, mut firsts) = (Vec::new(), Vec::new());
     for s in 0..series_count {
-        let series = select(&all, &format!("S{s}"), "XOC", None).unwrap();
+        let series = select(&all, &format!("S{s}"), "XOC", None, false).unwrap();
         assert_eq!(series.points.len(), 20);
         assert!(series.left_out.is_empty());
         for (k, p) in series.points.iter().enumerate() {
@@ -580,5 +580,41 @@ fn the_csv_header_names_a_rate_unit_without_a_slash() {
     assert!(
         fraction.starts_with("check,measured_at,value,std,change,"),
         "{fraction}"
+    );
+}
+
+/// Re-checks make their own series: the calibrations' series leaves them out and says why, and
+/// `rechecks` trends them alone, the calibrations left out.
+#[test]
+fn rechecks_and_calibrations_are_two_series() {
+    let mut checks = Vec::new();
+    for (id, day, recheck) in [(1, 0, false), (2, 7, true), (3, 14, true), (4, 21, false)] {
+        let mut c = check("M123", day, 10.0 + id as f64 * 0.1, 0.3);
+        c.recheck = recheck;
+        checks.push(recorded(id, c));
+    }
+    let s = select(&checks, "M123", "XOC", None, false).unwrap();
+    assert_eq!(s.points.iter().map(|p| p.id).collect::<Vec<_>>(), [1, 4]);
+    assert_eq!(s.reference, 4);
+    assert!(
+        s.left_out
+            .iter()
+            .all(|l| l.reason.contains("a re-check (its own series")),
+        "{:?}",
+        s.left_out
+    );
+    let s = select(&checks, "M123", "XOC", None, true).unwrap();
+    assert_eq!(s.points.iter().map(|p| p.id).collect::<Vec<_>>(), [2, 3]);
+    assert_eq!(s.reference, 3);
+    assert_eq!(
+        s.left_out.iter().map(|l| l.id).collect::<Vec<_>>(),
+        [1, 4],
+        "{:?}",
+        s.left_out
+    );
+    assert!(
+        s.left_out[0]
+            .reason
+            .contains("a calibration, not a re-check")
     );
 }

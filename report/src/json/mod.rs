@@ -29,6 +29,7 @@ pub mod plan;
 pub mod plan_probe;
 pub mod probe;
 pub mod read;
+pub mod recheck;
 pub mod tolerance;
 pub mod validate;
 pub mod verdict;

@@ -25,6 +25,9 @@
 //! were fitted on it. `unidentified_set_to_zero` at the top lists every parameter some record's
 //! prediction set to 0.
 //!
+//! A re-check (`--refit NAMES`) adds `recheck` ([`super::recheck`]): the machine parameters
+//! refitted over every record, with every other value held.
+//!
 //! With `--tolerance FILE`, `tolerance` holds the verdict per test and direction, before and
 //! after, with the rule and the noise it assumed ([`super::tolerance`]); it is absent
 //! otherwise.
@@ -180,6 +183,10 @@ pub struct ValidationReport {
     /// The verdicts against a tolerance file (`--tolerance`); absent without one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tolerance: Option<ToleranceReport>,
+    /// The re-check (`--refit`): the machine parameters refitted over the records
+    /// ([`super::recheck`]); absent in a validation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recheck: Option<super::recheck::RecheckReport>,
 }
 
 /// Where the values and records of a validation come from.
@@ -302,6 +309,7 @@ impl ValidationReport {
             unidentified_set_to_zero: unidentified,
             records,
             tolerance: None,
+            recheck: None,
         })
     }
 

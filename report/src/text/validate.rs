@@ -4,6 +4,7 @@
 //! ([`super::tolerance`]).
 
 use super::{header, table, value, zeroed_text};
+use crate::json::recheck::RecheckReport;
 use crate::json::validate::{DirectionReport, RecordValidationReport, ValidationReport};
 use model_spec::units::{fixed, plural, readable, symbol};
 use simulation::record::Record;
@@ -64,10 +65,57 @@ pub fn validation(r: &ValidationReport) -> String {
     for x in &r.records {
         text.push_str(&record_line(x, one));
     }
+    if let Some(c) = &r.recheck {
+        text.push_str(&recheck(c));
+    }
     if let Some(t) = &r.tolerance {
         text.push_str(&super::tolerance::verdicts(t));
     }
     text
+}
+
+/// The re-check: the machine parameters refitted beside the calibration's values, their
+/// changes, and the scale of the uncertainties.
+pub fn recheck(c: &RecheckReport) -> String {
+    let mut out = format!(
+        "\nRe-check: {} refitted over every record, with each record's set-up when it is new (the preset) and its zero when zeroed, every other value held at the calibration's ({} degree{} of freedom; uncertainties at {}):\n",
+        c.refit.join(", "),
+        c.dof,
+        plural(c.dof, "s"),
+        c.scale_text()
+    );
+    let head = header(&[
+        "parameter",
+        "unit",
+        "calibrated",
+        "± σ",
+        "re-checked",
+        "± σ",
+        "change",
+        "z",
+    ]);
+    let opt = |x: Option<f64>| x.map_or_else(|| "undetermined".to_string(), value);
+    let cells: Vec<Vec<String>> = c
+        .pivot
+        .iter()
+        .map(|p| {
+            vec![
+                p.name.clone(),
+                symbol(&p.unit).to_string(),
+                opt(p.calibrated),
+                p.calibrated_std.map_or_else(String::new, value),
+                opt(p.value),
+                p.std.map_or_else(String::new, value),
+                p.change.map_or_else(String::new, value),
+                p.change_z.map_or_else(String::new, |z| fixed(z, 2)),
+            ]
+        })
+        .collect();
+    out.push_str(&table(&head, &cells));
+    out.push_str(
+        "The re-check's uncertainties hold its own readings' noise, not the calibration's uncertainty of the held values; z is the change over both uncertainties.\n",
+    );
+    out
 }
 
 /// Where a record's values came from, what was refitted on it, and what was set to 0 (`one`:

@@ -67,6 +67,7 @@ pub fn check(machine_id: &str, day: i64, xoc: f64, std: f64) -> Check {
         recorded_at: Timestamp(at.0 + 3600),
         rtest_version: "0.1.0".into(),
         kind: CheckKind::Record,
+        recheck: false,
         inputs: vec![InputFile {
             role: "--data".into(),
             path: "k4.csv".into(),

@@ -1,0 +1,356 @@
+//! A re-check: a few poses measured again (one sphere at a few positions of the rotary axes, as
+//! a controller's preset cycle does after a head change or a crash) refit named machine
+//! parameters (the **pivot**: a head's offsets, an axis's location) together over every record
+//! of the re-check, each record's new set-up (the **preset**: where the sphere is) and its zero
+//! as [`super::validate()`] refits them, and every other value held at the calibration's.
+//!
+//! The columns refitted are, over the re-check's records, the named shared parameters (one value
+//! for all records) and each record's own refits (its set-up errors when its set-up was not
+//! fitted by the calibration, its zero when zeroed). Their least-squares fit is the fit of the
+//! readings minus the prediction at the held values (first order), refined against the exact
+//! machine by Gauss–Newton when the prediction is exact, as a validation's refit is. Readings
+//! through an instrument (a probe's sphere fits) are weighted by their covariances, and the
+//! uncertainties are at the instrument's declared scale unless the residual refutes it (the
+//! χ² upper tail below [`super::fit::DECLARED_REFUTED`]); readings without covariances give
+//! uncertainties at the residual's scale.
+//!
+//! A parameter the re-check cannot separate from the others has no value (`None`), never a
+//! number: the re-check's poses must see it.
+
+use super::validate::{CampaignValidation, CampaignValues, Refitted, prepare};
+use crate::hmatrix::parameter_name;
+use crate::identify::{check_readings, fit_rows};
+use crate::least_squares::{Constraint, Tolerances};
+use crate::noise::NoiseChoice;
+use crate::refine::{GaussNewton, IdentifyError, RefineOptions, gauss_newton};
+use crate::validate::{ValidateError, ValidateOptions, statistics};
+use formats::progress::Progress;
+use model_spec::Machine;
+use nalgebra::{DMatrix, DVector};
+use simulation::campaign::Campaign;
+use simulation::model::Term;
+
+use super::design::Owner;
+
+/// A machine parameter the re-check refitted.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PivotRefit {
+    /// Its name (`ZOB`, `XOC`).
+    pub name: String,
+    /// Its term.
+    pub term: Term,
+    /// Which of the term's columns.
+    pub component: usize,
+    /// The calibration's value (mm, rad); `None` when the calibration did not determine it.
+    pub calibrated: Option<f64>,
+    /// The calibration's standard uncertainty.
+    pub calibrated_std: Option<f64>,
+    /// The re-check's value (mm, rad); `None` when the re-check cannot separate it.
+    pub value: Option<f64>,
+    /// Its standard uncertainty.
+    pub std: Option<f64>,
+}
+
+/// How the re-check's uncertainties are scaled.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RecheckScale {
+    /// The readings carry no covariances: the residual's σ̂ (mm).
+    Residual(Option<f64>),
+    /// The instrument's declared covariances; `ratio` is the σ̂ of the whitened residual (about
+    /// 1 when the declared σ is right), and its χ² upper tail `p`.
+    Declared {
+        /// σ̂ of the whitened residual (unitless).
+        ratio: f64,
+        /// Its χ² upper tail.
+        p: f64,
+    },
+    /// The declared covariances refuted by the residual (χ² upper tail `p` below
+    /// [`super::fit::DECLARED_REFUTED`]): the uncertainties keep the residual's scale.
+    Refuted {
+        /// σ̂ of the whitened residual (unitless).
+        ratio: f64,
+        /// Its χ² upper tail.
+        p: f64,
+    },
+}
+
+/// A re-check's result.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Recheck {
+    /// The machine parameters refitted, in the order asked.
+    pub pivot: Vec<PivotRefit>,
+    /// Per record, the validation after the re-check: its own refits (the set-up: the preset;
+    /// the zero) and its residual with every value at the re-check's.
+    pub validation: CampaignValidation,
+    /// Degrees of freedom of the refit (readings minus rank).
+    pub dof: usize,
+    /// How the uncertainties are scaled.
+    pub scale: RecheckScale,
+}
+
+/// Re-checks `values` (a calibration) on `campaign`: the shared parameters `pivot` (names as
+/// the calibration's report gives them, any case, `X0C` for `XOC`) refitted with each record's
+/// own refits, every other value held (see the module documentation). `opts` as for
+/// [`super::validate()`]; records are reported to `progress`.
+///
+/// # Errors
+/// A name that is not a machine parameter of the calibration, or given twice; no name; as
+/// [`super::validate()`]; fewer readings than refitted parameters plus one; a refinement that
+/// does not converge.
+pub fn recheck(
+    m: &Machine,
+    values: &CampaignValues,
+    campaign: &Campaign,
+    pivot: &[String],
+    opts: &ValidateOptions,
+    progress: &dyn Progress,
+) -> Result<Recheck, ValidateError> {
+    campaign.check(m).map_err(|e| ValidateError::Shape(e.0))?;
+    let layout = &values.layout;
+    let pivot_cols = pivot_columns(m, values, pivot).map_err(ValidateError::Shape)?;
+    let shared_name = |j: usize| {
+        let c = &layout.columns[j];
+        parameter_name(m, &c.term, c.component)
+    };
+    // Every record made ready; per record its refitted columns, each with its place among the
+    // unknowns: the pivot first (shared), then every record's own.
+    let total = campaign.records.len() as u64;
+    let mut prepared = Vec::with_capacity(campaign.records.len());
+    let mut unknowns: Vec<String> = pivot_cols.iter().map(|&j| shared_name(j)).collect();
+    let mut places: Vec<Vec<(usize, usize)>> = Vec::new();
+    for (i, r) in campaign.records.iter().enumerate() {
+        progress.update("re-checking records", i as u64, total);
+        let p = prepare(m, values, r, opts)?;
+        let mut place = Vec::new();
+        for (k, s) in p.plan.sources.iter().enumerate() {
+            match s {
+                Some(c) => {
+                    if let Some(u) = pivot_cols.iter().position(|j| j == c) {
+                        place.push((k, u));
+                    }
+                }
+                None => {
+                    place.push((k, unknowns.len()));
+                    unknowns.push(p.plan.names[k].clone());
+                }
+            }
+        }
+        prepared.push(p);
+        places.push(place);
+    }
+    let rows: Vec<usize> = prepared.iter().map(|p| p.r.record.samples.len()).collect();
+    check_readings(rows.iter().sum(), unknowns.len())?;
+    let n_rows: usize = prepared.iter().map(|p| p.y.len()).sum();
+    let mut h = DMatrix::<f64>::zeros(n_rows, unknowns.len());
+    let mut y = DVector::<f64>::zeros(n_rows);
+    let mut held = DVector::<f64>::zeros(n_rows);
+    let mut at = 0;
+    for (p, place) in prepared.iter().zip(&places) {
+        let n = p.y.len();
+        for &(k, u) in place {
+            h.view_mut((at, u), (n, 1)).copy_from(&p.h.column(k));
+        }
+        y.rows_mut(at, n).copy_from(&p.y);
+        let base = held_values(&p.v, place);
+        let q = p.predict(m, &base, opts.exact).map_err(|e| p.failed(e))?;
+        held.rows_mut(at, n).copy_from(&q);
+        at += n;
+    }
+    let weights = super::whitening(campaign, &NoiseChoice::Instrument)
+        .map_err(ValidateError::Measurements)?;
+    let tol = Tolerances::default();
+    let (first, first_sigma) = fit_rows(
+        &h,
+        &(&y - &held),
+        &unknowns,
+        &Constraint::None,
+        &tol,
+        None,
+        &rows,
+        weights.as_ref(),
+    )?;
+    // Every record's values at the unknowns `x` (mm, rad).
+    let at_unknowns = |x: &[f64]| -> Vec<Vec<f64>> {
+        prepared
+            .iter()
+            .zip(&places)
+            .map(|(p, place)| {
+                let mut v = held_values(&p.v, place);
+                for &(k, u) in place {
+                    v[k] = x[u];
+                }
+                v
+            })
+            .collect()
+    };
+    let (fit, weighted_sigma) = if opts.exact {
+        let coordinates = prepared
+            .iter()
+            .map(|p| p.coordinates())
+            .fold(1.0f64, f64::max);
+        let problem = GaussNewton {
+            h: &h,
+            y: &y,
+            layout: &rows,
+            tolerances: &tol,
+            noise: None,
+            coordinates,
+            weights: weights.as_ref(),
+            factored: None,
+        };
+        let mut predict = |x: &[f64]| -> Result<DVector<f64>, IdentifyError> {
+            let mut out = DVector::<f64>::zeros(n_rows);
+            let mut at = 0;
+            for (p, v) in prepared.iter().zip(at_unknowns(x)) {
+                let q = p.predict(m, &v, true)?;
+                out.rows_mut(at, q.len()).copy_from(&q);
+                at += q.len();
+            }
+            Ok(out)
+        };
+        let (fit, sigma, refinement) =
+            gauss_newton(&problem, &first, &RefineOptions::default(), &mut predict)
+                .map_err(|e| ValidateError::Shape(format!("the re-check: {e}")))?;
+        if !refinement.converged {
+            return Err(ValidateError::Shape(format!(
+                "the re-check: {}",
+                IdentifyError::NotConverged {
+                    iterations: refinement.iterations,
+                    last_step_mm: refinement.steps_mm.last().copied().unwrap_or(0.0),
+                    tolerance_mm: refinement.tolerance_mm,
+                }
+            )));
+        }
+        (fit, sigma)
+    } else {
+        (first, first_sigma)
+    };
+    let (scale, factor) = scale_of(weights.is_some(), weighted_sigma, fit.sigma, fit.dof);
+    let std: Vec<Option<f64>> = fit.std.iter().map(|s| s.map(|s| s * factor)).collect();
+    let pivot_out = pivot_cols
+        .iter()
+        .enumerate()
+        .map(|(u, &j)| {
+            let c = &layout.columns[j];
+            PivotRefit {
+                name: unknowns[u].clone(),
+                term: c.term,
+                component: c.component,
+                calibrated: values.values[j],
+                calibrated_std: values.std[j],
+                value: fit.values[u],
+                std: std[u],
+            }
+        })
+        .collect();
+    let mut records = Vec::with_capacity(prepared.len());
+    let (mut measured, mut predicted) = (Vec::new(), Vec::new());
+    for ((p, place), v) in prepared.iter().zip(&places).zip(at_unknowns(&fit.solution)) {
+        let own: Vec<Refitted> = place
+            .iter()
+            .filter(|&&(_, u)| u >= pivot_cols.len())
+            .map(|&(k, u)| p.refitted(k, fit.values[u], std[u]))
+            .collect();
+        let rv = p.finish(m, &v, own, opts.exact)?;
+        measured.extend(p.r.record.measured.iter().copied());
+        predicted.extend(rv.validation.prediction.iter().copied());
+        records.push(rv);
+    }
+    progress.update("re-checking records", total, total);
+    let (per_direction, overall) = statistics(&measured, &predicted);
+    Ok(Recheck {
+        pivot: pivot_out,
+        validation: CampaignValidation {
+            records,
+            per_direction,
+            overall,
+        },
+        dof: fit.dof,
+        scale,
+    })
+}
+
+/// The layout columns of `values` that the names `pivot` refit: each a machine parameter
+/// (shared) of the calibration, named as its report names it (any case, `X0C` for `XOC`), at
+/// most once; at least one name.
+///
+/// # Errors
+/// What is wrong, naming the name and the calibration's machine parameters.
+pub fn pivot_columns(
+    m: &Machine,
+    values: &CampaignValues,
+    pivot: &[String],
+) -> Result<Vec<usize>, String> {
+    let shared: Vec<(usize, String)> = values
+        .layout
+        .columns
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.owner == Owner::Shared)
+        .map(|(j, c)| (j, parameter_name(m, &c.term, c.component)))
+        .collect();
+    if pivot.is_empty() {
+        return Err("a re-check refits at least one machine parameter".into());
+    }
+    let mut out: Vec<usize> = Vec::with_capacity(pivot.len());
+    for name in pivot {
+        let key = canonical(name);
+        let Some(&(j, _)) = shared.iter().find(|(_, n)| canonical(n) == key) else {
+            let names: Vec<&str> = shared.iter().map(|(_, n)| n.as_str()).collect();
+            return Err(format!(
+                "`{name}` is not a machine parameter of the calibration (its machine parameters: {})",
+                names.join(", ")
+            ));
+        };
+        if out.contains(&j) {
+            return Err(format!("`{name}` is named twice"));
+        }
+        if values.layout.columns[j].term.effect.symbol().is_some() {
+            return Err(format!(
+                "`{name}` is the change of a kinematic length, which a re-check does not refit: refit the location errors it moves"
+            ));
+        }
+        out.push(j);
+    }
+    Ok(out)
+}
+
+/// A record's values `v` with its refitted columns (`place`) at 0.
+fn held_values(v: &[f64], place: &[(usize, usize)]) -> Vec<f64> {
+    let mut v = v.to_vec();
+    for &(k, _) in place {
+        v[k] = 0.0;
+    }
+    v
+}
+
+/// The scale of the uncertainties and the factor the fit's own (at the residual's scale)
+/// take: with covariances, the declared scale (÷ the whitened σ̂) unless the χ² of the
+/// whitened residual refutes it; without, the residual's.
+fn scale_of(
+    weighted: bool,
+    ratio: Option<f64>,
+    sigma: Option<f64>,
+    dof: usize,
+) -> (RecheckScale, f64) {
+    match ratio.filter(|r| weighted && *r > 0.0 && r.is_finite() && dof > 0) {
+        Some(ratio) => {
+            let p = crate::distributions::chi2_upper_tail(ratio * ratio * dof as f64, dof as f64);
+            if p < super::fit::DECLARED_REFUTED {
+                (RecheckScale::Refuted { ratio, p }, 1.0)
+            } else {
+                (RecheckScale::Declared { ratio, p }, 1.0 / ratio)
+            }
+        }
+        None => (RecheckScale::Residual(sigma), 1.0),
+    }
+}
+
+/// A name as compared: the canonical spelling of its effect (`X0C` is `XOC`), any case.
+fn canonical(name: &str) -> String {
+    let name = name.trim();
+    match name.split_once('@') {
+        Some((e, b)) => format!("{}@{}", model_spec::canonical_name(e), b.to_lowercase()),
+        None => model_spec::canonical_name(name),
+    }
+}

@@ -131,10 +131,10 @@ pub struct ValidateArgs {
     params_out: Option<Target>,
     /// With --refit: refuse a re-check that moves a translational parameter by more than this,
     /// µm (a controller's maxModification).
-    #[arg(long, value_name = "UM", default_value_t = 50.0, requires = "refit")]
+    #[arg(long, value_name = "UM", default_value_t = compensation::limits::MAX_CHANGE_UM, value_parser = super::args::positive, requires = "refit")]
     max_change_um: f64,
     /// With --refit: refuse a re-check that moves an angular parameter by more than this, µrad.
-    #[arg(long, value_name = "URAD", default_value_t = 200.0, requires = "refit")]
+    #[arg(long, value_name = "URAD", default_value_t = compensation::limits::MAX_CHANGE_URAD, value_parser = super::args::positive, requires = "refit")]
     max_change_urad: f64,
     #[command(flatten)]
     bounds: ValueBounds,
@@ -372,7 +372,7 @@ pub fn run(args: &ValidateArgs) -> VerbResult<Done> {
 /// The names of `--refit` (a re-check), or `None` (a validation).
 ///
 /// # Errors
-/// A usage error for an empty name or list.
+/// A usage error for an empty name.
 fn refit_names(args: &ValidateArgs) -> VerbResult<Option<Vec<String>>> {
     let Some(list) = &args.refit else {
         return Ok(None);
@@ -382,16 +382,6 @@ fn refit_names(args: &ValidateArgs) -> VerbResult<Option<Vec<String>>> {
         return Err(Error::usage(format!(
             "--refit `{list}`: give machine parameters separated by commas (XOB,ZOB)"
         )));
-    }
-    for (limit, flag) in [
-        (args.max_change_um, "--max-change-um"),
-        (args.max_change_urad, "--max-change-urad"),
-    ] {
-        if !(limit.is_finite() && limit > 0.0) {
-            return Err(Error::usage(format!(
-                "{flag}: {limit} is not a limit (a finite number above 0)"
-            )));
-        }
     }
     Ok(Some(names))
 }

@@ -184,7 +184,8 @@ pub fn run(common: &Common<'_>, probe_file: &Path, flags: &ProbeFlags) -> VerbRe
             (c.plan.clone(), Some(c))
         }
     };
-    let bed = pattern_covariance(&probe).map_err(fail)?;
+    // The pattern's centre covariance in the probe's frame (the pattern turns with the probe).
+    let pattern = pattern_covariance(&probe).map_err(fail)?;
     let source = PlanProbeSource {
         label: &label,
         base_model: common.model,
@@ -194,7 +195,9 @@ pub fn run(common: &Common<'_>, probe_file: &Path, flags: &ProbeFlags) -> VerbRe
             tip_radius_mm: probe.tip_radius_mm,
             sphere_radius_mm: probe.sphere_radius_mm,
             noise_mm: probe.noise_mm,
-            centre_covariance_mm2: std::array::from_fn(|i| std::array::from_fn(|j| bed[(i, j)])),
+            centre_covariance_mm2: std::array::from_fn(|i| {
+                std::array::from_fn(|j| pattern[(i, j)])
+            }),
         },
         params: &params,
         plan: &plan,

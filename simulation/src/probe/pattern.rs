@@ -90,9 +90,6 @@ pub enum PatternAzimuth {
 }
 
 impl PatternAzimuth {
-    /// The names, as the command line takes them.
-    pub const NAMES: [&'static str; 2] = ["cycled", "fixed"];
-
     /// The azimuth offset of pose `pose` (0-based, in probing order), rad.
     pub fn offset_rad(self, pose: usize) -> f64 {
         match self {
@@ -100,23 +97,6 @@ impl PatternAzimuth {
                 AZIMUTH_CYCLE_DEG[pose % AZIMUTH_CYCLE_DEG.len()].to_radians()
             }
             PatternAzimuth::Fixed => 0.0,
-        }
-    }
-
-    /// Its name: `cycled` or `fixed`.
-    pub fn name(self) -> &'static str {
-        match self {
-            PatternAzimuth::Cycled => Self::NAMES[0],
-            PatternAzimuth::Fixed => Self::NAMES[1],
-        }
-    }
-
-    /// The choice named `name` (`cycled`, `fixed`), or `None`.
-    pub fn parse(name: &str) -> Option<Self> {
-        match name {
-            "cycled" => Some(PatternAzimuth::Cycled),
-            "fixed" => Some(PatternAzimuth::Fixed),
-            _ => None,
         }
     }
 }
@@ -223,6 +203,27 @@ mod tests {
         assert_eq!(d[0], Vector3::new(-1.0, -0.0, -0.0));
         assert_eq!(d[8], Vector3::new(-0.0, -0.0, -1.0));
         assert!(d[4..8].iter().all(|n| (n.z + 0.5).abs() < 1e-15));
+    }
+
+    #[test]
+    fn the_turn_is_the_tool_rotation_after_the_azimuth_about_the_stylus() {
+        // Identity and azimuth 0: the pattern's directions bit for bit.
+        let still = PatternTurn::new(&Matrix3::identity(), PatternAzimuth::Fixed.offset_rad(5));
+        assert_eq!(still.approach_directions(), approach_directions());
+        // 22.5° about z (the second pose of the cycle), then a tool tilted 90° about y (its
+        // z along the bed's x): the −x approach of the pattern turns to
+        // R_y(90°)·(−cos 22.5°, −sin 22.5°, 0).
+        let phi = PatternAzimuth::Cycled.offset_rad(1);
+        assert_eq!(phi, 22.5f64.to_radians());
+        assert_eq!(PatternAzimuth::Cycled.offset_rad(4), 0.0);
+        let tilt = Matrix3::new(0.0, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 0.0, 0.0);
+        let turn = PatternTurn::new(&tilt, phi);
+        let n = turn.approach_directions()[0];
+        let want = Vector3::new(0.0, -phi.sin(), phi.cos());
+        assert!((n - want).norm() < 1e-15, "{n:?}");
+        // The pole stays along the stylus: −z of the tool, −x of the bed.
+        let pole = turn.approach_directions()[8];
+        assert!((pole + Vector3::x()).norm() < 1e-15, "{pole:?}");
     }
 
     #[test]

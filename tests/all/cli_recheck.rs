@@ -80,8 +80,8 @@ fn calibrated(dir: &Path) {
     );
 }
 
-/// `rtest validate --refit XOB,ZOB` of `data`, with `extra` flags.
-fn recheck<'a>(data: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+/// `rtest validate` of the calibration on the probe hits `data`, with `extra` flags.
+fn validate<'a>(data: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "validate",
         "--machine",
@@ -92,9 +92,14 @@ fn recheck<'a>(data: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
         data,
         "--probe",
         "probe.toml",
-        "--refit",
-        "XOB,ZOB",
     ];
+    args.extend_from_slice(extra);
+    args
+}
+
+/// `rtest validate --refit XOB,ZOB` of `data`, with `extra` flags.
+fn recheck<'a>(data: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = validate(data, &["--refit", "XOB,ZOB"]);
     args.extend_from_slice(extra);
     args
 }
@@ -221,21 +226,7 @@ fn a_bad_recheck_is_refused_and_writes_nothing() {
     let before = entries(&dir);
     fails(
         &dir,
-        &[
-            "validate",
-            "--machine",
-            "head-table-bc",
-            "--params",
-            "cal.json",
-            "--data",
-            "re1.csv",
-            "--probe",
-            "probe.toml",
-            "--refit",
-            "XOW",
-            "--json",
-            "x.json",
-        ],
+        &validate("re1.csv", &["--refit", "XOW", "--json", "x.json"]),
         2,
         &[
             "--refit: `XOW` is not a machine parameter of the calibration",
@@ -261,20 +252,7 @@ fn a_bad_recheck_is_refused_and_writes_nothing() {
     );
     fails(
         &dir,
-        &[
-            "validate",
-            "--machine",
-            "head-table-bc",
-            "--params",
-            "cal.json",
-            "--data",
-            "re1.csv",
-            "--probe",
-            "probe.toml",
-            "--record",
-            "--machine-id",
-            "H1",
-        ],
+        &validate("re1.csv", &["--record", "--machine-id", "H1"]),
         2,
         &["--record records a re-check (--refit NAMES)"],
     );

@@ -4,7 +4,7 @@
 
 use super::Confounded;
 use super::columns::Columns;
-use super::projected::{orthonormalise, project_out, unit_columns};
+use super::projected::{orthonormalise, project_out, to_unit_norm};
 use super::select::{SPAN_TOLERANCE, Scored, Span, gram};
 use nalgebra::{DMatrix, DVector};
 use simulation::model::{Basis, Effect, Model, Term};
@@ -180,14 +180,15 @@ pub(super) fn confounded_with(
         .filter(|&c| !chosen.contains(&c) && !unexcited.contains(&candidates[c]))
         .collect();
     let widths_of: Vec<usize> = looked.iter().map(|&c| widths[nb + c]).collect();
-    let mut projected = DMatrix::zeros(q.rows(), widths_of.iter().sum());
-    let mut at = 0;
-    for (&c, &w) in looked.iter().zip(&widths_of) {
-        projected
-            .columns_mut(at, w)
-            .copy_from(&unit_columns(&group(nb + c)));
-        at += w;
+    // Each candidate's columns scaled to unit norm where they are held.
+    let total: usize = widths_of.iter().sum();
+    let mut data = Vec::with_capacity(q.rows() * total);
+    for &c in &looked {
+        let from = data.len();
+        data.extend_from_slice(group(nb + c).as_slice());
+        to_unit_norm(&mut data[from..], q.rows());
     }
+    let mut projected = DMatrix::from_vec(q.rows(), total, data);
     project_out(&q.q, &mut projected);
     let mut at = 0;
     let mut out = Vec::new();

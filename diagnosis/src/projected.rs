@@ -22,7 +22,7 @@
 //! computed from the span (one vector).
 
 use super::select::{SPAN_TOLERANCE, Span};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, DVectorView};
 
 /// The candidates' columns with a model's span projected out.
 #[derive(Clone, Debug)]
@@ -57,10 +57,13 @@ impl Projected {
         let mut data = Vec::new();
         let mut total = 0;
         for &c in held {
-            let g = unit_columns(&columns(c));
+            let g = columns(c);
             at[c] = (total, g.ncols());
             total += g.ncols();
+            // Scaled to unit norm where they are held.
+            let from = data.len();
             data.extend_from_slice(g.as_slice());
+            to_unit_norm(&mut data[from..], n);
         }
         let unit = DMatrix::from_vec(n, total, data);
         let mut columns = unit.clone();
@@ -237,28 +240,28 @@ impl Model<'_> {
     }
 }
 
-/// The columns of `g` scaled to unit norm; a column of zero or non-finite norm is zero (it adds
-/// no direction, as in [`Span::new_directions`]).
-pub fn unit_columns(g: &DMatrix<f64>) -> DMatrix<f64> {
-    let mut unit = g.clone();
-    // Each column divided by its norm in place (the same quotients as `col / norm`, without a
-    // column of its own for each).
-    for mut col in unit.column_iter_mut() {
-        let norm = col.norm();
+/// Columns `m` (of `n` rows each, one after the other) scaled to unit norm in place: each
+/// divided by its norm; a column of zero or non-finite norm is zero (it adds no direction, as in
+/// [`Span::new_directions`]).
+pub fn to_unit_norm(m: &mut [f64], n: usize) {
+    if n == 0 {
+        return;
+    }
+    for col in m.chunks_exact_mut(n) {
+        let norm = DVectorView::from_slice(col, n).norm();
         if norm > 0.0 && norm.is_finite() {
             col.iter_mut().for_each(|x| *x /= norm);
         } else {
             col.fill(0.0);
         }
     }
-    unit
 }
 
 /// Columns `m` (of `n` rows each, one after the other: unit columns with a model projected
 /// out) orthonormalised in place, in order, by Gram–Schmidt with re-orthogonalisation; a
 /// column whose part outside the previous directions has a norm at most [`SPAN_TOLERANCE`]
 /// adds none. The directions kept are moved to the front; their number. With [`project_out`]
-/// and [`unit_columns`], what [`Span::new_directions`] gives.
+/// and [`to_unit_norm`], what [`Span::new_directions`] gives.
 pub fn orthonormalise(m: &mut [f64], n: usize) -> usize {
     if n == 0 {
         return 0;

@@ -143,8 +143,16 @@ fn stem(name: &str, taken: &mut Vec<String>) -> String {
 /// comes before one that reverses, whatever their shares: an abscissa that turns back folds
 /// the curves onto themselves. Equal shares go to the rotary axis, then to the first axis
 /// in the machine's order. Only a path on which no axis moves falls back to the sample
-/// index, and its label says so.
+/// index, and its label says so. A touch probe's record (its poses, each one reading through
+/// its sphere fit) is drawn over its poses' numbers, and its label says so.
 pub fn abscissa(m: &Machine, record: &Record) -> (String, Vec<f64>) {
+    // A touch probe's record is no path: one reading per pose, numbered in order.
+    if !record.probe.is_empty() {
+        return (
+            "pose (a touch probe's record: one reading per pose, not a path)".into(),
+            (1..=record.samples.len()).map(|i| i as f64).collect(),
+        );
+    }
     // (one way?, share, rotary?, axis), compared lexicographically; the first axis wins ties.
     let mut best: Option<(bool, f64, bool, usize)> = None;
     for (a, axis) in m.axes.iter().enumerate() {
@@ -468,6 +476,18 @@ mod tests {
             .map(|r| vec![r[0], r[1].to_radians(), r[2].to_radians(), r[3], r[4]])
             .collect();
         record_from_commands(commands, (0..rows.len()).map(|i| i as f64).collect())
+    }
+
+    #[test]
+    fn a_probes_record_is_drawn_over_its_poses() {
+        let rows: Vec<[f64; 5]> = (0..4)
+            .map(|i| [10.0 * i as f64, -30.0 * i as f64, 0.0, 0.0, 0.0])
+            .collect();
+        let mut record = path(&rows);
+        record.probe = vec![Vec::new(); rows.len()];
+        let (label, x) = abscissa(&seed_ac(), &record);
+        assert!(label.starts_with("pose (a touch probe's record"), "{label}");
+        assert_eq!(x, [1.0, 2.0, 3.0, 4.0]);
     }
 
     #[test]

@@ -109,17 +109,30 @@ fn campaign(m: &Machine, tests: &[&str], seed: u64, ebb: Option<&str>) -> Campai
     Campaign::new(records).unwrap()
 }
 
-/// [`run`] at noise seeds 1 to 5, each on a thread of its own (a whole campaign's diagnosis
-/// each), in seed order.
+/// [`run`] at noise seeds 1 to 5, in seed order: shared out over as many threads as the
+/// machine has cores (at most five; thread `w` takes the seeds `w + 1`, `w + 1 + threads`, …).
+/// A whole campaign's diagnosis holds about a gigabyte at its peak: five at once took 5.2 GB
+/// (two at a time: 2.1 GB) in the same time on two cores.
 fn run_seeds(m: &Machine, tests: &[&str], ebb: Option<&str>) -> Vec<(u64, Diagnosis)> {
-    std::thread::scope(|scope| {
-        let runs: Vec<_> = (1..=5)
-            .map(|seed| scope.spawn(move || (seed, run(m, tests, seed, ebb))))
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get().min(5));
+    let mut all: Vec<(u64, Diagnosis)> = std::thread::scope(|scope| {
+        let runs: Vec<_> = (0..threads)
+            .map(|w| {
+                scope.spawn(move || {
+                    (1..=5u64)
+                        .skip(w)
+                        .step_by(threads)
+                        .map(|seed| (seed, run(m, tests, seed, ebb)))
+                        .collect::<Vec<_>>()
+                })
+            })
             .collect();
         runs.into_iter()
-            .map(|r| r.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .flat_map(|r| r.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect()
-    })
+    });
+    all.sort_by_key(|(seed, _)| *seed);
+    all
 }
 
 fn run(m: &Machine, tests: &[&str], seed: u64, ebb: Option<&str>) -> Diagnosis {

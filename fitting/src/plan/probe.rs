@@ -33,7 +33,10 @@
 //! pattern's own, `C` (the free-radius fit's, [`RadiusMode::Free`] with the calibrated radius,
 //! of the nine exact hits under the probe's σ, in the probe's frame), turned by the pose's
 //! azimuth offset about the stylus: `R_z(φ₀)·C·R_z(φ₀)ᵀ`, the same at every pose to rounding
-//! (the pattern is four-fold symmetric about the stylus).
+//! (the pattern is four-fold symmetric about the stylus). Each pose also carries its hits'
+//! responses to pre-travel ([`crate::probe::pretravel_responses`] of the pattern at the pose),
+//! as a probe record's poses do, so a model with the probe's lobing (`PRE@harmonic:3`) is
+//! predicted too.
 //!
 //! **The prediction** is that of the campaign of one record (label [`PROBE_RECORD`], its own
 //! sphere set-up, not zeroed) whose samples are the poses with those covariances, by
@@ -61,7 +64,7 @@ use simulation::exact::VirtualMachine;
 use simulation::generator::{self, Clearance, TestKind};
 use simulation::model::{Effect, Model};
 use simulation::probe::{PatternAzimuth, PatternTurn, PoseFrame, approach_directions};
-use simulation::record::{Record, Sample};
+use simulation::record::{PreTravelResponse, Record, Sample};
 
 /// The fewest positions per rotary axis (three points fix a circle).
 pub const MIN_PER_AXIS: usize = 3;
@@ -233,6 +236,9 @@ pub struct PlannedPose {
     pub commands: Vec<f64>,
     /// The reading's covariance, tool frame, mm².
     pub covariance_mm2: [[f64; 3]; 3],
+    /// Per hit of the pattern at the pose, the reading's response to its pre-travel
+    /// ([`crate::probe::pretravel_responses`]): what a model's `PRE@harmonic:K` is made of.
+    pub pretravel: Vec<PreTravelResponse>,
 }
 
 /// A pose left out, and why.
@@ -289,7 +295,11 @@ pub fn probe_poses(
             axes[s.axis] = angle;
             let azimuth_rad = PatternAzimuth::Cycled.offset_rad(poses.len());
             match pose_at(&vm, params, &axes, azimuth_rad, effective_radius_mm) {
-                Ok(geometry) => {
+                Ok((geometry, pattern)) => {
+                    let pretravel = crate::probe::pretravel_responses(
+                        &geometry,
+                        &pattern.approach_directions(),
+                    );
                     let (sin, cos) = azimuth_rad.sin_cos();
                     let turn = Matrix3::new(cos, -sin, 0.0, sin, cos, 0.0, 0.0, 0.0, 1.0);
                     let c = turn * pattern_covariance * turn.transpose();
@@ -299,6 +309,7 @@ pub fn probe_poses(
                         angle_deg: angle,
                         commands: geometry.commands,
                         covariance_mm2: std::array::from_fn(|i| std::array::from_fn(|j| c[(i, j)])),
+                        pretravel,
                     });
                 }
                 Err(reason) => skipped.push(SkippedPose {
@@ -338,7 +349,7 @@ fn pose_at(
     axes: &[f64],
     azimuth_rad: f64,
     effective_radius_mm: f64,
-) -> Result<PoseFrame, String> {
+) -> Result<(PoseFrame, PatternTurn), String> {
     let m = vm.machine();
     let frame = crate::probe::pose_frame(vm, axes, params).map_err(|e| e.to_string())?;
     if let Some(o) = m.outside_limits(&frame.commands).first() {
@@ -360,11 +371,11 @@ fn pose_at(
             return Err(format!("{o} at hit {} of the pattern", h + 1));
         }
     }
-    Ok(frame)
+    Ok((frame, turn))
 }
 
 /// The record of `poses`: one sample per pose (its commands, `t` its index in s, timed), no
-/// readings, the poses' covariances.
+/// readings, the poses' covariances and their hits' responses to pre-travel.
 pub fn planned_record(poses: &ProbePoses, axes: usize) -> Record {
     let mut r = Record::default();
     for (i, p) in poses.poses.iter().enumerate() {
@@ -375,6 +386,7 @@ pub fn planned_record(poses: &ProbePoses, axes: usize) -> Record {
             timed: true,
         });
         r.covariance.push(p.covariance_mm2);
+        r.probe.push(p.pretravel.clone());
     }
     r
 }

@@ -8,7 +8,7 @@ use formats::probe::{ProbeHits, ProbeInstrument, ProbePose};
 use model_spec::Machine;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use simulation::exact::VirtualMachine;
-use simulation::probe::{PreTravel, approach_in_probe_frame};
+use simulation::probe::{PoseFrame, PreTravel, approach_in_probe_frame};
 use simulation::record::{PreTravelResponse, Record, Sample};
 
 /// What reading a probe record needs besides its hits.
@@ -155,14 +155,7 @@ pub fn probe_record(
                 .pretravel_gain
                 .iter()
                 .zip(&fitted.approach_tool)
-                .map(|(g, n)| {
-                    let (across, azimuth_rad) = approach_in_probe_frame(n);
-                    PreTravelResponse {
-                        gain: [g.x, g.y, g.z],
-                        across,
-                        azimuth_rad,
-                    }
-                })
+                .map(|(g, n)| response(g, n))
                 .collect(),
         );
         poses.push(fitted);
@@ -284,10 +277,8 @@ fn fit_pose(
     let reading = -geometry.to_tool(&c);
     let r = geometry.tool_rotation.matrix();
     let cov: Matrix3<f64> = r.transpose() * fit.covariance_mm2 * r;
-    let pretravel_gain = pretravel_gains(&latches)
-        .into_iter()
-        .map(|dc| -geometry.to_tool(&dc))
-        .collect();
+    let approaches: Vec<Vector3<f64>> = latches.iter().map(|l| l.approach).collect();
+    let pretravel_gain = tool_gains(&geometry, &approaches);
     Ok(PoseFit {
         label: pose.label.clone(),
         commands: geometry.commands.clone(),
@@ -353,6 +344,41 @@ fn refusal(pose: &ProbePose, e: &SphereFitError) -> (usize, String) {
     (pose.hits[0].line, e.to_string())
 }
 
+/// Per hit of a pose of nominal frame `frame` whose approaches are `approaches` (unit, bed
+/// frame, as aimed), how the pose's reading responds to the hit's pre-travel: what the term
+/// `PRE@harmonic:K` of a model is made of, for a probe record ([`probe_record`]) and for a
+/// planned pose alike.
+pub fn pretravel_responses(
+    frame: &PoseFrame,
+    approaches: &[Vector3<f64>],
+) -> Vec<PreTravelResponse> {
+    tool_gains(frame, approaches)
+        .iter()
+        .zip(approaches)
+        .map(|(g, n)| response(g, &frame.to_tool(n)))
+        .collect()
+}
+
+/// The response of a hit whose reading gain is `gain` (tool frame, mm/mm) and whose approach
+/// is `n_tool` (unit, tool frame).
+fn response(gain: &Vector3<f64>, n_tool: &Vector3<f64>) -> PreTravelResponse {
+    let (across, azimuth_rad) = approach_in_probe_frame(n_tool);
+    PreTravelResponse {
+        gain: [gain.x, gain.y, gain.z],
+        across,
+        azimuth_rad,
+    }
+}
+
+/// Per hit, the change of the pose's reading (tool frame, mm per mm) when the hit latches
+/// 1 mm farther along its approach: `−R_tool0ᵀ` times [`pretravel_gains`].
+fn tool_gains(frame: &PoseFrame, approaches: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+    pretravel_gains(approaches)
+        .into_iter()
+        .map(|dc| -frame.to_tool(&dc))
+        .collect()
+}
+
 /// Per hit, the fitted centre's first-order change (bed frame, mm per mm) when that hit
 /// latches 1 mm farther along its approach (a pre-travel), the radius free: `Δx = (JᵀJ)⁻¹Jᵀ·e_i`
 /// with the Jacobian rows `[n_iᵀ, −1]` of the residuals `‖p_i − c‖ − R` for hits aimed at the
@@ -361,11 +387,11 @@ fn refusal(pose: &ProbePose, e: &SphereFitError) -> (usize, String) {
 /// move by microns): a response of the pattern alone, so two poses whose approaches are the
 /// same in the tool frame get the same response to the digit, and what a pose set cannot
 /// separate stays exactly confounded.
-fn pretravel_gains(latches: &[Latch]) -> Vec<Vector3<f64>> {
-    let n = latches.len();
+fn pretravel_gains(approaches: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+    let n = approaches.len();
     let mut j = DMatrix::zeros(n, 4);
-    for (i, l) in latches.iter().enumerate() {
-        let u = -l.approach.normalize();
+    for (i, a) in approaches.iter().enumerate() {
+        let u = -a.normalize();
         for k in 0..3 {
             j[(i, k)] = -u[k];
         }

@@ -32,7 +32,9 @@ mod pose;
 mod summary;
 
 pub use centres::centre_record;
-pub use hits::{OFF_SPHERE_MM, PoseFit, ProbeRecord, ProbeSettings, probe_record};
+pub use hits::{
+    OFF_SPHERE_MM, PoseFit, ProbeRecord, ProbeSettings, pretravel_responses, probe_record,
+};
 pub use pose::pose_frame;
 pub use simulation::probe::{PoseFrame, PreTravel, approach_in_probe_frame};
 pub use summary::ProbeSummary;

@@ -549,3 +549,59 @@ fn a_linear_axis_backlash_or_a_servo_lag_is_refused_on_probe_records() {
         assert!(e.contains(term) && e.contains(why), "{term}: {e}");
     }
 }
+
+#[test]
+fn the_plan_predicts_the_lobings_uncertainty_the_campaign_reports() {
+    // The plan's poses carry their hits' responses to pre-travel (the pattern as it will be
+    // probed, turned pose by pose), so a model with PRE@harmonic:3 is predicted: its std is
+    // the one the identification of the simulated campaign at those poses reports.
+    let lobing = PreTravel {
+        constant_mm: 0.0,
+        lobing_mm: [2e-3, -1e-3],
+    };
+    for name in ["head-table-bc", "table-table-bc"] {
+        let case = case(name);
+        let mut model = case.model.clone();
+        model
+            .terms
+            .push(simulation::model::Term::parse(&case.m, "PRE@harmonic:3").unwrap());
+        let params = case.m.default_parameters();
+        let inputs = ProbePlanInputs {
+            machine: &case.m,
+            model: &model,
+            params: &params,
+            clearance: &Clearance::default(),
+            probe: &ProbeSetup {
+                tip_radius_mm: TIP_MM,
+                sphere_radius_mm: SPHERE_MM,
+                noise_mm: NOISE_MM,
+            },
+            constraint: &case.constraint,
+            tol: &Tolerances::default(),
+        };
+        let plan = inputs.plan(6).unwrap();
+        let poses: Vec<Vec<f64>> = plan
+            .poses
+            .poses
+            .iter()
+            .map(|p| p.commands.clone())
+            .collect();
+        let ident = identified_as(&case, &model, false, &poses, 3, lobing, Default::default());
+        for k in ["PRE@harmonic:3:cos", "PRE@harmonic:3:sin"] {
+            let jp = plan.prediction.names.iter().position(|n| n == k).unwrap();
+            let jf = ident.fit.names.iter().position(|n| n == k).unwrap();
+            let (predicted, reported) =
+                (plan.prediction.std[jp].unwrap(), ident.fit.std[jf].unwrap());
+            println!(
+                "{name}, {} poses: {k}: predicted ± {:.3} µm, reported ± {:.3} µm",
+                poses.len(),
+                predicted * 1e3,
+                reported * 1e3
+            );
+            assert!(
+                (predicted / reported - 1.0).abs() < 0.02,
+                "{name}: {k}: predicted {predicted}, reported {reported}"
+            );
+        }
+    }
+}

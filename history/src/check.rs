@@ -277,7 +277,7 @@ impl Check {
         }
     }
 
-    /// The check of a re-check ([`CheckKind::Recheck`]): the validation report `v` with its
+    /// The check of a re-check ([`Check::recheck`] set): the validation report `v` with its
     /// `recheck` part, of the calibration `calibration` (its model's label and terms). Its
     /// parameters are the pivot (owner `shared`) and every record's refits (the preset: owner
     /// `setup`; a zero: owner `record`); the held values are not the re-check's and are not

@@ -49,8 +49,8 @@ pub struct ProbeReport {
     pub sphere_radius_mm: f64,
     /// The probe's σ along the approach, µm.
     pub noise_um: f64,
-    /// The standard uncertainty of a pose's fitted centre along bed x, y, z, µm (the default
-    /// pattern, free radius).
+    /// The standard uncertainty of a pose's fitted centre along x, y, z of the probe frame
+    /// (across and along the stylus), µm (the default pattern, free radius).
     pub centre_std_um: [f64; 3],
 }
 

@@ -36,7 +36,7 @@ fn intro(r: &PlanProbeReport) -> String {
     };
     format!(
         "Probe plan on machine {}, model {} ({} parameter{}): {} positions per rotary axis{how}, {} pose{} ({} readings).\n\
-         Probe{}: tip radius {} mm, sphere radius {} mm, σ {} µm; the default 9-hit pattern gives a pose's centre with a standard uncertainty of {}, {}, {} µm (bed x, y, z). \
+         Probe{}: tip radius {} mm, sphere radius {} mm, σ {} µm; the default 9-hit pattern gives a pose's centre with a standard uncertainty of {}, {}, {} µm (x, y, z of the probe frame: across and along the stylus). \
          The uncertainties are those a fit of these readings would report, each pose weighted by its covariance (first order); nothing is measured.{held}\n",
         r.machine,
         r.model,

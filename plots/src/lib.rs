@@ -185,6 +185,22 @@ fn ensure_font() -> Result<(), PlotError> {
     if ok { Ok(()) } else { Err(PlotError::Font) }
 }
 
+/// Draws a panel's `header` (its name and what its residual shows) left-aligned over the
+/// panel's plot in `area`; returns the plot's left edge, px (the y labels' area and 2 px).
+fn panel_header(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    header: String,
+) -> Result<u32, PlotError> {
+    const LEFT: u32 = 92;
+    area.draw(&Text::new(
+        header,
+        (LEFT as i32, 16),
+        text(13.5, &MUTED).pos(Pos::new(HPos::Left, VPos::Center)),
+    ))
+    .map_err(render_err)?;
+    Ok(LEFT)
+}
+
 fn render_err<E: std::fmt::Debug>(e: E) -> PlotError {
     PlotError::Render(format!("{e:?}"))
 }
@@ -512,13 +528,7 @@ fn draw_path_panel(
             );
         }
     }
-    let left = 92;
-    area.draw(&Text::new(
-        header,
-        (left, 16),
-        text(13.5, &MUTED).pos(Pos::new(HPos::Left, VPos::Center)),
-    ))
-    .map_err(render_err)?;
+    let left = panel_header(area, header)?;
 
     let mut chart = ChartBuilder::on(area)
         .margin_top(30)

@@ -199,13 +199,7 @@ fn draw_pose_panel(
         residual.len(),
         if residual.len() == 1 { "" } else { "s" }
     );
-    let left = 92;
-    area.draw(&Text::new(
-        header,
-        (left, 16),
-        text(13.5, &MUTED).pos(Pos::new(HPos::Left, VPos::Center)),
-    ))
-    .map_err(render_err)?;
+    let left = panel_header(area, header)?;
 
     let categorical = !fig.ticks.is_empty();
     let label_area = match ticks_below {

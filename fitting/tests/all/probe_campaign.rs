@@ -247,13 +247,13 @@ pub fn z_scores_of(
     out
 }
 
-/// The poses `rtest plan --probe --per-axis auto` chooses for `case` (targets 1 µm, 5 µrad,
-/// valuation 2), with the number of positions per axis.
-pub fn planned(case: &Case) -> (usize, Vec<Vec<f64>>) {
+/// `f` of the probe plan's inputs for `case` with `model` (the case's probe, its default
+/// kinematic parameters and constraint).
+fn with_plan_inputs<T>(case: &Case, model: &Model, f: impl FnOnce(&ProbePlanInputs) -> T) -> T {
     let params = case.m.default_parameters();
-    let inputs = ProbePlanInputs {
+    f(&ProbePlanInputs {
         machine: &case.m,
-        model: &case.model,
+        model,
         params: &params,
         clearance: &Clearance::default(),
         probe: &ProbeSetup {
@@ -263,8 +263,15 @@ pub fn planned(case: &Case) -> (usize, Vec<Vec<f64>>) {
         },
         constraint: &case.constraint,
         tol: &Tolerances::default(),
-    };
-    let choice = choose_per_axis(&inputs, &Targets::default(), 2.0).unwrap();
+    })
+}
+
+/// The poses `rtest plan --probe --per-axis auto` chooses for `case` (targets 1 µm, 5 µrad,
+/// valuation 2), with the number of positions per axis.
+pub fn planned(case: &Case) -> (usize, Vec<Vec<f64>>) {
+    let choice = with_plan_inputs(case, &case.model, |inputs| {
+        choose_per_axis(inputs, &Targets::default(), 2.0).unwrap()
+    });
     assert!(
         choice.met,
         "{}: the plan meets no valuation of 2",
@@ -565,21 +572,7 @@ fn the_plan_predicts_the_lobings_uncertainty_the_campaign_reports() {
         model
             .terms
             .push(simulation::model::Term::parse(&case.m, "PRE@harmonic:3").unwrap());
-        let params = case.m.default_parameters();
-        let inputs = ProbePlanInputs {
-            machine: &case.m,
-            model: &model,
-            params: &params,
-            clearance: &Clearance::default(),
-            probe: &ProbeSetup {
-                tip_radius_mm: TIP_MM,
-                sphere_radius_mm: SPHERE_MM,
-                noise_mm: NOISE_MM,
-            },
-            constraint: &case.constraint,
-            tol: &Tolerances::default(),
-        };
-        let plan = inputs.plan(6).unwrap();
+        let plan = with_plan_inputs(&case, &model, |inputs| inputs.plan(6).unwrap());
         let poses: Vec<Vec<f64>> = plan
             .poses
             .poses

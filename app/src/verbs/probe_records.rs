@@ -6,8 +6,8 @@ use super::{Error, ReadFile, VerbResult};
 use fitting::probe::{ProbeSettings, ProbeSummary, centre_record, probe_record};
 use formats::csv::{CsvError, ReadOptions};
 use formats::probe::{
-    ProbeFile, ProbeInstrument, instrument::MAX_PROBE_INSTRUMENT_BYTES, parse_probe_hits,
-    parse_probe_instrument, parse_sphere_centres, read_probe_file,
+    ProbeFile, ProbeInstrument, instrument::MAX_PROBE_INSTRUMENT_BYTES, parse_probe_instrument,
+    read_probe_file, read_probe_from,
 };
 use model_spec::Machine;
 use model_spec::sha256::Digest;
@@ -68,12 +68,12 @@ pub fn read_probe_record(
 }
 
 /// The record of a probe file's `bytes` (named `file` in messages), read as
-/// [`read_probe_record`] reads the file (the same readers, told apart by the header as
-/// `formats::probe::read_probe_file` tells them: a column `cx` makes it centres): for
-/// `rtest report`, which reads the records a report names once, hashing them.
+/// [`read_probe_record`] reads the file (`formats::probe::read_probe_from`: the same readers,
+/// told apart by the header): for `rtest report`, which reads the records a report names once,
+/// hashing them.
 ///
 /// # Errors
-/// As [`read_probe_record`]; bytes that are not UTF-8, at their line.
+/// As [`read_probe_record`].
 pub fn probe_record_of_bytes(
     file: &str,
     bytes: &[u8],
@@ -82,29 +82,7 @@ pub fn probe_record_of_bytes(
     probe: &ProbeInstrument,
     opts: &ReadOptions,
 ) -> Result<(Record, ProbeSummary), CsvError> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        let at = e.valid_up_to();
-        CsvError::Format {
-            file: file.to_string(),
-            line: 1 + bytes[..at].iter().filter(|b| **b == b'\n').count(),
-            column: None,
-            message: format!("not UTF-8 text (byte 0x{:02x})", bytes[at]),
-        }
-    })?;
-    let centres = text
-        .lines()
-        .map(|l| l.trim_start_matches('\u{feff}').trim())
-        .find(|l| !l.is_empty() && !l.starts_with('#'))
-        .is_some_and(|header| {
-            header
-                .split(',')
-                .any(|c| c.trim().trim_matches('"').trim().eq_ignore_ascii_case("cx"))
-        });
-    let content = if centres {
-        ProbeFile::Centres(parse_sphere_centres(file, text, m)?)
-    } else {
-        ProbeFile::Hits(parse_probe_hits(file, text, m)?)
-    };
+    let content = read_probe_from(file, bytes, m)?;
     fitted(file, content, m, params, probe, opts)
 }
 

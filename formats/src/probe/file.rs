@@ -31,41 +31,80 @@ pub enum ProbeFile {
 /// As [`super::read_probe_hits`] and [`super::read_sphere_centres`].
 pub fn read_probe_file(path: &Path, m: &Machine) -> Result<(ProbeFile, Digest), CsvError> {
     let file = path.display().to_string();
-    let io = |source| CsvError::Io {
+    let f = std::fs::File::open(path).map_err(|source| CsvError::Io {
         file: file.clone(),
         source,
-    };
-    let f = std::fs::File::open(path).map_err(io)?;
+    })?;
     let mut hashing = HashingReader::new(f);
-    let content = {
-        let mut buffered = BufReader::new(&mut hashing);
-        let mut prefix = Vec::new();
-        let mut centres = false;
-        while prefix.len() < SNIFF_BYTES {
-            let start = prefix.len();
-            let read = (&mut buffered)
-                .take((SNIFF_BYTES - start) as u64)
-                .read_until(b'\n', &mut prefix)
-                .map_err(io)?;
-            if read == 0 {
-                break;
-            }
-            let line = String::from_utf8_lossy(&prefix[start..]);
-            let line = line.trim_start_matches('\u{feff}').trim();
-            if line.is_empty() || line.starts_with('#') {
-                continue;
-            }
-            centres = line
-                .split(',')
-                .any(|c| c.trim().trim_matches('"').trim().eq_ignore_ascii_case("cx"));
+    let content = read_probe_from(&file, &mut hashing, m)?;
+    Ok((content, hashing.digest()))
+}
+
+/// Reads a probe file of machine `m` (named `file` in messages) from `reader`, told apart as
+/// [`read_probe_file`] tells it: the bytes a caller already holds (`&[u8]`) are read as the
+/// file was.
+///
+/// # Errors
+/// As [`read_probe_file`].
+pub fn read_probe_from(file: &str, reader: impl Read, m: &Machine) -> Result<ProbeFile, CsvError> {
+    let io = |source| CsvError::Io {
+        file: file.to_string(),
+        source,
+    };
+    let mut buffered = BufReader::new(reader);
+    let mut prefix = Vec::new();
+    let mut centres = false;
+    while prefix.len() < SNIFF_BYTES {
+        let start = prefix.len();
+        let read = (&mut buffered)
+            .take((SNIFF_BYTES - start) as u64)
+            .read_until(b'\n', &mut prefix)
+            .map_err(io)?;
+        if read == 0 {
             break;
         }
-        let rest = Cursor::new(prefix).chain(buffered);
-        if centres {
-            ProbeFile::Centres(read_centres_from(&file, rest, m)?)
-        } else {
-            ProbeFile::Hits(read_hits_from(&file, rest, m)?)
+        let line = String::from_utf8_lossy(&prefix[start..]);
+        let line = line.trim_start_matches('\u{feff}').trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
         }
-    };
-    Ok((content, hashing.digest()))
+        centres = line
+            .split(',')
+            .any(|c| c.trim().trim_matches('"').trim().eq_ignore_ascii_case("cx"));
+        break;
+    }
+    let rest = Cursor::new(prefix).chain(buffered);
+    Ok(if centres {
+        ProbeFile::Centres(read_centres_from(file, rest, m)?)
+    } else {
+        ProbeFile::Hits(read_hits_from(file, rest, m)?)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bytes held in memory and the file itself are told apart and read alike, a byte-order
+    /// mark or a comment before the header notwithstanding.
+    #[test]
+    fn bytes_and_files_are_told_apart_by_the_header() {
+        let m = model_spec::builtin("seed-ac").unwrap().unwrap();
+        let hits = "\u{feff}pose,X,Y,Z,A,C,nx,ny,nz,t_s\np1,0,0,0,0,0,1,0,0,0\n";
+        let centres = "# from the CMM\npose,X,Y,Z,A,C,cx,cy,cz\np1,0,0,0,0,0,0.001,0,0\n";
+        assert!(matches!(
+            read_probe_from("h.csv", hits.as_bytes(), &m).unwrap(),
+            ProbeFile::Hits(_)
+        ));
+        let read = read_probe_from("c.csv", centres.as_bytes(), &m);
+        assert!(matches!(read, Ok(ProbeFile::Centres(_))), "{read:?}");
+        let dir = std::env::temp_dir().join(format!("rtest-probe-file-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("c.csv");
+        std::fs::write(&path, centres).unwrap();
+        let (from_file, digest) = read_probe_file(&path, &m).unwrap();
+        assert_eq!(from_file, read.unwrap());
+        assert_eq!(digest.bytes, centres.len() as u64);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -40,7 +40,7 @@ pub use centres::{
     CENTRE_COLUMNS, SphereCentre, SphereCentres, format_sphere_centres, parse_sphere_centres,
     read_sphere_centres,
 };
-pub use file::{ProbeFile, read_probe_file};
+pub use file::{ProbeFile, read_probe_file, read_probe_from};
 pub use hits::{
     HIT_COLUMNS, ProbeHit, ProbeHits, ProbePose, format_probe_hits, parse_probe_hits,
     read_probe_hits,

@@ -49,7 +49,7 @@ pub use validate::{
     validate, validate_record,
 };
 
-use simulation::campaign::Campaign;
+use simulation::campaign::{Campaign, CampaignRecord};
 use simulation::record::Record;
 
 /// The per-sample whitening of `campaign`'s readings, stacked in record order, when its
@@ -64,8 +64,19 @@ pub fn whitening(
     campaign: &Campaign,
     noise: &crate::noise::NoiseChoice,
 ) -> Result<Option<crate::noise::SampleWhitening>, crate::EstimateError> {
-    let with: Vec<&str> = campaign
-        .records
+    let records: Vec<&CampaignRecord> = campaign.records.iter().collect();
+    whitening_of(&records, noise)
+}
+
+/// [`whitening`] of `records`, in their order.
+///
+/// # Errors
+/// As [`whitening`].
+pub(crate) fn whitening_of(
+    records: &[&CampaignRecord],
+    noise: &crate::noise::NoiseChoice,
+) -> Result<Option<crate::noise::SampleWhitening>, crate::EstimateError> {
+    let with: Vec<&str> = records
         .iter()
         .filter(|r| !r.record.covariance.is_empty())
         .map(|r| r.label.as_str())
@@ -73,9 +84,8 @@ pub fn whitening(
     if with.is_empty() {
         return Ok(None);
     }
-    if with.len() != campaign.records.len() {
-        let without: Vec<&str> = campaign
-            .records
+    if with.len() != records.len() {
+        let without: Vec<&str> = records
             .iter()
             .filter(|r| r.record.covariance.is_empty())
             .map(|r| r.label.as_str())
@@ -88,7 +98,7 @@ pub fn whitening(
         .into());
     }
     let mut all = Record::default();
-    for r in &campaign.records {
+    for r in records {
         all.samples.extend(r.record.samples.iter().cloned());
         all.covariance.extend(r.record.covariance.iter().copied());
     }

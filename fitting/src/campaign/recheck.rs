@@ -17,20 +17,14 @@
 //! A parameter the re-check cannot separate from the others has no value (`None`), never a
 //! number: the re-check's poses must see it.
 
-use super::validate::{CampaignValidation, CampaignValues, Refitted, prepare};
+use super::design::Owner;
+use super::validate::{CampaignValidation, CampaignValues, prepare, refit_held};
 use crate::hmatrix::parameter_name;
-use crate::identify::{check_readings, fit_rows};
-use crate::least_squares::{Constraint, Tolerances};
-use crate::noise::NoiseChoice;
-use crate::refine::{GaussNewton, IdentifyError, RefineOptions, gauss_newton};
 use crate::validate::{ValidateError, ValidateOptions, statistics};
 use formats::progress::Progress;
 use model_spec::Machine;
-use nalgebra::{DMatrix, DVector};
 use simulation::campaign::Campaign;
 use simulation::model::Term;
-
-use super::design::Owner;
 
 /// A machine parameter the re-check refitted.
 #[derive(Clone, Debug, PartialEq)]
@@ -107,151 +101,41 @@ pub fn recheck(
 ) -> Result<Recheck, ValidateError> {
     campaign.check(m).map_err(|e| ValidateError::Shape(e.0))?;
     let layout = &values.layout;
-    let pivot_cols = pivot_columns(m, values, pivot).map_err(ValidateError::Shape)?;
-    let shared_name = |j: usize| {
-        let c = &layout.columns[j];
-        parameter_name(m, &c.term, c.component)
-    };
-    // Every record made ready; per record its refitted columns, each with its place among the
-    // unknowns: the pivot first (shared), then every record's own.
+    let shared = pivot_columns(m, values, pivot).map_err(ValidateError::Shape)?;
     let total = campaign.records.len() as u64;
     let mut prepared = Vec::with_capacity(campaign.records.len());
-    let mut unknowns: Vec<String> = pivot_cols.iter().map(|&j| shared_name(j)).collect();
-    let mut places: Vec<Vec<(usize, usize)>> = Vec::new();
     for (i, r) in campaign.records.iter().enumerate() {
         progress.update("re-checking records", i as u64, total);
-        let p = prepare(m, values, r, opts)?;
-        let mut place = Vec::new();
-        for (k, s) in p.plan.sources.iter().enumerate() {
-            match s {
-                Some(c) => {
-                    if let Some(u) = pivot_cols.iter().position(|j| j == c) {
-                        place.push((k, u));
-                    }
-                }
-                None => {
-                    place.push((k, unknowns.len()));
-                    unknowns.push(p.plan.names[k].clone());
-                }
-            }
-        }
-        prepared.push(p);
-        places.push(place);
+        prepared.push(prepare(m, values, r, opts)?);
     }
-    let rows: Vec<usize> = prepared.iter().map(|p| p.r.record.samples.len()).collect();
-    check_readings(rows.iter().sum(), unknowns.len())?;
-    let n_rows: usize = prepared.iter().map(|p| p.y.len()).sum();
-    let mut h = DMatrix::<f64>::zeros(n_rows, unknowns.len());
-    let mut y = DVector::<f64>::zeros(n_rows);
-    let mut held = DVector::<f64>::zeros(n_rows);
-    let mut at = 0;
-    for (p, place) in prepared.iter().zip(&places) {
-        let n = p.y.len();
-        for &(k, u) in place {
-            h.view_mut((at, u), (n, 1)).copy_from(&p.h.column(k));
-        }
-        y.rows_mut(at, n).copy_from(&p.y);
-        let base = held_values(&p.v, place);
-        let q = p.predict(m, &base, opts.exact).map_err(|e| p.failed(e))?;
-        held.rows_mut(at, n).copy_from(&q);
-        at += n;
-    }
-    let weights = super::whitening(campaign, &NoiseChoice::Instrument)
-        .map_err(ValidateError::Measurements)?;
-    let tol = Tolerances::default();
-    let (first, first_sigma) = fit_rows(
-        &h,
-        &(&y - &held),
-        &unknowns,
-        &Constraint::None,
-        &tol,
-        None,
-        &rows,
-        weights.as_ref(),
-    )?;
-    // Every record's values at the unknowns `x` (mm, rad).
-    let at_unknowns = |x: &[f64]| -> Vec<Vec<f64>> {
-        prepared
-            .iter()
-            .zip(&places)
-            .map(|(p, place)| {
-                let mut v = held_values(&p.v, place);
-                for &(k, u) in place {
-                    v[k] = x[u];
-                }
-                v
-            })
-            .collect()
-    };
-    let (fit, weighted_sigma) = if opts.exact {
-        let coordinates = prepared
-            .iter()
-            .map(|p| p.coordinates())
-            .fold(1.0f64, f64::max);
-        let problem = GaussNewton {
-            h: &h,
-            y: &y,
-            layout: &rows,
-            tolerances: &tol,
-            noise: None,
-            coordinates,
-            weights: weights.as_ref(),
-            factored: None,
-        };
-        let mut predict = |x: &[f64]| -> Result<DVector<f64>, IdentifyError> {
-            let mut out = DVector::<f64>::zeros(n_rows);
-            let mut at = 0;
-            for (p, v) in prepared.iter().zip(at_unknowns(x)) {
-                let q = p.predict(m, &v, true)?;
-                out.rows_mut(at, q.len()).copy_from(&q);
-                at += q.len();
-            }
-            Ok(out)
-        };
-        let (fit, sigma, refinement) =
-            gauss_newton(&problem, &first, &RefineOptions::default(), &mut predict)
-                .map_err(|e| ValidateError::Shape(format!("the re-check: {e}")))?;
-        if !refinement.converged {
-            return Err(ValidateError::Shape(format!(
-                "the re-check: {}",
-                IdentifyError::NotConverged {
-                    iterations: refinement.iterations,
-                    last_step_mm: refinement.steps_mm.last().copied().unwrap_or(0.0),
-                    tolerance_mm: refinement.tolerance_mm,
-                }
-            )));
-        }
-        (fit, sigma)
-    } else {
-        (first, first_sigma)
-    };
-    let (scale, factor) = scale_of(weights.is_some(), weighted_sigma, fit.sigma, fit.dof);
-    let std: Vec<Option<f64>> = fit.std.iter().map(|s| s.map(|s| s * factor)).collect();
-    let pivot_out = pivot_cols
+    let f = refit_held(m, &prepared, &shared, opts.exact, "the re-check")?
+        .ok_or_else(|| ValidateError::Shape("the re-check has nothing to refit".into()))?;
+    let fit = &f.fit;
+    let (scale, factor) = scale_of(f.weighted, f.weighted_sigma, fit.sigma, fit.dof);
+    let pivot_out = shared
         .iter()
         .enumerate()
-        .map(|(u, &j)| {
-            let c = &layout.columns[j];
+        .map(|(u, (j, name))| {
+            let c = &layout.columns[*j];
             PivotRefit {
-                name: unknowns[u].clone(),
+                name: name.clone(),
                 term: c.term,
                 component: c.component,
-                calibrated: values.values[j],
-                calibrated_std: values.std[j],
+                calibrated: values.values[*j],
+                calibrated_std: values.std[*j],
                 value: fit.values[u],
-                std: std[u],
+                std: fit.std[u].map(|s| s * factor),
             }
         })
         .collect();
     let mut records = Vec::with_capacity(prepared.len());
     let (mut measured, mut predicted) = (Vec::new(), Vec::new());
-    for ((p, place), v) in prepared.iter().zip(&places).zip(at_unknowns(&fit.solution)) {
-        let own: Vec<Refitted> = place
-            .iter()
-            .filter(|&&(_, u)| u >= pivot_cols.len())
-            .map(|&(k, u)| p.refitted(k, fit.values[u], std[u]))
-            .collect();
-        let rv = p.finish(m, &v, own, opts.exact)?;
+    for (r, (p, v)) in prepared
+        .iter()
+        .zip(f.values(&prepared, &fit.solution))
+        .enumerate()
+    {
+        let rv = p.finish(m, &v, f.refitted(&prepared, r, factor), opts.exact)?;
         measured.extend(p.r.record.measured.iter().copied());
         predicted.extend(rv.validation.prediction.iter().copied());
         records.push(rv);
@@ -280,7 +164,7 @@ pub fn pivot_columns(
     m: &Machine,
     values: &CampaignValues,
     pivot: &[String],
-) -> Result<Vec<usize>, String> {
+) -> Result<Vec<(usize, String)>, String> {
     let shared: Vec<(usize, String)> = values
         .layout
         .columns
@@ -292,17 +176,18 @@ pub fn pivot_columns(
     if pivot.is_empty() {
         return Err("a re-check refits at least one machine parameter".into());
     }
-    let mut out: Vec<usize> = Vec::with_capacity(pivot.len());
+    let mut out: Vec<(usize, String)> = Vec::with_capacity(pivot.len());
     for name in pivot {
         let key = canonical(name);
-        let Some(&(j, _)) = shared.iter().find(|(_, n)| canonical(n) == key) else {
+        let Some((j, found)) = shared.iter().find(|(_, n)| canonical(n) == key) else {
             let names: Vec<&str> = shared.iter().map(|(_, n)| n.as_str()).collect();
             return Err(format!(
                 "`{name}` is not a machine parameter of the calibration (its machine parameters: {})",
                 names.join(", ")
             ));
         };
-        if out.contains(&j) {
+        let j = *j;
+        if out.iter().any(|(c, _)| *c == j) {
             return Err(format!("`{name}` is named twice"));
         }
         if values.layout.columns[j].term.effect.symbol().is_some() {
@@ -310,18 +195,9 @@ pub fn pivot_columns(
                 "`{name}` is the change of a kinematic length, which a re-check does not refit: refit the location errors it moves"
             ));
         }
-        out.push(j);
+        out.push((j, found.clone()));
     }
     Ok(out)
-}
-
-/// A record's values `v` with its refitted columns (`place`) at 0.
-fn held_values(v: &[f64], place: &[(usize, usize)]) -> Vec<f64> {
-    let mut v = v.to_vec();
-    for &(k, _) in place {
-        v[k] = 0.0;
-    }
-    v
 }
 
 /// The scale of the uncertainties and the factor the fit's own (at the residual's scale)

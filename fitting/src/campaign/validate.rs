@@ -28,18 +28,19 @@
 //! prediction's by about `√(1 − k/3N)` for `k` refitted parameters, and the report says which
 //! were refitted.
 
+mod refit;
 mod values;
+
+pub(crate) use refit::refit_held;
 
 pub use values::{CampaignValues, given_model, single_columns};
 
 use super::clock::own_clock_terms;
 use super::design::{Owner, block};
 use crate::hmatrix::{GainSource, check_model, parameter_name};
-use crate::identify::{check_readings, fit_rows, with_offsets};
-use crate::least_squares::{Constraint, Tolerances};
+use crate::identify::with_offsets;
 use crate::measurement_vector;
-use crate::noise::SampleWhitening;
-use crate::refine::{GaussNewton, IdentifyError, RefineOptions, exact_prediction, gauss_newton};
+use crate::refine::{IdentifyError, exact_prediction};
 use crate::validate::{
     Stats, Unidentified, ValidateError, ValidateOptions, Validation, statistics,
 };
@@ -265,8 +266,7 @@ pub fn record_plan(
 }
 
 /// A validation record made ready for its refit: its plan, its columns' values from the
-/// identification (mm, rad: the refitted ones 0 until refitted), its H matrix and readings,
-/// and its samples' whitening when read through an instrument.
+/// identification (mm, rad: the refitted ones 0 until refitted), its H matrix and readings.
 pub(crate) struct Prepared<'a> {
     /// The record.
     pub r: &'a CampaignRecord,
@@ -280,8 +280,6 @@ pub(crate) struct Prepared<'a> {
     pub h: DMatrix<f64>,
     /// Its readings (mm).
     pub y: DVector<f64>,
-    /// The per-sample whitening of readings through an instrument.
-    pub weights: Option<SampleWhitening>,
 }
 
 /// Record `r` made ready under `values` (see [`Prepared`]).
@@ -338,10 +336,6 @@ pub(crate) fn prepare<'a>(
     let mut source = GainSource::new(m, &plan.model.errors(), &r.params)?;
     let h =
         block(m, &plan.model, rec, &mut source, plan.clock).map_err(ValidateError::Measurements)?;
-    // Readings through an instrument carry their covariances: a refit weights by them, as the
-    // identification does.
-    let weights = SampleWhitening::of(rec)
-        .map_err(|e| ValidateError::Shape(format!("record `{}`: {e}", r.label)))?;
     Ok(Prepared {
         r,
         plan,
@@ -349,7 +343,6 @@ pub(crate) fn prepare<'a>(
         defaulted,
         h,
         y,
-        weights,
     })
 }
 
@@ -469,71 +462,14 @@ pub fn validate_record(
     r: &CampaignRecord,
     opts: &ValidateOptions,
 ) -> Result<RecordValidation, ValidateError> {
-    let p = prepare(m, values, r, opts)?;
-    let mut v = p.v.clone();
-    let refit: Vec<usize> = (0..v.len())
-        .filter(|&k| p.plan.sources[k].is_none())
-        .collect();
-    let mut refitted = Vec::new();
-    if !refit.is_empty() {
-        let rec = &r.record;
-        check_readings(rec.samples.len(), refit.len())?;
-        let h_r = p.h.select_columns(&refit);
-        let refit_names: Vec<String> = refit.iter().map(|&k| p.plan.names[k].clone()).collect();
-        let tol = Tolerances::default();
-        let y = &p.y;
-        let held = p.predict(m, &v, opts.exact).map_err(|e| p.failed(e))?;
-        let (first, _) = fit_rows(
-            &h_r,
-            &(y - held),
-            &refit_names,
-            &Constraint::None,
-            &tol,
-            None,
-            &[rec.samples.len()],
-            p.weights.as_ref(),
-        )?;
-        let fit = if opts.exact {
-            let problem = GaussNewton {
-                h: &h_r,
-                y,
-                layout: &[rec.samples.len()],
-                tolerances: &tol,
-                noise: None,
-                coordinates: p.coordinates(),
-                weights: p.weights.as_ref(),
-                factored: None,
-            };
-            let base = v.clone();
-            let mut predict_refit = |xr: &[f64]| -> Result<DVector<f64>, IdentifyError> {
-                let mut x = base.clone();
-                for (i, &k) in refit.iter().enumerate() {
-                    x[k] = xr[i];
-                }
-                p.predict(m, &x, true)
-            };
-            let (fit, _, refinement) = gauss_newton(
-                &problem,
-                &first,
-                &RefineOptions::default(),
-                &mut predict_refit,
-            )
-            .map_err(|e| p.failed(e))?;
-            if !refinement.converged {
-                return Err(p.failed(IdentifyError::NotConverged {
-                    iterations: refinement.iterations,
-                    last_step_mm: refinement.steps_mm.last().copied().unwrap_or(0.0),
-                    tolerance_mm: refinement.tolerance_mm,
-                }));
-            }
-            fit
-        } else {
-            first
-        };
-        for (i, &k) in refit.iter().enumerate() {
-            v[k] = fit.solution[i];
-            refitted.push(p.refitted(k, fit.values[i], fit.std[i]));
+    let prepared = [prepare(m, values, r, opts)?];
+    let what = format!("record `{}`", r.label);
+    let p = &prepared[0];
+    match refit_held(m, &prepared, &[], opts.exact, &what)? {
+        None => p.finish(m, &p.v, Vec::new(), opts.exact),
+        Some(f) => {
+            let v = f.values(&prepared, &f.fit.solution).swap_remove(0);
+            p.finish(m, &v, f.refitted(&prepared, 0, 1.0), opts.exact)
         }
     }
-    p.finish(m, &v, refitted, opts.exact)
 }

@@ -20,7 +20,7 @@
 use super::design::Owner;
 use super::validate::{CampaignValidation, CampaignValues, prepare, refit_held};
 use crate::hmatrix::parameter_name;
-use crate::validate::{ValidateError, ValidateOptions, statistics};
+use crate::validate::{ValidateError, ValidateOptions};
 use formats::progress::Progress;
 use model_spec::Machine;
 use simulation::campaign::Campaign;
@@ -129,26 +129,17 @@ pub fn recheck(
         })
         .collect();
     let mut records = Vec::with_capacity(prepared.len());
-    let (mut measured, mut predicted) = (Vec::new(), Vec::new());
     for (r, (p, v)) in prepared
         .iter()
         .zip(f.values(&prepared, &fit.solution))
         .enumerate()
     {
-        let rv = p.finish(m, &v, f.refitted(&prepared, r, factor), opts.exact)?;
-        measured.extend(p.r.record.measured.iter().copied());
-        predicted.extend(rv.validation.prediction.iter().copied());
-        records.push(rv);
+        records.push(p.finish(m, &v, f.refitted(&prepared, r, factor), opts.exact)?);
     }
     progress.update("re-checking records", total, total);
-    let (per_direction, overall) = statistics(&measured, &predicted);
     Ok(Recheck {
         pivot: pivot_out,
-        validation: CampaignValidation {
-            records,
-            per_direction,
-            overall,
-        },
+        validation: CampaignValidation::of(&campaign.records, records),
         dof: fit.dof,
         scale,
     })

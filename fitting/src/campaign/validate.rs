@@ -113,22 +113,34 @@ pub fn validate(
 ) -> Result<CampaignValidation, ValidateError> {
     campaign.check(m).map_err(|e| ValidateError::Shape(e.0))?;
     let mut records = Vec::with_capacity(campaign.records.len());
-    let (mut measured, mut predicted) = (Vec::new(), Vec::new());
     let total = campaign.records.len() as u64;
     for (i, r) in campaign.records.iter().enumerate() {
         progress.update("validating records", i as u64, total);
-        let v = validate_record(m, values, r, opts)?;
-        measured.extend(r.record.measured.iter().copied());
-        predicted.extend(v.validation.prediction.iter().copied());
-        records.push(v);
+        records.push(validate_record(m, values, r, opts)?);
     }
     progress.update("validating records", total, total);
-    let (per_direction, overall) = statistics(&measured, &predicted);
-    Ok(CampaignValidation {
-        records,
-        per_direction,
-        overall,
-    })
+    Ok(CampaignValidation::of(&campaign.records, records))
+}
+
+impl CampaignValidation {
+    /// The validation of the records `measured` (in order) by their `records`' predictions,
+    /// with the statistics over all of them.
+    pub(crate) fn of(measured: &[CampaignRecord], records: Vec<RecordValidation>) -> Self {
+        let m: Vec<[f64; 3]> = measured
+            .iter()
+            .flat_map(|r| r.record.measured.iter().copied())
+            .collect();
+        let p: Vec<[f64; 3]> = records
+            .iter()
+            .flat_map(|r| r.validation.prediction.iter().copied())
+            .collect();
+        let (per_direction, overall) = statistics(&m, &p);
+        CampaignValidation {
+            records,
+            per_direction,
+            overall,
+        }
+    }
 }
 
 /// How a validation record's own model takes its values: the model (with the record's zero
